@@ -1,0 +1,1 @@
+"""weft front ends: the ``weft`` command (``app.cli``) and the desktop studio (``app.gui``)."""

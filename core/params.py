@@ -1,0 +1,384 @@
+"""Frozen, validated parameter dataclasses and the recipe that records a run.
+
+One source of truth for every method's parameters: a method declares its parameters once with
+:func:`param`, the dataclass validates itself when built, and the CLI (options) and the GUI
+(sliders, tooltips, reset to default) read the same :class:`Spec` objects through :func:`specs`.
+
+Example
+-------
+>>> from dataclasses import dataclass
+>>> @dataclass(frozen=True)
+... class DemoParams(Params):
+...     block: int = param(32, lo=2, hi=512, symbol="B", help="block side in pixels")
+...     overlap: int = param(6, lo=1, hi=256, help="overlap between blocks")
+...     def check(self):
+...         if self.overlap >= self.block:
+...             raise out_of_range("overlap", self.overlap, 1, self.block - 1,
+...                                f"must be smaller than block = {self.block}")
+>>> DemoParams(block=32, overlap=40)
+Traceback (most recent call last):
+...
+core.errors.InvalidParameter: parameter 'overlap' = 40 is outside 1..31 (must be smaller than block = 32)
+
+Rules: a value of the wrong type or outside its range raises :class:`~core.errors.InvalidParameter`
+naming the parameter, the value and the allowed range. Nothing is clamped silently. Integral
+numpy scalars are accepted for ``int`` parameters and stored as ``int``; ``bool`` is never an ``int``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import numbers
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from .errors import InvalidParameter, WeftError
+
+KINDS = ("int", "float", "bool", "choice", "size", "str")
+MAX_SIDE = 16384
+RECIPE_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Spec:
+    """What a front end needs to know about one parameter.
+
+    Attributes
+    ----------
+    name : parameter name (the dataclass field); the CLI option is ``--name`` with ``_`` -> ``-``.
+    kind : one of ``int, float, bool, choice, size, str``; ``size`` is a ``(width, height)`` pair.
+    default : the default value (from the paper where it gives one).
+    lo, hi : inclusive bounds for ``int``, ``float`` and each side of ``size``.
+    choices : the allowed values of a ``choice``.
+    optional : ``None`` is allowed (meaning "derived from the inputs", see the method's docs).
+    symbol : the paper's symbol (shown in tooltips), e.g. ``"p_l"`` or ``"α"``.
+    help : one sentence for tooltips and ``--help``.
+    step : slider step for ``float`` parameters.
+    log : a ``float`` slider should move on a logarithmic scale.
+    """
+
+    name: str
+    kind: str
+    default: Any
+    lo: float | None = None
+    hi: float | None = None
+    choices: tuple = ()
+    optional: bool = False
+    symbol: str = ""
+    help: str = ""
+    step: float | None = None
+    log: bool = False
+
+    @property
+    def option(self) -> str:
+        return "--" + self.name.replace("_", "-")
+
+    def range_text(self) -> str:
+        if self.kind == "choice":
+            return ", ".join(str(c) for c in self.choices)
+        if self.lo is not None and self.hi is not None:
+            return f"{_fmt(self.lo)}..{_fmt(self.hi)}"
+        return ""
+
+    def validate(self, value: Any) -> Any:
+        """Return ``value`` converted to the canonical type, or raise ``InvalidParameter``."""
+        name = self.name
+        if value is None:
+            if self.optional:
+                return None
+            raise InvalidParameter(f"parameter '{name}' is required", name=name, value=value)
+        if self.kind == "int":
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+                raise InvalidParameter(f"parameter '{name}' = {value!r} must be an integer", name=name, value=value)
+            value = int(value)
+            self._check_bounds(value)
+        elif self.kind == "float":
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise InvalidParameter(f"parameter '{name}' = {value!r} must be a number", name=name, value=value)
+            value = float(value)
+            if not math.isfinite(value):
+                raise InvalidParameter(f"parameter '{name}' = {value} must be a finite number", name=name, value=value)
+            self._check_bounds(value)
+        elif self.kind == "bool":
+            if not isinstance(value, (bool, np.bool_)):
+                raise InvalidParameter(f"parameter '{name}' = {value!r} must be true or false", name=name, value=value)
+            value = bool(value)
+        elif self.kind == "choice":
+            if value not in self.choices:
+                raise InvalidParameter(
+                    f"parameter '{name}' = {value!r} is not one of {self.range_text()}", name=name, value=value
+                )
+        elif self.kind == "size":
+            if isinstance(value, str):
+                value = parse_size(value, name)
+            if (
+                not isinstance(value, (tuple, list))
+                or len(value) != 2
+                or any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in value)
+            ):
+                raise InvalidParameter(
+                    f"parameter '{name}' = {value!r} must be a size WIDTHxHEIGHT in pixels", name=name, value=value
+                )
+            value = (int(value[0]), int(value[1]))
+            lo = int(self.lo if self.lo is not None else 1)
+            hi = int(self.hi if self.hi is not None else MAX_SIDE)
+            if not all(lo <= v <= hi for v in value):
+                raise InvalidParameter(
+                    f"parameter '{name}' = {value[0]}x{value[1]} has a side outside {lo}..{hi}", name=name, value=value
+                )
+        elif self.kind == "str":
+            if not isinstance(value, str):
+                raise InvalidParameter(f"parameter '{name}' = {value!r} must be text", name=name, value=value)
+        return value
+
+    def _check_bounds(self, value: float) -> None:
+        if (self.lo is not None and value < self.lo) or (self.hi is not None and value > self.hi):
+            raise out_of_range(self.name, value, self.lo, self.hi)
+
+    def parse(self, text: str) -> Any:
+        """Parse a command-line string into a validated value."""
+        if self.optional and text.lower() in ("none", "auto"):
+            return None
+        if self.kind == "int":
+            try:
+                value: Any = int(text)
+            except ValueError:
+                raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be an integer", name=self.name, value=text) from None
+        elif self.kind == "float":
+            try:
+                value = float(text)
+            except ValueError:
+                raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be a number", name=self.name, value=text) from None
+        elif self.kind == "bool":
+            low = text.lower()
+            if low not in ("1", "0", "true", "false", "yes", "no", "on", "off"):
+                raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be true or false", name=self.name, value=text)
+            value = low in ("1", "true", "yes", "on")
+        elif self.kind == "size":
+            value = parse_size(text, self.name)
+        else:
+            value = text
+        return self.validate(value)
+
+
+def _fmt(x: float) -> str:
+    return str(int(x)) if float(x).is_integer() else f"{x:g}"
+
+
+def out_of_range(name: str, value: Any, lo: float | None, hi: float | None, why: str = "") -> InvalidParameter:
+    """Build the standard message: ``parameter 'overlap' = 40 is outside 1..31 (why)``."""
+    lo_t = "-inf" if lo is None else _fmt(lo)
+    hi_t = "inf" if hi is None else _fmt(hi)
+    shown = _fmt(value) if isinstance(value, (int, float)) else repr(value)
+    msg = f"parameter '{name}' = {shown} is outside {lo_t}..{hi_t}"
+    if why:
+        msg += f" ({why})"
+    return InvalidParameter(msg, name=name, value=value)
+
+
+def parse_size(text: str, name: str = "size") -> tuple[int, int]:
+    """Parse ``"512x384"`` (or ``"512"`` for a square) into ``(512, 384)``."""
+    parts = text.lower().replace("×", "x").split("x")
+    try:
+        if len(parts) == 1:
+            w = h = int(parts[0])
+        elif len(parts) == 2:
+            w, h = int(parts[0]), int(parts[1])
+        else:
+            raise ValueError
+    except ValueError:
+        raise InvalidParameter(
+            f"parameter '{name}' = {text!r} must be a size WIDTHxHEIGHT, e.g. 512x512", name=name, value=text
+        ) from None
+    return w, h
+
+
+def param(
+    default: Any,
+    *,
+    lo: float | None = None,
+    hi: float | None = None,
+    choices: Sequence | None = None,
+    kind: str | None = None,
+    optional: bool = False,
+    symbol: str = "",
+    help: str = "",
+    step: float | None = None,
+    log: bool = False,
+) -> Any:
+    """Declare a parameter field of a :class:`Params` dataclass.
+
+    The kind is inferred from ``default`` (``choices`` given -> ``choice``; a 2-tuple -> ``size``)
+    unless ``kind`` says otherwise.
+    """
+    if kind is None:
+        if choices is not None:
+            kind = "choice"
+        elif isinstance(default, bool):
+            kind = "bool"
+        elif isinstance(default, int):
+            kind = "int"
+        elif isinstance(default, float):
+            kind = "float"
+        elif isinstance(default, tuple):
+            kind = "size"
+        elif isinstance(default, str):
+            kind = "str"
+        else:
+            raise TypeError(f"cannot infer the kind of a parameter with default {default!r}")
+    if kind not in KINDS:
+        raise TypeError(f"unknown parameter kind {kind!r}")
+    meta = dict(
+        kind=kind, lo=lo, hi=hi, choices=tuple(choices or ()), optional=optional,
+        symbol=symbol, help=help, step=step, log=log,
+    )
+    return field(default=default, metadata={"weft": meta})
+
+
+@dataclass(frozen=True)
+class Params:
+    """Base of the per-method parameter dataclasses.
+
+    Subclasses are ``@dataclass(frozen=True)`` with fields declared by :func:`param`; they may
+    override :meth:`check` for rules that involve several parameters.
+    """
+
+    def __post_init__(self) -> None:
+        for spec in specs(type(self)):
+            value = spec.validate(getattr(self, spec.name))
+            object.__setattr__(self, spec.name, value)
+        self.check()
+
+    def check(self) -> None:
+        """Cross-parameter rules; raise ``InvalidParameter`` (see :func:`out_of_range`)."""
+
+    def replace(self, **changes: Any) -> "Params":
+        unknown = set(changes) - {s.name for s in specs(type(self))}
+        if unknown:
+            raise InvalidParameter(_unknown_message(type(self), unknown))
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        out = {}
+        for spec in specs(type(self)):
+            v = getattr(self, spec.name)
+            out[spec.name] = list(v) if isinstance(v, tuple) else v
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> "Params":
+        if not isinstance(data, Mapping):
+            raise InvalidParameter(f"{cls.__name__}: parameters must be a JSON object, not {type(data).__name__}")
+        unknown = set(data) - {s.name for s in specs(cls)}
+        if unknown:
+            raise InvalidParameter(_unknown_message(cls, unknown))
+        return cls(**dict(data))
+
+
+def _unknown_message(cls: type, unknown: set) -> str:
+    names = ", ".join(sorted(map(str, unknown)))
+    known = ", ".join(s.name for s in specs(cls))
+    return f"unknown parameter {names} for {cls.__name__} (known: {known})"
+
+
+def specs(cls: type) -> tuple[Spec, ...]:
+    """The :class:`Spec` of every declared parameter of a ``Params`` subclass, in field order."""
+    cached = cls.__dict__.get("_weft_specs")
+    if cached is not None:
+        return cached
+    out = []
+    for f in dataclasses.fields(cls):
+        meta = f.metadata.get("weft")
+        if meta is None:
+            continue
+        out.append(Spec(name=f.name, default=f.default, **meta))
+    result = tuple(out)
+    setattr(cls, "_weft_specs", result)
+    return result
+
+
+def as_rng(rng: None | int | np.random.Generator) -> np.random.Generator:
+    """``None`` -> fresh entropy, ``int`` -> seeded PCG64, a ``Generator`` is used as it is."""
+    if rng is None or isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
+        return np.random.default_rng(rng)
+    if isinstance(rng, np.random.Generator):
+        return rng
+    raise InvalidParameter(f"parameter 'rng' = {rng!r} must be None, an integer seed or a numpy Generator", name="rng")
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """Everything needed to reproduce a result: method, parameters, input paths and seed.
+
+    JSON form (DESIGN.md)::
+
+        {"weft": 1, "method": "fast", "params": {...},
+         "inputs": {"texture": "a.png", "target": "b.png"}, "seed": 7}
+
+    Input paths are stored as given; :meth:`load` resolves relative paths against the folder of the
+    recipe file, so a recipe next to its images keeps working when the folder moves.
+    """
+
+    method: str
+    params: Mapping[str, Any] = field(default_factory=dict)
+    inputs: Mapping[str, str] = field(default_factory=dict)
+    seed: int | None = None
+
+    def to_json(self) -> str:
+        return json.dumps(
+            {"weft": RECIPE_VERSION, "method": self.method, "params": dict(self.params),
+             "inputs": dict(self.inputs), "seed": self.seed},
+            sort_keys=False,
+        )
+
+    @classmethod
+    def from_json(cls, text: str, *, base: str | os.PathLike | None = None) -> "Recipe":
+        try:
+            data = json.loads(text)
+        except (json.JSONDecodeError, UnicodeDecodeError) as e:
+            raise WeftError(f"recipe is not valid JSON: {e}") from None
+        if not isinstance(data, dict):
+            raise WeftError("recipe must be a JSON object")
+        version = data.get("weft")
+        if version != RECIPE_VERSION:
+            raise WeftError(f"recipe has \"weft\": {version!r}; this version of weft reads recipes of version {RECIPE_VERSION}")
+        method = data.get("method")
+        if not isinstance(method, str):
+            raise WeftError("recipe has no \"method\" (a string such as \"quilt\")")
+        params = data.get("params", {})
+        inputs = data.get("inputs", {})
+        seed = data.get("seed")
+        if not isinstance(params, dict):
+            raise WeftError("recipe \"params\" must be a JSON object")
+        if not isinstance(inputs, dict) or not all(isinstance(v, str) for v in inputs.values()):
+            raise WeftError("recipe \"inputs\" must map input names to file paths")
+        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
+            raise WeftError(f"recipe \"seed\" = {seed!r} must be a non-negative integer or null")
+        if base is not None:
+            inputs = {k: str(Path(base) / v) if not os.path.isabs(v) else v for k, v in inputs.items()}
+        return cls(method=method, params=params, inputs=inputs, seed=seed)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> "Recipe":
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise WeftError(f"{path}: no such recipe file") from None
+        except (OSError, UnicodeDecodeError) as e:
+            raise WeftError(f"{path}: cannot read recipe ({getattr(e, 'strerror', None) or e})") from None
+        try:
+            return cls.from_json(text, base=path.resolve().parent)
+        except WeftError as e:
+            raise WeftError(f"{path}: {e}") from None
+
+    def save(self, path: str | os.PathLike) -> None:
+        from .image import atomic_write_bytes
+
+        atomic_write_bytes(Path(path), (self.to_json() + "\n").encode("utf-8"))
