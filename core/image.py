@@ -1,0 +1,583 @@
+"""Images in weft: float32 arrays in [0, 1], shape (H, W) grey or (H, W, 3) RGB.
+
+This module holds loading/saving (OpenCV's BGR never leaves it) and the colour helpers every
+method shares: luminance (Rec. 601), RGB <-> YIQ (Ashikhmin keeps the target's chroma in YIQ), and
+the principal-component grey of Smith & Bhalerao §3.4.
+
+Loading reads the header with Pillow (lazy, no pixels) to check the pixel limit, then decodes with
+OpenCV from bytes (non-ASCII paths work) and falls back to Pillow for what OpenCV cannot decode.
+Every failure is an :class:`~core.errors.ImageError` whose message is one line starting with the path.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import numbers
+import os
+import stat
+import struct
+import tempfile
+import threading
+import warnings
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+
+import cv2
+import numpy as np
+from PIL import Image, UnidentifiedImageError
+
+from .errors import ImageError, InvalidParameter
+
+# A corrupt file is reported once, by us, as one line: OpenCV's own warnings would add a second.
+cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
+
+# Rec. 601 luma weights, also the Y row of YIQ.
+_LUMA = np.array([0.299, 0.587, 0.114], dtype=np.float32)
+_RGB2YIQ = np.array(
+    [[0.299, 0.587, 0.114], [0.595716, -0.274453, -0.321263], [0.211456, -0.522591, 0.311135]],
+    dtype=np.float64,
+)
+_YIQ2RGB = np.linalg.inv(_RGB2YIQ)
+
+
+def _check_float_image(image: np.ndarray, what: str = "image") -> np.ndarray:
+    image = np.asarray(image)
+    if image.ndim not in (2, 3) or (image.ndim == 3 and image.shape[2] != 3):
+        raise ImageError(f"{what} must have shape (H, W) or (H, W, 3), not {image.shape}")
+    if image.shape[0] < 1 or image.shape[1] < 1:
+        raise ImageError(f"{what} is empty ({image.shape[1]}x{image.shape[0]})")
+    return image
+
+
+def luminance(image: np.ndarray) -> np.ndarray:
+    """Rec. 601 luminance ``0.299 R + 0.587 G + 0.114 B`` as float32 (H, W); grey passes through."""
+    image = _check_float_image(image)
+    if image.ndim == 2:
+        return image.astype(np.float32, copy=False)
+    return (image.astype(np.float32, copy=False) @ _LUMA).astype(np.float32, copy=False)
+
+
+def rgb_to_yiq(rgb: np.ndarray) -> np.ndarray:
+    """RGB in [0, 1] -> YIQ (NTSC), float32 (H, W, 3). Y in [0, 1], I in ±0.596, Q in ±0.523."""
+    rgb = _check_float_image(rgb, "RGB image")
+    if rgb.ndim != 3:
+        raise ImageError(f"RGB image must have shape (H, W, 3), not {rgb.shape}")
+    return (rgb.astype(np.float32, copy=False) @ _RGB2YIQ.T.astype(np.float32)).astype(np.float32, copy=False)
+
+
+def yiq_to_rgb(yiq: np.ndarray, *, clip: bool = True) -> np.ndarray:
+    """YIQ -> RGB float32 (H, W, 3), clipped to [0, 1] unless ``clip=False``."""
+    yiq = np.asarray(yiq)
+    if yiq.ndim != 3 or yiq.shape[2] != 3:
+        raise ImageError(f"YIQ image must have shape (H, W, 3), not {yiq.shape}")
+    rgb = (yiq.astype(np.float32, copy=False) @ _YIQ2RGB.T.astype(np.float32)).astype(np.float32, copy=False)
+    return np.clip(rgb, 0.0, 1.0, out=rgb) if clip else rgb
+
+
+@dataclass(frozen=True)
+class PcaBasis:
+    """An orthonormal colour basis: ``components = (rgb - mean) @ axes.T``.
+
+    ``axes`` rows are the principal directions, largest variance first; the first axis is signed so
+    that it correlates positively with luminance (bright stays bright). ``variances`` are the
+    eigenvalues in the same order.
+    """
+
+    mean: np.ndarray  # (3,)
+    axes: np.ndarray  # (3, 3), rows
+    variances: np.ndarray  # (3,)
+
+
+def pca_basis(rgb: np.ndarray) -> PcaBasis:
+    """The principal components of an RGB image's colours (Smith & Bhalerao §3.4, Jolliffe)."""
+    rgb = _check_float_image(rgb, "RGB image")
+    if rgb.ndim != 3:
+        raise ImageError(f"RGB image must have shape (H, W, 3), not {rgb.shape}")
+    pixels = rgb.reshape(-1, 3).astype(np.float64)
+    mean = pixels.mean(axis=0)
+    cov = np.cov((pixels - mean).T) if len(pixels) > 1 else np.zeros((3, 3))
+    variances, vectors = np.linalg.eigh(cov)
+    order = np.argsort(variances)[::-1]
+    variances = np.maximum(variances[order], 0.0)
+    axes = vectors[:, order].T.copy()
+    if variances[0] <= 1e-18:
+        # Flat colour: no preferred direction, use luminance so the grey still means brightness.
+        axes[0] = _LUMA / np.linalg.norm(_LUMA)
+    for i in range(3):
+        ref = _LUMA if i == 0 else axes[i]
+        if np.dot(axes[i], ref) < 0:
+            axes[i] = -axes[i]
+    return PcaBasis(mean=mean.astype(np.float32), axes=axes.astype(np.float32), variances=variances.astype(np.float32))
+
+
+def to_pca(rgb: np.ndarray, basis: PcaBasis | None = None) -> tuple[np.ndarray, PcaBasis]:
+    """Project RGB onto a PCA colour basis; returns float32 (H, W, 3) components and the basis."""
+    if basis is None:
+        basis = pca_basis(rgb)
+    comps = (np.asarray(rgb, dtype=np.float32) - basis.mean) @ basis.axes.T
+    return comps.astype(np.float32, copy=False), basis
+
+
+def from_pca(components: np.ndarray, basis: PcaBasis, *, clip: bool = True) -> np.ndarray:
+    """Inverse of :func:`to_pca`: float32 RGB (H, W, 3), clipped to [0, 1] unless ``clip=False``."""
+    rgb = (np.asarray(components, dtype=np.float32) @ basis.axes + basis.mean).astype(np.float32, copy=False)
+    return np.clip(rgb, 0.0, 1.0, out=rgb) if clip else rgb
+
+
+def pca_grey(rgb: np.ndarray) -> tuple[np.ndarray, PcaBasis]:
+    """The principal-component grey of §3.4: the colour direction of greatest variance.
+
+    Returns the first component offset by the mean's projection on that axis (so the values sit
+    around the image's mean brightness rather than around zero), float32 (H, W), and the basis.
+    Reconstruct with ``from_pca(stack([grey - offset, c1, c2]), basis)`` where
+    ``offset = basis.mean @ basis.axes[0]``.
+    """
+    comps, basis = to_pca(rgb)
+    offset = float(basis.mean @ basis.axes[0])
+    return (comps[..., 0] + offset).astype(np.float32), basis
+
+
+# --------------------------------------------------------------------------------------------------
+# Validation and resizing
+
+def validate_image(image: np.ndarray, what: str = "image") -> np.ndarray:
+    """Check an image and return it as C-contiguous float32 in [0, 1] (the input itself if it is one).
+
+    Parameters
+    ----------
+    image : ndarray
+        (H, W) or (H, W, 3); float in [0, 1] without NaN/inf, or uint8 (/255) or uint16 (/65535).
+    what : str, default "image"
+        Name used in error messages ("texture", "target", ...).
+
+    Raises
+    ------
+    ImageError
+        Wrong shape, empty, unsupported dtype, non-finite or out-of-range values.
+    """
+    image = _check_float_image(image, what)
+    if image.dtype in (np.uint8, np.uint16):
+        return np.ascontiguousarray(image, dtype=np.float32) / np.float32(np.iinfo(image.dtype).max)
+    if not np.issubdtype(image.dtype, np.floating):
+        raise ImageError(f"{what} has unsupported dtype {image.dtype} (use float in [0, 1], uint8 or uint16)")
+    image = np.ascontiguousarray(image, dtype=np.float32)
+    if not np.isfinite(image).all():
+        raise ImageError(f"{what} contains NaN or infinite values")
+    low, high = float(image.min()), float(image.max())
+    if low < 0.0 or high > 1.0:
+        raise ImageError(f"{what} has values outside [0, 1] (min {low:.4g}, max {high:.4g})")
+    return image
+
+
+_INTERPOLATIONS = {"cubic": cv2.INTER_CUBIC, "linear": cv2.INTER_LINEAR, "area": cv2.INTER_AREA,
+                   "nearest": cv2.INTER_NEAREST_EXACT}
+
+
+def resize(image: np.ndarray, size: tuple[int, int], interpolation: str = "cubic") -> np.ndarray:
+    """Resize to ``size = (width, height)`` (each >= 1); float32, same channel count as the input.
+
+    Parameters
+    ----------
+    image : ndarray
+        Anything :func:`validate_image` accepts.
+    size : (int, int)
+        Output width and height.
+    interpolation : {"cubic", "linear", "area", "nearest"}, default "cubic"
+        OpenCV bicubic (result clipped to [0, 1]), bilinear, pixel-area (best for shrinking) or
+        nearest neighbour (``INTER_NEAREST_EXACT``: pixel centres, as Pillow and scikit-image).
+    """
+    image = validate_image(image)
+    if not (isinstance(size, (tuple, list)) and len(size) == 2
+            and all(isinstance(s, numbers.Integral) and not isinstance(s, bool) and s >= 1 for s in size)):
+        raise InvalidParameter(f"parameter 'size' = {size!r} must be (width, height), both >= 1",
+                               name="size", value=size)
+    if interpolation not in _INTERPOLATIONS:
+        raise InvalidParameter(f"parameter 'interpolation' = {interpolation!r} is not one of "
+                               f"{', '.join(_INTERPOLATIONS)}", name="interpolation", value=interpolation)
+    out = cv2.resize(image, (int(size[0]), int(size[1])), interpolation=_INTERPOLATIONS[interpolation])
+    return np.clip(out, 0.0, 1.0, out=out) if interpolation == "cubic" else out
+
+
+# --------------------------------------------------------------------------------------------------
+# Pixel limit
+
+DEFAULT_MAX_PIXELS = 50_000_000
+_max_pixels_override: int | None = None
+
+
+def _check_limit(n: object) -> int:
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
+        raise InvalidParameter(f"parameter 'max_pixels' = {n!r} must be a positive integer", name="max_pixels", value=n)
+    return int(n)
+
+
+def get_max_pixels() -> int:
+    """The largest width x height :func:`load_image` accepts.
+
+    :func:`set_max_pixels` wins if called; else ``WEFT_MAX_PIXELS`` when it holds a positive integer
+    (``200_000_000`` works, invalid values are ignored); else :data:`DEFAULT_MAX_PIXELS` (50 Mpx,
+    600 MB as float32 RGB).
+    """
+    if _max_pixels_override is not None:
+        return _max_pixels_override
+    with contextlib.suppress(ValueError):
+        if (value := int(os.environ.get("WEFT_MAX_PIXELS", "").strip())) >= 1:
+            return value
+    return DEFAULT_MAX_PIXELS
+
+
+def set_max_pixels(n: int | None) -> None:
+    """Set the process-wide pixel limit (a positive int); ``None`` restores env var / default."""
+    global _max_pixels_override
+    _max_pixels_override = None if n is None else _check_limit(n)
+
+
+# --------------------------------------------------------------------------------------------------
+# Loading
+
+@dataclass(frozen=True)
+class ImageInfo:
+    """What :func:`load_image` found and did.
+
+    ``format`` is Pillow's name ("PNG", "JPEG", "TIFF", "BMP", "WEBP", "GIF"); width, height and
+    ``channels`` (1 or 3) describe the returned array; ``bit_depth`` is 8 or 16 (sources below 8 bits
+    count as 8); ``orientation`` is the EXIF orientation applied (1 if none); ``notes`` lists conversions.
+    """
+
+    path: str
+    format: str
+    width: int
+    height: int
+    channels: int
+    bit_depth: int
+    had_alpha: bool
+    orientation: int
+    notes: tuple[str, ...]
+
+
+class Loaded(NamedTuple):
+    """The result of :func:`load_image`: the float32 image and its :class:`ImageInfo`."""
+
+    image: np.ndarray
+    info: ImageInfo
+
+
+_PIL_LOCK = threading.Lock()
+_GREY_MODES = {"1", "L", "LA", "La", "I", "I;16", "I;16L", "I;16B", "I;16N", "F"}
+_ALPHA_MODES = {"RGBA", "RGBa", "LA", "La", "PA"}
+_SIGNATURES = {b"\x89PNG": "PNG", b"\xff\xd8\xff": "JPEG", b"II*\0": "TIFF", b"MM\0*": "TIFF", b"BM": "BMP",
+               b"GIF8": "GIF", b"RIFF": "WEBP"}
+# EXIF orientation -> transform showing the stored pixels upright, as Pillow's exif_transpose. OpenCV
+# applies it itself (IMREAD_ANYCOLOR without IMREAD_IGNORE_ORIENTATION); this is for the Pillow fallback.
+_ORIENT = {1: lambda a: a, 2: lambda a: a[:, ::-1], 3: lambda a: a[::-1, ::-1], 4: lambda a: a[::-1],
+           5: lambda a: a.swapaxes(0, 1), 6: lambda a: a.swapaxes(0, 1)[:, ::-1],
+           7: lambda a: a[::-1, ::-1].swapaxes(0, 1), 8: lambda a: a.swapaxes(0, 1)[::-1]}
+
+
+def _one_line(err: BaseException) -> str:
+    return " ".join(str(err).split()) or type(err).__name__
+
+
+def _os_error(name: str, err: OSError) -> ImageError:
+    problem = {FileNotFoundError: "no such file", IsADirectoryError: "is a directory",
+               PermissionError: "permission denied"}.get(type(err), f"cannot read ({err.strerror or _one_line(err)})")
+    return ImageError(f"{name}: {problem}", path=name)
+
+
+def _pil_open(source) -> tuple[Image.Image, bool]:
+    """Lazy ``Image.open`` (header only) and whether it is animated, with Pillow's own bomb check and
+    warnings off (our check, with a clearer message, follows). The lock keeps the switch local."""
+    with _PIL_LOCK, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        saved, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, None
+        try:
+            im = Image.open(source)
+            try:
+                return im, bool(getattr(im, "is_animated", False))  # GIF seeks a frame here
+            except BaseException:
+                im.close()
+                raise
+        finally:
+            Image.MAX_IMAGE_PIXELS = saved
+
+
+def _exif_orientation(im: Image.Image) -> int:
+    """EXIF orientation 1..8 (1 if absent/invalid) from the EXIF block or TIFF tags, not XMP: as OpenCV."""
+    with contextlib.suppress(Exception):
+        if "exif" in im.info:
+            exif = Image.Exif()
+            exif.load(im.info["exif"])
+            value = int(exif.get(0x0112, 1))
+        else:
+            value = int(getattr(im, "tag_v2", {}).get(0x0112, 1))
+        return value if value in _ORIENT else 1
+    return 1
+
+
+def _decode_pillow(data: np.ndarray) -> np.ndarray:
+    """Decode with Pillow: upright grey or RGB, uint8/uint16 (alpha dropped, palette expanded)."""
+    with _pil_open(io.BytesIO(data.tobytes()))[0] as im:
+        im.load()  # Pillow's TIFF loader applies the orientation itself and drops the tag
+        if im.mode == "F" or im.mode.startswith("I"):
+            arr = np.asarray(im)
+            if arr.dtype.kind == "f" or arr.min() < 0 or arr.max() > 65535:
+                raise ValueError(f"unsupported {arr.dtype} samples")
+            arr = arr.astype(np.uint16)
+        else:
+            arr = np.asarray(im.convert("L" if im.mode in _GREY_MODES else "RGB"))
+        return _ORIENT[_exif_orientation(im)](arr)
+
+
+def _damaged(name: str, reason: str) -> str | None:
+    """A header Pillow could not read: name the format when the file starts with a known signature."""
+    with contextlib.suppress(OSError), open(name, "rb") as f:
+        head = f.read(4)
+        for magic, fmt in _SIGNATURES.items():
+            if head.startswith(magic):
+                return f"truncated or corrupt {fmt} data ({reason})"
+    return None
+
+
+def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: str | None = None) -> Loaded:
+    """Load PNG, JPEG, TIFF, BMP, WebP or GIF (8 or 16 bits per sample) as float32 in [0, 1].
+
+    Parameters
+    ----------
+    path : str or PathLike
+        The file; non-ASCII paths work.
+    max_pixels : int, optional
+        Refuse more than this many pixels (default :func:`get_max_pixels`), checked from the header
+        before any pixel is decoded, so decompression bombs fail in milliseconds.
+    mode : {None, "rgb", "grey"}, default None
+        None keeps grey (H, W) and colour (H, W, 3); "rgb" always gives (H, W, 3); "grey" gives the
+        Rec. 601 :func:`luminance`.
+
+    Returns
+    -------
+    Loaded
+        ``(image, info)``: C-contiguous float32 RGB (never BGR). Alpha is dropped without compositing;
+        grey+alpha stays grey; palettes always become RGB (grey ones too); CMYK becomes RGB; the EXIF
+        orientation is applied; an animation gives its first frame. ``info.notes`` lists each of these.
+
+    Raises
+    ------
+    ImageError
+        Missing, a directory, unreadable, empty, not an image, too large, truncated or corrupt.
+    """
+    name = os.fsdecode(path)
+    if mode not in (None, "rgb", "grey"):
+        raise InvalidParameter(f"parameter 'mode' = {mode!r} is not one of None, 'rgb', 'grey'",
+                               name="mode", value=mode)
+    limit = get_max_pixels() if max_pixels is None else _check_limit(max_pixels)
+    try:
+        st = os.stat(name)
+        if stat.S_ISDIR(st.st_mode):
+            raise IsADirectoryError(21, "Is a directory")
+        if st.st_size == 0:
+            raise ImageError(f"{name}: empty file", path=name)
+        im, animated = _pil_open(name)
+        with im:
+            fmt, (width, height), src_mode = im.format or "unknown", im.size, im.mode
+            had_alpha = src_mode in _ALPHA_MODES or "transparency" in im.info
+            orientation = _exif_orientation(im)
+        if width * height > limit:
+            raise ImageError(f"{name}: {width}x{height} = {width * height / 1e6:.1f} megapixels exceeds the limit of "
+                             f"{limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS or max_pixels to raise it)", path=name)
+        data = np.fromfile(name, dtype=np.uint8)
+    except ImageError:
+        raise
+    except Exception as e:  # noqa: BLE001 - Pillow raises many kinds on corrupt headers
+        if isinstance(e, OSError) and e.errno is not None:  # real I/O errors; Pillow's own OSErrors have none
+            raise _os_error(name, e) from e
+        if isinstance(e, UnidentifiedImageError):
+            problem = _damaged(name, "cannot read the header") or "not an image file (cannot identify format)"
+        else:
+            problem = _damaged(name, _one_line(e)) or f"corrupt image header ({_one_line(e)})"
+        raise ImageError(f"{name}: {problem}", path=name) from e
+
+    try:
+        arr = None
+        with contextlib.suppress(cv2.error):
+            arr = cv2.imdecode(data, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)  # applies EXIF orientation
+        if arr is None:  # OpenCV could not: truncated, corrupt, or a variant only Pillow reads
+            try:
+                arr = _decode_pillow(data)
+            except Exception as e:  # noqa: BLE001
+                raise ImageError(f"{name}: truncated or corrupt {fmt} data ({_one_line(e)})", path=name) from e
+        elif arr.ndim == 3:
+            arr = arr[..., 2::-1]  # BGR(A) -> RGB
+        if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] == 3)):
+            raise ValueError(f"unexpected decoder output of shape {arr.shape}")
+        if arr.dtype not in (np.uint8, np.uint16):
+            raise ImageError(f"{name}: unsupported sample type {arr.dtype} (only 8- and 16-bit images are supported)",
+                             path=name)
+        # OpenCV expands grey+alpha to three equal channels; Pillow calls 16-bit grey+alpha PNG "RGBA",
+        # so for PNG the IHDR colour type (0 grey, 4 grey+alpha) decides.
+        if arr.ndim == 3 and (src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] in (0, 4))):
+            arr = arr[..., 0]
+        image = arr.astype(np.float32, order="C") / np.float32(np.iinfo(arr.dtype).max)
+    except MemoryError:
+        raise ImageError(f"{name}: not enough memory to decode {width}x{height} pixels", path=name) from None
+    except ImageError:
+        raise
+    except Exception as e:  # noqa: BLE001 - never let a raw cv2/numpy error escape
+        raise ImageError(f"{name}: cannot decode {fmt} data ({_one_line(e)})", path=name) from e
+
+    notes = [text for cond, text in [
+        (orientation != 1, f"EXIF orientation {orientation} applied"), (had_alpha, "alpha channel dropped"),
+        (src_mode in ("P", "PA"), "palette expanded to RGB"), (src_mode == "CMYK", "CMYK converted to RGB"),
+        (animated, "first frame of an animation used")] if cond]
+    if mode == "rgb" and image.ndim == 2:
+        image = np.repeat(image[..., None], 3, axis=2)
+        notes.append("grey expanded to RGB")
+    elif mode == "grey" and image.ndim == 3:
+        image = np.ascontiguousarray(luminance(image))
+        notes.append("converted to grey (Rec. 601 luminance)")
+    info = ImageInfo(path=name, format=fmt, width=image.shape[1], height=image.shape[0],
+                     channels=1 if image.ndim == 2 else 3, bit_depth=8 * arr.itemsize, had_alpha=had_alpha,
+                     orientation=orientation, notes=tuple(notes))
+    return Loaded(image, info)
+
+
+# --------------------------------------------------------------------------------------------------
+# Saving
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` so that readers see the old file or the new one, never half of one.
+
+    The bytes go to a temporary file in the same folder (``tempfile.mkstemp``), are flushed and
+    fsync'ed, then ``os.replace`` puts them over ``path``. A replaced file keeps its permission bits;
+    a new one gets ``0o666 & ~umask`` (not mkstemp's 0o600).
+
+    Raises
+    ------
+    ImageError
+        ``{path}: cannot write (reason)``; the temporary file is removed and an old ``path`` is intact.
+    """
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise ImageError(f"{path}: cannot write (folder {path.parent} does not exist)", path=str(path))
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        try:
+            mode = stat.S_IMODE(os.stat(path).st_mode)
+        except OSError:
+            umask = os.umask(0o022)  # read the umask (no portable getter)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+        tmp = None
+    except OSError as e:
+        raise ImageError(f"{path}: cannot write ({e.strerror or _one_line(e)})", path=str(path)) from e
+    finally:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+_RECIPE_KEY = b"weft-recipe"
+_SAVE_FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG", ".tif": "TIFF", ".tiff": "TIFF"}
+
+
+def _png_chunk(kind: bytes, body: bytes) -> bytes:
+    return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+
+def save_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | None = None,
+               bit_depth: int = 8, quality: int = 95) -> None:
+    """Save an image atomically (see :func:`atomic_write_bytes`) in the format of its extension.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        ``.png``, ``.jpg``/``.jpeg`` or ``.tif``/``.tiff`` (any case), in an existing folder.
+    image : ndarray
+        Anything :func:`validate_image` accepts; grey is saved grey.
+    recipe : str, optional
+        Text embedded in a PNG as a ``weft-recipe`` ``tEXt`` chunk (``iTXt``, UTF-8, when not
+        Latin-1) right after IHDR, for :func:`read_recipe`. JPEG and TIFF files do not carry it.
+    bit_depth : {8, 16}, default 8
+        Samples are ``round(value * 255)`` or ``round(value * 65535)``; JPEG is 8-bit only.
+    quality : int, default 95
+        JPEG quality, 0..100 (unused for PNG and TIFF).
+
+    Raises
+    ------
+    ImageError
+        Unknown extension, 16-bit JPEG, invalid image, missing folder, write failure.
+    """
+    target = Path(path)
+    ext, where = target.suffix.lower(), str(target)
+    if ext not in _SAVE_FORMATS:
+        raise ImageError(f"{target}: cannot save {ext or 'without an extension'} (allowed extensions: "
+                         f"{', '.join(_SAVE_FORMATS)})", path=where)
+    if bit_depth not in (8, 16) or isinstance(bit_depth, bool):
+        raise InvalidParameter(f"parameter 'bit_depth' = {bit_depth!r} must be 8 or 16",
+                               name="bit_depth", value=bit_depth)
+    if _SAVE_FORMATS[ext] == "JPEG" and bit_depth == 16:
+        raise ImageError(f"{target}: JPEG cannot store 16-bit samples (use bit_depth=8, or .png or .tif)", path=where)
+    if isinstance(quality, bool) or not isinstance(quality, numbers.Integral) or not 0 <= quality <= 100:
+        raise InvalidParameter(f"parameter 'quality' = {quality!r} is outside 0..100", name="quality", value=quality)
+    if recipe is not None and (not isinstance(recipe, str) or "\0" in recipe):
+        raise InvalidParameter("parameter 'recipe' must be text without NUL characters", name="recipe")
+    top = 65535.0 if bit_depth == 16 else 255.0
+    arr = np.clip(np.rint(validate_image(image) * top), 0, top).astype(np.uint16 if bit_depth == 16 else np.uint8)
+    if arr.ndim == 3:
+        arr = np.ascontiguousarray(arr[..., ::-1])  # RGB -> BGR for OpenCV
+    try:
+        params = [cv2.IMWRITE_JPEG_QUALITY, int(quality)] if _SAVE_FORMATS[ext] == "JPEG" else []
+        ok, encoded = cv2.imencode(ext, arr, params)
+        if not ok:
+            raise cv2.error("the encoder failed")
+    except cv2.error as e:
+        raise ImageError(f"{target}: cannot encode {_SAVE_FORMATS[ext]} ({_one_line(e)})", path=where) from e
+    data = encoded.tobytes()
+    if recipe is not None and ext == ".png":
+        try:
+            chunk = _png_chunk(b"tEXt", _RECIPE_KEY + b"\0" + recipe.encode("latin-1"))
+        except UnicodeEncodeError:  # iTXt: keyword, 0, no compression, method 0, no language/translation
+            chunk = _png_chunk(b"iTXt", _RECIPE_KEY + b"\0\0\0\0\0" + recipe.encode("utf-8"))
+        data = data[:33] + chunk + data[33:]  # OpenCV writes signature (8) + IHDR (25) first
+    atomic_write_bytes(target, data)
+
+
+def read_recipe(path: str | os.PathLike) -> str | None:
+    """The ``weft-recipe`` text (tEXt, zTXt or iTXt chunk) of a PNG file, parsed by hand.
+
+    Returns ``None`` when the file is not a PNG or has no such chunk (chunks with a bad CRC or
+    that cannot be decoded are skipped). Raises :class:`ImageError` when the file cannot be read.
+    """
+    name = os.fsdecode(path)
+    try:
+        with open(name, "rb") as f:
+            if f.read(8) != _PNG_SIGNATURE:
+                return None
+            while len(head := f.read(8)) == 8 and head[4:] != b"IEND":
+                length, kind = struct.unpack(">I4s", head)
+                if kind not in (b"tEXt", b"zTXt", b"iTXt"):
+                    f.seek(length + 4, os.SEEK_CUR)
+                    continue
+                body, crc = f.read(length), f.read(4)
+                key, _, rest = body.partition(b"\0")
+                if key != _RECIPE_KEY or crc != struct.pack(">I", zlib.crc32(kind + body)):
+                    continue
+                with contextlib.suppress(ValueError, IndexError, zlib.error):
+                    if kind == b"tEXt":
+                        return rest.decode("latin-1")
+                    if kind == b"zTXt":
+                        return zlib.decompress(rest[1:]).decode("latin-1")
+                    text = rest[2:].split(b"\0", 2)[2]  # skip language tag and translated keyword
+                    return (zlib.decompress(text) if rest[0] else text).decode("utf-8")
+    except OSError as e:
+        raise _os_error(name, e) from e
+    return None
