@@ -1,0 +1,173 @@
+"""Run benchmark cases: compute time, peak memory, quality figures, and G'MIC side by side.
+
+Timing: one untimed warm-up run (numba kernels compile or load from cache, OpenCV initialises),
+then ``repeats`` timed runs of the method's compute only (inputs already decoded); the table shows
+the median and the minimum. Peak memory is measured in one extra run under ``tracemalloc`` (so its
+overhead never touches the timings): it counts numpy's and Python's allocations during compute, not
+the interpreter or libraries already loaded. Quality figures come from ``core.metrics`` on the output
+of the last timed run. A case with a G'MIC counterpart, when ``gmic`` is on the PATH, also times the
+whole ``weft`` process against the whole ``gmic`` process on the same input file, alternating the two
+so that machine noise hits both alike.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import tracemalloc
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from core import metrics, registry
+from core.examples import example
+from core.image import load_image, luminance, resize, save_image
+
+from .cases import Case
+
+
+def prepare_inputs(case: Case) -> dict[str, np.ndarray]:
+    """Decode, crop, resize and (optionally) grey each input of ``case``."""
+    out = {}
+    for name, spec in case.inputs.items():
+        img = load_image(example(spec.example)).image
+        if spec.crop is not None:
+            x, y, w, h = spec.crop
+            img = img[y:y + h, x:x + w]
+        if spec.resize is not None:
+            img = resize(img, spec.resize, interpolation="area")
+        if spec.grey:
+            img = luminance(img)
+        out[name] = np.ascontiguousarray(img, dtype=np.float32)
+    return out
+
+
+def case_params(case: Case, quick: bool) -> dict[str, Any]:
+    params = dict(case.params)
+    if quick:
+        params.update(case.quick)
+    return params
+
+
+def _figures(case: Case, out: np.ndarray, inputs: dict[str, np.ndarray]) -> dict[str, float]:
+    figs = {}
+    for m in case.metrics:
+        if m in ("coherence", "completeness", "snr_db"):
+            ref = inputs["texture"]
+        elif m == "fidelity":
+            ref = inputs["target"]
+        else:
+            raise ValueError(f"benchmark case {case.name}: unknown metric {m!r}")
+        figs[m] = float(getattr(metrics, m)(out, ref))
+    return figs
+
+
+def _cli_args(params: dict[str, Any]) -> list[str]:
+    args = []
+    for k, v in params.items():
+        if isinstance(v, (tuple, list)):
+            v = f"{v[0]}x{v[1]}"
+        args += ["--" + k.replace("_", "-"), str(v)]
+    return args
+
+
+def _time_process(cmd: list[str]) -> float:
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    seconds = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed: {proc.stderr.strip()[-300:]}")
+    return seconds
+
+
+def compare_gmic(case: Case, inputs: dict[str, np.ndarray], params: dict[str, Any], repeats: int) -> dict[str, float]:
+    """Median whole-process seconds of ``weft`` and of ``gmic`` on the same texture file."""
+    gmic = shutil.which("gmic")
+    if gmic is None or case.gmic is None:
+        return {}
+    with tempfile.TemporaryDirectory(prefix="weft-bench-") as tmp:
+        src = Path(tmp) / "texture.png"
+        save_image(src, inputs["texture"])
+        weft_cmd = [sys.executable, "-m", "app.cli", case.method, str(src), "-o", str(Path(tmp) / "weft.png"),
+                    "--seed", str(case.seed), "--quiet"] + _cli_args(params)
+        gmic_cmd = [gmic, "-v", "-", str(src), *case.gmic, "-o", str(Path(tmp) / "gmic.png")]
+        _time_process(weft_cmd)  # warm caches (numba's on-disk cache, the OS file cache) for both
+        _time_process(gmic_cmd)
+        w, g = [], []
+        for _ in range(repeats):
+            w.append(_time_process(weft_cmd))
+            g.append(_time_process(gmic_cmd))
+    weft_s, gmic_s = statistics.median(w), statistics.median(g)
+    return {"weft_process_s": weft_s, "gmic_process_s": gmic_s, "weft_over_gmic": weft_s / gmic_s}
+
+
+def run_case(case: Case, *, repeats: int = 5, quick: bool = False) -> dict[str, Any]:
+    """Time ``case`` and compute its figures; returns one JSON-serialisable row."""
+    method = registry.get(case.method)
+    params_dict = case_params(case, quick)
+    params = method.params.from_dict(params_dict)
+    inputs = prepare_inputs(case)
+    method.run(inputs, params, rng=case.seed)  # warm-up
+    times = []
+    result = None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        result = method.run(inputs, params, rng=case.seed)
+        times.append(time.perf_counter() - t0)
+    tracemalloc.start()
+    try:
+        method.run(inputs, params, rng=case.seed)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    h, w = result.image.shape[:2]
+    row: dict[str, Any] = {
+        "case": case.name,
+        "method": case.method,
+        "size": [w, h],
+        "runs": repeats,
+        "median_s": statistics.median(times),
+        "min_s": min(times),
+        "peak_mib": peak / 2**20,
+    }
+    row.update(_figures(case, result.image, inputs))
+    row.update(compare_gmic(case, inputs, params_dict, max(1, min(repeats, 5))))
+    return row
+
+
+_COLUMNS = [
+    ("case", "case", "{}"),
+    ("size", "output", "{0[0]}x{0[1]}"),
+    ("runs", "runs", "{}"),
+    ("median_s", "median s", "{:.4f}"),
+    ("min_s", "min s", "{:.4f}"),
+    ("peak_mib", "peak MiB", "{:.1f}"),
+    ("coherence", "coherence", "{:.4f}"),
+    ("completeness", "completeness", "{:.4f}"),
+    ("fidelity", "fidelity", "{:.3f}"),
+    ("snr_db", "SNR dB", "{:.2f}"),
+    ("weft_process_s", "weft process s", "{:.3f}"),
+    ("gmic_process_s", "G'MIC process s", "{:.3f}"),
+    ("weft_over_gmic", "weft / G'MIC", "{:.2f}"),
+]
+
+
+def markdown_table(rows: list[dict[str, Any]]) -> str:
+    """The rows as a markdown table with only the columns some row has."""
+    cols = [c for c in _COLUMNS if any(c[0] in r for r in rows)]
+    lines = ["| " + " | ".join(c[1] for c in cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
+    for r in rows:
+        cells = [c[2].format(r[c[0]]) if c[0] in r else "" for c in cols]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def write_json(rows: list[dict[str, Any]], path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
