@@ -299,7 +299,7 @@ def specs(cls: type) -> tuple[Spec, ...]:
             continue
         out.append(Spec(name=f.name, default=f.default, **meta))
     result = tuple(out)
-    setattr(cls, "_weft_specs", result)
+    cls._weft_specs = result
     return result
 
 

@@ -517,7 +517,7 @@ def test_decompression_bomb_refused_from_header(tmp_path, monkeypatch):
 
     monkeypatch.setattr(cv2, "imdecode", must_not_decode)
     monkeypatch.setattr(np, "fromfile", must_not_decode)
-    monkeypatch.setattr(ci, "_decode_pillow", must_not_decode)
+    monkeypatch.setattr(ci.files, "_decode_pillow", must_not_decode)
     before = Image.MAX_IMAGE_PIXELS
     with pytest.raises(ImageError) as e:
         load_image(path)

@@ -1,8 +1,4 @@
-"""Images in weft: float32 arrays in [0, 1], shape (H, W) grey or (H, W, 3) RGB.
-
-This module holds loading/saving (OpenCV's BGR never leaves it) and the colour helpers every
-method shares: luminance (Rec. 601), RGB <-> YIQ (Ashikhmin keeps the target's chroma in YIQ), and
-the principal-component grey of Smith & Bhalerao §3.4.
+"""Loading, saving, validating and resizing images (OpenCV's BGR never leaves this module).
 
 Loading reads the header with Pillow (lazy, no pixels) to check the pixel limit, then decodes with
 OpenCV from bytes (non-ASCII paths work) and falls back to Pillow for what OpenCV cannot decode.
@@ -29,116 +25,11 @@ import cv2
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
-from .errors import ImageError, InvalidParameter
+from ..errors import ImageError, InvalidParameter
+from .colour import _check_float_image, luminance
 
 # A corrupt file is reported once, by us, as one line: OpenCV's own warnings would add a second.
 cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
-
-# Rec. 601 luma weights, also the Y row of YIQ.
-_LUMA = np.array([0.299, 0.587, 0.114], dtype=np.float32)
-_RGB2YIQ = np.array(
-    [[0.299, 0.587, 0.114], [0.595716, -0.274453, -0.321263], [0.211456, -0.522591, 0.311135]],
-    dtype=np.float64,
-)
-_YIQ2RGB = np.linalg.inv(_RGB2YIQ)
-
-
-def _check_float_image(image: np.ndarray, what: str = "image") -> np.ndarray:
-    image = np.asarray(image)
-    if image.ndim not in (2, 3) or (image.ndim == 3 and image.shape[2] != 3):
-        raise ImageError(f"{what} must have shape (H, W) or (H, W, 3), not {image.shape}")
-    if image.shape[0] < 1 or image.shape[1] < 1:
-        raise ImageError(f"{what} is empty ({image.shape[1]}x{image.shape[0]})")
-    return image
-
-
-def luminance(image: np.ndarray) -> np.ndarray:
-    """Rec. 601 luminance ``0.299 R + 0.587 G + 0.114 B`` as float32 (H, W); grey passes through."""
-    image = _check_float_image(image)
-    if image.ndim == 2:
-        return image.astype(np.float32, copy=False)
-    return (image.astype(np.float32, copy=False) @ _LUMA).astype(np.float32, copy=False)
-
-
-def rgb_to_yiq(rgb: np.ndarray) -> np.ndarray:
-    """RGB in [0, 1] -> YIQ (NTSC), float32 (H, W, 3). Y in [0, 1], I in ±0.596, Q in ±0.523."""
-    rgb = _check_float_image(rgb, "RGB image")
-    if rgb.ndim != 3:
-        raise ImageError(f"RGB image must have shape (H, W, 3), not {rgb.shape}")
-    return (rgb.astype(np.float32, copy=False) @ _RGB2YIQ.T.astype(np.float32)).astype(np.float32, copy=False)
-
-
-def yiq_to_rgb(yiq: np.ndarray, *, clip: bool = True) -> np.ndarray:
-    """YIQ -> RGB float32 (H, W, 3), clipped to [0, 1] unless ``clip=False``."""
-    yiq = np.asarray(yiq)
-    if yiq.ndim != 3 or yiq.shape[2] != 3:
-        raise ImageError(f"YIQ image must have shape (H, W, 3), not {yiq.shape}")
-    rgb = (yiq.astype(np.float32, copy=False) @ _YIQ2RGB.T.astype(np.float32)).astype(np.float32, copy=False)
-    return np.clip(rgb, 0.0, 1.0, out=rgb) if clip else rgb
-
-
-@dataclass(frozen=True)
-class PcaBasis:
-    """An orthonormal colour basis: ``components = (rgb - mean) @ axes.T``.
-
-    ``axes`` rows are the principal directions, largest variance first; the first axis is signed so
-    that it correlates positively with luminance (bright stays bright). ``variances`` are the
-    eigenvalues in the same order.
-    """
-
-    mean: np.ndarray  # (3,)
-    axes: np.ndarray  # (3, 3), rows
-    variances: np.ndarray  # (3,)
-
-
-def pca_basis(rgb: np.ndarray) -> PcaBasis:
-    """The principal components of an RGB image's colours (Smith & Bhalerao §3.4, Jolliffe)."""
-    rgb = _check_float_image(rgb, "RGB image")
-    if rgb.ndim != 3:
-        raise ImageError(f"RGB image must have shape (H, W, 3), not {rgb.shape}")
-    pixels = rgb.reshape(-1, 3).astype(np.float64)
-    mean = pixels.mean(axis=0)
-    cov = np.cov((pixels - mean).T) if len(pixels) > 1 else np.zeros((3, 3))
-    variances, vectors = np.linalg.eigh(cov)
-    order = np.argsort(variances)[::-1]
-    variances = np.maximum(variances[order], 0.0)
-    axes = vectors[:, order].T.copy()
-    if variances[0] <= 1e-18:
-        # Flat colour: no preferred direction, use luminance so the grey still means brightness.
-        axes[0] = _LUMA / np.linalg.norm(_LUMA)
-    for i in range(3):
-        ref = _LUMA if i == 0 else axes[i]
-        if np.dot(axes[i], ref) < 0:
-            axes[i] = -axes[i]
-    return PcaBasis(mean=mean.astype(np.float32), axes=axes.astype(np.float32), variances=variances.astype(np.float32))
-
-
-def to_pca(rgb: np.ndarray, basis: PcaBasis | None = None) -> tuple[np.ndarray, PcaBasis]:
-    """Project RGB onto a PCA colour basis; returns float32 (H, W, 3) components and the basis."""
-    if basis is None:
-        basis = pca_basis(rgb)
-    comps = (np.asarray(rgb, dtype=np.float32) - basis.mean) @ basis.axes.T
-    return comps.astype(np.float32, copy=False), basis
-
-
-def from_pca(components: np.ndarray, basis: PcaBasis, *, clip: bool = True) -> np.ndarray:
-    """Inverse of :func:`to_pca`: float32 RGB (H, W, 3), clipped to [0, 1] unless ``clip=False``."""
-    rgb = (np.asarray(components, dtype=np.float32) @ basis.axes + basis.mean).astype(np.float32, copy=False)
-    return np.clip(rgb, 0.0, 1.0, out=rgb) if clip else rgb
-
-
-def pca_grey(rgb: np.ndarray) -> tuple[np.ndarray, PcaBasis]:
-    """The principal-component grey of §3.4: the colour direction of greatest variance.
-
-    Returns the first component offset by the mean's projection on that axis (so the values sit
-    around the image's mean brightness rather than around zero), float32 (H, W), and the basis.
-    Reconstruct with ``from_pca(stack([grey - offset, c1, c2]), basis)`` where
-    ``offset = basis.mean @ basis.axes[0]``.
-    """
-    comps, basis = to_pca(rgb)
-    offset = float(basis.mean @ basis.axes[0])
-    return (comps[..., 0] + offset).astype(np.float32), basis
-
 
 # --------------------------------------------------------------------------------------------------
 # Validation and resizing

@@ -1,0 +1,27 @@
+"""Images in weft: float32 arrays in [0, 1], shape (H, W) grey or (H, W, 3) RGB.
+
+``core.image.files`` loads, saves, validates and resizes (OpenCV's BGR never leaves it);
+``core.image.colour`` holds the colour helpers: luminance (Rec. 601), RGB <-> YIQ, and the
+principal-component grey of Smith & Bhalerao §3.4. Everything public is importable from here.
+"""
+
+from .colour import PcaBasis, from_pca, luminance, pca_basis, pca_grey, rgb_to_yiq, to_pca, yiq_to_rgb
+from .files import (
+    DEFAULT_MAX_PIXELS,
+    ImageInfo,
+    Loaded,
+    atomic_write_bytes,
+    get_max_pixels,
+    load_image,
+    read_recipe,
+    resize,
+    save_image,
+    set_max_pixels,
+    validate_image,
+)
+
+__all__ = [
+    "DEFAULT_MAX_PIXELS", "ImageInfo", "Loaded", "PcaBasis", "atomic_write_bytes", "from_pca",
+    "get_max_pixels", "load_image", "luminance", "pca_basis", "pca_grey", "read_recipe", "resize",
+    "rgb_to_yiq", "save_image", "set_max_pixels", "to_pca", "validate_image", "yiq_to_rgb",
+]
