@@ -79,10 +79,11 @@ def build_parser() -> argparse.ArgumentParser:
     for method in registry.methods().values():
         p = sub.add_parser(method.name, help=method.summary, description=method.summary)
         for inp in method.inputs:
-            if inp.required:
+            if inp.is_positional:
                 p.add_argument(inp.name, metavar=inp.name.upper(), help=inp.help)
             else:
-                p.add_argument("--" + inp.name, metavar="IMAGE", help=inp.help)
+                p.add_argument("--" + inp.name.replace("_", "-"), dest=inp.name, metavar="IMAGE",
+                               required=inp.required, help=inp.help)
         group = p.add_argument_group("method parameters")
         from core.params import specs
 

@@ -29,7 +29,7 @@ from core import metrics, registry
 from core.examples import example
 from core.image import load_image, luminance, resize, save_image
 
-from .cases import Case
+from .cases.base import Case
 
 
 def prepare_inputs(case: Case) -> dict[str, np.ndarray]:
@@ -86,17 +86,29 @@ def _time_process(cmd: list[str]) -> float:
     return seconds
 
 
+def weft_command(case: Case, input_files: dict[str, Path], output: Path, params: dict[str, Any]) -> list[str]:
+    """The ``weft`` command line that runs ``case`` on the given input files."""
+    method = registry.get(case.method)
+    cmd = [sys.executable, "-m", "app.cli", case.method]
+    for spec in method.inputs:
+        if spec.name in input_files:
+            path = str(input_files[spec.name])
+            cmd += [path] if spec.is_positional else ["--" + spec.name.replace("_", "-"), path]
+    return cmd + ["-o", str(output), "--seed", str(case.seed), "--quiet"] + _cli_args(params)
+
+
 def compare_gmic(case: Case, inputs: dict[str, np.ndarray], params: dict[str, Any], repeats: int) -> dict[str, float]:
-    """Median whole-process seconds of ``weft`` and of ``gmic`` on the same texture file."""
+    """Median whole-process seconds of ``weft`` and of ``gmic`` on the same input files."""
     gmic = shutil.which("gmic")
     if gmic is None or case.gmic is None:
         return {}
     with tempfile.TemporaryDirectory(prefix="weft-bench-") as tmp:
-        src = Path(tmp) / "texture.png"
-        save_image(src, inputs["texture"])
-        weft_cmd = [sys.executable, "-m", "app.cli", case.method, str(src), "-o", str(Path(tmp) / "weft.png"),
-                    "--seed", str(case.seed), "--quiet"] + _cli_args(params)
-        gmic_cmd = [gmic, "-v", "-", str(src), *case.gmic, "-o", str(Path(tmp) / "gmic.png")]
+        files = {}
+        for name, image in inputs.items():
+            files[name] = Path(tmp) / f"{name}.png"
+            save_image(files[name], image)
+        weft_cmd = weft_command(case, files, Path(tmp) / "weft.png", params)
+        gmic_cmd = [gmic, "-v", "-", str(files["texture"]), *case.gmic, "-o", str(Path(tmp) / "gmic.png")]
         _time_process(weft_cmd)  # warm caches (numba's on-disk cache, the OS file cache) for both
         _time_process(gmic_cmd)
         w, g = [], []

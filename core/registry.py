@@ -23,11 +23,21 @@ _MODULES = ("core.quilting",)
 
 @dataclass(frozen=True)
 class InputSpec:
-    """One image a method takes. Required inputs are positional on the command line."""
+    """One image a method takes.
+
+    On the command line a required input is positional unless ``positional=False`` (then it is a
+    required ``--name IMAGE`` option, e.g. ``weft blend FG BG --mask MASK``); an optional input is
+    always an option.
+    """
 
     name: str
     help: str
     required: bool = True
+    positional: bool | None = None
+
+    @property
+    def is_positional(self) -> bool:
+        return self.required if self.positional is None else (self.positional and self.required)
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The registered benchmark cases. Each method's issue adds its cases here.
+"""What a benchmark case is. The cases themselves live in one module per method beside this one.
 
 An input is ``Input(example, crop=(x, y, w, h) | None, resize=(w, h) | None, grey=False)`` over a
 bundled example of ``resources/``. ``metrics`` names the figures of ``core.metrics`` to compute on
@@ -33,21 +33,3 @@ class Case:
     quick: dict[str, Any] = field(default_factory=dict)
     seed: int = 1
     note: str = ""
-
-
-CASES: list[Case] = [
-    Case(
-        name="quilt-random-512",
-        method="quilt",
-        inputs={"texture": Input("brick", crop=(0, 0, 128, 128))},
-        params={"mode": "random", "block": 32, "size": (512, 512)},
-        metrics=("coherence", "completeness"),
-        gmic=("syntexturize_matchpatch", "512,512"),
-        quick={"size": (256, 256)},
-        note="random block tiling (no overlap); G'MIC runs its patch-matching synthesis on the same input",
-    ),
-]
-
-
-def by_name() -> dict[str, Case]:
-    return {c.name: c for c in CASES}
