@@ -40,6 +40,8 @@ class _Parser(argparse.ArgumentParser):
 class _TerminalProgress:
     """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
 
+    wants_preview = False  # it draws the fraction only: algorithms need not build partial images
+
     def __init__(self, enabled: bool):
         self.enabled = enabled and sys.stderr.isatty()
         self.drawn = False
@@ -157,6 +159,8 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         seed = secrets.randbits(31)
 
     images = {name: load_image(path).image for name, path in input_paths.items()}
+    if method.warm_up is not None:
+        method.warm_up()  # load compiled kernels now, so "seconds" is the compute alone
     bar = _TerminalProgress(not args.quiet)
     t0 = time.perf_counter()
     try:

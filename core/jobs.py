@@ -89,7 +89,9 @@ class ProgressReporter:
     Parameters
     ----------
     callback : callable or None
-        The algorithm's ``progress`` argument; ``None`` makes every update a cheap no-op.
+        The algorithm's ``progress`` argument; ``None`` makes every update a cheap no-op. A callback
+        with an attribute ``wants_preview = False`` (a progress bar that only draws the fraction)
+        gets ``preview=None`` and preview callables are never called for it.
     stage : str
         Stage name put into each :class:`Progress`.
     total : int
@@ -105,13 +107,14 @@ class ProgressReporter:
     (101, 1.0)
     """
 
-    __slots__ = ("callback", "stage", "total", "_last")
+    __slots__ = ("callback", "stage", "total", "_last", "_previews")
 
     def __init__(self, callback: ProgressCallback | None, stage: str, total: int) -> None:
         self.callback = callback
         self.stage = stage
         self.total = int(total)
         self._last: int | None = None
+        self._previews = bool(getattr(callback, "wants_preview", True))
 
     def update(self, done: int, preview: np.ndarray | Callable[[], np.ndarray] | None = None) -> bool:
         """Report ``done`` units if the integer percentage changed or ``done == total``.
@@ -132,7 +135,9 @@ class ProgressReporter:
         if percent == self._last and done != self.total:
             return False
         self._last = percent
-        if callable(preview):
+        if not self._previews:
+            preview = None
+        elif callable(preview):
             preview = preview()
         self.callback(Progress(self.stage, int(done), self.total, preview))
         return True

@@ -18,7 +18,7 @@ from .errors import WeftError
 from .params import Params
 
 # Modules that define a module-level ``METHOD``; imported on first use.
-_MODULES = ("core.quilting",)
+_MODULES = ("core.quilting", "core.fast")
 
 
 @dataclass(frozen=True)
@@ -53,7 +53,10 @@ class Method:
     """A runnable method.
 
     ``run(inputs, params, *, rng, progress, cancel) -> Result`` where ``inputs`` maps input names
-    to float32 images; it must honour ``cancel`` and report through ``progress``.
+    to float32 images; it must honour ``cancel`` and report through ``progress``. ``warm_up()``, when
+    given, loads the method's compiled kernels (from numba's on-disk cache, or compiling them) on
+    tiny inputs, so that the first real run is not charged with it; the CLI calls it before timing,
+    the GUI once in a background thread at start.
     """
 
     name: str
@@ -61,6 +64,7 @@ class Method:
     params: type[Params]
     inputs: tuple[InputSpec, ...]
     run: Callable[..., Result]
+    warm_up: Callable[[], None] | None = None
 
 
 _registry: dict[str, Method] | None = None
@@ -84,3 +88,10 @@ def get(name: str) -> Method:
     if name not in reg:
         raise WeftError(f"unknown method {name!r} (known: {', '.join(reg)})")
     return reg[name]
+
+
+def warm_up_all() -> None:
+    """Run every method's ``warm_up`` (for a background thread at GUI start)."""
+    for method in methods().values():
+        if method.warm_up is not None:
+            method.warm_up()

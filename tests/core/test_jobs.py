@@ -161,6 +161,24 @@ def test_reporter_small_total_and_final_always_reported():
     assert [p.done for p in calls] == [1, 2, 3, 3]
 
 
+def test_reporter_skips_previews_for_callbacks_that_do_not_want_them():
+    class Bar:
+        wants_preview = False
+
+        def __init__(self):
+            self.calls = []
+
+        def __call__(self, p):
+            self.calls.append(p)
+
+    bar, built = Bar(), []
+    reporter = ProgressReporter(bar, "rows", 4)
+    for done in range(1, 5):
+        reporter.update(done, preview=lambda: built.append(1) or np.zeros(2))
+    assert len(bar.calls) == 4 and built == []
+    assert all(p.preview is None for p in bar.calls)
+
+
 def test_reporter_passes_array_preview_through():
     calls = []
     image = np.ones((3, 3), np.float32)

@@ -1,0 +1,1 @@
+"""numba kernels (njit, cache=True, nogil=True), one module per method."""
