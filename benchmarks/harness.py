@@ -56,7 +56,7 @@ def case_params(case: Case, quick: bool) -> dict[str, Any]:
 
 
 def _figures(case: Case, out: np.ndarray, inputs: dict[str, np.ndarray]) -> dict[str, float]:
-    figs = {}
+    figs = dict(case.figures(inputs, out)) if case.figures is not None else {}
     for m in case.metrics:
         if m in ("coherence", "completeness", "snr_db"):
             ref = inputs["texture"]
@@ -97,10 +97,11 @@ def weft_command(case: Case, input_files: dict[str, Path], output: Path, params:
     return cmd + ["-o", str(output), "--seed", str(case.seed), "--quiet"] + _cli_args(params)
 
 
-def compare_gmic(case: Case, inputs: dict[str, np.ndarray], params: dict[str, Any], repeats: int) -> dict[str, float]:
-    """Median whole-process seconds of ``weft`` and of ``gmic`` on the same input files."""
-    gmic = shutil.which("gmic")
-    if gmic is None or case.gmic is None:
+def time_processes(case: Case, inputs: dict[str, np.ndarray], params: dict[str, Any], repeats: int) -> dict[str, float]:
+    """Median whole-process seconds of ``weft`` (and of ``gmic``, when the case has a counterpart
+    and it is installed) on the same input files, the two alternated so noise hits both alike."""
+    gmic = shutil.which("gmic") if case.gmic is not None else None
+    if not case.process and gmic is None:
         return {}
     with tempfile.TemporaryDirectory(prefix="weft-bench-") as tmp:
         files = {}
@@ -108,15 +109,43 @@ def compare_gmic(case: Case, inputs: dict[str, np.ndarray], params: dict[str, An
             files[name] = Path(tmp) / f"{name}.png"
             save_image(files[name], image)
         weft_cmd = weft_command(case, files, Path(tmp) / "weft.png", params)
-        gmic_cmd = [gmic, "-v", "-", str(files["texture"]), *case.gmic, "-o", str(Path(tmp) / "gmic.png")]
+        gmic_cmd = [gmic, "-v", "-", str(files["texture"]), *case.gmic, "-o", str(Path(tmp) / "gmic.png")] if gmic else None
         _time_process(weft_cmd)  # warm caches (numba's on-disk cache, the OS file cache) for both
-        _time_process(gmic_cmd)
+        if gmic_cmd:
+            _time_process(gmic_cmd)
         w, g = [], []
         for _ in range(repeats):
             w.append(_time_process(weft_cmd))
-            g.append(_time_process(gmic_cmd))
-    weft_s, gmic_s = statistics.median(w), statistics.median(g)
-    return {"weft_process_s": weft_s, "gmic_process_s": gmic_s, "weft_over_gmic": weft_s / gmic_s}
+            if gmic_cmd:
+                g.append(_time_process(gmic_cmd))
+    row = {"weft_process_s": statistics.median(w)}
+    if g:
+        row["gmic_process_s"] = statistics.median(g)
+        row["weft_over_gmic"] = row["weft_process_s"] / row["gmic_process_s"]
+    return row
+
+
+def parallel_speedup(method, inputs, params, seed: int, repeats: int) -> float:
+    """(time of two runs one after the other) / (time of the same two runs on two threads at once)."""
+    import threading
+
+    def one():
+        method.run(inputs, params, rng=seed)
+
+    serial, parallel = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        one()
+        one()
+        serial.append(time.perf_counter() - t0)
+        threads = [threading.Thread(target=one) for _ in range(2)]
+        t0 = time.perf_counter()
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        parallel.append(time.perf_counter() - t0)
+    return statistics.median(serial) / statistics.median(parallel)
 
 
 def run_case(case: Case, *, repeats: int = 5, quick: bool = False) -> dict[str, Any]:
@@ -149,8 +178,10 @@ def run_case(case: Case, *, repeats: int = 5, quick: bool = False) -> dict[str, 
         "peak_mib": peak / 2**20,
     }
     row.update(_figures(case, result.image, inputs))
+    if case.parallel:
+        row["speedup_2_threads"] = parallel_speedup(method, inputs, params, case.seed, repeats)
     if not quick:  # G'MIC's command line is written for the full-size case
-        row.update(compare_gmic(case, inputs, params_dict, max(1, min(repeats, 5))))
+        row.update(time_processes(case, inputs, params_dict, max(1, min(repeats, 5))))
     return row
 
 
@@ -165,6 +196,9 @@ _COLUMNS = [
     ("completeness", "completeness", "{:.4f}"),
     ("fidelity", "fidelity", "{:.3f}"),
     ("snr_db", "SNR dB", "{:.2f}"),
+    ("psnr_db", "PSNR dB", "{:.2f}"),
+    ("psnr_cubic_db", "cubic PSNR dB", "{:.2f}"),
+    ("speedup_2_threads", "2-thread speed-up", "{:.2f}x"),
     ("weft_process_s", "weft process s", "{:.3f}"),
     ("gmic_process_s", "G'MIC process s", "{:.3f}"),
     ("weft_over_gmic", "weft / G'MIC", "{:.2f}"),

@@ -38,7 +38,7 @@ import numpy as np
 
 from ._kernels import fast as _k
 from .errors import ImageError, InvalidParameter
-from .image import luminance, resize, rgb_to_yiq, validate_image, yiq_to_rgb
+from .image import luminance, resize, validate_image
 from .jobs import CancelToken, Progress, ProgressReporter
 from .params import Params, as_rng, out_of_range, param
 from .registry import InputSpec, Method, Result
@@ -157,7 +157,7 @@ def transfer(
     progress: Callable[[Progress], None] | None = None,
     cancel: CancelToken | None = None,
 ) -> np.ndarray:
-    """Fast texture transfer, coherent synthesis, super-resolution and novel styles (Ashikhmin).
+    """Fast texture transfer, coherent synthesis, super-resolution and novel styles (Ashikhmin 2003).
 
     Parameters
     ----------
@@ -253,7 +253,7 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
     else:
         src_mean = tgt_mean = np.zeros((1, 1), np.float32)
         res = np.zeros((height, width), np.float32)
-    pos = np.zeros((height, width, 2), np.int32)
+    pos = np.zeros((height, width), np.int32)  # flat source index y * ws + x
     state = np.array([rng.integers(1, 2**63, dtype=np.uint64)], dtype=np.uint64)
     causal, square, rest = _offsets(params.n)
 
@@ -270,27 +270,31 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
                              y0, y1, h, metric, tgt_y is not None, params.target_weight, params.w,
                              params.p, params.p_l, m, state)
             done += 1
-            report.update(done, preview=lambda: _colourize(pos, src_y, texture, target, params.colour))
-    return _colourize(pos, src_y, texture, target, params.colour), pos, params
+            report.update(done, preview=lambda: _colourize(pos, src_y, texture, target, tgt_y, params.colour))
+    return _colourize(pos, src_y, texture, target, tgt_y, params.colour), pos, params
 
 
-def _colourize(pos, src_y, texture, target, colour) -> np.ndarray:
-    """The output image from the chosen source positions (see ``colour``)."""
+def _colourize(pos, src_y, texture, target, tgt_y, colour) -> np.ndarray:
+    """The output image from the chosen source positions (flat indices; see ``colour``).
+
+    Keeping the target's chroma means replacing Y in YIQ and converting back; YIQ -> RGB is linear
+    and its Y column is (1, 1, 1), so that is ``target + (Y_new - Y_target)`` on every channel,
+    then clipped to [0, 1] -- the same pixels as going through YIQ, at a fraction of the cost.
+    """
     if colour == "source" and texture.ndim == 3:
-        return texture[pos[..., 0], pos[..., 1]]
-    lum = src_y[pos[..., 0], pos[..., 1]]
+        return texture.reshape(-1, 3)[pos]
+    lum = src_y.ravel()[pos]
     if colour == "source" or target is None or target.ndim == 2:
         return lum
-    yiq = rgb_to_yiq(target)
-    yiq[..., 0] = lum
-    return yiq_to_rgb(yiq)
+    out = target + (lum - tgt_y)[..., None]
+    return np.clip(out, 0.0, 1.0, out=out)
 
 
 def _run(inputs: Mapping[str, np.ndarray], params: FastParams, *, rng=None, progress=None, cancel=None) -> Result:
     out, pos, resolved = _transfer(inputs["texture"], inputs.get("target"), params, mask=inputs.get("mask"),
                                    rng=rng, progress=progress, cancel=cancel)
-    # Mean size of the coherent patches: how often a pixel continues its left neighbour's patch.
-    cont = np.mean((pos[:, 1:, 0] == pos[:, :-1, 0]) & (pos[:, 1:, 1] == pos[:, :-1, 1] + 1)) if pos.shape[1] > 1 else 0.0
+    # How often a pixel continues its left neighbour's patch (flat source index one further).
+    cont = np.mean(pos[:, 1:] == pos[:, :-1] + 1) if pos.shape[1] > 1 else 0.0
     return Result(out, {"mode": resolved.mode, "metric": resolved.metric, "p": resolved.p, "p_l": resolved.p_l,
                         "coherent_fraction": round(float(cont), 4)})
 

@@ -27,7 +27,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from .errors import ImageError, InvalidParameter
 from .image import luminance, validate_image
 
-__all__ = ["coherence", "completeness", "fidelity", "snr_db"]
+__all__ = ["coherence", "completeness", "fidelity", "psnr_db", "snr_db"]
 
 MIN_SIDE = 7
 # Upper bound on the float32 distance block held at once by the nearest-neighbour search
@@ -308,3 +308,17 @@ def snr_db(orig, synth) -> float:
     if var == 0.0:
         return -math.inf
     return 10.0 * math.log10(var / mse)
+
+
+def psnr_db(orig, synth) -> float:
+    """Peak signal-to-noise ratio of ``synth`` against ``orig`` in decibels, peak 1.
+
+    ``10 log10(1 / mean((orig - synth)^2))`` over all pixels and channels, float64; ``inf`` when
+    the arrays are identical. Same inputs and errors as :func:`snr_db`.
+    """
+    orig = _check_image(orig, "original image")
+    synth = _check_image(synth, "synthesized image")
+    if orig.shape != synth.shape:
+        raise ImageError(f"original image has shape {orig.shape} but synthesized image has {synth.shape}")
+    mse = float(np.mean((orig.astype(np.float64) - synth.astype(np.float64)) ** 2))
+    return math.inf if mse == 0.0 else -10.0 * math.log10(mse)

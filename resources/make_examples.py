@@ -10,6 +10,7 @@ recorded in ``resources/README.md``. Outputs:
 
 * textures (grey): ``brick.png``, ``gravel.png``, ``grass.png`` -- 256x256 crops;
 * textures (colour): ``wood-grain.png`` (coffee table top), ``cat-fur.png`` (Chelsea's forehead);
+* a fractal (self-similar) image for super-resolution: ``clouds.png``;
 * targets: ``camera.png``, ``astronaut.png`` (256x256), ``coffee.png``, ``chelsea.png`` (300x200);
 * a perspective photo of a texture for the non-frontal-parallel method (``nfpt``):
   ``perspective-frontal.png`` (the frontal brick wall, ground truth), ``perspective.png`` (that wall
@@ -260,6 +261,23 @@ def _dump_json(doc: dict) -> str:
 # ------------------------------------------------------------------------------------------
 
 
+def fractal_clouds(size: int = 256, beta: float = 2.5, seed: int = SEED + 1) -> np.ndarray:
+    """Fractional Brownian "clouds": random phases under a 1/f^(beta/2) amplitude spectrum.
+
+    Statistically self-similar across scales by construction, so it is the kind of image Ashikhmin's
+    super-resolution is meant for (his Fig. 6 uses an aerial photograph of a fractal terrain).
+    """
+    rng = np.random.default_rng(seed)
+    fy = np.fft.fftfreq(size)[:, None]
+    fx = np.fft.fftfreq(size)[None, :]
+    f = np.hypot(fx, fy)
+    f[0, 0] = 1.0
+    spectrum = (rng.normal(size=(size, size)) + 1j * rng.normal(size=(size, size))) / f ** (beta / 2)
+    spectrum[0, 0] = 0.0
+    img = np.real(np.fft.ifft2(spectrum))
+    return ((img - img.min()) / (img.max() - img.min())).astype(np.float32)
+
+
 def main() -> None:
     rng = np.random.default_rng(SEED)
     made = []
@@ -281,6 +299,8 @@ def main() -> None:
     h = photo_homography()
     made.append(_save("perspective-frontal.png", wall_rgb))
     made.append(_save("perspective.png", perspective_photo(wall_rgb, h, rng)))
+    # a self-similar (fractal) image for super-resolution
+    made.append(_save("clouds.png", fractal_clouds()))
     lines_path = HERE / "perspective-lines.json"
     lines_path.write_text(_dump_json(feature_lines(h, rows)), encoding="utf-8")
     made.append(lines_path)

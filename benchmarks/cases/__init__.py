@@ -6,10 +6,10 @@ to the import below.
 
 from __future__ import annotations
 
-from . import quilt
+from . import fast, quilt
 from .base import Case, Input
 
-CASES: list[Case] = [*quilt.CASES]
+CASES: list[Case] = [*quilt.CASES, *fast.CASES]
 
 
 def by_name() -> dict[str, Case]:

@@ -5,13 +5,16 @@ bundled example of ``resources/``. ``metrics`` names the figures of ``core.metri
 the output: ``coherence`` / ``completeness`` against the ``texture`` input, ``fidelity`` against the
 ``target`` input, ``snr_db`` against the ``texture`` input. ``gmic`` is a G'MIC command line run on
 the texture input in the same run (whole process against whole ``weft`` process) when ``gmic`` is
-installed; ``quick`` overrides parameters for ``--quick`` runs.
+installed; ``process`` also times the whole ``weft`` process without G'MIC; ``parallel`` also runs
+two copies on two threads at once and reports the speed-up over running them one after the other;
+``figures`` is a function ``(inputs, output) -> {name: value}`` for figures particular to the case;
+``quick`` overrides parameters for ``--quick`` runs.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 
 @dataclass(frozen=True)
@@ -30,6 +33,9 @@ class Case:
     params: dict[str, Any]
     metrics: tuple[str, ...] = ()
     gmic: tuple[str, ...] | None = None
+    process: bool = False
+    parallel: bool = False
+    figures: Callable[[dict, Any], dict[str, float]] | None = None
     quick: dict[str, Any] = field(default_factory=dict)
     seed: int = 1
     note: str = ""

@@ -12,9 +12,10 @@ src_mean   (Hs, Ws) float32   n x n box mean of the source (artistic metric; els
 tgt        (H+2h, W+2h) f32   target luminance padded by h (edge-replicated); unused without target
 tgt_mean   (H, W) float32     n x n box mean of the target (artistic metric)
 res        (H, W) float32     result luminance (in/out)
-pos        (H, W, 2) int32    source (y, x) of every result pixel (in/out)
+pos        (H, W) int32       source position of every result pixel, as y * Ws + x (in/out)
 allowed    (K, 2) int32       source positions a random candidate may come from
-mask       (Hs, Ws) uint8     1 where a candidate may come from (valid interior & user mask)
+mask       (Hs, Ws) uint8     1 where a candidate may come from (valid interior & user mask); it
+                              must be 0 within h of every border (the kernel relies on it)
 res_offs   (k, 2) int32       offsets of the result part: the causal L (first pass) or the whole
                               square without its centre (later passes); also the candidate sources
 tgt_offs   (j, 2) int32       offsets of the target part: the complementary half with the centre
@@ -67,6 +68,8 @@ def coherent_rows(src, src_mean, tgt, tgt_mean, res, pos, allowed, mask, res_off
     n_tgt = tgt_offs.shape[0]
     n_allowed = allowed.shape[0]
     srcf = src.ravel()
+    maskf = mask.ravel()
+    meanf = src_mean.ravel()
     resf = res.ravel()
     tgtf = tgt.ravel()
     # Flat offsets: neighbour k of pixel i is i + off[k] in each image's own row stride.
@@ -91,15 +94,16 @@ def coherent_rows(src, src_mean, tgt, tgt_mean, res, pos, allowed, mask, res_off
                 qx = x + r_dx[k]
                 if not inside and (qy < 0 or qy >= H or qx < 0 or qx >= W):
                     continue
-                cy = pos[qy, qx, 0] - r_dy[k]
-                cx = pos[qy, qx, 1] - r_dx[k]
-                if cy < lo_y or cy > hi_y or cx < lo_x or cx > hi_x or mask[cy, cx] == 0:
+                # The neighbour's source position lies in the interior (h from every border), so
+                # shifting it by an offset of at most h stays inside the source: no row wrap-around.
+                c = pos[qy, qx] - r_src[k]
+                if maskf[c] == 0:
                     # Its neighbourhood would leave the source (or the mask): dropped, and a
                     # random position stands in for it (as in Ashikhmin 2001).
                     r = min(int(_uniform(state) * n_allowed), n_allowed - 1)
                     nc = _add(cand, nc, allowed[r, 0] * Ws + allowed[r, 1])
                 else:
-                    nc = _add(cand, nc, cy * Ws + cx)
+                    nc = _add(cand, nc, c)
             # ---- extra candidates: random with probability p, location-specific with p_l
             if nc == 0 or (p > 0.0 and _uniform(state) < p):
                 r = min(int(_uniform(state) * n_allowed), n_allowed - 1)
@@ -139,7 +143,7 @@ def coherent_rows(src, src_mean, tgt, tgt_mean, res, pos, allowed, mask, res_off
                                 s_res += d
                                 cnt += 1
                     if metric == METRIC_ARTISTIC:
-                        dm = src_mean[c // Ws, c % Ws] - tgt_mean[y, x]
+                        dm = meanf[c] - tgt_mean[y, x]
                         dist = w * dm * dm
                         if cnt > 0:
                             # high-pass L2: sum((r - mean r) - (s - mean s))^2 = sum d^2 - (sum d)^2 / n
@@ -155,8 +159,5 @@ def coherent_rows(src, src_mean, tgt, tgt_mean, res, pos, allowed, mask, res_off
                     if dist < best:
                         best = dist
                         best_c = c
-            by = best_c // Ws
-            bx = best_c - by * Ws
-            pos[y, x, 0] = by
-            pos[y, x, 1] = bx
+            pos[y, x] = best_c
             res[y, x] = srcf[best_c]

@@ -256,3 +256,14 @@ def test_errors_are_weft_errors(tile):
         coherence(np.zeros((3, 3)), tile)
     with pytest.raises(ValueError):
         fidelity(np.array([["a"] * 8] * 8), tile[:8, :8])
+
+
+def test_psnr_of_a_known_error():
+    from core.metrics import psnr_db
+
+    orig = np.full((16, 16), 0.5, np.float32)
+    synth = orig + np.float32(0.1)  # mse 0.01 -> 20 dB
+    assert psnr_db(orig, synth) == pytest.approx(20.0, abs=1e-4)
+    assert psnr_db(orig, orig) == math.inf
+    with pytest.raises(ImageError, match="shape"):
+        psnr_db(orig, orig[:8])
