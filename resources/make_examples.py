@@ -10,7 +10,8 @@ recorded in ``resources/README.md``. Outputs:
 
 * textures (grey): ``brick.png``, ``gravel.png``, ``grass.png`` -- 256x256 crops;
 * textures (colour): ``wood-grain.png`` (coffee table top), ``cat-fur.png`` (Chelsea's forehead);
-* a fractal (self-similar) image for super-resolution: ``clouds.png``;
+* a fractal (self-similar) image for super-resolution: ``clouds.png``; a pen-hatching style
+  sample: ``hatching.png``;
 * targets: ``camera.png``, ``astronaut.png`` (256x256), ``coffee.png``, ``chelsea.png`` (300x200);
 * a perspective photo of a texture for the non-frontal-parallel method (``nfpt``):
   ``perspective-frontal.png`` (the frontal brick wall, ground truth), ``perspective.png`` (that wall
@@ -278,6 +279,30 @@ def fractal_clouds(size: int = 256, beta: float = 2.5, seed: int = SEED + 1) -> 
     return ((img - img.min()) / (img.max() - img.min())).astype(np.float32)
 
 
+def hatching(size: int = 256, seed: int = SEED + 2) -> np.ndarray:
+    """A pen-hatching "drawing" to use as an artistic style sample (cf. Ashikhmin Fig. 3b).
+
+    A smooth random tone field is rendered with layers of short anti-aliased strokes: one direction
+    where the tone is below 0.7, a crossing one below 0.45, a third below 0.25, so the sample holds
+    every tone from paper white to dense cross-hatching.
+    """
+    rng = np.random.default_rng(seed)
+    tone = cv2.GaussianBlur(rng.random((size, size)).astype(np.float32), (0, 0), size / 10)
+    tone = (tone - tone.min()) / (tone.max() - tone.min())
+    canvas = np.full((size * 2, size * 2), 255, np.uint8)  # drawn at 2x, shrunk: finer strokes
+    for angle, threshold in ((np.pi / 4, 0.7), (-np.pi / 4, 0.45), (0.0, 0.25)):
+        dx, dy = np.cos(angle), np.sin(angle)
+        for _ in range(int(size * size * 0.09)):
+            x, y = rng.uniform(0, size, 2)
+            if tone[int(y), int(x)] > threshold:
+                continue
+            length = rng.uniform(6, 14)
+            p0 = (int(2 * (x - dx * length / 2)), int(2 * (y - dy * length / 2)))
+            p1 = (int(2 * (x + dx * length / 2)), int(2 * (y + dy * length / 2)))
+            cv2.line(canvas, p0, p1, int(rng.uniform(20, 90)), 1, cv2.LINE_AA)
+    return _resize_area(canvas, (size, size)).astype(np.float32) / 255.0
+
+
 def main() -> None:
     rng = np.random.default_rng(SEED)
     made = []
@@ -299,8 +324,9 @@ def main() -> None:
     h = photo_homography()
     made.append(_save("perspective-frontal.png", wall_rgb))
     made.append(_save("perspective.png", perspective_photo(wall_rgb, h, rng)))
-    # a self-similar (fractal) image for super-resolution
+    # a self-similar (fractal) image for super-resolution, and an artistic style sample
     made.append(_save("clouds.png", fractal_clouds()))
+    made.append(_save("hatching.png", hatching()))
     lines_path = HERE / "perspective-lines.json"
     lines_path.write_text(_dump_json(feature_lines(h, rows)), encoding="utf-8")
     made.append(lines_path)

@@ -24,6 +24,7 @@ from PySide6.QtWidgets import (
     QMainWindow,
 )
 
+from core import registry
 from core.examples import examples
 from core.image import load_image
 from core.jobs import JobResult, JobRunner
@@ -130,8 +131,10 @@ class MainWindow(QMainWindow):
         self.statusBar().addPermanentWidget(self.zoom_label)
 
         self._bridge = _Bridge(self)
-        self._bridge.finished.connect(self._on_loaded)
+        self._bridge.finished.connect(self._on_job_done)
         self.runner = JobRunner(max_workers=2, on_result=self._bridge.finished.emit)
+        # Load the methods' compiled kernels off the GUI thread, so the first result is not slow.
+        self.runner.submit("warm-up", _warm_up_job)
 
         self.example_list = QListWidget()
         self.example_list.setViewMode(QListWidget.ViewMode.IconMode)
@@ -186,6 +189,12 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(f"opening {path.name}…")
         self.runner.submit("open", _load_job, str(path))
 
+    def _on_job_done(self, result: JobResult) -> None:
+        if result.slot == "open":
+            self._on_loaded(result)
+        elif result.error is not None:
+            self.statusBar().showMessage(f"{result.slot} failed: {result.error}")
+
     def _on_loaded(self, result: JobResult) -> None:
         if result.error is not None:
             self.statusBar().showMessage(f"could not open: {result.error}")
@@ -226,6 +235,10 @@ class MainWindow(QMainWindow):
     def closeEvent(self, event):  # noqa: N802
         self.shutdown()
         super().closeEvent(event)
+
+
+def _warm_up_job(*, progress=None, cancel=None) -> None:
+    registry.warm_up_all()
 
 
 def _load_job(path: str, *, progress=None, cancel=None):

@@ -85,3 +85,9 @@ def test_no_worker_thread_left_after_shutdown(window, qtbot):
     qtbot.waitUntil(lambda: window.view.image is not None, timeout=5000)
     window.shutdown()
     assert not [t for t in threading.enumerate() if t.name.startswith("weft-job") and t.is_alive()]
+
+
+def test_kernels_warm_up_in_the_background_without_error(window, qtbot):
+    qtbot.waitUntil(lambda: not window.runner.busy("warm-up"), timeout=60000)
+    job = window.runner.latest("warm-up")
+    assert job.result(timeout=1).ok
