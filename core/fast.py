@@ -36,7 +36,6 @@ from typing import Callable, Mapping
 import cv2
 import numpy as np
 
-from ._kernels import fast as _k
 from .errors import ImageError, InvalidParameter
 from .image import luminance, resize, validate_image
 from .jobs import CancelToken, Progress, ProgressReporter
@@ -44,7 +43,9 @@ from .params import Params, as_rng, out_of_range, param
 from .registry import InputSpec, Method, Result
 
 MODES = ("auto", "transfer", "synthesis", "superres", "novel")
-METRICS = {"full": _k.METRIC_FULL, "target": _k.METRIC_TARGET, "artistic": _k.METRIC_ARTISTIC}
+# Metric codes of the kernel (core._kernels.fast), which is imported on first use: importing numba
+# costs a quarter of a second that `weft --help` or another method's run need not pay.
+METRICS = {"full": 0, "target": 1, "artistic": 2}
 _ROWS_PER_BAND = 16
 
 
@@ -213,6 +214,8 @@ def transfer(
 
 
 def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progress=None, cancel=None):
+    from ._kernels import fast as _k
+
     texture = validate_image(texture, "texture")
     if target is not None:
         target = validate_image(target, "target")
@@ -245,7 +248,7 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
         tgt_pad = cv2.copyMakeBorder(tgt_y, h, h, h, h, cv2.BORDER_REPLICATE)
     else:
         tgt_pad = np.zeros((1, 1), np.float32)
-    if metric == _k.METRIC_ARTISTIC:
+    if params.metric == "artistic":
         ksize = (params.n, params.n)
         src_mean = cv2.blur(match_y, ksize, borderType=cv2.BORDER_REFLECT)
         tgt_mean = cv2.blur(tgt_y, ksize, borderType=cv2.BORDER_REFLECT)

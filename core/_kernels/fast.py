@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-METRIC_FULL = 0
+METRIC_FULL = 0  # the codes of core.fast.METRICS
 METRIC_TARGET = 1
 METRIC_ARTISTIC = 2
 

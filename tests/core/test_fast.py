@@ -211,3 +211,10 @@ def test_two_threads_give_the_same_pixels_as_one(gravel, camera):
     for t in threads:
         t.join(timeout=60)
     assert all(np.array_equal(g, e) for g, e in zip(got, expected))
+
+
+def test_metric_codes_match_the_kernel():
+    from core._kernels import fast as kernel
+    from core.fast import METRICS
+
+    assert METRICS == {"full": kernel.METRIC_FULL, "target": kernel.METRIC_TARGET, "artistic": kernel.METRIC_ARTISTIC}
