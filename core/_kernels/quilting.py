@@ -1,0 +1,613 @@
+"""numba kernels of image quilting (``core.quilting``), its seams (``core.seams``) and its Poisson
+seam blending (``core.blending``).
+
+Three public kernels, so that few signatures compile:
+
+* :func:`cut_mask` -- the minimum-error boundary cut of one block (dynamic programming over the
+  overlap strips, the vertical and the horizontal cut joined at the best corner pixel).
+* :func:`poisson_cg` -- a conjugate-gradient solve of the discrete Poisson equation on an arbitrary
+  set of pixels (matrix-free, 4-neighbours, Dirichlet values from the image, Neumann at invalid
+  neighbours), used by ``core.blending.poisson_blend`` and by :func:`place_block`.
+* :func:`place_block` -- one block of quilting: pick a source position from the SSD map of every
+  position, cut, paste, and optionally Poisson-blend a band around the seam.
+* :func:`make_template` -- writes the correlation templates of one block (the overlap, the previous
+  iteration and the correspondence terms) into the zero-padded FFT buffers.
+
+Everything is float32 in, float64 inside sums. Random numbers come from the caller (a uniform
+``u`` and a 64-bit seed for the sampled rule, hashed with splitmix64), so a seed gives the same
+pixels on any thread.
+
+Integer parameters of :func:`place_block` travel in one int64 array (fewer arguments to dispatch
+per block; see the ``P_*`` indices below).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# place_block integer parameters
+P_Y0, P_X0, P_B, P_TOP, P_LEFT, P_RIGHT, P_BOTTOM, P_WRAP = 0, 1, 2, 3, 4, 5, 6, 7
+P_MODE, P_RULE, P_TOL, P_SEED, P_POISSON, P_BAND, P_FIX_Y, P_FIX_X = 8, 9, 10, 11, 12, 13, 14, 15
+N_IPARAMS = 16
+# place_block float parameters
+F_CONST, F_EPS, F_U = 0, 1, 2
+N_FPARAMS = 3
+
+MODE_RANDOM, MODE_OVERLAP, MODE_MINCUT = 0, 1, 2
+RULE_TOL, RULE_EPSILON, RULE_SAMPLED = 0, 1, 2
+
+_DY = (1, -1, 0, 0)
+_DX = (0, 0, 1, -1)
+
+SAMPLE_FRACTION = 0.1  # the Poisson write-up: a random 10% of the positions ...
+TOP_FRACTION = 0.1  # ... of which the best 10% are candidates
+
+
+# --------------------------------------------------------------------------------------------
+# minimum-error boundary cut
+
+
+@njit(cache=True, nogil=True)
+def _vertical_acc(err, r0, r1, c0, c1):
+    """Accumulated cost from the bottom row up, columns [c0, c1): E[y] = e[y] + min of 3 below."""
+    h = r1 - r0
+    w = c1 - c0
+    acc = np.empty((h, w), dtype=np.float64)
+    for x in range(w):
+        acc[h - 1, x] = err[r1 - 1, c0 + x]
+    for y in range(h - 2, -1, -1):
+        for x in range(w):
+            m = acc[y + 1, x]
+            if x > 0 and acc[y + 1, x - 1] < m:
+                m = acc[y + 1, x - 1]
+            if x < w - 1 and acc[y + 1, x + 1] < m:
+                m = acc[y + 1, x + 1]
+            acc[y, x] = err[r0 + y, c0 + x] + m
+    return acc
+
+
+@njit(cache=True, nogil=True)
+def _horizontal_acc(err, r0, r1, c0, c1):
+    """Accumulated cost from the right column leftwards, rows [r0, r1): E[:, x] = e + min of 3 right."""
+    h = r1 - r0
+    w = c1 - c0
+    acc = np.empty((h, w), dtype=np.float64)
+    for y in range(h):
+        acc[y, w - 1] = err[r0 + y, c1 - 1]
+    for x in range(w - 2, -1, -1):
+        for y in range(h):
+            m = acc[y, x + 1]
+            if y > 0 and acc[y - 1, x + 1] < m:
+                m = acc[y - 1, x + 1]
+            if y < h - 1 and acc[y + 1, x + 1] < m:
+                m = acc[y + 1, x + 1]
+            acc[y, x] = err[r0 + y, c0 + x] + m
+    return acc
+
+
+@njit(cache=True, nogil=True)
+def _trace_down(acc, y_start, x_start, path, c0):
+    """Follow ``acc`` (from _vertical_acc) downwards from (y_start, x_start); path[y] = column + c0."""
+    h, w = acc.shape
+    x = x_start
+    path[y_start] = x + c0
+    for y in range(y_start + 1, h):
+        best = x
+        m = acc[y, x]
+        if x > 0 and acc[y, x - 1] < m:
+            m = acc[y, x - 1]
+            best = x - 1
+        if x < w - 1 and acc[y, x + 1] < m:
+            best = x + 1
+        x = best
+        path[y] = x + c0
+
+
+@njit(cache=True, nogil=True)
+def _trace_right(acc, y_start, x_start, path, r0):
+    """Follow ``acc`` (from _horizontal_acc) rightwards from (y_start, x_start); path[x] = row + r0."""
+    h, w = acc.shape
+    y = y_start
+    path[x_start] = y + r0
+    for x in range(x_start + 1, w):
+        best = y
+        m = acc[y, x]
+        if y > 0 and acc[y - 1, x] < m:
+            m = acc[y - 1, x]
+            best = y - 1
+        if y < h - 1 and acc[y + 1, x] < m:
+            best = y + 1
+        y = best
+        path[x] = y + r0
+
+
+@njit(cache=True, nogil=True)
+def cut_mask(err, top, left, right, bottom, mask):
+    """Minimum-error boundary cut of a block; ``mask[y, x] = 1`` where the new block shows.
+
+    ``err`` (h, w) is the squared difference between the existing pixels and the new block; only the
+    overlap strips are read: rows [0, top), columns [0, left), columns [w-right, w), rows
+    [h-bottom, h). The left and top cuts are one path through the L-shaped overlap: both dynamic
+    programs end in the top-left corner, and the corner pixel minimising the sum of the two
+    accumulated costs joins them. Right and bottom cuts (tileable output) are separate paths and
+    the new region is the intersection of the four sides. Path pixels belong to the new block.
+    """
+    h, w = err.shape
+    for y in range(h):
+        for x in range(w):
+            mask[y, x] = 1
+    if left > 0 and top > 0:
+        ev = _vertical_acc(err, 0, h, 0, left)
+        eh = _horizontal_acc(err, 0, top, 0, w)
+        best = np.inf
+        r = 0
+        c = 0
+        for y in range(top):
+            for x in range(left):
+                v = ev[y, x] + eh[y, x] - err[y, x]
+                if v < best:
+                    best = v
+                    r = y
+                    c = x
+        vpath = np.empty(h, dtype=np.int64)
+        hpath = np.empty(w, dtype=np.int64)
+        _trace_down(ev, r, c, vpath, 0)
+        _trace_right(eh, r, c, hpath, 0)
+        for y in range(h):
+            for x in range(w):
+                a = x >= vpath[y] if y >= r else x >= c
+                b = y >= hpath[x] if x >= c else y >= r
+                if not (a and b):
+                    mask[y, x] = 0
+    elif left > 0:
+        ev = _vertical_acc(err, 0, h, 0, left)
+        x0 = 0
+        for x in range(left):
+            if ev[0, x] < ev[0, x0]:
+                x0 = x
+        vpath = np.empty(h, dtype=np.int64)
+        _trace_down(ev, 0, x0, vpath, 0)
+        for y in range(h):
+            for x in range(vpath[y]):
+                mask[y, x] = 0
+    elif top > 0:
+        eh = _horizontal_acc(err, 0, top, 0, w)
+        y0 = 0
+        for y in range(top):
+            if eh[y, 0] < eh[y0, 0]:
+                y0 = y
+        hpath = np.empty(w, dtype=np.int64)
+        _trace_right(eh, y0, 0, hpath, 0)
+        for x in range(w):
+            for y in range(hpath[x]):
+                mask[y, x] = 0
+    if right > 0:
+        c0 = w - right
+        ev = _vertical_acc(err, 0, h, c0, w)
+        x0 = 0
+        for x in range(right):
+            if ev[0, x] < ev[0, x0]:
+                x0 = x
+        vpath = np.empty(h, dtype=np.int64)
+        _trace_down(ev, 0, x0, vpath, c0)
+        for y in range(h):
+            for x in range(vpath[y] + 1, w):
+                mask[y, x] = 0
+    if bottom > 0:
+        r0 = h - bottom
+        eh = _horizontal_acc(err, r0, h, 0, w)
+        y0 = 0
+        for y in range(bottom):
+            if eh[y, 0] < eh[y0, 0]:
+                y0 = y
+        hpath = np.empty(w, dtype=np.int64)
+        _trace_right(eh, y0, 0, hpath, r0)
+        for x in range(w):
+            for y in range(hpath[x] + 1, h):
+                mask[y, x] = 0
+
+
+# --------------------------------------------------------------------------------------------
+# Poisson solve (conjugate gradient, matrix-free)
+
+
+@njit(cache=True, nogil=True)
+def poisson_cg(nbr, ndeg, rhs, x, tol, max_iter):
+    """Solve ``A x = rhs`` for the discrete Poisson system of a pixel set, by conjugate gradient.
+
+    ``nbr`` (n, 4) int64 lists each unknown's neighbours that are unknowns too (-1: none);
+    ``ndeg`` (n,) the number of valid neighbours (unknown or Dirichlet), so
+    ``(A x)_p = ndeg_p x_p - sum_{q in nbr_p} x_q``. ``rhs`` (n, C) holds, per channel, the guidance
+    divergence plus the Dirichlet neighbours' values; ``x`` (n, C) is the initial guess and is
+    overwritten with the solution. Stops when ``||r|| <= tol * ||rhs||`` or after ``max_iter``
+    iterations. Returns the largest iteration count over the channels.
+    """
+    n, nc = rhs.shape
+    r = np.empty(n)
+    p = np.empty(n)
+    ap = np.empty(n)
+    most = 0
+    for c in range(nc):
+        bnorm = 0.0
+        for i in range(n):
+            bnorm += rhs[i, c] * rhs[i, c]
+        bnorm = np.sqrt(bnorm)
+        if bnorm == 0.0:
+            bnorm = 1.0
+        rr = 0.0
+        for i in range(n):
+            s = ndeg[i] * x[i, c]
+            for k in range(4):
+                q = nbr[i, k]
+                if q >= 0:
+                    s -= x[q, c]
+            r[i] = rhs[i, c] - s
+            p[i] = r[i]
+            rr += r[i] * r[i]
+        it = 0
+        while it < max_iter and np.sqrt(rr) > tol * bnorm:
+            pap = 0.0
+            for i in range(n):
+                s = ndeg[i] * p[i]
+                for k in range(4):
+                    q = nbr[i, k]
+                    if q >= 0:
+                        s -= p[q]
+                ap[i] = s
+                pap += p[i] * s
+            if pap <= 0.0:
+                break
+            a = rr / pap
+            rr_new = 0.0
+            for i in range(n):
+                x[i, c] += a * p[i]
+                r[i] -= a * ap[i]
+                rr_new += r[i] * r[i]
+            beta = rr_new / rr
+            rr = rr_new
+            for i in range(n):
+                p[i] = r[i] + beta * p[i]
+            it += 1
+        if it > most:
+            most = it
+    return most
+
+
+# --------------------------------------------------------------------------------------------
+# one block of quilting
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _splitmix(state):
+    z = state + np.uint64(0x9E3779B97F4A7C15)
+    state = z
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z = z ^ (z >> np.uint64(31))
+    return state, z
+
+
+@njit(cache=True, nogil=True)
+def _select(cost, rule, tol, eps, u, seed):
+    """Index into the flat ``cost`` of the chosen candidate (see core.quilting for the rules)."""
+    n = cost.size
+    if rule == RULE_TOL:
+        if tol <= 1:
+            return np.argmin(cost)
+        k = min(tol, n)
+        kth = np.partition(cost, k - 1)[k - 1]
+        pick = min(int(u * k), k - 1)
+        seen = 0
+        # candidates strictly better than the k-th, then ties with it, in index order
+        below = 0
+        for i in range(n):
+            if cost[i] < kth:
+                below += 1
+        if pick < below:
+            for i in range(n):
+                if cost[i] < kth:
+                    if seen == pick:
+                        return i
+                    seen += 1
+        pick -= below
+        for i in range(n):
+            if cost[i] == kth:
+                if seen == pick:
+                    return i
+                seen += 1
+        return np.argmin(cost)
+    if rule == RULE_EPSILON:
+        m = max(cost.min(), 0.0)
+        thr = (1.0 + eps) * m
+        count = 0
+        for i in range(n):
+            if cost[i] <= thr:
+                count += 1
+        pick = min(int(u * count), count - 1)
+        seen = 0
+        for i in range(n):
+            if cost[i] <= thr:
+                if seen == pick:
+                    return i
+                seen += 1
+        return np.argmin(cost)
+    # RULE_SAMPLED: a random SAMPLE_FRACTION of the positions, a random one of their best TOP_FRACTION
+    state = np.uint64(seed)
+    limit = np.uint64(int(SAMPLE_FRACTION * 18446744073709551615.0))
+    idx = np.empty(n, dtype=np.int64)
+    m = 0
+    for i in range(n):
+        state, z = _splitmix(state)
+        if z < limit:
+            idx[m] = i
+            m += 1
+    if m == 0:
+        state, z = _splitmix(state)
+        idx[0] = np.int64(z % np.uint64(n))
+        m = 1
+    vals = np.empty(m)
+    for i in range(m):
+        vals[i] = cost[idx[i]]
+    k = max(1, int(np.ceil(TOP_FRACTION * m)))
+    order = np.argsort(vals)
+    pick = min(int(u * k), k - 1)
+    return idx[order[pick]]
+
+
+@njit(cache=True, nogil=True)
+def make_template(canvas, prev, corr_t, y0, x0, bsz, top, left, right, bottom, wrap,
+                  w_overlap, w_prev, w_corr, mean, mean_c, tbuf, tcorr):
+    """Write the correlation templates of the block at (y0, x0) and return the constant term.
+
+    ``tbuf`` (C, N, N) gets ``w_overlap * M * (O - mean) + w_prev * (P - mean)`` in its top-left
+    ``bsz x bsz`` corner (M: the overlap strips, O: the canvas, P: ``prev``); ``tcorr`` (N, N) gets
+    ``w_corr * (T - mean_c)`` (T: ``corr_t``). The rest of the buffers is left as it is (zero).
+    The constant is ``sum w_overlap M |O - mean|^2 + w_prev |P - mean|^2 + w_corr (T - mean_c)^2``,
+    so that SSD = sq - 2 cross + const.
+    """
+    hc, wc, nc = canvas.shape
+    const = 0.0
+    for by in range(bsz):
+        cy = y0 + by
+        if wrap:
+            cy %= hc
+        in_top = by < top or by >= bsz - bottom
+        for bx in range(bsz):
+            cx = x0 + bx
+            if wrap:
+                cx %= wc
+            m = in_top or bx < left or bx >= bsz - right
+            for c in range(nc):
+                v = 0.0
+                if m and w_overlap != 0.0:
+                    o = canvas[cy, cx, c] - mean
+                    v += w_overlap * o
+                    const += w_overlap * o * o
+                if w_prev != 0.0:
+                    pv = prev[cy, cx, c] - mean
+                    v += w_prev * pv
+                    const += w_prev * pv * pv
+                tbuf[c, by, bx] = v
+            if w_corr != 0.0:
+                t = corr_t[cy, cx] - mean_c
+                tcorr[by, bx] = w_corr * t
+                const += w_corr * t * t
+    return const
+
+
+@njit(cache=True, nogil=True)
+def place_block(canvas, filled, tex, cross, sq, iparams, fparams):
+    """Choose, cut, paste (and Poisson-blend) one block; returns the chosen source (y, x).
+
+    ``canvas`` (Hc, Wc, C) float32 and ``filled`` (Hc, Wc) uint8 are updated in place. ``cross``
+    (N, N) is the cross-correlation of the centred source with the block's template and ``sq``
+    (Ph, Pw) the weighted sum of squares of the source under the template's weights, so that the
+    SSD of candidate (py, px) is ``sq - 2 cross + const``. ``iparams``/``fparams``: see ``P_*`` and
+    ``F_*``. With ``P_FIX_Y >= 0`` the source position is given (random mode, first block).
+    """
+    hc, wc, nc = canvas.shape
+    th, tw = tex.shape[0], tex.shape[1]
+    y0 = iparams[P_Y0]
+    x0 = iparams[P_X0]
+    bsz = iparams[P_B]
+    top = iparams[P_TOP]
+    left = iparams[P_LEFT]
+    right = iparams[P_RIGHT]
+    bottom = iparams[P_BOTTOM]
+    wrap = iparams[P_WRAP] != 0
+    mode = iparams[P_MODE]
+    ph = th - bsz + 1
+    pw = tw - bsz + 1
+
+    # 1. the source position
+    if iparams[P_FIX_Y] >= 0:
+        sy = iparams[P_FIX_Y]
+        sx = iparams[P_FIX_X]
+    else:
+        const = fparams[F_CONST]
+        cost = np.empty(ph * pw)
+        for py in range(ph):
+            for px in range(pw):
+                v = sq[py, px] - 2.0 * cross[py, px] + const
+                cost[py * pw + px] = v if v > 0.0 else 0.0
+        k = _select(cost, iparams[P_RULE], iparams[P_TOL], fparams[F_EPS], fparams[F_U],
+                    iparams[P_SEED])
+        sy = k // pw
+        sx = k % pw
+
+    # 2. the cut: which pixels of the footprint show the new block
+    mask = np.ones((bsz, bsz), dtype=np.uint8)
+    if mode == MODE_MINCUT and (top > 0 or left > 0 or right > 0 or bottom > 0):
+        err = np.zeros((bsz, bsz))
+        for by in range(bsz):
+            cy = (y0 + by) % hc if wrap else y0 + by
+            for bx in range(bsz):
+                if by < top or bx < left or bx >= bsz - right or by >= bsz - bottom:
+                    cx = (x0 + bx) % wc if wrap else x0 + bx
+                    if filled[cy, cx]:
+                        e = 0.0
+                        for c in range(nc):
+                            d = canvas[cy, cx, c] - tex[sy + by, sx + bx, c]
+                            e += d * d
+                        err[by, bx] = e
+        cut_mask(err, top, left, right, bottom, mask)
+
+    # 3. paste (keeping a window of the old pixels for the Poisson band)
+    poisson = iparams[P_POISSON] != 0 and mode != MODE_RANDOM
+    band = iparams[P_BAND]
+    margin = band + 2 if poisson else 0
+    ws = bsz + 2 * margin
+    win_y = np.empty(ws, dtype=np.int64)
+    win_x = np.empty(ws, dtype=np.int64)
+    for i in range(ws):
+        cy = y0 - margin + i
+        cx = x0 - margin + i
+        if wrap:
+            cy %= hc
+            cx %= wc
+        win_y[i] = cy if 0 <= cy < hc else -1
+        win_x[i] = cx if 0 <= cx < wc else -1
+    # label: -1 outside canvas or empty, 0 old pixel, 1 new pixel (after the paste)
+    label = np.full((ws, ws), -1, dtype=np.int8)
+    old = np.full((ws, ws, nc), np.nan, dtype=np.float32)
+    for wy in range(ws):
+        cy = win_y[wy]
+        if cy < 0:
+            continue
+        for wx in range(ws):
+            cx = win_x[wx]
+            if cx < 0:
+                continue
+            if filled[cy, cx]:
+                label[wy, wx] = 0
+                for c in range(nc):
+                    old[wy, wx, c] = canvas[cy, cx, c]
+    for by in range(bsz):
+        cy = win_y[by + margin]
+        for bx in range(bsz):
+            if mask[by, bx]:
+                cx = win_x[bx + margin]
+                for c in range(nc):
+                    canvas[cy, cx, c] = tex[sy + by, sx + bx, c]
+                filled[cy, cx] = 1
+                label[by + margin, bx + margin] = 1
+
+    # 4. Poisson band: ceil(band/2) pixels on the old side of the seam, floor(band/2) on the new side
+    if poisson:
+        _poisson_band(canvas, old, label, win_y, win_x, wrap, band)
+    return sy, sx
+
+
+@njit(cache=True, nogil=True)
+def _poisson_band(canvas, old, label, win_y, win_x, wrap, band):
+    ws = label.shape[0]
+    nc = canvas.shape[2]
+    hc, wc = canvas.shape[0], canvas.shape[1]
+    big = 1 << 20
+    # Chebyshev distance of each labelled pixel to the nearest pixel of the other label (<= band)
+    dist = np.full((ws, ws), big, dtype=np.int64)
+    for wy in range(ws):
+        for wx in range(ws):
+            lab = label[wy, wx]
+            if lab < 0:
+                continue
+            for dy in (-1, 0, 1):
+                for dx in (-1, 0, 1):
+                    qy = wy + dy
+                    qx = wx + dx
+                    if 0 <= qy < ws and 0 <= qx < ws:
+                        ql = label[qy, qx]
+                        if ql >= 0 and ql != lab:
+                            dist[wy, wx] = 1
+    for step in range(2, band + 1):
+        for wy in range(ws):
+            for wx in range(ws):
+                if label[wy, wx] < 0 or dist[wy, wx] <= band:
+                    continue
+                found = False
+                for dy in (-1, 0, 1):
+                    for dx in (-1, 0, 1):
+                        qy = wy + dy
+                        qx = wx + dx
+                        if 0 <= qy < ws and 0 <= qx < ws and dist[qy, qx] == step - 1 \
+                                and label[qy, qx] == label[wy, wx]:
+                            found = True
+                if found:
+                    dist[wy, wx] = step
+    old_side = (band + 1) // 2
+    new_side = band // 2
+    # the unknowns: the band, except next to empty canvas pixels (nothing to meet there yet)
+    index = np.full((ws, ws), -1, dtype=np.int64)
+    n = 0
+    for wy in range(1, ws - 1):
+        for wx in range(1, ws - 1):
+            lab = label[wy, wx]
+            if lab < 0:
+                continue
+            d = dist[wy, wx]
+            if lab == 0 and d > old_side:
+                continue
+            if lab == 1 and d > new_side:
+                continue
+            ok = True
+            for k in range(4):
+                qy = wy + _DY[k]
+                qx = wx + _DX[k]
+                if label[qy, qx] < 0 and win_y[qy] >= 0 and win_x[qx] >= 0:
+                    ok = False
+            if ok:
+                index[wy, wx] = n
+                n += 1
+    if n == 0:
+        return
+    nbr = np.full((n, 4), -1, dtype=np.int64)
+    ndeg = np.zeros(n)
+    rhs = np.zeros((n, nc))
+    x = np.empty((n, nc))
+    for wy in range(1, ws - 1):
+        for wx in range(1, ws - 1):
+            i = index[wy, wx]
+            if i < 0:
+                continue
+            cy = win_y[wy]
+            cx = win_x[wx]
+            for c in range(nc):
+                x[i, c] = canvas[cy, cx, c]
+            for k in range(4):
+                qy = wy + _DY[k]
+                qx = wx + _DX[k]
+                if label[qy, qx] < 0:
+                    continue  # outside the canvas: Neumann
+                ndeg[i] += 1.0
+                j = index[qy, qx]
+                qcy = win_y[qy]
+                qcx = win_x[qx]
+                if label[qy, qx] == label[wy, wx]:
+                    # same side of the seam: the gradient of the quilt as pasted
+                    for c in range(nc):
+                        rhs[i, c] += canvas[cy, cx, c] - canvas[qcy, qcx, c]
+                elif _had_old(old, wy, wx) and _had_old(old, qy, qx):
+                    # across the seam: the existing pixels' gradient (the write-up's source)
+                    for c in range(nc):
+                        rhs[i, c] += old[wy, wx, c] - old[qy, qx, c]
+                if j >= 0:
+                    nbr[i, k] = j
+                else:
+                    for c in range(nc):
+                        rhs[i, c] += canvas[qcy, qcx, c]
+    poisson_cg(nbr, ndeg, rhs, x, 1e-6, 500)
+    for wy in range(1, ws - 1):
+        for wx in range(1, ws - 1):
+            i = index[wy, wx]
+            if i < 0:
+                continue
+            for c in range(nc):
+                v = x[i, c]
+                canvas[win_y[wy], win_x[wx], c] = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _had_old(old, wy, wx):
+    # ``old`` holds NaN in its first channel where the canvas was empty before the paste
+    return not np.isnan(old[wy, wx, 0])
