@@ -20,7 +20,6 @@ from typing import Mapping
 
 import numpy as np
 
-from ._kernels import quilting as _k
 from .errors import ImageError, InvalidParameter
 from .image import luminance, validate_image
 from .params import Params, out_of_range, param
@@ -148,6 +147,8 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, mask: np.ndarray, *, t
         nbr[i[inside], k] = j[inside]
         rhs[i[~inside]] += t3[qy[~inside], qx[~inside]]
     x = t3[ys, xs].copy()
+    from ._kernels import quilting as _k  # numba loads on first use
+
     _k.poisson_cg(nbr, ndeg, rhs, x, float(tol), int(max_iter))
     out = t3.copy()
     out[ys, xs] = x

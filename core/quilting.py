@@ -35,7 +35,6 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ._kernels import quilting as _k
 from .errors import ImageError, InvalidParameter
 from .image import luminance, validate_image
 from .jobs import CancelToken, Progress, ProgressReporter
@@ -301,6 +300,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
             if report is not None:
                 report.update(i + 1, preview=preview)
         return canvas[:out_h, :out_w], rows * cols
+
+    from ._kernels import quilting as _k  # numba loads on first use, not with the CLI
 
     src = _Source(tex, corr[0] if corr is not None else None, b)
     prev_c = np.zeros((1, 1, nc), dtype=np.float32)

@@ -66,3 +66,175 @@ def test_progress_previews_and_cancel(texture):
     token.cancel()
     with pytest.raises(Cancelled):
         synthesize(texture, size=(80, 80), block=8, rng=0, cancel=token)
+
+
+# --------------------------------------------------------------------------------------------
+# overlap / min-cut synthesis, tileability, Poisson seams, transfer
+
+from core import metrics  # noqa: E402
+from core.examples import example  # noqa: E402
+from core.image import load_image  # noqa: E402
+from core.quilting import METHOD, transfer, transfer_schedule  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def brick():
+    return load_image(example("brick")).image[:64, :64].copy()
+
+
+@pytest.fixture(scope="module")
+def gravel():
+    return load_image(example("gravel")).image[:64, :64].copy()
+
+
+def test_overlap_mode_picks_the_least_ssd_position_among_all(texture):
+    """Second block of a one-row quilt = brute-force argmin of the left-overlap SSD over every position."""
+    b, ov = 10, 4
+    out = synthesize(texture, size=(2 * b - ov, b), block=b, overlap=ov, mode="overlap", tol=1, rng=3)
+    h, w = texture.shape[:2]
+    left = out[:, b - ov:b]  # the first block's right strip, in place before the second block came
+    first = out[:, :b - ov]
+    best, best_pos = np.inf, None
+    for y in range(h - b + 1):
+        for x in range(w - b + 1):
+            ssd = float(((texture[y:y + b, x:x + ov] - left) ** 2).sum())
+            if ssd < best:
+                best, best_pos = ssd, (y, x)
+    y, x = best_pos
+    assert np.array_equal(out[:, b - ov:], texture[y:y + b, x:x + b])  # overwritten by the chosen block
+    assert first.shape[:2] == (b, b - ov)
+
+
+def test_mincut_output_is_made_of_texture_pixels_and_beats_random(brick):
+    outs = {m: synthesize(brick, size=(128, 128), block=20, overlap=4, mode=m, rng=2)
+            for m in ("random", "overlap", "mincut")}
+    values = set(np.unique(brick).tolist())
+    assert set(np.unique(outs["mincut"]).tolist()) <= values  # no new values without Poisson
+    coh = {m: metrics.coherence(o, brick) for m, o in outs.items()}
+    assert coh["mincut"] < 0.6 * coh["random"] and coh["overlap"] < 0.6 * coh["random"]
+
+
+def test_same_seed_same_pixels_for_every_mode_and_option(brick):
+    for kw in (dict(mode="mincut", poisson=True), dict(mode="overlap", rule="sampled"),
+               dict(mode="mincut", rule="epsilon", epsilon=0.5, tile=True)):
+        a = synthesize(brick, size=(70, 60), block=16, overlap=4, rng=7, **kw)
+        b = synthesize(brick, size=(70, 60), block=16, overlap=4, rng=7, **kw)
+        c = synthesize(brick, size=(70, 60), block=16, overlap=4, rng=8, **kw)
+        assert np.array_equal(a, b) and not np.array_equal(a, c), kw
+
+
+def test_tileable_output_wraps_like_its_interior(brick):
+    out = synthesize(brick, size=(90, 80), block=20, overlap=5, mode="mincut", tile=True, poisson=True, rng=4)
+    assert out.shape == (80, 90)
+    rolled = np.roll(out, (40, 45), axis=(0, 1))  # the wrap seams now run through the middle
+    c_out, c_rolled = metrics.coherence(out, brick), metrics.coherence(rolled, brick)
+    assert c_rolled < 1.3 * c_out + 0.005
+    # a non-tileable quilt rolled the same way shows its edges as seams
+    plain = synthesize(brick, size=(90, 80), block=20, overlap=5, mode="mincut", rng=4)
+    assert metrics.coherence(np.roll(plain, (40, 45), axis=(0, 1)), brick) > c_rolled
+
+
+def test_cut_and_poisson_band_lower_the_seam_and_leave_the_rest():
+    """Two blocks in a row (the second chosen alike in every mode): overwrite > cut > cut + Poisson."""
+    import cv2
+
+    rng = np.random.default_rng(5)
+    tex = cv2.GaussianBlur(rng.random((64, 64)).astype(np.float32), (0, 0), 4)
+    tex = np.ascontiguousarray((tex - tex.min()) / (tex.max() - tex.min()), dtype=np.float32)
+
+    def energy(img):  # squared horizontal gradients around the overlap (columns 10..15)
+        return float((np.diff(img[:, 4:22], axis=1) ** 2).sum())
+
+    for seed in (0, 2, 3):
+        kw = dict(size=(26, 16), block=16, overlap=6, rule="sampled", rng=seed)
+        over = synthesize(tex, mode="overlap", **kw)
+        cut = synthesize(tex, mode="mincut", **kw)
+        blended = synthesize(tex, mode="mincut", poisson=True, band=4, **kw)
+        assert energy(cut) < 0.8 * energy(over)
+        assert energy(blended) < energy(cut)
+        cols = np.nonzero(np.any(blended != cut, axis=0))[0]
+        assert cols.size and cols.min() >= 10 - 2 and cols.max() <= 16 + 1  # only around the overlap
+        assert blended.min() >= 0 and blended.max() <= 1
+
+
+def test_rules_and_schedule():
+    assert transfer_schedule(5) == [(31, 21, 0.1), (21, 14, 0.30000000000000004), (14, 9, 0.5),
+                                    (9, 6, 0.7000000000000001), (9, 4, 0.9)]
+    for n in (2, 3, 4, 6):
+        sched = transfer_schedule(n)
+        for i, (_, _, a) in enumerate(sched, start=1):
+            assert a == pytest.approx(0.8 * (i - 1) / (n - 1) + 0.1)
+        for (b0, o0, _), (b1, o1, _) in zip(sched, sched[1:]):
+            assert b1 == max(9, int(np.floor(b0 * 2 / 3 + 0.5))) and o1 < b1
+            assert o1 == min(b1 - 1, max(3, int(np.floor(o0 * 2 / 3 + 0.5))))
+    assert transfer_schedule(3, block=9, overlap=3) == [(9, 3, 0.1), (9, 3, 0.5), (9, 3, 0.9)]
+    assert transfer_schedule(1, block=12, overlap=4, alpha=0.3) == [(12, 4, 0.3)]
+
+
+def test_transfer_follows_target_and_iterations_shrink_blocks(gravel):
+    y, x = np.mgrid[0:48, 0:56]
+    target = (0.15 + 0.7 * (((y // 12) + (x // 14)) % 2)).astype(np.float32)  # a checkerboard
+    seen = []
+    outs = transfer(gravel, target, iterations=3, block=15, overlap=9, rng=1, return_all=True,
+                    progress=seen.append)
+    assert len(outs) == 3 and all(o.shape == (48, 56) for o in outs)
+    assert metrics.fidelity(outs[-1], target) > 0.9
+    stages = sorted({p.stage for p in seen})
+    assert stages == ["transfer 1/3", "transfer 2/3", "transfer 3/3"]
+    totals = {p.stage: p.total for p in seen}
+    # block rows per pass: 15/9 (step 6), 10/6 (step 4), 9/4 (step 5) over 48 rows
+    assert totals == {"transfer 1/3": 7, "transfer 2/3": 11, "transfer 3/3": 9}
+    again = transfer(gravel, target, iterations=3, block=15, overlap=9, rng=1)
+    assert np.array_equal(again, outs[-1])
+
+
+def test_transfer_with_user_maps_and_colour(gravel):
+    tex = np.stack([gravel, gravel * 0.5, 1 - gravel], axis=2)
+    target = np.linspace(0, 1, 40 * 40, dtype=np.float32).reshape(40, 40)
+    out = transfer(tex, target, source_map=gravel, target_map=target, block=8, overlap=3, rng=0)
+    assert out.shape == (40, 40, 3)
+    with pytest.raises(InvalidParameter, match="'target_map' is required"):
+        transfer(tex, target, source_map=gravel)
+    with pytest.raises(Exception, match="target map is 20x20 but the target is 40x40"):
+        transfer(tex, target, source_map=gravel, target_map=target[:20, :20])
+
+
+def test_errors_name_the_parameter(texture, brick):
+    with pytest.raises(InvalidParameter, match=r"parameter 'overlap' = 40 is outside 1..31 \(must be smaller than block = 32\)"):
+        QuiltParams(block=32, overlap=40)
+    with pytest.raises(InvalidParameter, match=r"parameter 'overlap' = 10 is outside 1..9 \(must be smaller than block = 10\)"):
+        synthesize(texture, block=10, overlap=10, mode="mincut")
+    with pytest.raises(InvalidParameter, match="'poisson' = true needs mode overlap or mincut"):
+        QuiltParams(mode="random", poisson=True)
+    with pytest.raises(InvalidParameter, match="'mode' = 'random' is not one of overlap, mincut"):
+        transfer(brick, brick, mode="random")
+    with pytest.raises(InvalidParameter, match=r"parameter 'block' = 50 is outside 2..40"):
+        transfer(texture, brick, block=50)
+    with pytest.raises(InvalidParameter, match="too small for a tileable output with block = 16"):
+        synthesize(brick, size=(40, 12), block=16, mode="mincut", tile=True)
+    with pytest.raises(InvalidParameter, match="'band' = 6 is outside 1..5"):
+        QuiltParams(band=6)
+
+
+def test_mincut_progress_and_cancel(brick):
+    seen = []
+    out = synthesize(brick, size=(80, 80), block=16, overlap=4, mode="mincut", rng=0, progress=seen.append)
+    assert seen[-1].done == seen[-1].total == 7  # ceil((80 - 4) / 12) block rows
+    assert np.array_equal(seen[-1].preview, out)
+    token = CancelToken()
+    token.cancel()
+    with pytest.raises(Cancelled):
+        synthesize(brick, size=(80, 80), block=16, mode="mincut", rng=0, cancel=token)
+    with pytest.raises(Cancelled):
+        transfer(brick, brick, rng=0, cancel=token)
+
+
+def test_method_run_synthesis_and_transfer(brick, gravel):
+    res = METHOD.run({"texture": brick}, QuiltParams(mode="mincut", block=16, size=(60, 50)), rng=1)
+    assert res.image.shape == (50, 60) and res.figures["blocks"] == 5 * 4
+    res = METHOD.run({"texture": gravel, "target": brick[:40, :30]}, QuiltParams(iterations=2, block=12), rng=1)
+    assert res.image.shape == (40, 30) and res.figures == {"iterations": 2}
+    with pytest.raises(InvalidParameter, match="'iterations' = 2 is outside 1..1"):
+        METHOD.run({"texture": gravel}, QuiltParams(iterations=2), rng=1)
+    with pytest.raises(InvalidParameter, match="'size' cannot be given with a target"):
+        METHOD.run({"texture": gravel, "target": brick}, QuiltParams(size=(10, 10)), rng=1)
