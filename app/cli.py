@@ -67,6 +67,8 @@ def _add_common(p: argparse.ArgumentParser) -> None:
                    help="output image (.png, .jpg, .tif); PNGs carry the recipe")
     p.add_argument("--seed", metavar="N", help="random seed (default: a fresh one, recorded in the recipe)")
     p.add_argument("--bit-depth", metavar="BITS", default="8", help="8 or 16 bits per channel (16: PNG, TIFF)")
+    p.add_argument("--region", metavar="X,Y,S",
+                   help="use only this square of the texture (top-left corner and side, pixels) as the source")
     p.add_argument("--report", action="store_true", help="print one JSON line with the compute time and figures")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
@@ -142,9 +144,9 @@ def _parse_int(text: str | None, name: str, lo: int, hi: int) -> int | None:
 
 
 def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
-             args: argparse.Namespace) -> int:
+             args: argparse.Namespace, region: tuple[int, int, int] | None = None) -> int:
     from core import registry
-    from core.image import load_image, save_image
+    from core.image import crop_square, load_image, save_image
     from core.params import Recipe
 
     method = registry.get(method_name)
@@ -159,6 +161,9 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         seed = secrets.randbits(31)
 
     images = {name: load_image(path).image for name, path in input_paths.items()}
+    if region is not None:
+        first = method.inputs[0].name
+        images[first] = crop_square(images[first], region, what=first)
     if method.warm_up is not None:
         method.warm_up()  # load compiled kernels now, so "seconds" is the compute alone
     bar = _TerminalProgress(not args.quiet)
@@ -176,7 +181,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
             rel_inputs[name] = os.path.relpath(Path(path).resolve(), out_dir)
         except ValueError:  # another drive on Windows
             rel_inputs[name] = str(Path(path).resolve())
-    recipe = Recipe(method=method.name, params=params.to_dict(), inputs=rel_inputs, seed=seed)
+    recipe = Recipe(method=method.name, params=params.to_dict(), inputs=rel_inputs, seed=seed, region=region)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if args.report:
         h, w = result.image.shape[:2]
@@ -206,6 +211,7 @@ def _load_recipe(path: str):
 
 def _dispatch(args: argparse.Namespace) -> int:
     from core import registry
+    from core.image import parse_square
 
     if args.command == "run":
         recipe = _load_recipe(args.recipe)
@@ -217,7 +223,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
         else:
             seed = recipe.seed
-        return _execute(recipe.method, dict(recipe.params), dict(recipe.inputs), seed, args)
+        region = parse_square(args.region) if args.region is not None else recipe.region
+        return _execute(recipe.method, dict(recipe.params), dict(recipe.inputs), seed, args, region)
 
     method = registry.get(args.method)
     from core.params import specs
@@ -234,7 +241,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         if value is not None:
             inputs[inp.name] = value
     seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
-    return _execute(method.name, params.to_dict(), inputs, seed, args)
+    region = parse_square(args.region) if args.region is not None else None
+    return _execute(method.name, params.to_dict(), inputs, seed, args, region)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -321,6 +321,9 @@ class Recipe:
         {"weft": 1, "method": "fast", "params": {...},
          "inputs": {"texture": "a.png", "target": "b.png"}, "seed": 7}
 
+    plus, when the user picked one, ``"region": [x, y, side]``: the square of the texture the method
+    used as its source (the studio's prototype rectangle; ``--region X,Y,S`` on the command line).
+
     Input paths are stored as given; :meth:`load` resolves relative paths against the folder of the
     recipe file, so a recipe next to its images keeps working when the folder moves.
     """
@@ -329,13 +332,14 @@ class Recipe:
     params: Mapping[str, Any] = field(default_factory=dict)
     inputs: Mapping[str, str] = field(default_factory=dict)
     seed: int | None = None
+    region: tuple[int, int, int] | None = None
 
     def to_json(self) -> str:
-        return json.dumps(
-            {"weft": RECIPE_VERSION, "method": self.method, "params": dict(self.params),
-             "inputs": dict(self.inputs), "seed": self.seed},
-            sort_keys=False,
-        )
+        data = {"weft": RECIPE_VERSION, "method": self.method, "params": dict(self.params),
+                "inputs": dict(self.inputs), "seed": self.seed}
+        if self.region is not None:
+            data["region"] = list(self.region)
+        return json.dumps(data, sort_keys=False)
 
     @classmethod
     def from_json(cls, text: str, *, base: str | os.PathLike | None = None) -> "Recipe":
@@ -360,9 +364,15 @@ class Recipe:
             raise WeftError("recipe \"inputs\" must map input names to file paths")
         if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
             raise WeftError(f"recipe \"seed\" = {seed!r} must be a non-negative integer or null")
+        region = data.get("region")
+        if region is not None:
+            if (not isinstance(region, list) or len(region) != 3
+                    or any(isinstance(v, bool) or not isinstance(v, int) or v < 0 for v in region)):
+                raise WeftError(f"recipe \"region\" = {region!r} must be [x, y, side] in pixels")
+            region = tuple(region)
         if base is not None:
             inputs = {k: str(Path(base) / v) if not os.path.isabs(v) else v for k, v in inputs.items()}
-        return cls(method=method, params=params, inputs=inputs, seed=seed)
+        return cls(method=method, params=params, inputs=inputs, seed=seed, region=region)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "Recipe":

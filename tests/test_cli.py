@@ -167,3 +167,24 @@ def test_real_process_prints_one_line_and_no_traceback(tmp_path, texture_path, k
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr and "input.png" in proc.stderr
     assert not out_path.exists()
+
+
+def test_region_restricts_the_source_and_is_recorded(texture_path, tmp_path, capsys):
+    out = tmp_path / "r.png"
+    code, _, err = run(["quilt", texture_path, "-o", out, "--region", "4,8,24", "--block", "8", "--seed", "1"], capsys)
+    assert code == 0, err
+    recipe = json.loads(read_recipe(out))
+    assert recipe["region"] == [4, 8, 24]
+    tex = load_image(texture_path).image[8:32, 4:28]
+    result = load_image(out).image
+    assert result.shape == (48, 48, 3)  # twice the region, the default size
+    # Every pixel comes from the region (random blocks are verbatim copies).
+    region_pixels = {tuple(np.round(p, 4)) for p in tex.reshape(-1, 3)}
+    assert all(tuple(np.round(p, 4)) in region_pixels for p in result.reshape(-1, 3)[::7])
+    again = tmp_path / "again.png"
+    assert run(["run", out, "-o", again], capsys)[0] == 0
+    assert np.array_equal(result, load_image(again).image)
+    code, _, err = run(["quilt", texture_path, "-o", tmp_path / "x.png", "--region", "30,30,30"], capsys)
+    assert code == 2 and "parameter 'region' = 30,30,30 leaves the texture (40x48)" in err
+    code, _, err = run(["quilt", texture_path, "-o", tmp_path / "x.png", "--region", "a,b"], capsys)
+    assert code == 2 and "must be X,Y,SIDE" in err

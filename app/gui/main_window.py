@@ -1,8 +1,9 @@
-"""The main window: the bundled examples on the left, the chosen image in a zoomable view.
+"""The weft studio's main window.
 
-Images are decoded on the worker pool (``core.jobs.JobRunner``) and come back to the GUI thread
-through a queued Qt signal, so opening a large file never freezes the window; a failed open keeps
-the image that was shown and says why in the status bar.
+Left: the method's inputs (the texture on top with the prototype tool; the other inputs in tabs
+below). Right: the result, with a before/after split. Dock: method, parameters (generated from the
+specs), seed, variations. Every edit is an undo command on the document; renders run on the worker
+pool (``app.gui.render``); the GUI thread only decodes nothing larger than a frame's work.
 """
 
 from __future__ import annotations
@@ -10,229 +11,586 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QObject, QPointF, QSize, Qt, Signal
-from PySide6.QtGui import QAction, QIcon, QKeySequence, QPainter, QPixmap
+from PySide6.QtCore import QMimeData, QSettings, QSize, Qt, QUrl, Signal
+from PySide6.QtGui import QAction, QIcon, QKeySequence, QPixmap
 from PySide6.QtWidgets import (
+    QComboBox,
     QDockWidget,
     QFileDialog,
-    QGraphicsPixmapItem,
-    QGraphicsScene,
-    QGraphicsView,
+    QHBoxLayout,
     QLabel,
     QListWidget,
     QListWidgetItem,
     QMainWindow,
+    QProgressBar,
+    QPushButton,
+    QScrollArea,
+    QSpinBox,
+    QSplitter,
+    QTabWidget,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
 )
 
 from core import registry
-from core.examples import examples
-from core.image import load_image
-from core.jobs import JobResult, JobRunner
+from core.errors import WeftError
+from core.examples import example, examples
+from core.image import load_image, save_image
+from core.jobs import JobRunner
 
 from .convert import to_qimage
+from .document import Document, InputImage, read_session
+from .params_panel import ParamsPanel
+from .render import Renderer, describe
+from .tools import PatchTool
+from .views import ImageView, ResultView, is_image_path
 
 OPEN_FILTER = "Images (*.png *.jpg *.jpeg *.tif *.tiff *.bmp *.webp);;All files (*)"
+SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
+DEFAULT_INPUTS = {"texture": "wood-grain", "target": "astronaut"}
+MAX_RECENT = 8
 
 
-class ImageView(QGraphicsView):
-    """A zoomable, pannable view of one image; reports the pixel under the mouse.
+class _ExampleList(QListWidget):
+    """The bundled examples; drag one onto a view to open it there."""
 
-    Wheel zooms under the cursor, left-drag pans, ``fit()`` fits the window, ``actual_size()`` is 1:1.
-    ``hovered(x, y)`` carries image pixel coordinates (-1, -1 when outside the image).
-    """
-
-    hovered = Signal(int, int)
-    zoomed = Signal(float)
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.setScene(QGraphicsScene(self))
-        self._item = QGraphicsPixmapItem()
-        self._item.setTransformationMode(Qt.TransformationMode.FastTransformation)
-        self.scene().addItem(self._item)
-        self.image: np.ndarray | None = None
-        self.setTransformationAnchor(QGraphicsView.ViewportAnchor.NoAnchor)
-        self.setResizeAnchor(QGraphicsView.ViewportAnchor.AnchorViewCenter)
-        self.setDragMode(QGraphicsView.DragMode.ScrollHandDrag)
-        self.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, False)
-        self.setMouseTracking(True)
-        self.setBackgroundBrush(Qt.GlobalColor.darkGray)
-
-    def set_image(self, image: np.ndarray, *, fit: bool = True) -> None:
-        self.image = image
-        self._item.setPixmap(QPixmap.fromImage(to_qimage(image)))
-        self.scene().setSceneRect(self._item.boundingRect())
-        if fit:
-            self.fit()
-
-    def scale_factor(self) -> float:
-        return self.transform().m11()
-
-    def fit(self) -> None:
-        if self.image is not None:
-            self.fitInView(self._item, Qt.AspectRatioMode.KeepAspectRatio)
-            self.zoomed.emit(self.scale_factor())
-
-    def actual_size(self) -> None:
-        self.resetTransform()
-        self.zoomed.emit(1.0)
-
-    def zoom_by(self, factor: float, at=None) -> None:
-        """Zoom by ``factor`` keeping the image point under view position ``at`` (default: centre) fixed."""
-        new = self.scale_factor() * factor
-        if not 1 / 64 <= new <= 64:
-            return
-        if at is None:
-            at = self.viewport().rect().center()
-        anchor = self.mapToScene(at)
-        self.scale(factor, factor)
-        moved = self.mapFromScene(anchor) - at
-        self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() + moved.x())
-        self.verticalScrollBar().setValue(self.verticalScrollBar().value() + moved.y())
-        self.zoomed.emit(self.scale_factor())
-
-    def wheelEvent(self, event):  # noqa: N802 (Qt naming)
-        steps = event.angleDelta().y() / 120.0
-        if steps:
-            self.zoom_by(1.25 ** steps, at=event.position().toPoint())
-        event.accept()
-
-    def image_pos(self, view_pos) -> tuple[int, int]:
-        p: QPointF = self.mapToScene(view_pos)
-        x, y = int(np.floor(p.x())), int(np.floor(p.y()))
-        if self.image is None or not (0 <= x < self.image.shape[1] and 0 <= y < self.image.shape[0]):
-            return -1, -1
-        return x, y
-
-    def mouseMoveEvent(self, event):  # noqa: N802
-        self.hovered.emit(*self.image_pos(event.position().toPoint()))
-        super().mouseMoveEvent(event)
-
-
-class _Bridge(QObject):
-    """Carries job results from worker threads to the GUI thread (queued connection)."""
-
-    finished = Signal(object)
+    def mimeData(self, items):  # noqa: N802 (Qt naming)
+        data = QMimeData()
+        data.setUrls([QUrl.fromLocalFile(i.data(Qt.ItemDataRole.UserRole)) for i in items])
+        return data
 
 
 class MainWindow(QMainWindow):
-    """The examples browser: pick a bundled example or open a file, zoom and inspect pixels."""
+    """The studio window (see the module docstring)."""
 
-    def __init__(self, parent=None):
+    message = Signal(str)
+    _opened = Signal(object)
+
+    def __init__(self, parent=None, *, settings: QSettings | None = None, load_defaults: bool = True):
         super().__init__(parent)
         self.setWindowTitle("weft")
-        self.resize(1100, 720)
-        self.view = ImageView(self)
-        self.setCentralWidget(self.view)
-        self.current_path: Path | None = None
-        self.pixel_label = QLabel("")
-        self.zoom_label = QLabel("")
-        self.statusBar().addPermanentWidget(self.pixel_label)
-        self.statusBar().addPermanentWidget(self.zoom_label)
+        self.resize(1280, 800)
+        self.settings = settings if settings is not None else QSettings("weft", "weft")
+        self.doc = Document(self)
+        self.renderer = Renderer(self.doc, self)
+        # Opened files are decoded off the GUI thread; the result comes back through a queued signal.
+        self.loader = JobRunner(max_workers=1, on_result=self._opened.emit)
+        self._opened.connect(self._on_opened)
+        self._dragging = False
 
-        self._bridge = _Bridge(self)
-        self._bridge.finished.connect(self._on_job_done)
-        self.runner = JobRunner(max_workers=2, on_result=self._bridge.finished.emit)
+        # views
+        self.views: dict[str, ImageView] = {}
+        self.result_view = ResultView(self)
+        self.texture_view = self._input_view("texture")
+        self.patch_tool = PatchTool(self.texture_view, self.doc, on_drag=self._prototype_dragged)
+        self.texture_view.tool = self.patch_tool
+        self.input_tabs = QTabWidget()
+        left = QSplitter(Qt.Orientation.Vertical)
+        left.addWidget(self._titled(self.texture_view, "texture — drag a square: the prototype patch, or "
+                                                       "the source region (Edit > Clear Prototype to use all)"))
+        left.addWidget(self.input_tabs)
+        self.splitter = QSplitter(Qt.Orientation.Horizontal)
+        self.splitter.addWidget(left)
+        self.splitter.addWidget(self._titled(self.result_view, "result"))
+        self.splitter.setStretchFactor(1, 2)
+        self.setCentralWidget(self.splitter)
+
+        self._build_dock()
+        self._build_examples()
+        self._build_status()
+        self._build_menus()
+
+        self.doc.changed.connect(self._on_doc_changed)
+        self.doc.undo_stack.indexChanged.connect(self._update_title)
+        self.renderer.shown.connect(self._on_shown)
+        self.renderer.partial.connect(lambda img: self.result_view.set_image(img))
+        self.renderer.progress.connect(self._on_progress)
+        self.renderer.busy.connect(self._on_busy)
+        self.renderer.failed.connect(self._on_failed)
+        self.renderer.cancelled.connect(self._on_cancelled)
+        self._rebuild_method()
+        self.restoreGeometry(self.settings.value("geometry", b""))
+        self.restoreState(self.settings.value("state", b""))
         # Load the methods' compiled kernels off the GUI thread, so the first result is not slow.
-        self.runner.submit("warm-up", _warm_up_job)
+        self.renderer.runner.submit("warm-up", _warm_up_job)
+        if load_defaults:
+            self.load_examples()
 
-        self.example_list = QListWidget()
+    # --- construction --------------------------------------------------------------------------
+    def _titled(self, view: ImageView, title: str) -> QWidget:
+        box = QWidget()
+        lay = QVBoxLayout(box)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.setSpacing(0)
+        label = QLabel(f"  {title}")
+        label.setStyleSheet("background:#2b2b2b; color:#ddd; padding:2px;")
+        lay.addWidget(label)
+        lay.addWidget(view)
+        return box
+
+    def _input_view(self, name: str) -> ImageView:
+        view = self.views.get(name)
+        if view is None:
+            view = ImageView(self, title=name)
+            view.hovered.connect(lambda x, y, v=view: self._on_hover(v, x, y))
+            view.file_dropped.connect(lambda path, n=name: self.open_input(n, path))
+            self.views[name] = view
+        return view
+
+    def _build_dock(self) -> None:
+        panel = QWidget()
+        lay = QVBoxLayout(panel)
+        top = QHBoxLayout()
+        top.addWidget(QLabel("Method"))
+        self.method_box = QComboBox()
+        for name, m in registry.methods().items():
+            if m.inputs and m.inputs[0].name in ("texture",):
+                self.method_box.addItem(name)
+                self.method_box.setItemData(self.method_box.count() - 1, m.summary, Qt.ItemDataRole.ToolTipRole)
+        self.method_box.currentTextChanged.connect(lambda name: self.doc.set_method(name) if name else None)
+        top.addWidget(self.method_box, 1)
+        lay.addLayout(top)
+        self.params_panel = ParamsPanel()
+        self.params_panel.edited.connect(self._on_param_edited)
+        scroll = QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(self.params_panel)
+        lay.addWidget(scroll, 1)
+        self.prototype_label = QLabel()
+        self.prototype_label.setFixedSize(96, 96)
+        self.prototype_label.setToolTip("the prototype patch (drag a square on the texture)")
+        self.prototype_label.setStyleSheet("border:1px solid #888;")
+        seed_row = QHBoxLayout()
+        seed_row.addWidget(QLabel("seed"))
+        self.seed_box = QSpinBox()
+        self.seed_box.setRange(0, 2**31 - 1)
+        self.seed_box.setValue(self.doc.seed)
+        self.seed_box.setKeyboardTracking(False)
+        self.seed_box.valueChanged.connect(self._on_seed)
+        seed_row.addWidget(self.seed_box, 1)
+        new_seed = QToolButton()
+        new_seed.setText("New")
+        new_seed.setToolTip("a new random seed")
+        new_seed.clicked.connect(self.new_seed)
+        seed_row.addWidget(new_seed)
+        seed_row.addWidget(self.prototype_label)
+        lay.addLayout(seed_row)
+        buttons = QHBoxLayout()
+        self.render_button = QPushButton("Render")
+        self.render_button.setToolTip("render the full-size result (F5)")
+        self.render_button.clicked.connect(lambda: self.renderer.final(now=True))
+        self.compare_button = QPushButton("Compare")
+        self.compare_button.setCheckable(True)
+        self.compare_button.setToolTip("before/after split on the result: drag to move the divider (C)")
+        self.compare_button.toggled.connect(self.result_view.set_comparing)
+        self.variations_button = QPushButton("Variations…")
+        self.variations_button.setToolTip("render a grid over two parameters and adopt a cell")
+        self.variations_button.clicked.connect(self.open_variations)
+        for b in (self.render_button, self.compare_button, self.variations_button):
+            buttons.addWidget(b)
+        lay.addLayout(buttons)
+        dock = QDockWidget("Method", self)
+        dock.setObjectName("method")
+        dock.setWidget(panel)
+        dock.setMinimumWidth(340)
+        self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+
+    def _build_examples(self) -> None:
+        self.example_list = _ExampleList()
         self.example_list.setViewMode(QListWidget.ViewMode.IconMode)
-        self.example_list.setIconSize(QSize(96, 96))
+        self.example_list.setIconSize(QSize(72, 72))
         self.example_list.setResizeMode(QListWidget.ResizeMode.Adjust)
         self.example_list.setMovement(QListWidget.Movement.Static)
-        self.example_list.setSpacing(6)
+        self.example_list.setDragEnabled(True)
+        self.example_list.setSpacing(4)
         for path in examples():
             item = QListWidgetItem(QIcon(str(path)), path.stem)
             item.setData(Qt.ItemDataRole.UserRole, str(path))
-            item.setToolTip(str(path))
+            item.setToolTip(f"{path.name}: double-click to open as texture, drag onto a view to open it there")
             self.example_list.addItem(item)
-        self.example_list.currentItemChanged.connect(self._on_example)
+        self.example_list.itemDoubleClicked.connect(
+            lambda item: self.open_input("texture", item.data(Qt.ItemDataRole.UserRole)))
         dock = QDockWidget("Examples", self)
         dock.setObjectName("examples")
         dock.setWidget(self.example_list)
-        dock.setMinimumWidth(250)
         self.addDockWidget(Qt.DockWidgetArea.LeftDockWidgetArea, dock)
+        self.examples_dock = dock
 
-        self.view.hovered.connect(self._on_hover)
-        self.view.zoomed.connect(lambda s: self.zoom_label.setText(f"{s * 100:.0f}%"))
-        self._build_menus()
-        if self.example_list.count():
-            self.example_list.setCurrentRow(0)
-        else:
-            self.statusBar().showMessage("no bundled examples found (resources/ is missing); use File > Open")
+    def _build_status(self) -> None:
+        self.pixel_label = QLabel("")
+        self.zoom_label = QLabel("")
+        self.progress_bar = QProgressBar()
+        self.progress_bar.setMaximumWidth(220)
+        self.progress_bar.setRange(0, 1000)
+        self.cancel_button = QPushButton("Cancel")
+        self.cancel_button.clicked.connect(self.renderer.cancel)
+        for w in (self.pixel_label, self.zoom_label, self.progress_bar, self.cancel_button):
+            self.statusBar().addPermanentWidget(w)
+        self.progress_bar.hide()
+        self.cancel_button.hide()
+        for view in (self.texture_view, self.result_view):
+            view.zoomed.connect(lambda s: self.zoom_label.setText(f"{s * 100:.0f}%"))
+        self.result_view.hovered.connect(lambda x, y: self._on_hover(self.result_view, x, y))
+
+    def _action(self, menu, text, slot, shortcut=None, tip=None) -> QAction:
+        action = QAction(text, self)
+        if shortcut is not None:
+            action.setShortcut(QKeySequence(shortcut))
+        if tip:
+            action.setStatusTip(tip)
+        action.triggered.connect(slot)
+        menu.addAction(action)
+        return action
 
     def _build_menus(self) -> None:
-        file_menu = self.menuBar().addMenu("&File")
-        self.open_action = QAction("&Open Image…", self, shortcut=QKeySequence.StandardKey.Open)
-        self.open_action.triggered.connect(self._open_dialog)
-        file_menu.addAction(self.open_action)
-        file_menu.addSeparator()
-        quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit)
-        quit_action.triggered.connect(self.close)
-        file_menu.addAction(quit_action)
-        view_menu = self.menuBar().addMenu("&View")
-        for text, keys, slot in (
-            ("Zoom &In", QKeySequence.StandardKey.ZoomIn, lambda: self.view.zoom_by(1.25)),
-            ("Zoom &Out", QKeySequence.StandardKey.ZoomOut, lambda: self.view.zoom_by(0.8)),
-            ("&Fit to Window", QKeySequence("Ctrl+0"), self.view.fit),
-            ("&Actual Size", QKeySequence("Ctrl+1"), self.view.actual_size),
-        ):
-            action = QAction(text, self, shortcut=keys)
-            action.triggered.connect(slot)
-            view_menu.addAction(action)
+        m = self.menuBar().addMenu("&File")
+        self._action(m, "Open &Texture…", lambda: self.open_input_dialog("texture"), QKeySequence.StandardKey.Open)
+        self._action(m, "Open T&arget…", lambda: self.open_input_dialog("target"), "Ctrl+Shift+O")
+        self.open_other_menu = m.addMenu("Open Other Input")
+        self.recent_menu = m.addMenu("Open &Recent")
+        m.addSeparator()
+        self._action(m, "Open &Session…", self.open_session_dialog, "Ctrl+Shift+L")
+        self._action(m, "&Save Session…", self.save_session_dialog, QKeySequence.StandardKey.Save)
+        m.addSeparator()
+        self.save_result_action = self._action(m, "&Export Result…", self.save_result_dialog, "Ctrl+E")
+        self._action(m, "Export &Recipe…", self.export_recipe_dialog, "Ctrl+Shift+E")
+        m.addSeparator()
+        self._action(m, "&Quit", self.close, QKeySequence.StandardKey.Quit)
+        e = self.menuBar().addMenu("&Edit")
+        undo = self.doc.undo_stack.createUndoAction(self, "&Undo")
+        undo.setShortcut(QKeySequence.StandardKey.Undo)
+        redo = self.doc.undo_stack.createRedoAction(self, "&Redo")
+        redo.setShortcut(QKeySequence.StandardKey.Redo)
+        e.addAction(undo)
+        e.addAction(redo)
+        self.undo_action, self.redo_action = undo, redo
+        e.addSeparator()
+        self._action(e, "New &Seed", self.new_seed, "Ctrl+R")
+        self._action(e, "Clear &Prototype", lambda: self.doc.set_prototype(None))
+        v = self.menuBar().addMenu("&View")
+        self._action(v, "Zoom &In", lambda: self._focused_view().zoom_by(1.25), QKeySequence.StandardKey.ZoomIn)
+        self._action(v, "Zoom &Out", lambda: self._focused_view().zoom_by(0.8), QKeySequence.StandardKey.ZoomOut)
+        self._action(v, "&Fit to Window", lambda: self._focused_view().fit(), "Ctrl+0")
+        self._action(v, "&Actual Size", lambda: self._focused_view().actual_size(), "Ctrl+1")
+        self._action(v, "&Compare Before/After", self.compare_button.toggle, "C")
+        self._action(v, "&Render", lambda: self.renderer.final(now=True), "F5")
+        v.addSeparator()
+        v.addAction(self.examples_dock.toggleViewAction())
+        self._refresh_recent()
 
-    # --- loading -----------------------------------------------------------------------------
-    def open_path(self, path: str | Path) -> None:
-        """Decode ``path`` on the worker pool; the result (or error) arrives in ``_on_loaded``."""
-        path = Path(path)
-        self.statusBar().showMessage(f"opening {path.name}…")
-        self.runner.submit("open", _load_job, str(path))
+    # --- inputs ----------------------------------------------------------------------------------
+    def load_examples(self) -> None:
+        """Open the bundled default texture and target (the window opens with a result)."""
+        for name, stem in DEFAULT_INPUTS.items():
+            try:
+                path = example(stem)
+            except WeftError:
+                continue
+            loaded = load_image(path)  # small bundled files: a few milliseconds
+            self.doc._put_input(name, InputImage(str(path), loaded.image))
+        self.doc.undo_stack.clear()
+        self.renderer.final(now=True)
 
-    def _on_job_done(self, result: JobResult) -> None:
-        if result.slot == "open":
-            self._on_loaded(result)
-        elif result.error is not None:
-            self.statusBar().showMessage(f"{result.slot} failed: {result.error}")
-
-    def _on_loaded(self, result: JobResult) -> None:
-        if result.error is not None:
-            self.statusBar().showMessage(f"could not open: {result.error}")
-            return
-        path, loaded = result.value
-        self.current_path = Path(path)
-        self.view.set_image(loaded.image)
-        info = loaded.info
-        notes = f" — {', '.join(info.notes)}" if info.notes else ""
-        self.setWindowTitle(f"{self.current_path.name} — weft")
-        self.statusBar().showMessage(
-            f"{self.current_path.name}: {info.width}x{info.height}, {info.format}, {info.bit_depth}-bit{notes}"
-        )
-
-    def _on_example(self, item: QListWidgetItem | None, _previous=None) -> None:
-        if item is not None:
-            self.open_path(item.data(Qt.ItemDataRole.UserRole))
-
-    def _open_dialog(self) -> None:
-        start = str(self.current_path.parent) if self.current_path else ""
-        path, _ = QFileDialog.getOpenFileName(self, "Open image", start, OPEN_FILTER)
+    def open_input_dialog(self, name: str) -> None:
+        start = str(self.settings.value("last_dir", ""))
+        path, _ = QFileDialog.getOpenFileName(self, f"Open {name}", start, OPEN_FILTER)
         if path:
-            self.open_path(path)
+            self.open_input(name, path)
 
-    def _on_hover(self, x: int, y: int) -> None:
-        img = self.view.image
+    def open_input(self, name: str, path: str) -> None:
+        """Decode ``path`` off the GUI thread and make it input ``name`` (undoable)."""
+        if not is_image_path(path) and not Path(path).is_file():
+            self.show_message(f"{path}: not an image file")
+            return
+        self.statusBar().showMessage(f"opening {Path(path).name}…")
+        self.loader.submit(f"open-{name}", _load_job, name, str(path))
+
+    def _on_opened(self, result) -> None:
+        if result.cancelled:
+            return
+        if result.error is not None:
+            self.show_message(f"could not open: {result.error}")
+            return
+        name, path, image = result.value
+        self.settings.setValue("last_dir", str(Path(path).parent))
+        self._add_recent(path)
+        self.doc.set_input(name, path, image)
+        self.statusBar().showMessage(f"{name}: {Path(path).name} {image.shape[1]}x{image.shape[0]}", 4000)
+
+    def _add_recent(self, path: str) -> None:
+        recent = [p for p in (self.settings.value("recent", []) or []) if p != path]
+        self.settings.setValue("recent", [path] + recent[:MAX_RECENT - 1])
+        self._refresh_recent()
+
+    def _refresh_recent(self) -> None:
+        self.recent_menu.clear()
+        recent = self.settings.value("recent", []) or []
+        if isinstance(recent, str):
+            recent = [recent]
+        for path in recent:
+            sub = self.recent_menu.addMenu(Path(path).name)
+            for inp in ("texture", "target"):
+                act = sub.addAction(f"as {inp}")
+                act.triggered.connect(lambda _=False, p=path, n=inp: self.open_input(n, p))
+        self.recent_menu.setEnabled(bool(recent))
+
+    # --- document changes ----------------------------------------------------------------------
+    def _on_doc_changed(self, what: str) -> None:
+        if what.startswith("input:"):
+            name = what.split(":", 1)[1]
+            view = self._input_view(name)
+            view.set_image(self.doc.image(name), fit=True)
+            if name == "texture":
+                self.patch_tool.refresh()
+                self._update_prototype_thumb()
+            self._update_compare()
+            self.renderer.final()
+        elif what == "method":
+            self._rebuild_method()
+            self.renderer.final()
+        elif what == "params":
+            self._show_params()
+            if not self._dragging:
+                self.renderer.final()
+        elif what == "prototype":
+            self.patch_tool.refresh()
+            self._update_prototype_thumb()
+            self.renderer.final()
+        elif what == "seed":
+            self.seed_box.blockSignals(True)
+            self.seed_box.setValue(self.doc.seed)
+            self.seed_box.blockSignals(False)
+            self.renderer.final()
+
+    def _rebuild_method(self) -> None:
+        method = self.doc.current
+        self.method_box.blockSignals(True)
+        self.method_box.setCurrentText(self.doc.method)
+        self.method_box.blockSignals(False)
+        self.params_panel.build(method.params)
+        self._show_params()
+        self.input_tabs.clear()
+        for inp in method.inputs[1:]:
+            view = self._input_view(inp.name)
+            label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")
+            self.input_tabs.addTab(self._titled(view, inp.help), label)
+            view.set_image(self.doc.image(inp.name))
+        self.input_tabs.setVisible(len(method.inputs) > 1)
+        self.open_other_menu.clear()
+        for inp in method.inputs:
+            act = self.open_other_menu.addAction(f"{inp.name.replace('_', ' ')}…")
+            act.triggered.connect(lambda _=False, n=inp.name: self.open_input_dialog(n))
+        self._update_compare()
+
+    def _show_params(self) -> None:
+        params = self.doc.current_params
+        auto = {}
+        resolver = getattr(params, "resolved", None)
+        if resolver is not None:
+            try:
+                resolved = resolver("target" in self.doc.inputs)
+                auto = {name: getattr(resolved, name) for name in self.params_panel.rows}
+            except WeftError:
+                auto = {}
+        self.params_panel.show_params(params, auto)
+
+    def _on_param_edited(self, name: str, value, dragging: bool) -> None:
+        try:
+            self._dragging = dragging
+            self.doc.set_param(name, value)
+        except WeftError as e:
+            self.show_message(str(e))
+            self._show_params()  # back to the valid value
+            return
+        finally:
+            self._dragging = False
+        if dragging:
+            self.renderer.preview()
+        else:
+            self.renderer.final()
+
+    def _on_seed(self, value: int) -> None:
+        self.doc.seed = int(value)
+        self.doc.changed.emit("seed")
+
+    def new_seed(self) -> None:
+        self.seed_box.setValue(int(np.random.default_rng().integers(0, 2**31 - 1)))
+
+    def _prototype_dragged(self, rect) -> None:
+        self._update_prototype_thumb(rect)
+
+    def _update_prototype_thumb(self, rect=None) -> None:
+        rect = rect or self.doc.prototype
+        tex = self.doc.image("texture")
+        if rect is None or tex is None:
+            self.prototype_label.clear()
+            return
+        x, y, s = rect
+        patch = tex[y:y + s, x:x + s]
+        if patch.size:
+            pix = QPixmap.fromImage(to_qimage(patch)).scaled(96, 96, Qt.AspectRatioMode.KeepAspectRatio)
+            self.prototype_label.setPixmap(pix)
+
+    def _update_compare(self) -> None:
+        self.result_view.set_compare(self.doc.image("target") if "target" in self.doc.inputs else self.doc.image("texture"))
+
+    # --- results ---------------------------------------------------------------------------------
+    def _on_shown(self, shown) -> None:
+        self.result_view.set_image(shown.image)
+        self.statusBar().showMessage(describe(shown))
+
+    def _on_progress(self, fraction: float, stage: str) -> None:
+        self.progress_bar.setValue(int(fraction * 1000))
+        self.progress_bar.setFormat(f"{stage} %p%")
+
+    def _on_busy(self, busy: bool) -> None:
+        self.progress_bar.setVisible(busy)
+        self.cancel_button.setVisible(busy)
+        if busy:
+            self.progress_bar.setValue(0)
+
+    def _on_failed(self, message: str) -> None:
+        self.show_message(message)
+        if self.renderer.last is not None:
+            self.result_view.set_image(self.renderer.last.image)
+
+    def _on_cancelled(self) -> None:
+        if self.renderer.last is not None:
+            self.result_view.set_image(self.renderer.last.image)
+        self.statusBar().showMessage("cancelled; the previous result is kept", 4000)
+
+    def show_message(self, text: str) -> None:
+        """A one-line message in the status bar (errors never open a blocking dialog mid-drag)."""
+        self.statusBar().showMessage(text, 8000)
+        self.message.emit(text)
+
+    def _on_hover(self, view: ImageView, x: int, y: int) -> None:
+        img = view.image
         if x < 0 or img is None:
             self.pixel_label.setText("")
             return
         v = img[y, x]
         value = f"{float(v):.3f}" if np.ndim(v) == 0 else " ".join(f"{float(c):.3f}" for c in v)
-        self.pixel_label.setText(f"x {x}  y {y}  value {value}")
+        self.pixel_label.setText(f"{view.title}  x {x}  y {y}  {value}")
 
-    # --- shutdown ----------------------------------------------------------------------------
+    def _focused_view(self) -> ImageView:
+        for view in [self.result_view, *self.views.values()]:
+            if view.hasFocus():
+                return view
+        return self.result_view
+
+    # --- sessions, export ------------------------------------------------------------------------
+    def save_result_dialog(self) -> None:
+        if self.renderer.last is None or not self.renderer.last.final:
+            self.show_message("nothing to export yet: wait for the full-size result")
+            return
+        path, _ = QFileDialog.getSaveFileName(self, "Export result", str(self.settings.value("last_dir", "")), SAVE_FILTER)
+        if path:
+            self.export_result(path)
+
+    def export_result(self, path: str) -> bool:
+        """Save the shown full-size result: PNG carries the recipe, TIFF is 16-bit, JPEG 8-bit."""
+        shown = self.renderer.last
+        if shown is None or not shown.final:
+            self.show_message("nothing to export yet: wait for the full-size result")
+            return False
+        p = Path(path)
+        if p.suffix.lower() not in (".png", ".jpg", ".jpeg", ".tif", ".tiff"):
+            p = p.with_suffix(".png")
+        for item in self.doc.inputs.values():
+            if item.path and Path(item.path).resolve() == p.resolve():
+                self.show_message(f"{p.name}: refusing to overwrite an input image")
+                return False
+        recipe = self.doc.recipe(relative_to=p.resolve().parent).to_json()
+        try:
+            save_image(p, shown.image, recipe=recipe, bit_depth=16 if p.suffix.lower() in (".tif", ".tiff") else 8)
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
+        self.statusBar().showMessage(f"exported {p}", 5000)
+        return True
+
+    def export_recipe_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Export recipe", "", "Recipe (*.json)")
+        if path:
+            try:
+                self.doc.recipe(relative_to=Path(path).resolve().parent).save(path)
+            except WeftError as e:
+                self.show_message(str(e))
+
+    def save_session_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save session", "", "weft session (*.weft.json *.json)")
+        if path:
+            self.save_session(path)
+
+    def save_session(self, path: str) -> bool:
+        try:
+            self.doc.save_session(path)
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
+        self.doc.undo_stack.setClean()
+        self.statusBar().showMessage(f"session saved to {path}", 4000)
+        return True
+
+    def open_session_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Open session", "", "weft session (*.json)")
+        if path:
+            self.open_session(path)
+
+    def open_session(self, path: str) -> bool:
+        """Replace the document with a saved session (inputs re-read from their files)."""
+        try:
+            data = read_session(path)
+            images = {name: InputImage(p, load_image(p).image) for name, p in data["inputs"].items()}
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
+        doc = self.doc
+        self.renderer.enabled = False
+        try:
+            doc.inputs = {}
+            for name, item in images.items():
+                doc._put_input(name, item)
+            for name, params in data["params"].items():
+                doc.params[name] = params
+            doc._put_method(data["method"])
+            doc._put_prototype(data["prototype"])
+            doc.frontal_size = data["frontal_size"]
+            doc._put_lines(data["image_lines"], data["frontal_lines"])
+            doc.seed = data["seed"]
+            doc.changed.emit("seed")
+            doc.undo_stack.clear()
+            self._show_params()
+        finally:
+            self.renderer.enabled = True
+        self.renderer.final(now=True)
+        self.statusBar().showMessage(f"session {Path(path).name} opened", 4000)
+        return True
+
+    def open_variations(self) -> None:
+        from .variations import VariationsDialog
+
+        dialog = VariationsDialog(self.doc, self)
+        dialog.show()
+        self._variations = dialog
+
+    def _update_title(self, *_args) -> None:
+        dirty = "" if self.doc.undo_stack.isClean() else " *"
+        self.setWindowTitle(f"weft — {self.doc.method}{dirty}")
+
+    # --- shutdown --------------------------------------------------------------------------------
     def shutdown(self) -> None:
-        self.runner.shutdown(wait=True, cancel=True)
+        self.renderer.shutdown()
+        self.loader.shutdown(wait=True, cancel=True)
+        dialog = getattr(self, "_variations", None)
+        if dialog is not None:
+            dialog.shutdown()
 
     def closeEvent(self, event):  # noqa: N802
+        self.settings.setValue("geometry", self.saveGeometry())
+        self.settings.setValue("state", self.saveState())
         self.shutdown()
         super().closeEvent(event)
 
@@ -241,8 +599,6 @@ def _warm_up_job(*, progress=None, cancel=None) -> None:
     registry.warm_up_all()
 
 
-def _load_job(path: str, *, progress=None, cancel=None):
+def _load_job(name: str, path: str, *, progress=None, cancel=None):
     loaded = load_image(path)
-    if cancel is not None:
-        cancel.raise_if_cancelled()
-    return path, loaded
+    return name, path, loaded.image

@@ -1,93 +1,323 @@
-"""The examples window: shows every bundled example, loads off the GUI thread, survives bad files."""
+"""The studio as a user drives it: real mouse events, sliders, undo, cancel, errors, sessions, export."""
 
+import json
 import threading
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
-from PySide6.QtGui import QMouseEvent, QWheelEvent
+from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
+from PySide6.QtGui import QDragEnterEvent, QDropEvent, QWheelEvent
 from PySide6.QtWidgets import QApplication
 
-from app.gui.main_window import MainWindow
-from core.examples import examples
-from core.image import load_image
+from app.cli import main as cli_main
+from core.errors import Cancelled, WeftError
+from core.examples import example
+from core.image import load_image, read_recipe
+from core.registry import Method, Result
+
+from .helpers import drag, mouse, no_job_threads
 
 
-@pytest.fixture
-def window(qtbot):
-    w = MainWindow()
-    qtbot.addWidget(w)
-    w.show()
-    yield w
-    w.shutdown()
+def test_opens_on_the_examples_with_a_result(window):
+    assert window.doc.method == "fast"
+    assert set(window.doc.inputs) >= {"texture", "target"}
+    shown = window.renderer.last
+    assert shown.final and shown.image.shape == window.doc.image("target").shape
+    assert window.result_view.image is shown.image
+    assert window.example_list.count() >= 10
+    assert "result" in window.statusBar().currentMessage()
 
 
-def test_opens_on_the_bundled_examples(window, qtbot):
-    assert len(examples()) >= 5
-    assert window.example_list.count() == len(examples())
-    qtbot.waitUntil(lambda: window.view.image is not None, timeout=5000)
-    assert window.current_path == examples()[0]
-    assert window.view.image.shape[:2] == load_image(examples()[0]).image.shape[:2]
+@pytest.mark.parametrize("zoom", [2.0, 0.5])
+def test_drawing_a_prototype_sets_the_rectangle_in_image_pixels(window, qtbot, zoom):
+    view = window.texture_view
+    view.actual_size()
+    view.zoom_by(zoom)
+    view.centerOn(40, 40)
+    drag(view, (10.2, 20.2), (50.2, 44.2))
+    assert window.doc.prototype == (10, 20, 40)  # side = larger extent, even
+    # Move it by dragging inside, then resize from the bottom-right handle.
+    drag(view, (30, 40), (36, 42))
+    assert window.doc.prototype == (16, 22, 40)
+    drag(view, (56, 62), (46.5, 50))
+    assert window.doc.prototype == (16, 22, 30)
+    window.doc.undo_stack.undo()
+    assert window.doc.prototype == (16, 22, 40)
+    window.doc.undo_stack.redo()
+    assert window.doc.prototype == (16, 22, 30)
 
 
-def test_clicking_an_example_shows_it(window, qtbot):
-    qtbot.waitUntil(lambda: window.view.image is not None, timeout=5000)
-    item = window.example_list.item(2)
-    rect = window.example_list.visualItemRect(item)
-    qtbot.mouseClick(window.example_list.viewport(), Qt.MouseButton.LeftButton, pos=rect.center())
-    qtbot.waitUntil(lambda: window.current_path == examples()[2], timeout=5000)
-    assert str(examples()[2].name) in window.statusBar().currentMessage()
+def test_escape_cancels_a_prototype_drag(window):
+    view = window.texture_view
+    window.doc.set_prototype((4, 4, 20))
+    mouse(view, "press", (60, 60))
+    mouse(view, "move", (90, 90))
+    assert window.patch_tool.live is not None
+    from PySide6.QtGui import QKeyEvent
+    from PySide6.QtCore import QEvent
+
+    QApplication.sendEvent(view, QKeyEvent(QEvent.Type.KeyPress, Qt.Key.Key_Escape, Qt.KeyboardModifier.NoModifier))
+    mouse(view, "release", (90, 90))
+    assert window.doc.prototype == (4, 4, 20)
 
 
-def test_bad_file_keeps_the_previous_image(window, qtbot, tmp_path):
-    qtbot.waitUntil(lambda: window.view.image is not None, timeout=5000)
-    before = window.view.image
+def test_the_prototype_is_the_source_region_of_fast_and_is_in_the_recipe(window, qtbot, tmp_path):
+    before = window.renderer.last.job_id
+    window.doc.set_prototype((10, 10, 40))
+    qtbot.waitUntil(lambda: window.renderer.last.job_id > before and window.renderer.last.final, timeout=10000)
+    out = tmp_path / "r.png"
+    assert window.export_result(str(out))
+    assert json.loads(read_recipe(out))["region"] == [10, 10, 40]
+    again = tmp_path / "again.png"
+    assert cli_main(["run", str(out), "-o", str(again)]) == 0
+    assert np.array_equal(load_image(out).image, load_image(again).image)
+
+
+def test_slider_drag_previews_then_renders_full_size(window, qtbot):
+    row = window.params_panel.row("n")
+    slider = row.editor
+    shown = []
+    window.renderer.shown.connect(lambda s: shown.append(s))
+    slider.setSliderDown(True)
+    for v in (7, 9, 11):
+        slider.setValue(v)
+    qtbot.waitUntil(lambda: any(not s.final for s in shown), timeout=10000)
+    slider.setSliderDown(False)
+    slider.sliderReleased.emit()
+    qtbot.waitUntil(lambda: shown and shown[-1].final and window.doc.current_params.n == 11, timeout=10000)
+    qtbot.wait(200)
+    ids = [s.job_id for s in shown]
+    assert ids == sorted(ids)  # never an older result over a newer one
+    assert window.result_view.image is window.renderer.last.image
+    # The drag is one undo step.
+    window.doc.undo_stack.undo()
+    assert window.doc.current_params.n == 5
+
+
+def test_stale_results_are_dropped(window, qtbot):
+    r = window.renderer
+    shown = []
+    r.shown.connect(lambda s: shown.append(s.job_id))
+    for p in (0.1, 0.2, 0.3, 0.4, 0.5):
+        window.doc.set_param("p", p)
+        r.final(now=True)
+    qtbot.waitUntil(lambda: not r.runner.busy("final"), timeout=10000)
+    qtbot.wait(100)
+    assert shown and shown == sorted(shown)
+    assert r.last.job_id == r.latest_final
+
+
+def _slow_method(started: threading.Event) -> Method:
+    """A stand-in for ``fast`` that runs until it is cancelled."""
+    from core.fast import METHOD
+
+    def run(inputs, params, *, rng=None, progress=None, cancel=None):
+        started.set()
+        while True:
+            cancel.raise_if_cancelled()
+            threading.Event().wait(0.01)
+
+    return Method("fast", "slow stand-in", METHOD.params, METHOD.inputs, run)
+
+
+def test_cancel_keeps_the_previous_result(window, qtbot, monkeypatch):
+    previous = window.renderer.last
+    started = threading.Event()
+    monkeypatch.setitem(window.doc.methods, "fast", _slow_method(started))
+    window.renderer.final(now=True)
+    qtbot.waitUntil(started.is_set, timeout=5000)
+    qtbot.waitUntil(window.cancel_button.isVisible, timeout=5000)  # long job: progress + Cancel shown
+    window.cancel_button.click()
+    qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
+    assert window.renderer.last is previous
+    assert window.result_view.image is previous.image
+    assert not window.cancel_button.isVisible()
+
+
+def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, monkeypatch):
+    previous = window.renderer.last
+    real = window.doc.methods["fast"]
+
+    def boom(inputs, params, *, rng=None, progress=None, cancel=None):
+        raise WeftError("texture.png: something is wrong with it")
+
+    monkeypatch.setitem(window.doc.methods, "fast", Method("fast", "broken", real.params, real.inputs, boom))
+    messages = []
+    window.message.connect(messages.append)
+    window.renderer.final(now=True)
+    qtbot.waitUntil(lambda: bool(messages), timeout=5000)
+    assert "something is wrong" in messages[-1]
+    assert window.result_view.image is previous.image
+    monkeypatch.setitem(window.doc.methods, "fast", real)
+    window.renderer.final(now=True)
+    qtbot.waitUntil(lambda: window.renderer.last is not previous, timeout=10000)
+
+
+def test_invalid_value_is_refused_with_a_message(window):
+    messages = []
+    window.message.connect(messages.append)
+    window._on_param_edited("n", 4, False)  # even: refused by FastParams
+    assert window.doc.current_params.n == 5
+    assert "must be odd" in messages[-1]
+    assert window.params_panel.row("n").value() == 5
+
+
+def test_undo_redo_parameters_and_method(window):
+    doc = window.doc
+    doc.set_param("w", 2.0)
+    doc.set_param("w", 3.0)  # merges with the previous change of w
+    doc.set_param("iterations", 2)
+    doc.set_method("quilt")
+    assert window.params_panel.params_cls is doc.methods["quilt"].params
+    doc.undo_stack.undo()
+    assert doc.method == "fast" and window.params_panel.params_cls is doc.methods["fast"].params
+    doc.undo_stack.undo()
+    assert doc.current_params.iterations == 1
+    doc.undo_stack.undo()
+    assert doc.current_params.w == 1.0
+    doc.undo_stack.redo()
+    assert doc.current_params.w == 3.0
+    assert window.params_panel.row("w").value() == 3.0
+
+
+def test_dropping_a_file_on_the_target_view_opens_it(window, qtbot):
+    view = window.views["target"]
+    path = str(example("camera"))
+    data = QMimeData()
+    data.setUrls([QUrl.fromLocalFile(path)])
+    enter = QDragEnterEvent(QPoint(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton,
+                            Qt.KeyboardModifier.NoModifier)
+    assert QApplication.sendEvent(view.viewport(), enter) and enter.isAccepted()
+    drop = QDropEvent(QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton,
+                      Qt.KeyboardModifier.NoModifier)
+    QApplication.sendEvent(view.viewport(), drop)
+    qtbot.waitUntil(lambda: window.doc.inputs["target"].path == path, timeout=5000)
+    assert window.doc.image("target").shape == (256, 256)
+    window.doc.undo_stack.undo()
+    assert window.doc.inputs["target"].path != path
+
+
+def test_opening_a_corrupt_file_keeps_the_document(window, qtbot, tmp_path):
     bad = tmp_path / "broken.png"
     bad.write_text("not an image")
-    window.open_path(bad)
-    qtbot.waitUntil(lambda: "could not open" in window.statusBar().currentMessage(), timeout=5000)
-    assert "broken.png" in window.statusBar().currentMessage()
-    assert window.view.image is before
+    before = window.doc.inputs["texture"]
+    messages = []
+    window.message.connect(messages.append)
+    window.open_input("texture", str(bad))
+    qtbot.waitUntil(lambda: bool(messages), timeout=5000)
+    assert "broken.png" in messages[-1]
+    assert window.doc.inputs["texture"] is before
 
 
-def test_hover_reports_pixel_coordinates_and_value(window, qtbot):
-    qtbot.waitUntil(lambda: window.view.image is not None, timeout=5000)
-    window.view.actual_size()
-    window.view.zoom_by(4.0)  # a pixel spans 4 screen pixels: no rounding ambiguity
-    view = window.view
-    view.centerOn(10.5, 20.5)
-    pos = view.mapFromScene(10.5, 20.5)
-    move = QMouseEvent(QEvent.Type.MouseMove, QPointF(pos), QPointF(view.viewport().mapToGlobal(pos)),
-                       Qt.MouseButton.NoButton, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier)
-    QApplication.sendEvent(view.viewport(), move)
-    qtbot.waitUntil(lambda: window.pixel_label.text().startswith("x 10  y 20"), timeout=2000)
-    v = view.image[20, 10]
-    assert f"{float(np.ravel(v)[0]):.3f}" in window.pixel_label.text()
+def test_session_round_trip(window, qtbot, tmp_path):
+    doc = window.doc
+    doc.set_param("p", 0.3)
+    doc.set_prototype((2, 4, 16))
+    window.seed_box.setValue(42)
+    path = tmp_path / "s.weft.json"
+    assert window.save_session(str(path))
+    data = json.loads(path.read_text())
+    assert data["params"]["fast"]["p"] == 0.3 and data["seed"] == 42 and data["prototype"] == [2, 4, 16]
+    doc.set_param("p", 0.9)
+    doc.set_prototype(None)
+    window.seed_box.setValue(1)
+    assert window.open_session(str(path))
+    assert doc.current_params.p == 0.3 and doc.prototype == (2, 4, 16) and doc.seed == 42
+    assert window.seed_box.value() == 42 and window.params_panel.row("p").value() == 0.3
+    bad = tmp_path / "bad.json"
+    bad.write_text("{")
+    messages = []
+    window.message.connect(messages.append)
+    assert not window.open_session(str(bad))
+    assert "not a weft session" in messages[-1]
 
 
-def test_wheel_zooms_under_the_mouse(window, qtbot):
-    qtbot.waitUntil(lambda: window.view.image is not None, timeout=5000)
-    view = window.view
+def test_export_png_jpeg_tiff_and_weft_run_reproduces_bit_for_bit(window, qtbot, tmp_path):
+    png = tmp_path / "out.png"
+    assert window.export_result(str(png))
+    recipe = json.loads(read_recipe(png))
+    assert recipe["method"] == "fast" and recipe["seed"] == window.doc.seed
+    again = tmp_path / "again.png"
+    assert cli_main(["run", str(png), "-o", str(again)]) == 0
+    assert np.array_equal(load_image(png).image, load_image(again).image)
+    tif = tmp_path / "out.tif"
+    assert window.export_result(str(tif))
+    assert load_image(tif).info.bit_depth == 16
+    jpg = tmp_path / "out.jpg"
+    assert window.export_result(str(jpg))
+    assert load_image(jpg).image.shape == window.renderer.last.image.shape
+
+
+def test_compare_split_and_wheel_zoom_on_the_result(window):
+    view = window.result_view
+    window.compare_button.click()
+    assert view.comparing and view._clip.isVisible()
     view.actual_size()
-    view.zoom_by(4.0)  # larger than the viewport, so the view can scroll
+    mouse(view, "press", (64, 10))
+    mouse(view, "release", (64, 10))
+    assert view.split == pytest.approx(64 / view.image.shape[1], abs=0.02)
+    view.zoom_by(4.0)
     start = view.scale_factor()
     pos = view.mapFromScene(40.0, 30.0)
-    event = QWheelEvent(QPointF(pos), QPointF(view.viewport().mapToGlobal(pos)), QPoint(0, 0), QPoint(0, 120),
+    wheel = QWheelEvent(QPointF(pos), QPointF(view.viewport().mapToGlobal(pos)), QPoint(0, 0), QPoint(0, 120),
                         Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
-    QApplication.sendEvent(view.viewport(), event)
+    QApplication.sendEvent(view.viewport(), wheel)
     assert view.scale_factor() == pytest.approx(start * 1.25)
-    # The image point under the cursor stays under the cursor.
     after = view.mapToScene(pos)
     assert abs(after.x() - 40.0) < 1.5 and abs(after.y() - 30.0) < 1.5
 
 
-def test_no_worker_thread_left_after_shutdown(window, qtbot):
-    qtbot.waitUntil(lambda: window.view.image is not None, timeout=5000)
-    window.shutdown()
-    assert not [t for t in threading.enumerate() if t.name.startswith("weft-job") and t.is_alive()]
+def test_hover_shows_pixel_coordinates_and_value(window):
+    view = window.result_view
+    view.actual_size()
+    view.zoom_by(4.0)
+    view.centerOn(10.5, 20.5)
+    mouse(view, "move", (10.5, 20.5), buttons=Qt.MouseButton.NoButton)
+    assert window.pixel_label.text().startswith("result  x 10  y 20")
 
 
-def test_kernels_warm_up_in_the_background_without_error(window, qtbot):
-    qtbot.waitUntil(lambda: not window.runner.busy("warm-up"), timeout=60000)
-    job = window.runner.latest("warm-up")
-    assert job.result(timeout=1).ok
+def test_variations_grid_renders_and_adopts_a_cell(window, qtbot):
+    window.open_variations()
+    dialog = window._variations
+    dialog.combo[0].setCurrentText("p")
+    dialog.combo[1].setCurrentText("w")
+    dialog.lo[0].setValue(0.0)
+    dialog.hi[0].setValue(0.5)
+    dialog.lo[1].setValue(0.0)
+    dialog.hi[1].setValue(4.0)
+    done = set()
+    dialog.cell_done.connect(lambda i, j: done.add((i, j)))
+    dialog.render_grid()
+    qtbot.waitUntil(lambda: len(done) == 9, timeout=30000)
+    assert all(not b.icon().isNull() for b in dialog.cells.values())
+    steps = window.doc.undo_stack.count()
+    dialog.cells[(2, 1)].click()
+    assert window.doc.current_params.p == 0.5 and window.doc.current_params.w == 2.0
+    assert window.doc.undo_stack.count() == steps + 1
+    dialog.close()
+
+
+def test_no_worker_thread_left_after_close(qtbot, settings):
+    from app.gui.main_window import MainWindow
+
+    w = MainWindow(settings=settings)
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitUntil(lambda: w.renderer.last is not None, timeout=20000)
+    w.close()
+    assert no_job_threads()
+
+
+def test_slow_stand_in_is_cancellable_directly():
+    """The stand-in used above really blocks until cancelled (so the cancel test means something)."""
+    from core.jobs import CancelToken
+
+    started, token = threading.Event(), CancelToken()
+    method = _slow_method(started)
+    t = threading.Thread(target=lambda: pytest.raises(Cancelled, method.run, {}, None, cancel=token))
+    t.start()
+    assert started.wait(5)
+    assert t.is_alive()
+    token.cancel()
+    t.join(5)
+    assert not t.is_alive()

@@ -1,0 +1,188 @@
+"""The parameter panel, generated from a method's ``Params`` specs (the CLI reads the same specs).
+
+Numbers get labelled sliders with a typed entry (superqt), choices a combo box, switches a check
+box, sizes two spin boxes; an optional parameter has an "auto" box (its value is then derived, see
+the method's docs). Tooltips give the paper's symbol, the range and the help text; the ↺ button resets
+to the default. ``edited(name, value, dragging)`` is emitted on every user change; ``dragging`` is
+true while a slider is held down (the window renders a preview then, and the full result on release).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QSpinBox,
+    QToolButton,
+    QWidget,
+)
+from superqt import QLabeledDoubleSlider, QLabeledSlider
+
+from core.params import Params, Spec, specs
+
+
+class _Row(QWidget):
+    """One parameter's editor."""
+
+    changed = Signal(object, bool)  # value, dragging
+
+    def __init__(self, spec: Spec, parent=None):
+        super().__init__(parent)
+        self.spec = spec
+        lay = QHBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        self.auto: QCheckBox | None = None
+        if spec.optional:
+            self.auto = QCheckBox("auto")
+            self.auto.setToolTip("derive the value from the inputs and mode (see the tooltip)")
+            self.auto.toggled.connect(self._auto_toggled)
+            lay.addWidget(self.auto)
+        k = spec.kind
+        if k in ("int", "float"):
+            cls = QLabeledSlider if k == "int" else QLabeledDoubleSlider
+            self.editor = cls(Qt.Orientation.Horizontal)
+            lo = spec.lo if spec.lo is not None else 0
+            hi = spec.hi if spec.hi is not None else 100
+            self.editor.setRange(lo, hi)
+            if k == "float":
+                self.editor.setDecimals(3)
+                self.editor.setSingleStep(spec.step or (hi - lo) / 100)
+            self.editor.valueChanged.connect(self._value_changed)
+            self.editor.sliderReleased.connect(lambda: self.changed.emit(self.value(), False))
+        elif k == "choice":
+            self.editor = QComboBox()
+            self.editor.addItems([str(c) for c in spec.choices])
+            self.editor.currentTextChanged.connect(lambda _: self.changed.emit(self.value(), False))
+        elif k == "bool":
+            self.editor = QCheckBox()
+            self.editor.toggled.connect(lambda _: self.changed.emit(self.value(), False))
+        elif k == "size":
+            self.editor = QWidget()
+            sl = QHBoxLayout(self.editor)
+            sl.setContentsMargins(0, 0, 0, 0)
+            self.w_box, self.h_box = QSpinBox(), QSpinBox()
+            for box in (self.w_box, self.h_box):
+                box.setRange(int(spec.lo or 1), int(spec.hi or 16384))
+                box.setKeyboardTracking(False)
+                box.valueChanged.connect(lambda _: self.changed.emit(self.value(), False))
+                sl.addWidget(box)
+            self.w_box.setValue(512)
+            self.h_box.setValue(512)
+        else:
+            self.editor = QLineEdit()
+            self.editor.editingFinished.connect(lambda: self.changed.emit(self.value(), False))
+        lay.addWidget(self.editor, 1)
+        self.reset = QToolButton()
+        self.reset.setText("↺")
+        self.reset.setToolTip(f"reset {spec.name} to its default")
+        self.reset.clicked.connect(lambda: self.changed.emit(spec.default, False))
+        lay.addWidget(self.reset)
+        tip = [spec.help or spec.name]
+        if spec.symbol:
+            tip.insert(0, f"paper symbol: {spec.symbol}")
+        if spec.range_text():
+            tip.append(("one of " if k == "choice" else "range ") + spec.range_text())
+        self.setToolTip("\n".join(tip))
+
+    def _auto_toggled(self, on: bool) -> None:
+        self.editor.setEnabled(not on)
+        self.changed.emit(self.value(), False)
+
+    def _value_changed(self, _v) -> None:
+        if self.auto is not None and self.auto.isChecked():
+            self.auto.blockSignals(True)
+            self.auto.setChecked(False)
+            self.auto.blockSignals(False)
+            self.editor.setEnabled(True)
+        self.changed.emit(self.value(), bool(self.editor.isSliderDown()))
+
+    def value(self) -> Any:
+        if self.auto is not None and self.auto.isChecked():
+            return None
+        k = self.spec.kind
+        if k == "int":
+            return int(self.editor.value())
+        if k == "float":
+            return round(float(self.editor.value()), 6)
+        if k == "choice":
+            return self.spec.choices[self.editor.currentIndex()]
+        if k == "bool":
+            return self.editor.isChecked()
+        if k == "size":
+            return (self.w_box.value(), self.h_box.value())
+        return self.editor.text()
+
+    def set_value(self, value: Any, shown_when_auto: Any = None) -> None:
+        """Show ``value`` without emitting ``changed``."""
+        widgets = [self, self.editor] + ([self.auto] if self.auto else []) + (
+            [self.w_box, self.h_box] if self.spec.kind == "size" else [])
+        for w in widgets:
+            w.blockSignals(True)
+        try:
+            if self.auto is not None:
+                self.auto.setChecked(value is None)
+                self.editor.setEnabled(value is not None)
+            if value is None:
+                value = shown_when_auto
+            if value is None:
+                return
+            k = self.spec.kind
+            if k in ("int", "float"):
+                self.editor.setValue(value)
+            elif k == "choice":
+                self.editor.setCurrentIndex(list(self.spec.choices).index(value))
+            elif k == "bool":
+                self.editor.setChecked(bool(value))
+            elif k == "size":
+                self.w_box.setValue(int(value[0]))
+                self.h_box.setValue(int(value[1]))
+            else:
+                self.editor.setText(str(value))
+        finally:
+            for w in widgets:
+                w.blockSignals(False)
+
+
+class ParamsPanel(QWidget):
+    """Editors for every parameter of one ``Params`` class."""
+
+    edited = Signal(str, object, bool)  # name, value, dragging
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.form = QFormLayout(self)
+        self.form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        self.rows: dict[str, _Row] = {}
+        self.params_cls: type[Params] | None = None
+
+    def build(self, params_cls: type[Params], hidden: tuple[str, ...] = ()) -> None:
+        """(Re)build the editors for ``params_cls``; names in ``hidden`` are edited elsewhere."""
+        while self.form.rowCount():
+            self.form.removeRow(0)
+        self.rows = {}
+        self.params_cls = params_cls
+        for spec in specs(params_cls):
+            if spec.name in hidden:
+                continue
+            row = _Row(spec, self)
+            row.changed.connect(lambda value, dragging, name=spec.name: self.edited.emit(name, value, dragging))
+            label = QLabel(f"{spec.name} ({spec.symbol})" if spec.symbol and spec.symbol != spec.name else spec.name)
+            label.setToolTip(row.toolTip())
+            self.form.addRow(label, row)
+            self.rows[spec.name] = row
+
+    def show_params(self, params: Params, auto_values: dict[str, Any] | None = None) -> None:
+        """Show ``params`` (``auto_values`` are what "auto" resolves to, shown greyed)."""
+        auto_values = auto_values or {}
+        for name, row in self.rows.items():
+            row.set_value(getattr(params, name), auto_values.get(name))
+
+    def row(self, name: str) -> _Row:
+        return self.rows[name]

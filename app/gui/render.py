@@ -1,0 +1,209 @@
+"""Rendering: turns the document into preview and final jobs on the worker pool, results into images.
+
+* While a slider is held down, ``preview()`` submits a reduced-size job (slot ``"preview"``), at most
+  once per frame; release, and any other edit, asks for ``final()`` (slot ``"final"``, full size).
+  The fast method is quick enough to preview at full size up to ``FULL_PREVIEW_PIXELS``.
+* Jobs carry ids; a result older than the one shown is dropped, so what is shown is always the last
+  completed job. Workers never touch widgets: results and progress arrive through queued signals.
+* A job running longer than ``PROGRESS_DELAY_MS`` shows its progress (with partial previews where the
+  method gives them) and can be cancelled; after a cancel or an error the last good result stays.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+import numpy as np
+from PySide6.QtCore import QObject, QTimer, Signal
+
+from core.errors import WeftError
+from core.image import resize
+from core.jobs import JobResult, JobRunner, Progress
+from core.params import Params
+
+PREVIEW_SIDE = 320
+FULL_PREVIEW_PIXELS = {"fast": 700_000}
+PROGRESS_DELAY_MS = 300
+
+
+@dataclass
+class Shown:
+    """What the result view shows: the image, which job made it and how long it took."""
+
+    image: np.ndarray
+    job_id: int
+    seconds: float
+    figures: dict
+    final: bool
+
+
+class Renderer(QObject):
+    """Preview/final job logic for one document (see the module docstring).
+
+    Signals: ``shown(Shown)`` a new result to display; ``partial(image)`` a partial image of a
+    running job; ``progress(fraction, stage)``; ``busy(bool)`` a job over the progress delay is
+    running (show the bar); ``failed(message)``; ``cancelled()``.
+    """
+
+    shown = Signal(object)
+    partial = Signal(object)
+    progress = Signal(float, str)
+    busy = Signal(bool)
+    failed = Signal(str)
+    cancelled = Signal()
+    _delivered = Signal(object)
+    _progressed = Signal(int, str, object)
+
+    def __init__(self, doc, parent=None, *, workers: int = 2):
+        super().__init__(parent)
+        self.doc = doc
+        self.runner = JobRunner(max_workers=workers, on_result=self._delivered.emit,
+                                on_progress=lambda jid, slot, p: self._progressed.emit(jid, slot, p))
+        self._delivered.connect(self._on_result)
+        self._progressed.connect(self._on_progress)
+        self.last: Shown | None = None
+        self.submitted_at: dict[int, float] = {}
+        self.latest_final: int | None = None
+        self._preview_timer = QTimer(self, singleShot=True, interval=16)
+        self._preview_timer.timeout.connect(self._submit_preview)
+        self._final_timer = QTimer(self, singleShot=True, interval=60)
+        self._final_timer.timeout.connect(self._submit_final)
+        self._busy_timer = QTimer(self, singleShot=True, interval=PROGRESS_DELAY_MS)
+        self._busy_timer.timeout.connect(self._maybe_busy)
+        self.enabled = True
+
+    # --- requests ------------------------------------------------------------------------------
+    def preview(self) -> None:
+        """Ask for a reduced-size render soon (coalesced to one per frame)."""
+        if not self._preview_timer.isActive():
+            self._preview_timer.start()
+
+    def final(self, *, now: bool = False) -> None:
+        """Ask for the full-size render (coalesced; ``now`` skips the short delay)."""
+        self._preview_timer.stop()
+        if now:
+            self._final_timer.stop()
+            self._submit_final()
+        else:
+            self._final_timer.start()
+
+    def cancel(self) -> None:
+        """Cancel running renders; the last good result stays shown."""
+        self._preview_timer.stop()
+        self._final_timer.stop()
+        self.runner.cancel("preview")
+        self.runner.cancel("final")
+        self._busy_timer.stop()
+        self.busy.emit(False)
+        self.cancelled.emit()
+
+    def shutdown(self) -> None:
+        self._preview_timer.stop()
+        self._final_timer.stop()
+        self._busy_timer.stop()
+        self.runner.shutdown(wait=True, cancel=True)
+
+    # --- job construction ----------------------------------------------------------------------
+    def job_inputs(self, *, preview: bool) -> tuple[dict[str, np.ndarray], Params] | None:
+        """Inputs and parameters of a render of the current method, or None if inputs are missing."""
+        doc = self.doc
+        if doc.missing_inputs():
+            return None
+        inputs = doc.method_inputs()
+        params = doc.current_params
+        if preview:
+            inputs, params = reduced(inputs, params, PREVIEW_SIDE, FULL_PREVIEW_PIXELS.get(doc.method, 0))
+        return inputs, params
+
+    def _submit(self, slot: str, preview: bool) -> int | None:
+        if not self.enabled:
+            return None
+        built = self.job_inputs(preview=preview)
+        if built is None:
+            return None
+        inputs, params = built
+        method, seed = self.doc.current, self.doc.seed
+
+        def job(*, progress=None, cancel=None):
+            t0 = time.perf_counter()
+            result = method.run(inputs, params, rng=seed, progress=progress, cancel=cancel)
+            return result, time.perf_counter() - t0, not preview
+
+        if slot == "final":
+            self.runner.cancel("preview")
+        handle = self.runner.submit(slot, job)
+        self.submitted_at[handle.id] = time.perf_counter()
+        if slot == "final":
+            self.latest_final = handle.id
+            self._busy_timer.start()
+        return handle.id
+
+    def _submit_preview(self) -> None:
+        self._submit("preview", preview=True)
+
+    def _submit_final(self) -> None:
+        self._submit("final", preview=False)
+
+    # --- results -------------------------------------------------------------------------------
+    def _on_result(self, result: JobResult) -> None:
+        self.submitted_at.pop(result.job_id, None)
+        if result.slot not in ("preview", "final"):  # e.g. the kernels' warm-up
+            if result.error is not None:
+                self.failed.emit(f"{result.slot} failed: {result.error}")
+            return
+        if result.slot == "final" and result.job_id == self.latest_final:
+            self._busy_timer.stop()
+            self.busy.emit(False)
+        if result.error is not None:
+            if self.last is None or result.job_id > self.last.job_id:
+                self.failed.emit(f"render failed: {result.error}")
+            return
+        if self.last is not None and result.job_id < self.last.job_id:
+            return  # older than what is shown: stale
+        res, seconds, final = result.value
+        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final)
+        self.shown.emit(self.last)
+
+    def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
+        if slot != "final" or job_id != self.latest_final:
+            return
+        self.progress.emit(p.fraction, p.stage)
+        if p.preview is not None:
+            self.partial.emit(p.preview)
+
+    def _maybe_busy(self) -> None:
+        if self.latest_final is not None and self.latest_final in self.submitted_at:
+            self.busy.emit(True)
+
+
+def reduced(inputs: dict[str, np.ndarray], params: Params, side: int, full_pixels: int = 0
+            ) -> tuple[dict[str, np.ndarray], Params]:
+    """Inputs and parameters of a reduced render: the target (or the output ``size``) scaled so its
+    longer side is ``side``, unless it has at most ``full_pixels`` pixels (then unchanged)."""
+    target = inputs.get("target")
+    limit = full_pixels
+    if target is not None:
+        h, w = target.shape[:2]
+        if h * w <= limit or max(h, w) <= side:
+            return inputs, params
+        k = side / max(h, w)
+        small = dict(inputs)
+        small["target"] = resize(target, (max(8, round(w * k)), max(8, round(h * k))), interpolation="area")
+        return small, params
+    size = getattr(params, "size", None)
+    if size is not None and max(size) > side and size[0] * size[1] > limit:
+        k = side / max(size)
+        try:
+            return inputs, params.replace(size=(max(8, round(size[0] * k)), max(8, round(size[1] * k))))
+        except WeftError:  # a size the method refuses at preview scale: render at full size
+            return inputs, params
+    return inputs, params
+
+
+def describe(shown: Shown) -> str:
+    """Status-bar text for a shown result."""
+    h, w = shown.image.shape[:2]
+    kind = "result" if shown.final else "preview"
+    figs = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in shown.figures.items()
+                     if not isinstance(v, (list, dict)))
+    return f"{kind} {w}x{h} in {shown.seconds * 1000:.0f} ms" + (f" — {figs}" if figs else "")

@@ -1,0 +1,22 @@
+"""Shared fixtures of the GUI tests: a studio window with private settings."""
+
+import pytest
+from PySide6.QtCore import QSettings
+
+from app.gui.main_window import MainWindow
+
+
+@pytest.fixture
+def settings(tmp_path):
+    return QSettings(str(tmp_path / "weft.ini"), QSettings.Format.IniFormat)
+
+
+@pytest.fixture
+def window(qtbot, settings):
+    w = MainWindow(settings=settings)
+    qtbot.addWidget(w)
+    w.resize(1300, 820)
+    w.show()
+    qtbot.waitUntil(lambda: w.renderer.last is not None and w.renderer.last.final, timeout=20000)
+    yield w
+    w.shutdown()
