@@ -256,8 +256,9 @@ def _run(inputs: Mapping[str, np.ndarray], params: BlendParams, *, rng=None, pro
     return Result(image, figures)
 
 
-def _warm_up() -> None:
-    """Load (or compile) the Poisson solver on a tiny input."""
+def warm_up() -> None:
+    """Load (or compile) the numba Poisson solver on a tiny input (for the GUI's background start-up;
+    ``METHOD.warm_up`` is None so that ``weft blend`` in pyramid mode never loads numba)."""
     img = np.linspace(0, 1, 64, dtype=np.float32).reshape(8, 8)
     mask = np.zeros((8, 8), dtype=bool)
     mask[2:6, 2:6] = True
@@ -274,5 +275,4 @@ METHOD = Method(
         InputSpec("mask", "grey image, white = foreground, same size as the images", positional=False),
     ),
     run=_run,
-    warm_up=_warm_up,
 )

@@ -56,6 +56,26 @@ SYNTH_TOL = 2
 CORR_SIGMA = 2.0  # Gaussian blur (pixels) of the luminance correspondence maps ("blur")
 
 
+class _K:
+    """Indices and codes of the kernel's parameter arrays (the same as ``core._kernels.quilting``'s,
+    repeated here so that the numpy engine runs without importing numba; a test checks they agree)."""
+
+    P_Y0, P_X0, P_B, P_TOP, P_LEFT, P_RIGHT, P_BOTTOM, P_WRAP = 0, 1, 2, 3, 4, 5, 6, 7
+    P_MODE, P_RULE, P_TOL, P_SEED, P_POISSON, P_BAND, P_FIX_Y, P_FIX_X = 8, 9, 10, 11, 12, 13, 14, 15
+    N_IPARAMS = 16
+    F_CONST, F_EPS, F_U = 0, 1, 2
+    N_FPARAMS = 3
+    MODE_RANDOM, MODE_OVERLAP, MODE_MINCUT = 0, 1, 2
+    RULE_TOL, RULE_EPSILON, RULE_SAMPLED = 0, 1, 2
+    SAMPLE_FRACTION = TOP_FRACTION = 0.1
+
+
+# Below this many blocks a synthesis without Poisson runs the per-block step in numpy when numba
+# is not loaded yet: numba's one-time start-up (~0.6 s: import, registries, kernel cache) costs more
+# than the numpy step (~0.3 ms a block) there. Both engines give the same pixels.
+NUMPY_ENGINE_MAX_BLOCKS = 1024
+
+
 @dataclass(frozen=True)
 class QuiltParams(Params):
     """Parameters of image quilting (Efros & Freeman §2 synthesis, §3 transfer).
@@ -128,6 +148,7 @@ class _Pass:
     w_overlap: float = 1.0
     w_prev: float = 0.0
     w_corr: float = 0.0
+    engine: str = "auto"  # "auto", "numba" or "numpy" (tests compare the two)
 
 
 def _round_half_up(x: float) -> int:
@@ -301,8 +322,17 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                 report.update(i + 1, preview=preview)
         return canvas[:out_h, :out_w], rows * cols
 
-    from ._kernels import quilting as _k  # numba loads on first use, not with the CLI
+    import sys
 
+    use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and prev is None and corr is None
+                 and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "core._kernels.quilting" not in sys.modules)
+    if use_numpy:
+        _k = _K
+        place, template = _place_block_numpy, _make_template_numpy
+    else:
+        from ._kernels import quilting as _k  # numba loads on first use, not with the CLI
+
+        place, template = _k.place_block, _k.make_template
     src = _Source(tex, corr[0] if corr is not None else None, b)
     prev_c = np.zeros((1, 1, nc), dtype=np.float32)
     corr_t = np.zeros((1, 1), dtype=np.float32)
@@ -343,7 +373,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
             fp[_k.F_U] = us[i, j]
             if top or left or right or bottom or has_static:
                 ip[_k.P_FIX_Y] = ip[_k.P_FIX_X] = -1
-                const = _k.make_template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
+                const = template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
                                          p.w_overlap, p.w_prev, p.w_corr, src.mean, src.mean_c, tbuf, tcorr)
                 fp[_k.F_CONST] = const
                 spec = cv2.mulSpectrums(spectra[0], cv2.dft(tbuf[0]), 0, conjB=True)
@@ -356,10 +386,168 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
             else:  # synthesis, first block: a random position
                 ip[_k.P_FIX_Y], ip[_k.P_FIX_X] = first
                 cross, sq = dummy_cross, dummy_sq
-            _k.place_block(canvas, filled, tex, cross, sq, ip, fp)
+            place(canvas, filled, tex, cross, sq, ip, fp)
         if report is not None:
             report.update(i + 1, preview=preview)
     return canvas[:out_h, :out_w], rows * cols
+
+
+# --------------------------------------------------------------------------------------------
+# the numpy engine: the kernel's place_block (without the Poisson band), step for step
+
+
+def _splitmix_numpy(seed: int, n: int) -> np.ndarray:
+    """The kernel's splitmix64 outputs 1..n for ``seed`` (uint64 arithmetic wraps, as in numba)."""
+    golden = np.uint64(0x9E3779B97F4A7C15)
+    with np.errstate(over="ignore"):
+        z = np.uint64(seed) + golden * np.arange(1, n + 1, dtype=np.uint64)
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+def _select_numpy(cost: np.ndarray, rule: int, tol: int, eps: float, u: float, seed: int) -> int:
+    n = cost.size
+    if rule == _K.RULE_TOL:
+        if tol <= 1:
+            return int(np.argmin(cost))
+        k = min(tol, n)
+        kth = np.partition(cost, k - 1)[k - 1]
+        order = np.concatenate([np.flatnonzero(cost < kth), np.flatnonzero(cost == kth)])
+        return int(order[min(int(u * k), k - 1)])
+    if rule == _K.RULE_EPSILON:
+        thr = (1.0 + eps) * max(float(cost.min()), 0.0)
+        cand = np.flatnonzero(cost <= thr)
+        return int(cand[min(int(u * len(cand)), len(cand) - 1)])
+    z = _splitmix_numpy(seed, n + 1)
+    limit = np.uint64(int(_K.SAMPLE_FRACTION * 18446744073709551615.0))
+    idx = np.flatnonzero(z[:n] < limit)
+    if idx.size == 0:
+        idx = np.array([int(z[n] % np.uint64(n))])
+    k = max(1, int(np.ceil(_K.TOP_FRACTION * idx.size)))
+    order = np.argsort(cost[idx], kind="stable")
+    return int(idx[order[min(int(u * k), k - 1)]])
+
+
+def _vertical_acc_numpy(err: np.ndarray) -> np.ndarray:
+    h, w = err.shape
+    acc = np.empty((h, w))
+    acc[h - 1] = err[h - 1]
+    pad = np.full(w + 2, np.inf)
+    for y in range(h - 2, -1, -1):
+        pad[1:-1] = acc[y + 1]
+        acc[y] = err[y] + np.minimum(np.minimum(pad[1:-1], pad[:-2]), pad[2:])
+    return acc
+
+
+def _trace_numpy(acc: np.ndarray, y_start: int, x_start: int) -> np.ndarray:
+    h, w = acc.shape
+    path = np.empty(h, dtype=np.int64)
+    x = x_start
+    path[y_start] = x
+    for y in range(y_start + 1, h):
+        best, m = x, acc[y, x]
+        if x > 0 and acc[y, x - 1] < m:
+            m, best = acc[y, x - 1], x - 1
+        if x < w - 1 and acc[y, x + 1] < m:
+            best = x + 1
+        x = best
+        path[y] = x
+    return path
+
+
+def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: int) -> np.ndarray:
+    """The kernel's ``cut_mask`` in numpy (horizontal cuts by transposition)."""
+    h, w = err.shape
+    mask = np.ones((h, w), dtype=bool)
+    yy, xx = np.mgrid[0:h, 0:w]
+    if left > 0 and top > 0:
+        ev = _vertical_acc_numpy(err[:, :left])
+        eh = _vertical_acc_numpy(err[:top, :].T)  # (w, top): rows = columns from the right
+        corner = ev[:top, :left] + eh[:left, :top].T - err[:top, :left]
+        r, c = divmod(int(np.argmin(corner)), left)
+        vpath = np.zeros(h, dtype=np.int64)
+        vpath[r:] = _trace_numpy(ev, r, c)[r:]
+        hpath = np.zeros(w, dtype=np.int64)
+        hpath[c:] = _trace_numpy(eh, c, r)[c:]
+        a = np.where(yy >= r, xx >= vpath[:, None], xx >= c)
+        b = np.where(xx >= c, yy >= hpath[None, :], yy >= r)
+        mask &= a & b
+    elif left > 0:
+        ev = _vertical_acc_numpy(err[:, :left])
+        vpath = _trace_numpy(ev, 0, int(np.argmin(ev[0])))
+        mask &= xx >= vpath[:, None]
+    elif top > 0:
+        eh = _vertical_acc_numpy(err[:top, :].T)
+        hpath = _trace_numpy(eh, 0, int(np.argmin(eh[0])))
+        mask &= yy >= hpath[None, :]
+    if right > 0:
+        ev = _vertical_acc_numpy(err[:, w - right:])
+        vpath = _trace_numpy(ev, 0, int(np.argmin(ev[0]))) + (w - right)
+        mask &= xx <= vpath[:, None]
+    if bottom > 0:
+        eh = _vertical_acc_numpy(err[h - bottom:, :].T)
+        hpath = _trace_numpy(eh, 0, int(np.argmin(eh[0]))) + (h - bottom)
+        mask &= yy <= hpath[None, :]
+    return mask
+
+
+def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bottom, wrap,
+                         w_overlap, w_prev, w_corr, mean, mean_c, tbuf, tcorr):
+    """The kernel's ``make_template`` for synthesis (overlap term only), in numpy (same values)."""
+    if w_prev or w_corr:
+        raise NotImplementedError("the numpy engine quilts synthesis only")
+    hc, wc, nc = canvas.shape
+    iy = (y0 + np.arange(b)) % hc
+    ix = (x0 + np.arange(b)) % wc
+    m = np.zeros((b, b), dtype=bool)
+    m[:top] = m[:, :left] = True
+    m[:, b - right:] = True
+    m[b - bottom:] = True
+    o = canvas[np.ix_(iy, ix)].astype(np.float64) - mean
+    v = np.where(m[..., None], w_overlap * o, 0.0)
+    tbuf[:, :b, :b] = v.transpose(2, 0, 1)
+    terms = (v * o)[m]  # (w o) o in the kernel's loop order: row, column, channel
+    return float(np.cumsum(terms.ravel())[-1]) if terms.size else 0.0
+
+
+def _place_block_numpy(canvas, filled, tex, cross, sq, ip, fp):
+    """``core._kernels.quilting.place_block`` without the Poisson band, in numpy (same pixels)."""
+    hc, wc, nc = canvas.shape
+    b = int(ip[_K.P_B])
+    y0, x0 = int(ip[_K.P_Y0]), int(ip[_K.P_X0])
+    top, left, right, bottom = (int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM))
+    ph, pw = tex.shape[0] - b + 1, tex.shape[1] - b + 1
+    if ip[_K.P_FIX_Y] >= 0:
+        sy, sx = int(ip[_K.P_FIX_Y]), int(ip[_K.P_FIX_X])
+    else:
+        cost = sq[:ph, :pw].astype(np.float64) - 2.0 * cross[:ph, :pw].astype(np.float64) + fp[_K.F_CONST]
+        cost = np.maximum(cost, 0.0).ravel()
+        k = _select_numpy(cost, int(ip[_K.P_RULE]), int(ip[_K.P_TOL]), float(fp[_K.F_EPS]), float(fp[_K.F_U]),
+                          int(ip[_K.P_SEED]))
+        sy, sx = divmod(k, pw)
+    iy = (y0 + np.arange(b)) % hc
+    ix = (x0 + np.arange(b)) % wc
+    block = tex[sy:sy + b, sx:sx + b]
+    if ip[_K.P_MODE] == _K.MODE_MINCUT and (top or left or right or bottom):
+        old = canvas[np.ix_(iy, ix)]
+        d = old - block
+        err = (d * d).astype(np.float64).sum(axis=2)
+        strips = np.zeros((b, b), dtype=bool)
+        strips[:top] = strips[:, :left] = True
+        strips[:, b - right:] = True
+        strips[b - bottom:] = True
+        err[~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
+        mask = _cut_mask_numpy(err, top, left, right, bottom)
+        merged = np.where(mask[..., None], block, old)
+        canvas[np.ix_(iy, ix)] = merged
+        f = filled[np.ix_(iy, ix)]
+        f[mask] = 1
+        filled[np.ix_(iy, ix)] = f
+    else:
+        canvas[np.ix_(iy, ix)] = block
+        filled[np.ix_(iy, ix)] = 1
+    return sy, sx
 
 
 def _pad_to(img: np.ndarray, h: int, w: int) -> np.ndarray:
@@ -703,8 +891,14 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
     return Result(image, {"iterations": len(images)})
 
 
-def _warm_up() -> None:
-    """Load (or compile) the kernels on tiny inputs, so the first real run is not charged with it."""
+def warm_up() -> None:
+    """Load (or compile) the numba kernels on tiny inputs, so the first real run is not charged with it.
+
+    For the GUI's background start-up. ``METHOD.warm_up`` is deliberately None: the CLI calls a
+    method's warm-up before every run, and a small synthesis (the numpy engine, see
+    ``NUMPY_ENGINE_MAX_BLOCKS``) would then pay numba's ~0.6 s start-up for nothing. A CLI transfer's
+    reported ``seconds`` therefore include that one-time load.
+    """
     rng = np.random.default_rng(0)
     tex = rng.random((12, 12), dtype=np.float32)
     synthesize(tex, size=(16, 16), block=6, overlap=2, mode="mincut", poisson=True, rng=0)
@@ -723,5 +917,4 @@ METHOD = Method(
         InputSpec("target_map", "transfer: the target's correspondence map (with --source-map)", required=False),
     ),
     run=_run,
-    warm_up=_warm_up,
 )

@@ -350,7 +350,7 @@ def _select(cost, rule, tol, eps, u, seed):
     for i in range(m):
         vals[i] = cost[idx[i]]
     k = max(1, int(np.ceil(TOP_FRACTION * m)))
-    order = np.argsort(vals)
+    order = np.argsort(vals, kind="mergesort")  # stable, as the numpy engine's
     pick = min(int(u * k), k - 1)
     return idx[order[pick]]
 

@@ -238,3 +238,24 @@ def test_method_run_synthesis_and_transfer(brick, gravel):
         METHOD.run({"texture": gravel}, QuiltParams(iterations=2), rng=1)
     with pytest.raises(InvalidParameter, match="'size' cannot be given with a target"):
         METHOD.run({"texture": gravel, "target": brick}, QuiltParams(size=(10, 10)), rng=1)
+
+
+@pytest.mark.parametrize("kw", [dict(mode="mincut"), dict(mode="overlap", tol=4), dict(mode="mincut", rule="epsilon"),
+                                dict(mode="mincut", rule="sampled", tile=True)])
+def test_numpy_and_numba_engines_give_the_same_pixels(brick, monkeypatch, kw):
+    import dataclasses
+
+    import core.quilting as q
+    from core._kernels import quilting as k
+
+    for name in ("P_Y0", "P_FIX_X", "N_IPARAMS", "F_U", "N_FPARAMS", "MODE_MINCUT", "RULE_SAMPLED",
+                 "SAMPLE_FRACTION", "TOP_FRACTION"):
+        assert getattr(q._K, name) == getattr(k, name)
+    colour = np.ascontiguousarray(np.stack([brick, brick[::-1], brick.T], axis=2))
+    original = q._quilt_pass
+    outs = {}
+    for engine in ("numba", "numpy"):
+        monkeypatch.setattr(q, "_quilt_pass", lambda tex, h, w, p, rng, _e=engine, **k2:
+                            original(tex, h, w, dataclasses.replace(p, engine=_e), rng, **k2))
+        outs[engine] = q.synthesize(colour, size=(90, 70), block=16, overlap=5, rng=3, **kw)
+    assert np.array_equal(outs["numba"], outs["numpy"])
