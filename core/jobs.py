@@ -91,7 +91,9 @@ class ProgressReporter:
     callback : callable or None
         The algorithm's ``progress`` argument; ``None`` makes every update a cheap no-op. A callback
         with an attribute ``wants_preview = False`` (a progress bar that only draws the fraction)
-        gets ``preview=None`` and preview callables are never called for it.
+        gets ``preview=None`` and preview callables are never called for it. A callback with an
+        attribute ``preview_interval`` (seconds) gets a built preview at most that often, the first
+        one only after that long: a job faster than the interval never pays for building one.
     stage : str
         Stage name put into each :class:`Progress`.
     total : int
@@ -107,7 +109,7 @@ class ProgressReporter:
     (101, 1.0)
     """
 
-    __slots__ = ("callback", "stage", "total", "_last", "_previews")
+    __slots__ = ("callback", "stage", "total", "_last", "_previews", "_interval", "_next_preview")
 
     def __init__(self, callback: ProgressCallback | None, stage: str, total: int) -> None:
         self.callback = callback
@@ -115,6 +117,8 @@ class ProgressReporter:
         self.total = int(total)
         self._last: int | None = None
         self._previews = bool(getattr(callback, "wants_preview", True))
+        self._interval = float(getattr(callback, "preview_interval", 0.0))
+        self._next_preview = time.monotonic() + self._interval
 
     def update(self, done: int, preview: np.ndarray | Callable[[], np.ndarray] | None = None) -> bool:
         """Report ``done`` units if the integer percentage changed or ``done == total``.
@@ -137,6 +141,13 @@ class ProgressReporter:
         self._last = percent
         if not self._previews:
             preview = None
+        elif self._interval > 0.0:
+            now = time.monotonic()
+            if now < self._next_preview:
+                preview = None
+            else:
+                self._next_preview = now + self._interval
+                preview = preview() if callable(preview) else preview
         elif callable(preview):
             preview = preview()
         self.callback(Progress(self.stage, int(done), self.total, preview))

@@ -1,8 +1,13 @@
 """Rendering: turns the document into preview and final jobs on the worker pool, results into images.
 
-* While a slider is held down, ``preview()`` submits a reduced-size job (slot ``"preview"``), at most
-  once per frame; release, and any other edit, asks for ``final()`` (slot ``"final"``, full size).
-  The fast method is quick enough to preview at full size up to ``FULL_PREVIEW_PIXELS``.
+* While a slider is held down, ``preview()`` submits a reduced-size job (slot ``"preview"``). At most
+  one preview is computed at a time: changes that arrive meanwhile are coalesced into the next one,
+  started as soon as the running one is done (cancelling a running preview at every slider step
+  would starve the display while the slider moves). Release, and any other edit, asks for
+  ``final()`` (slot ``"final"``, full size), which cancels any preview.
+  Previews scale the target (or the output size) so its longer side is ``PREVIEW_SIDE``; measured with
+  ``python -m benchmarks.gui_latency``, full-size previews of a 640x500 fast transfer (~40 ms each)
+  gave a median latency of ~100 ms, 400 px previews meet the 50 ms goal.
 * Jobs carry ids; a result older than the one shown is dropped, so what is shown is always the last
   completed job. Workers never touch widgets: results and progress arrive through queued signals.
 * A job running longer than ``PROGRESS_DELAY_MS`` shows its progress (with partial previews where the
@@ -21,9 +26,22 @@ from core.image import resize
 from core.jobs import JobResult, JobRunner, Progress
 from core.params import Params
 
-PREVIEW_SIDE = 320
-FULL_PREVIEW_PIXELS = {"fast": 700_000}
+PREVIEW_SIDE = 400
+FULL_PREVIEW_PIXELS: dict[str, int] = {}  # method -> pixel count up to which previews are full size
 PROGRESS_DELAY_MS = 300
+PARTIAL_INTERVAL = 0.25
+
+
+class _Partial:
+    """A progress callback that asks algorithms for a partial image at most every PARTIAL_INTERVAL s."""
+
+    preview_interval = PARTIAL_INTERVAL
+
+    def __init__(self, forward):
+        self.forward = forward
+
+    def __call__(self, p: Progress) -> None:
+        self.forward(p)
 
 
 @dataclass
@@ -53,6 +71,7 @@ class Renderer(QObject):
     cancelled = Signal()
     _delivered = Signal(object)
     _progressed = Signal(int, str, object)
+    _preview_finished = Signal(int)
 
     def __init__(self, doc, parent=None, *, workers: int = 2):
         super().__init__(parent)
@@ -61,6 +80,9 @@ class Renderer(QObject):
                                 on_progress=lambda jid, slot, p: self._progressed.emit(jid, slot, p))
         self._delivered.connect(self._on_result)
         self._progressed.connect(self._on_progress)
+        self._preview_finished.connect(self._on_preview_finished)
+        self._preview_running: int | None = None
+        self._preview_dirty = False
         self.last: Shown | None = None
         self.submitted_at: dict[int, float] = {}
         self.latest_final: int | None = None
@@ -91,6 +113,7 @@ class Renderer(QObject):
         """Cancel running renders; the last good result stays shown."""
         self._preview_timer.stop()
         self._final_timer.stop()
+        self._preview_running, self._preview_dirty = None, False
         self.runner.cancel("preview")
         self.runner.cancel("final")
         self._busy_timer.stop()
@@ -125,13 +148,20 @@ class Renderer(QObject):
         method, seed = self.doc.current, self.doc.seed
 
         def job(*, progress=None, cancel=None):
+            # Previews report nothing; a final render's partial images are built at most every
+            # PARTIAL_INTERVAL seconds (a fast render never pays for one).
+            report = None if preview or progress is None else _Partial(progress)
             t0 = time.perf_counter()
-            result = method.run(inputs, params, rng=seed, progress=progress, cancel=cancel)
+            result = method.run(inputs, params, rng=seed, progress=report, cancel=cancel)
             return result, time.perf_counter() - t0, not preview
 
         if slot == "final":
             self.runner.cancel("preview")
+            self._preview_running, self._preview_dirty = None, False
         handle = self.runner.submit(slot, job)
+        if slot == "preview":
+            self._preview_running = handle.id
+            handle.future.add_done_callback(lambda _f, jid=handle.id: self._preview_finished.emit(jid))
         self.submitted_at[handle.id] = time.perf_counter()
         if slot == "final":
             self.latest_final = handle.id
@@ -139,7 +169,18 @@ class Renderer(QObject):
         return handle.id
 
     def _submit_preview(self) -> None:
+        if self._preview_running is not None:
+            self._preview_dirty = True  # started when the running preview is done
+            return
         self._submit("preview", preview=True)
+
+    def _on_preview_finished(self, job_id: int) -> None:
+        if job_id != self._preview_running:
+            return
+        self._preview_running = None
+        if self._preview_dirty:
+            self._preview_dirty = False
+            self._submit("preview", preview=True)
 
     def _submit_final(self) -> None:
         self._submit("final", preview=False)

@@ -561,3 +561,28 @@ def test_stress_random_submit_and_cancel(make_runner):
             assert job.token.cancelled
         elif r.error is not None:
             assert isinstance(r.error, WeftError)
+
+
+def test_reporter_builds_previews_at_most_every_preview_interval(monkeypatch):
+    import core.jobs as jobs
+
+    clock = [100.0]
+    monkeypatch.setattr(jobs.time, "monotonic", lambda: clock[0])
+
+    class Slow:
+        preview_interval = 0.5
+
+        def __init__(self):
+            self.calls = []
+
+        def __call__(self, p):
+            self.calls.append(p)
+
+    cb, built = Slow(), []
+    reporter = ProgressReporter(cb, "rows", 10)
+    for done in range(1, 11):
+        clock[0] += 0.2  # 0.2 s per unit of work
+        reporter.update(done, preview=lambda: built.append(done) or np.zeros(1))
+    assert len(cb.calls) == 10  # progress itself is not throttled
+    # First preview only after 0.5 s (done = 3), then at most every 0.5 s.
+    assert built == [3, 6, 9]
