@@ -1,50 +1,95 @@
-"""Render README screenshots from the real app: ``QT_QPA_PLATFORM=offscreen python docs/screenshots.py``.
+"""Render the README's screenshots from the real app: ``.venv/bin/python docs/screenshots.py``.
 
-Each shot opens the real main window, waits until its jobs have delivered, and grabs the window
-into ``docs/images/``.
+Runs offscreen (``QT_QPA_PLATFORM=offscreen``); each shot opens the real main window with private
+settings, sets up a method the way a user would (inputs, parameters, prototype, lines), waits for the
+full-size result and grabs the window into ``docs/images/studio-<name>.png``.
 """
 
 from __future__ import annotations
 
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
+from PySide6.QtCore import QSettings  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
+from app.gui.document import InputImage  # noqa: E402
 from app.gui.main_window import MainWindow  # noqa: E402
+from core import registry  # noqa: E402
+from core.examples import example  # noqa: E402
+from core.image import load_image  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "images"
 
 
-def _wait(app: QApplication, condition, timeout: float = 10.0) -> None:
+def _wait(app, condition, timeout: float = 60.0) -> None:
     end = time.monotonic() + timeout
     while not condition():
         if time.monotonic() > end:
             raise RuntimeError("timed out waiting for the window")
         app.processEvents()
-        time.sleep(0.01)
+        time.sleep(0.005)
+
+
+def _input(name: str) -> InputImage:
+    path = example(name)
+    return InputImage(str(path), load_image(path).image)
+
+
+def shoot(app, name: str, setup) -> Path:
+    with tempfile.TemporaryDirectory() as tmp:
+        window = MainWindow(settings=QSettings(os.path.join(tmp, "s.ini"), QSettings.Format.IniFormat),
+                            load_defaults=False)
+        window.resize(1440, 860)
+        window.show()
+        app.processEvents()
+        setup(window)
+        window.doc.undo_stack.clear()
+        window.renderer.final(now=True)
+        _wait(app, lambda: window.renderer.last is not None and window.renderer.last.final
+              and not window.renderer.runner.busy("final"))
+        for _ in range(5):
+            app.processEvents()
+        path = OUT / f"studio-{name}.png"
+        window.grab().save(str(path))
+        window.close()
+    return path
+
+
+def fast(window) -> None:
+    doc = window.doc
+    doc._put_method("fast")
+    doc._put_input("texture", _input("hatching"))
+    doc._put_input("target", _input("chelsea"))
+    doc.set_param("metric", "artistic")
+    doc.set_param("p", 0.2)
+    doc.set_param("colour", "source")
+
+
+def quilt(window) -> None:
+    doc = window.doc
+    doc._put_method("quilt")
+    doc._put_input("texture", _input("brick"))
+    doc.set_prototype((0, 0, 128))
+    doc.set_param("mode", "mincut")
+    doc.set_param("size", (384, 384))
+    window.compare_button.setChecked(False)
+
+
+SHOTS = {"fast": fast, "quilt": quilt}
 
 
 def main() -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     OUT.mkdir(parents=True, exist_ok=True)
-    window = MainWindow()
-    window.resize(1100, 700)
-    window.show()
-    _wait(app, lambda: window.view.image is not None)
-    target = next(i for i in range(window.example_list.count()) if window.example_list.item(i).text() == "brick")
-    window.example_list.setCurrentRow(target)
-    _wait(app, lambda: window.current_path is not None and window.current_path.stem == "brick")
-    window.view.fit()
-    app.processEvents()
-    path = OUT / "main-window.png"
-    window.grab().save(str(path))
-    print(path)
-    window.shutdown()
+    for name, setup in SHOTS.items():
+        if name in registry.methods():
+            print(shoot(app, name, setup))
     return 0
 
 

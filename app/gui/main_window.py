@@ -50,6 +50,8 @@ OPEN_FILTER = "Images (*.png *.jpg *.jpeg *.tif *.tiff *.bmp *.webp);;All files 
 SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
 DEFAULT_INPUTS = {"texture": "wood-grain", "target": "astronaut"}
 MAX_RECENT = 8
+# The methods the studio offers (those registered): "blend" and "rectify" are command-line steps.
+STUDIO_METHODS = ("fast", "quilt", "affine", "nfpt")
 
 
 class _ExampleList(QListWidget):
@@ -87,13 +89,14 @@ class MainWindow(QMainWindow):
         self.texture_view.tool = self.patch_tool
         self.input_tabs = QTabWidget()
         left = QSplitter(Qt.Orientation.Vertical)
-        left.addWidget(self._titled(self.texture_view, "texture — drag a square: the prototype patch, or "
-                                                       "the source region (Edit > Clear Prototype to use all)"))
+        left.addWidget(self._titled(self.texture_view, "texture — drag a square: prototype / source region"))
         left.addWidget(self.input_tabs)
         self.splitter = QSplitter(Qt.Orientation.Horizontal)
         self.splitter.addWidget(left)
         self.splitter.addWidget(self._titled(self.result_view, "result"))
-        self.splitter.setStretchFactor(1, 2)
+        self.splitter.setStretchFactor(0, 2)
+        self.splitter.setStretchFactor(1, 3)
+        self.splitter.setSizes([420, 630])
         self.setCentralWidget(self.splitter)
 
         self._build_dock()
@@ -145,7 +148,7 @@ class MainWindow(QMainWindow):
         top.addWidget(QLabel("Method"))
         self.method_box = QComboBox()
         for name, m in registry.methods().items():
-            if m.inputs and m.inputs[0].name in ("texture",):
+            if name in STUDIO_METHODS:
                 self.method_box.addItem(name)
                 self.method_box.setItemData(self.method_box.count() - 1, m.summary, Qt.ItemDataRole.ToolTipRole)
         self.method_box.currentTextChanged.connect(lambda name: self.doc.set_method(name) if name else None)
@@ -193,7 +196,7 @@ class MainWindow(QMainWindow):
         dock = QDockWidget("Method", self)
         dock.setObjectName("method")
         dock.setWidget(panel)
-        dock.setMinimumWidth(340)
+        dock.setMinimumWidth(390)
         self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
 
     def _build_examples(self) -> None:

@@ -93,6 +93,7 @@ class _Row(QWidget):
 
     def _auto_toggled(self, on: bool) -> None:
         self.editor.setEnabled(not on)
+        self.editor.setVisible(True)
         self.changed.emit(self.value(), False)
 
     def _value_changed(self, _v) -> None:
@@ -129,6 +130,8 @@ class _Row(QWidget):
             if self.auto is not None:
                 self.auto.setChecked(value is None)
                 self.editor.setEnabled(value is not None)
+                # "auto" with no known value: show no number rather than a misleading one
+                self.editor.setVisible(value is not None or shown_when_auto is not None)
             if value is None:
                 value = shown_when_auto
             if value is None:
