@@ -74,6 +74,7 @@ class _K:
 # is not loaded yet: numba's one-time start-up (~0.6 s: import, registries, kernel cache) costs more
 # than the numpy step (~0.3 ms a block) there. Both engines give the same pixels.
 NUMPY_ENGINE_MAX_BLOCKS = 1024
+STATIC_AHEAD = True  # transfer: static terms one row ahead on a second thread
 
 
 @dataclass(frozen=True)
@@ -361,34 +362,68 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     flags = cv2.DFT_REAL_OUTPUT | cv2.DFT_SCALE
     spectra, spectrum_c = src.spectra, src.spectrum_c
     wrap = bool(p.tile)
-    for i in range(rows):
-        if cancel is not None:
-            cancel.raise_if_cancelled()
-        y0, top, bottom = ys[i], tops[i], bottoms[i]
-        ip[_k.P_Y0], ip[_k.P_TOP], ip[_k.P_BOTTOM] = y0, top, bottom
-        for j in range(cols):
-            x0, left, right = xs[j], lefts[j], rights[j]
-            ip[_k.P_X0], ip[_k.P_LEFT], ip[_k.P_RIGHT] = x0, left, right
-            ip[_k.P_SEED] = seeds[i, j]
-            fp[_k.F_U] = us[i, j]
-            if top or left or right or bottom or has_static:
-                ip[_k.P_FIX_Y] = ip[_k.P_FIX_X] = -1
-                const = template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
-                                         p.w_overlap, p.w_prev, p.w_corr, src.mean, src.mean_c, tbuf, tcorr)
-                fp[_k.F_CONST] = const
-                spec = cv2.mulSpectrums(spectra[0], cv2.dft(tbuf[0]), 0, conjB=True)
-                for c in range(1, nc):
-                    spec += cv2.mulSpectrums(spectra[c], cv2.dft(tbuf[c]), 0, conjB=True)
-                if spectrum_c is not None and p.w_corr:
-                    spec += cv2.mulSpectrums(spectrum_c, cv2.dft(tcorr), 0, conjB=True)
-                cross = cv2.idft(spec, flags=flags)
-                sq = src.sq((top, left, right, bottom), p)
-            else:  # synthesis, first block: a random position
-                ip[_k.P_FIX_Y], ip[_k.P_FIX_X] = first
-                cross, sq = dummy_cross, dummy_sq
-            place(canvas, filled, tex, cross, sq, ip, fp)
-        if report is not None:
-            report.update(i + 1, preview=preview)
+    static_rows = None
+    if has_static:
+        # The previous-pass and correspondence terms do not depend on the blocks placed in this pass:
+        # their spectra are computed one block row ahead on a second thread (cv2 and the numba
+        # kernels release the GIL), while this thread adds the overlap term block by block.
+        from concurrent.futures import ThreadPoolExecutor
+
+        tbuf_s = np.zeros_like(tbuf)
+        tcorr_s = np.zeros_like(tcorr)
+
+        def static_row(i):
+            out = []
+            for j in range(cols):
+                cst = template(prev_c, prev_c, corr_t, ys[i], xs[j], b, 0, 0, 0, 0, wrap,
+                               0.0, p.w_prev, p.w_corr, src.mean, src.mean_c, tbuf_s, tcorr_s)
+                spec = cv2.mulSpectrums(spectrum_c, cv2.dft(tcorr_s), 0, conjB=True)
+                if p.w_prev:
+                    for c in range(nc):
+                        spec += cv2.mulSpectrums(spectra[c], cv2.dft(tbuf_s[c]), 0, conjB=True)
+                out.append((spec, cst))
+            return out
+
+        if STATIC_AHEAD:
+            static_rows = ThreadPoolExecutor(max_workers=1, thread_name_prefix="weft-quilt")
+    try:
+        ahead = static_rows.submit(static_row, 0) if static_rows is not None else None
+        for i in range(rows):
+            if cancel is not None:
+                cancel.raise_if_cancelled()
+            row_static = static_row(i) if has_static and static_rows is None else None
+            if ahead is not None:
+                row_static = ahead.result()
+                ahead = static_rows.submit(static_row, i + 1) if i + 1 < rows else None
+            y0, top, bottom = ys[i], tops[i], bottoms[i]
+            ip[_k.P_Y0], ip[_k.P_TOP], ip[_k.P_BOTTOM] = y0, top, bottom
+            for j in range(cols):
+                x0, left, right = xs[j], lefts[j], rights[j]
+                ip[_k.P_X0], ip[_k.P_LEFT], ip[_k.P_RIGHT] = x0, left, right
+                ip[_k.P_SEED] = seeds[i, j]
+                fp[_k.F_U] = us[i, j]
+                overlaps = top or left or right or bottom
+                if overlaps or row_static is not None:
+                    ip[_k.P_FIX_Y] = ip[_k.P_FIX_X] = -1
+                    spec, const = (None, 0.0) if row_static is None else row_static[j]
+                    if overlaps:
+                        const += template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
+                                          p.w_overlap, 0.0, 0.0, src.mean, src.mean_c, tbuf, tcorr)
+                        for c in range(nc):
+                            part = cv2.mulSpectrums(spectra[c], cv2.dft(tbuf[c]), 0, conjB=True)
+                            spec = part if spec is None else spec + part
+                    fp[_k.F_CONST] = const
+                    cross = cv2.idft(spec, flags=flags)
+                    sq = src.sq((top, left, right, bottom), p)
+                else:  # synthesis, first block: a random position
+                    ip[_k.P_FIX_Y], ip[_k.P_FIX_X] = first
+                    cross, sq = dummy_cross, dummy_sq
+                place(canvas, filled, tex, cross, sq, ip, fp)
+            if report is not None:
+                report.update(i + 1, preview=preview)
+    finally:
+        if static_rows is not None:
+            static_rows.shutdown(wait=True, cancel_futures=True)
     return canvas[:out_h, :out_w], rows * cols
 
 
