@@ -164,7 +164,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     if region is not None:
         first = method.inputs[0].name
         images[first] = crop_square(images[first], region, what=first)
-    if method.warm_up is not None:
+    if method.warm_up is not None and method.warm_up_in_cli:
         method.warm_up()  # load compiled kernels now, so "seconds" is the compute alone
     bar = _TerminalProgress(not args.quiet)
     t0 = time.perf_counter()

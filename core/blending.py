@@ -258,7 +258,7 @@ def _run(inputs: Mapping[str, np.ndarray], params: BlendParams, *, rng=None, pro
 
 def warm_up() -> None:
     """Load (or compile) the numba Poisson solver on a tiny input (for the GUI's background start-up;
-    ``METHOD.warm_up`` is None so that ``weft blend`` in pyramid mode never loads numba)."""
+    ``METHOD.warm_up_in_cli`` is False so that ``weft blend`` in pyramid mode never loads numba)."""
     img = np.linspace(0, 1, 64, dtype=np.float32).reshape(8, 8)
     mask = np.zeros((8, 8), dtype=bool)
     mask[2:6, 2:6] = True
@@ -275,4 +275,6 @@ METHOD = Method(
         InputSpec("mask", "grey image, white = foreground, same size as the images", positional=False),
     ),
     run=_run,
+    warm_up=warm_up,
+    warm_up_in_cli=False,
 )

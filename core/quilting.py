@@ -81,16 +81,16 @@ STATIC_AHEAD = True  # transfer: static terms one row ahead on a second thread
 class QuiltParams(Params):
     """Parameters of image quilting (Efros & Freeman §2 synthesis, §3 transfer).
 
-    ``None`` means "derived from what is made": ``mode`` random for synthesis and mincut for
-    transfer; ``block`` 32 for synthesis, 9 for one transfer pass, 31 for iterative transfer;
+    ``mode`` defaults to mincut, the paper's full method. ``None`` means "derived from what is
+    made": ``block`` 32 for synthesis, 9 for one transfer pass, 31 for iterative transfer;
     ``overlap`` a sixth of the block rounded up for synthesis (E&F §2.1), a third for one transfer
     pass (Ngo's 9 / 3) and two thirds for iterative transfer (Ngo's 31 / 21); ``tol`` 2 for
     synthesis and 1 for transfer.
     """
 
-    mode: str = param(None, choices=MODES, optional=True,
+    mode: str = param("mincut", choices=MODES,
                       help="random: blocks side by side; overlap: blocks matched on their overlap; "
-                           "mincut: plus the least-error cut (default: random, mincut with a target)")
+                           "mincut: plus the least-error cut")
     block: int = param(None, kind="int", lo=2, hi=1024, optional=True, symbol="B",
                        help="side of the square blocks in pixels (default 32; transfer 9, iterative 31)")
     overlap: int = param(None, kind="int", lo=1, hi=1023, optional=True,
@@ -636,7 +636,7 @@ def synthesize(
     size: tuple[int, int] | None = None,
     block: int = SYNTH_BLOCK,
     overlap: int | None = None,
-    mode: str = "random",
+    mode: str = "mincut",
     tol: int = SYNTH_TOL,
     rule: str = "tol",
     epsilon: float = 0.1,
@@ -660,7 +660,7 @@ def synthesize(
     overlap : int, optional
         Overlap between neighbouring blocks, 1..B-1; default ceil(B / 6) (E&F §2.1: "the size of
         the overlap was 1/6 of the size of the block"). Unused in ``random`` mode.
-    mode : {"random", "overlap", "mincut"}, default "random"
+    mode : {"random", "overlap", "mincut"}, default "mincut"
         ``random``: blocks from uniformly random positions, side by side, no overlap (E&F Fig. 2a).
         ``overlap``: blocks step by B - overlap; each is chosen by the SSD between its overlap with
         the pixels already in place (left and top strips) and the same strips at *every* position
@@ -897,7 +897,7 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
                 raise InvalidParameter(f"input '{name.replace('_', '-')}' needs a target (--target)", name=name)
         if params.iterations > 1:
             raise out_of_range("iterations", params.iterations, 1, 1, "more passes need a target (--target)")
-        mode = params.mode or "random"
+        mode = params.mode
         block = params.block or SYNTH_BLOCK
         image = synthesize(
             texture, size=params.size, block=block, overlap=params.overlap, mode=mode,
@@ -916,7 +916,7 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
                                name="size", value=params.size)
     images = transfer(
         texture, target, block=params.block, overlap=params.overlap, alpha=params.alpha,
-        iterations=params.iterations, mode=params.mode or "mincut", correspondence=params.correspondence,
+        iterations=params.iterations, mode=params.mode, correspondence=params.correspondence,
         source_map=maps["source_map"], target_map=maps["target_map"], remap=params.remap,
         tol=params.tol or 1, rule=params.rule,
         epsilon=params.epsilon, tile=params.tile, poisson=params.poisson, band=params.band,
@@ -929,10 +929,9 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
 def warm_up() -> None:
     """Load (or compile) the numba kernels on tiny inputs, so the first real run is not charged with it.
 
-    For the GUI's background start-up. ``METHOD.warm_up`` is deliberately None: the CLI calls a
-    method's warm-up before every run, and a small synthesis (the numpy engine, see
-    ``NUMPY_ENGINE_MAX_BLOCKS``) would then pay numba's ~0.6 s start-up for nothing. A CLI transfer's
-    reported ``seconds`` therefore include that one-time load.
+    For the GUI's background start-up; ``METHOD.warm_up_in_cli`` is False: a small synthesis on the
+    command line (the numpy engine, see ``NUMPY_ENGINE_MAX_BLOCKS``) would otherwise pay numba's
+    ~0.6 s start-up for nothing. A CLI transfer's reported ``seconds`` therefore include that load.
     """
     rng = np.random.default_rng(0)
     tex = rng.random((12, 12), dtype=np.float32)
@@ -952,4 +951,6 @@ METHOD = Method(
         InputSpec("target_map", "transfer: the target's correspondence map (with --source-map)", required=False),
     ),
     run=_run,
+    warm_up=warm_up,
+    warm_up_in_cli=False,
 )

@@ -55,8 +55,9 @@ class Method:
     ``run(inputs, params, *, rng, progress, cancel) -> Result`` where ``inputs`` maps input names
     to float32 images; it must honour ``cancel`` and report through ``progress``. ``warm_up()``, when
     given, loads the method's compiled kernels (from numba's on-disk cache, or compiling them) on
-    tiny inputs, so that the first real run is not charged with it; the CLI calls it before timing,
-    the GUI once in a background thread at start.
+    tiny inputs, so that the first real run is not charged with it; the GUI calls it once in a
+    background thread at start, the CLI before timing unless ``warm_up_in_cli`` is false (a method
+    that can avoid its kernels on small inputs, such as quilting's numpy engine, would only pay).
     """
 
     name: str
@@ -65,6 +66,7 @@ class Method:
     inputs: tuple[InputSpec, ...]
     run: Callable[..., Result]
     warm_up: Callable[[], None] | None = None
+    warm_up_in_cli: bool = True
 
 
 _registry: dict[str, Method] | None = None

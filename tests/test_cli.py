@@ -29,7 +29,7 @@ def run(argv, capsys):
 def test_quilt_writes_image_and_report(texture_path, tmp_path, capsys):
     out_path = tmp_path / "out.png"
     code, out, err = run(["quilt", texture_path, "-o", out_path, "--size", "64x50", "--block", "16",
-                          "--seed", "3", "--report"], capsys)
+                          "--mode", "random", "--seed", "3", "--report"], capsys)
     assert code == 0, err
     assert err == ""  # not a terminal: no progress bar
     lines = out.strip().splitlines()
@@ -83,7 +83,7 @@ def test_sixteen_bit_tiff_output(texture_path, tmp_path, capsys):
         (["--block", "abc"], "parameter 'block' = 'abc' must be an integer"),
         (["--block", "41"], "parameter 'block' = 41 is outside 2..40 (must fit in the texture, 40x48)"),
         (["--size", "0x5"], "parameter 'size' = 0x5 has a side outside 1..16384"),
-        (["--mode", "wild"], "parameter 'mode' = 'wild' is not one of random"),
+        (["--mode", "wild"], "parameter 'mode' = 'wild' is not one of random, overlap, mincut"),
         (["--seed", "-4"], "parameter 'seed' = -4 is outside"),
         (["--bit-depth", "12"], "'bit-depth' = 12 must be 8 or 16"),
         (["--frobnicate"], "unrecognized arguments: --frobnicate"),
@@ -171,7 +171,8 @@ def test_real_process_prints_one_line_and_no_traceback(tmp_path, texture_path, k
 
 def test_region_restricts_the_source_and_is_recorded(texture_path, tmp_path, capsys):
     out = tmp_path / "r.png"
-    code, _, err = run(["quilt", texture_path, "-o", out, "--region", "4,8,24", "--block", "8", "--seed", "1"], capsys)
+    code, _, err = run(["quilt", texture_path, "-o", out, "--region", "4,8,24", "--block", "8", "--mode", "random",
+                        "--seed", "1"], capsys)
     assert code == 0, err
     recipe = json.loads(read_recipe(out))
     assert recipe["region"] == [4, 8, 24]

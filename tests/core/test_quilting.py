@@ -31,7 +31,7 @@ def test_same_seed_same_pixels_other_seed_differs(texture):
 
 def test_every_block_is_a_copy_of_the_texture(texture):
     b = 10
-    out = synthesize(texture, size=(45, 35), block=b, rng=2)
+    out = synthesize(texture, size=(45, 35), block=b, mode="random", rng=2)
     h, w = texture.shape[:2]
     windows = np.lib.stride_tricks.sliding_window_view(texture, (b, b), axis=(0, 1))  # (h-b+1, w-b+1, 3, b, b)
     for y0 in range(0, 35, b):
@@ -56,7 +56,7 @@ def test_params_validation():
 
 def test_progress_previews_and_cancel(texture):
     seen = []
-    out = synthesize(texture, size=(80, 80), block=8, rng=0, progress=seen.append)
+    out = synthesize(texture, size=(80, 80), block=8, mode="random", rng=0, progress=seen.append)
     assert seen[-1].done == seen[-1].total == 10
     assert all(p.preview.shape == out.shape for p in seen)
     # The preview grows row by row: the first report has later rows still empty.
