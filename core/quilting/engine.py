@@ -1,0 +1,450 @@
+"""The quilting engine: one pass of block quilting over a canvas.
+
+For every block: the SSD of its template against every source position (the squared-sum term once
+per overlap shape with ``cv2.filter2D``, the cross-term as one FFT product with the source spectra
+computed once per pass), then choosing, cutting, pasting and the Poisson band in one call of the
+numba kernel (``core._kernels.quilting``) -- or, for small syntheses while numba is not loaded yet,
+the same steps in numpy (``_place_block_numpy``, pixel for pixel the same; a test checks it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..jobs import CancelToken, ProgressReporter
+
+RULES = ("tol", "epsilon", "sampled")  # the order is the kernel's rule codes
+
+
+class _K:
+    """Indices and codes of the kernel's parameter arrays (the same as ``core._kernels.quilting``'s,
+    repeated here so that the numpy engine runs without importing numba; a test checks they agree)."""
+
+    P_Y0, P_X0, P_B, P_TOP, P_LEFT, P_RIGHT, P_BOTTOM, P_WRAP = 0, 1, 2, 3, 4, 5, 6, 7
+    P_MODE, P_RULE, P_TOL, P_SEED, P_POISSON, P_BAND, P_FIX_Y, P_FIX_X = 8, 9, 10, 11, 12, 13, 14, 15
+    N_IPARAMS = 16
+    F_CONST, F_EPS, F_U = 0, 1, 2
+    N_FPARAMS = 3
+    MODE_RANDOM, MODE_OVERLAP, MODE_MINCUT = 0, 1, 2
+    RULE_TOL, RULE_EPSILON, RULE_SAMPLED = 0, 1, 2
+    SAMPLE_FRACTION = TOP_FRACTION = 0.1
+
+
+# Below this many blocks a synthesis without Poisson runs the per-block step in numpy when numba
+# is not loaded yet: numba's one-time start-up (~0.6 s: import, registries, kernel cache) costs more
+# than the numpy step (~0.3 ms a block) there. Both engines give the same pixels.
+NUMPY_ENGINE_MAX_BLOCKS = 1024
+STATIC_AHEAD = True  # transfer: static terms one row ahead on a second thread
+
+
+@dataclass(frozen=True)
+class _Pass:
+    mode: str
+    block: int
+    overlap: int
+    rule: str
+    tol: int
+    epsilon: float
+    tile: bool
+    poisson: bool
+    band: int
+    w_overlap: float = 1.0
+    w_prev: float = 0.0
+    w_corr: float = 0.0
+    engine: str = "auto"  # "auto", "numba" or "numpy" (tests compare the two)
+
+
+def _grid(n: int, block: int, overlap: int, tile: bool) -> tuple[list[int], list[int], list[int], int]:
+    """Block starts along one axis, the overlaps before/after each block, and the canvas length.
+
+    Without ``tile`` the blocks step by ``block - overlap`` and the canvas is cropped to ``n``
+    afterwards. With ``tile`` the canvas is exactly ``n`` and wraps: ``k = ceil(n / step)`` blocks
+    start at ``round(j n / k)``, so their overlaps are ``overlap`` or a pixel more, and the last
+    block overlaps the first one by its ``after`` width.
+    """
+    step = block - overlap
+    if tile:
+        k = -(-n // step)
+        starts = [(j * n + k // 2) // k for j in range(k)]
+        before = [0] + [starts[j - 1] + block - starts[j] for j in range(1, k)]
+        after = [0] * (k - 1) + [starts[-1] + block - n]
+        return starts, before, after, n
+    k = 1 if n <= block else -(-(n - overlap) // step)
+    starts = [j * step for j in range(k)]
+    before = [0] + [overlap] * (k - 1)
+    return starts, before, [0] * k, max(block, starts[-1] + block)
+
+
+# --------------------------------------------------------------------------------------------
+# the engine: one pass of quilting over a canvas
+
+
+class _Source:
+    """The source texture prepared for one block size: centred, spectra, squared sums."""
+
+    def __init__(self, tex: np.ndarray, corr_src: np.ndarray | None, block: int):
+        import cv2
+
+        self.tex = tex  # (h, w, C) float32
+        h, w, nc = tex.shape
+        self.block = block
+        self.ph, self.pw = h - block + 1, w - block + 1
+        self.n_h, self.n_w = cv2.getOptimalDFTSize(h), cv2.getOptimalDFTSize(w)
+        self.mean = float(tex.mean())
+        centred = tex - np.float32(self.mean)
+        self.spectra = [cv2.dft(self._pad(centred[..., c])) for c in range(nc)]
+        self.sq_src = (centred.astype(np.float64) ** 2).sum(axis=2).astype(np.float32)
+        if corr_src is not None:
+            self.mean_c = float(corr_src.mean())
+            cc = (corr_src - np.float32(self.mean_c)).astype(np.float32)
+            self.spectrum_c = cv2.dft(self._pad(cc))
+            self.sq_c = cc * cc
+        else:
+            self.mean_c = 0.0
+            self.spectrum_c = None
+            self.sq_c = None
+        self._cache: dict = {}
+
+    def _pad(self, img: np.ndarray) -> np.ndarray:
+        out = np.zeros((self.n_h, self.n_w), dtype=np.float32)
+        out[: img.shape[0], : img.shape[1]] = img
+        return out
+
+    def sq(self, key: tuple[int, int, int, int], p: _Pass) -> np.ndarray:
+        """``sum_x w(x) |F(p + x)|²`` for every position p, for this overlap shape and weights."""
+        cached = self._cache.get(key)
+        if cached is not None:
+            return cached
+        import cv2
+
+        b = self.block
+        top, left, right, bottom = key
+        kernel = np.zeros((b, b), dtype=np.float32)
+        if p.w_overlap:
+            m = np.zeros((b, b), dtype=bool)
+            m[:top] = True
+            m[:, :left] = True
+            m[:, b - right:] = True  # an empty slice when right == 0
+            m[b - bottom:] = True
+            kernel += np.float32(p.w_overlap) * m
+        kernel += np.float32(p.w_prev)
+        out = np.zeros((self.ph, self.pw), dtype=np.float32)
+        if kernel.any():
+            out += cv2.filter2D(self.sq_src, cv2.CV_32F, kernel, anchor=(0, 0),
+                                borderType=cv2.BORDER_CONSTANT)[: self.ph, : self.pw]
+        if p.w_corr and self.sq_c is not None:
+            box = np.full((b, b), np.float32(p.w_corr), dtype=np.float32)
+            out += cv2.filter2D(self.sq_c, cv2.CV_32F, box, anchor=(0, 0),
+                                borderType=cv2.BORDER_CONSTANT)[: self.ph, : self.pw]
+        out = np.ascontiguousarray(out)
+        self._cache[key] = out
+        return out
+
+
+def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.random.Generator, *,
+                prev: np.ndarray | None = None, corr: tuple[np.ndarray, np.ndarray] | None = None,
+                report: ProgressReporter | None = None, cancel: CancelToken | None = None,
+                channels_out: int = 3) -> tuple[np.ndarray, int]:
+    """One pass of quilting; returns the (out_h, out_w, C) image and the number of blocks."""
+    import cv2
+
+    b = p.block
+    th, tw, nc = tex.shape
+    ys, tops, bottoms, hc = _grid(out_h, b, p.overlap, p.tile)
+    xs, lefts, rights, wc = _grid(out_w, b, p.overlap, p.tile)
+    rows, cols = len(ys), len(xs)
+    canvas = np.zeros((hc, wc, nc), dtype=np.float32)
+    filled = np.zeros((hc, wc), dtype=np.uint8)
+
+    def preview():
+        img = canvas[:out_h, :out_w]
+        return (img[..., 0] if channels_out == 1 else img).copy()
+
+    if p.mode == "random":
+        # One draw of all positions up front: the picture depends on the seed only.
+        sy = rng.integers(0, th - b + 1, size=(rows, cols))
+        sx = rng.integers(0, tw - b + 1, size=(rows, cols))
+        for i in range(rows):
+            if cancel is not None:
+                cancel.raise_if_cancelled()
+            y0 = ys[i]
+            bh = min(b, hc - y0)
+            for j in range(cols):
+                x0 = xs[j]
+                bw = min(b, wc - x0)
+                canvas[y0:y0 + bh, x0:x0 + bw] = tex[sy[i, j]:sy[i, j] + bh, sx[i, j]:sx[i, j] + bw]
+            if report is not None:
+                report.update(i + 1, preview=preview)
+        return canvas[:out_h, :out_w], rows * cols
+
+    import sys
+
+    use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and prev is None and corr is None
+                 and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "core._kernels.quilting" not in sys.modules)
+    if use_numpy:
+        _k = _K
+        place, template = _place_block_numpy, _make_template_numpy
+    else:
+        from .._kernels import quilting as _k  # numba loads on first use, not with the CLI
+
+        place, template = _k.place_block, _k.make_template
+    src = _Source(tex, corr[0] if corr is not None else None, b)
+    prev_c = np.zeros((1, 1, nc), dtype=np.float32)
+    corr_t = np.zeros((1, 1), dtype=np.float32)
+    if prev is not None:
+        prev_c = _pad_to(prev, hc, wc)
+    if corr is not None:
+        corr_t = _pad_to(corr[1], hc, wc)
+    tbuf = np.zeros((nc, src.n_h, src.n_w), dtype=np.float32)
+    tcorr = np.zeros((src.n_h, src.n_w), dtype=np.float32)
+    us = rng.random((rows, cols))
+    seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
+    first = (int(rng.integers(0, src.ph)), int(rng.integers(0, src.pw)))
+    ip = np.zeros(_k.N_IPARAMS, dtype=np.int64)
+    fp = np.zeros(_k.N_FPARAMS, dtype=np.float64)
+    ip[_k.P_B] = b
+    ip[_k.P_WRAP] = int(p.tile)
+    ip[_k.P_MODE] = {"overlap": _k.MODE_OVERLAP, "mincut": _k.MODE_MINCUT}[p.mode]
+    ip[_k.P_RULE] = RULES.index(p.rule)
+    ip[_k.P_TOL] = p.tol
+    ip[_k.P_POISSON] = int(p.poisson)
+    ip[_k.P_BAND] = p.band
+    fp[_k.F_EPS] = p.epsilon
+    has_static = p.w_prev != 0.0 or (p.w_corr != 0.0 and corr is not None)
+    dummy_cross = np.zeros((1, 1), dtype=np.float32)
+    dummy_sq = np.zeros((1, 1), dtype=np.float32)
+    flags = cv2.DFT_REAL_OUTPUT | cv2.DFT_SCALE
+    spectra, spectrum_c = src.spectra, src.spectrum_c
+    wrap = bool(p.tile)
+    static_rows = None
+    if has_static:
+        # The previous-pass and correspondence terms do not depend on the blocks placed in this pass:
+        # their spectra are computed one block row ahead on a second thread (cv2 and the numba
+        # kernels release the GIL), while this thread adds the overlap term block by block.
+        from concurrent.futures import ThreadPoolExecutor
+
+        tbuf_s = np.zeros_like(tbuf)
+        tcorr_s = np.zeros_like(tcorr)
+
+        def static_row(i):
+            out = []
+            for j in range(cols):
+                cst = template(prev_c, prev_c, corr_t, ys[i], xs[j], b, 0, 0, 0, 0, wrap,
+                               0.0, p.w_prev, p.w_corr, src.mean, src.mean_c, tbuf_s, tcorr_s)
+                spec = cv2.mulSpectrums(spectrum_c, cv2.dft(tcorr_s), 0, conjB=True)
+                if p.w_prev:
+                    for c in range(nc):
+                        spec += cv2.mulSpectrums(spectra[c], cv2.dft(tbuf_s[c]), 0, conjB=True)
+                out.append((spec, cst))
+            return out
+
+        if STATIC_AHEAD:
+            static_rows = ThreadPoolExecutor(max_workers=1, thread_name_prefix="weft-quilt")
+    try:
+        ahead = static_rows.submit(static_row, 0) if static_rows is not None else None
+        for i in range(rows):
+            if cancel is not None:
+                cancel.raise_if_cancelled()
+            row_static = static_row(i) if has_static and static_rows is None else None
+            if ahead is not None:
+                row_static = ahead.result()
+                ahead = static_rows.submit(static_row, i + 1) if i + 1 < rows else None
+            y0, top, bottom = ys[i], tops[i], bottoms[i]
+            ip[_k.P_Y0], ip[_k.P_TOP], ip[_k.P_BOTTOM] = y0, top, bottom
+            for j in range(cols):
+                x0, left, right = xs[j], lefts[j], rights[j]
+                ip[_k.P_X0], ip[_k.P_LEFT], ip[_k.P_RIGHT] = x0, left, right
+                ip[_k.P_SEED] = seeds[i, j]
+                fp[_k.F_U] = us[i, j]
+                overlaps = top or left or right or bottom
+                if overlaps or row_static is not None:
+                    ip[_k.P_FIX_Y] = ip[_k.P_FIX_X] = -1
+                    spec, const = (None, 0.0) if row_static is None else row_static[j]
+                    if overlaps:
+                        const += template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
+                                          p.w_overlap, 0.0, 0.0, src.mean, src.mean_c, tbuf, tcorr)
+                        for c in range(nc):
+                            part = cv2.mulSpectrums(spectra[c], cv2.dft(tbuf[c]), 0, conjB=True)
+                            spec = part if spec is None else spec + part
+                    fp[_k.F_CONST] = const
+                    cross = cv2.idft(spec, flags=flags)
+                    sq = src.sq((top, left, right, bottom), p)
+                else:  # synthesis, first block: a random position
+                    ip[_k.P_FIX_Y], ip[_k.P_FIX_X] = first
+                    cross, sq = dummy_cross, dummy_sq
+                place(canvas, filled, tex, cross, sq, ip, fp)
+            if report is not None:
+                report.update(i + 1, preview=preview)
+    finally:
+        if static_rows is not None:
+            static_rows.shutdown(wait=True, cancel_futures=True)
+    return canvas[:out_h, :out_w], rows * cols
+
+
+# --------------------------------------------------------------------------------------------
+# the numpy engine: the kernel's place_block (without the Poisson band), step for step
+
+
+def _splitmix_numpy(seed: int, n: int) -> np.ndarray:
+    """The kernel's splitmix64 outputs 1..n for ``seed`` (uint64 arithmetic wraps, as in numba)."""
+    golden = np.uint64(0x9E3779B97F4A7C15)
+    with np.errstate(over="ignore"):
+        z = np.uint64(seed) + golden * np.arange(1, n + 1, dtype=np.uint64)
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+def _select_numpy(cost: np.ndarray, rule: int, tol: int, eps: float, u: float, seed: int) -> int:
+    n = cost.size
+    if rule == _K.RULE_TOL:
+        if tol <= 1:
+            return int(np.argmin(cost))
+        k = min(tol, n)
+        kth = np.partition(cost, k - 1)[k - 1]
+        order = np.concatenate([np.flatnonzero(cost < kth), np.flatnonzero(cost == kth)])
+        return int(order[min(int(u * k), k - 1)])
+    if rule == _K.RULE_EPSILON:
+        thr = (1.0 + eps) * max(float(cost.min()), 0.0)
+        cand = np.flatnonzero(cost <= thr)
+        return int(cand[min(int(u * len(cand)), len(cand) - 1)])
+    z = _splitmix_numpy(seed, n + 1)
+    limit = np.uint64(int(_K.SAMPLE_FRACTION * 18446744073709551615.0))
+    idx = np.flatnonzero(z[:n] < limit)
+    if idx.size == 0:
+        idx = np.array([int(z[n] % np.uint64(n))])
+    k = max(1, int(np.ceil(_K.TOP_FRACTION * idx.size)))
+    order = np.argsort(cost[idx], kind="stable")
+    return int(idx[order[min(int(u * k), k - 1)]])
+
+
+def _vertical_acc_numpy(err: np.ndarray) -> np.ndarray:
+    h, w = err.shape
+    acc = np.empty((h, w))
+    acc[h - 1] = err[h - 1]
+    pad = np.full(w + 2, np.inf)
+    for y in range(h - 2, -1, -1):
+        pad[1:-1] = acc[y + 1]
+        acc[y] = err[y] + np.minimum(np.minimum(pad[1:-1], pad[:-2]), pad[2:])
+    return acc
+
+
+def _trace_numpy(acc: np.ndarray, y_start: int, x_start: int) -> np.ndarray:
+    h, w = acc.shape
+    path = np.empty(h, dtype=np.int64)
+    x = x_start
+    path[y_start] = x
+    for y in range(y_start + 1, h):
+        best, m = x, acc[y, x]
+        if x > 0 and acc[y, x - 1] < m:
+            m, best = acc[y, x - 1], x - 1
+        if x < w - 1 and acc[y, x + 1] < m:
+            best = x + 1
+        x = best
+        path[y] = x
+    return path
+
+
+def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: int) -> np.ndarray:
+    """The kernel's ``cut_mask`` in numpy (horizontal cuts by transposition)."""
+    h, w = err.shape
+    mask = np.ones((h, w), dtype=bool)
+    yy, xx = np.mgrid[0:h, 0:w]
+    if left > 0 and top > 0:
+        ev = _vertical_acc_numpy(err[:, :left])
+        eh = _vertical_acc_numpy(err[:top, :].T)  # (w, top): rows = columns from the right
+        corner = ev[:top, :left] + eh[:left, :top].T - err[:top, :left]
+        r, c = divmod(int(np.argmin(corner)), left)
+        vpath = np.zeros(h, dtype=np.int64)
+        vpath[r:] = _trace_numpy(ev, r, c)[r:]
+        hpath = np.zeros(w, dtype=np.int64)
+        hpath[c:] = _trace_numpy(eh, c, r)[c:]
+        a = np.where(yy >= r, xx >= vpath[:, None], xx >= c)
+        b = np.where(xx >= c, yy >= hpath[None, :], yy >= r)
+        mask &= a & b
+    elif left > 0:
+        ev = _vertical_acc_numpy(err[:, :left])
+        vpath = _trace_numpy(ev, 0, int(np.argmin(ev[0])))
+        mask &= xx >= vpath[:, None]
+    elif top > 0:
+        eh = _vertical_acc_numpy(err[:top, :].T)
+        hpath = _trace_numpy(eh, 0, int(np.argmin(eh[0])))
+        mask &= yy >= hpath[None, :]
+    if right > 0:
+        ev = _vertical_acc_numpy(err[:, w - right:])
+        vpath = _trace_numpy(ev, 0, int(np.argmin(ev[0]))) + (w - right)
+        mask &= xx <= vpath[:, None]
+    if bottom > 0:
+        eh = _vertical_acc_numpy(err[h - bottom:, :].T)
+        hpath = _trace_numpy(eh, 0, int(np.argmin(eh[0]))) + (h - bottom)
+        mask &= yy <= hpath[None, :]
+    return mask
+
+
+def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bottom, wrap,
+                         w_overlap, w_prev, w_corr, mean, mean_c, tbuf, tcorr):
+    """The kernel's ``make_template`` for synthesis (overlap term only), in numpy (same values)."""
+    if w_prev or w_corr:
+        raise NotImplementedError("the numpy engine quilts synthesis only")
+    hc, wc, nc = canvas.shape
+    iy = (y0 + np.arange(b)) % hc
+    ix = (x0 + np.arange(b)) % wc
+    m = np.zeros((b, b), dtype=bool)
+    m[:top] = m[:, :left] = True
+    m[:, b - right:] = True
+    m[b - bottom:] = True
+    o = canvas[np.ix_(iy, ix)].astype(np.float64) - mean
+    v = np.where(m[..., None], w_overlap * o, 0.0)
+    tbuf[:, :b, :b] = v.transpose(2, 0, 1)
+    terms = (v * o)[m]  # (w o) o in the kernel's loop order: row, column, channel
+    return float(np.cumsum(terms.ravel())[-1]) if terms.size else 0.0
+
+
+def _place_block_numpy(canvas, filled, tex, cross, sq, ip, fp):
+    """``core._kernels.quilting.place_block`` without the Poisson band, in numpy (same pixels)."""
+    hc, wc, nc = canvas.shape
+    b = int(ip[_K.P_B])
+    y0, x0 = int(ip[_K.P_Y0]), int(ip[_K.P_X0])
+    top, left, right, bottom = (int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM))
+    ph, pw = tex.shape[0] - b + 1, tex.shape[1] - b + 1
+    if ip[_K.P_FIX_Y] >= 0:
+        sy, sx = int(ip[_K.P_FIX_Y]), int(ip[_K.P_FIX_X])
+    else:
+        cost = sq[:ph, :pw].astype(np.float64) - 2.0 * cross[:ph, :pw].astype(np.float64) + fp[_K.F_CONST]
+        cost = np.maximum(cost, 0.0).ravel()
+        k = _select_numpy(cost, int(ip[_K.P_RULE]), int(ip[_K.P_TOL]), float(fp[_K.F_EPS]), float(fp[_K.F_U]),
+                          int(ip[_K.P_SEED]))
+        sy, sx = divmod(k, pw)
+    iy = (y0 + np.arange(b)) % hc
+    ix = (x0 + np.arange(b)) % wc
+    block = tex[sy:sy + b, sx:sx + b]
+    if ip[_K.P_MODE] == _K.MODE_MINCUT and (top or left or right or bottom):
+        old = canvas[np.ix_(iy, ix)]
+        d = old - block
+        err = (d * d).astype(np.float64).sum(axis=2)
+        strips = np.zeros((b, b), dtype=bool)
+        strips[:top] = strips[:, :left] = True
+        strips[:, b - right:] = True
+        strips[b - bottom:] = True
+        err[~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
+        mask = _cut_mask_numpy(err, top, left, right, bottom)
+        merged = np.where(mask[..., None], block, old)
+        canvas[np.ix_(iy, ix)] = merged
+        f = filled[np.ix_(iy, ix)]
+        f[mask] = 1
+        filled[np.ix_(iy, ix)] = f
+    else:
+        canvas[np.ix_(iy, ix)] = block
+        filled[np.ix_(iy, ix)] = 1
+    return sy, sx
+
+
+def _pad_to(img: np.ndarray, h: int, w: int) -> np.ndarray:
+    """``img`` grown to (h, w) by repeating its last row/column (the canvas may exceed the output)."""
+    ph, pw = h - img.shape[0], w - img.shape[1]
+    if ph == 0 and pw == 0:
+        return np.ascontiguousarray(img, dtype=np.float32)
+    pad = [(0, ph), (0, pw)] + [(0, 0)] * (img.ndim - 2)
+    return np.ascontiguousarray(np.pad(img, pad, mode="edge"), dtype=np.float32)
