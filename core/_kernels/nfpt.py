@@ -217,8 +217,8 @@ def select(cmap, const, valid, tol, u):
 
 
 @njit(cache=True, nogil=True)
-def repair(canvas, pos, todo, tex, allowed, half, shift, y0, y1):
-    """Re-synthesize the pixels with ``todo == 1`` in rows ``[y0, y1)``, in scan-line order.
+def repair(canvas, pos, todo, tex, allowed, half, shift, order):
+    """Re-synthesize the pixels with ``todo == 1`` listed in ``order`` (flat indices), in that order.
 
     For each, every known neighbour q (``todo != 1``) in the (2 half + 1)^2 window proposes the
     source pixel next to the one q was copied from (``pos[q]`` shifted back by q's offset), the
@@ -234,76 +234,77 @@ def repair(canvas, pos, todo, tex, allowed, half, shift, y0, y1):
     side = 2 * half + 1
     cand = np.empty(side * side + 1, np.int64)
     count = 0
-    for y in range(y0, y1):
-        for x in range(wc):
-            if todo[y, x] != 1:
+    for t in range(order.shape[0]):
+        y = order[t] // wc
+        x = order[t] % wc
+        if todo[y, x] != 1:
+            continue
+        nc_ = 0
+        for dy in range(-half, half + 1):
+            qy = y + dy
+            if qy < 0 or qy >= hc:
                 continue
-            nc_ = 0
+            for dx in range(-half, half + 1):
+                qx = x + dx
+                if qx < 0 or qx >= wc:
+                    continue
+                if (dy != 0 or dx != 0) and todo[qy, qx] == 1:
+                    continue
+                p = pos[qy, qx]
+                if p < 0:
+                    continue
+                cy = p // ws - dy
+                cx = p % ws - dx
+                if cy < 0 or cy >= hs or cx < 0 or cx >= ws or allowed[cy, cx] == 0:
+                    continue
+                c = cy * ws + cx
+                dup = False
+                for j in range(nc_):
+                    if cand[j] == c:
+                        dup = True
+                        break
+                if not dup:
+                    cand[nc_] = c
+                    nc_ += 1
+        best = -1
+        best_cost = np.inf
+        for jj in range(nc_ * (2 * shift + 1) * (2 * shift + 1)):
+            j = jj // ((2 * shift + 1) * (2 * shift + 1))
+            r = jj % ((2 * shift + 1) * (2 * shift + 1))
+            cy = cand[j] // ws + r // (2 * shift + 1) - shift
+            cx = cand[j] % ws + r % (2 * shift + 1) - shift
+            if cy < 0 or cy >= hs or cx < 0 or cx >= ws or allowed[cy, cx] == 0:
+                continue
+            cost = 0.0
+            n = 0
             for dy in range(-half, half + 1):
                 qy = y + dy
-                if qy < 0 or qy >= hc:
+                sy = cy + dy
+                if qy < 0 or qy >= hc or sy < 0 or sy >= hs:
                     continue
                 for dx in range(-half, half + 1):
                     qx = x + dx
-                    if qx < 0 or qx >= wc:
+                    sx = cx + dx
+                    if qx < 0 or qx >= wc or sx < 0 or sx >= ws:
                         continue
-                    if (dy != 0 or dx != 0) and todo[qy, qx] == 1:
+                    if todo[qy, qx] == 1 or (dy == 0 and dx == 0):
                         continue
-                    p = pos[qy, qx]
-                    if p < 0:
-                        continue
-                    cy = p // ws - dy
-                    cx = p % ws - dx
-                    if cy < 0 or cy >= hs or cx < 0 or cx >= ws or allowed[cy, cx] == 0:
-                        continue
-                    c = cy * ws + cx
-                    dup = False
-                    for j in range(nc_):
-                        if cand[j] == c:
-                            dup = True
-                            break
-                    if not dup:
-                        cand[nc_] = c
-                        nc_ += 1
-            best = -1
-            best_cost = np.inf
-            for jj in range(nc_ * (2 * shift + 1) * (2 * shift + 1)):
-                j = jj // ((2 * shift + 1) * (2 * shift + 1))
-                r = jj % ((2 * shift + 1) * (2 * shift + 1))
-                cy = cand[j] // ws + r // (2 * shift + 1) - shift
-                cx = cand[j] % ws + r % (2 * shift + 1) - shift
-                if cy < 0 or cy >= hs or cx < 0 or cx >= ws or allowed[cy, cx] == 0:
-                    continue
-                cost = 0.0
-                n = 0
-                for dy in range(-half, half + 1):
-                    qy = y + dy
-                    sy = cy + dy
-                    if qy < 0 or qy >= hc or sy < 0 or sy >= hs:
-                        continue
-                    for dx in range(-half, half + 1):
-                        qx = x + dx
-                        sx = cx + dx
-                        if qx < 0 or qx >= wc or sx < 0 or sx >= ws:
-                            continue
-                        if todo[qy, qx] == 1 or (dy == 0 and dx == 0):
-                            continue
-                        for ch in range(nc):
-                            d = canvas[qy, qx, ch] - tex[sy, sx, ch]
-                            cost += d * d
-                        n += 1
-                if n == 0:
-                    continue
-                cost /= n
-                if cost < best_cost:
-                    best_cost = cost
-                    best = cy * ws + cx
-            if best >= 0:
-                by = best // ws
-                bx = best % ws
-                for ch in range(nc):
-                    canvas[y, x, ch] = tex[by, bx, ch]
-                pos[y, x] = best
-            todo[y, x] = 2
-            count += 1
+                    for ch in range(nc):
+                        d = canvas[qy, qx, ch] - tex[sy, sx, ch]
+                        cost += d * d
+                    n += 1
+            if n == 0:
+                continue
+            cost /= n
+            if cost < best_cost:
+                best_cost = cost
+                best = cy * ws + cx
+        if best >= 0:
+            by = best // ws
+            bx = best % ws
+            for ch in range(nc):
+                canvas[y, x, ch] = tex[by, bx, ch]
+            pos[y, x] = best
+        todo[y, x] = 2
+        count += 1
     return count

@@ -122,6 +122,7 @@ def synthesize(
     sigma_s : float, default 0.35
         sigma of W_s (eq. 2), in intensity units (0..1 scale), 0.01..10. Smaller = features
         (pixels far from the L-shape's dominant colour) count more against the rest.
+        (Eqs. 1-2 share one symbol sigma in the paper; here each W has its own.)
     tol : int, default 2
         Pick uniformly among the ``tol`` most similar source positions, 1..64 (1 = the paper's best).
     repair : bool, default True
@@ -142,7 +143,7 @@ def synthesize(
         Same seed, same pixels.
     progress, cancel
         Progress callback, once per patch row (preview: the partial result) and once for the repair;
-        cancel token, checked before every patch row and every 32 rows of the repair.
+        cancel token, checked before every patch row and 16 times during the repair.
     return_details : bool, default False
         Return a :class:`~core.nfpt.synthesis.Synthesis` (image, patches, repaired pixel count, source
         positions, repaired mask) instead of the image.

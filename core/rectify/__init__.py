@@ -281,5 +281,8 @@ METHOD = Method(
     params=RectifyParams,
     inputs=(InputSpec("photo", "the photo of the texture (non-frontal-parallel)"),),
     run=_run,
-    warm_up=warm_up,
+    # No warm-up here: the default homography warp is numpy + OpenCV, and loading the numba kernel of
+    # the morphs would triple `weft rectify`'s start-up (0.2 s -> 0.9 s). ``core.nfpt``'s warm-up,
+    # which the studio runs at start, loads it for the studio.
+    warm_up=None,
 )

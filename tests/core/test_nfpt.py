@@ -159,3 +159,24 @@ def test_method_runs_with_params_and_reports_figures(photo):
     assert NfptParams().block == 48  # defaults construct (the studio builds them for every method)
     with pytest.raises(InvalidParameter, match="'view' and 'into_photo' exclude each other"):
         NfptParams(view="v.json", into_photo=True)
+
+
+def test_fft_search_equals_the_direct_sum_of_eq_3(fur):
+    from core.image import luminance
+    from core.nfpt.synthesis import _Search
+
+    rng = np.random.default_rng(0)
+    src = fur[:40, :50]
+    src_y = luminance(src)
+    canvas = rng.random((30, 30, 3), dtype=np.float32)
+    canvas_y = luminance(canvas)
+    wd = distance_weights(16, 5, 5, sigma_d=2.5)
+    search = _Search(src_y, float(src_y.mean()), 8, 0.35)
+    cmap, const = search.cost(canvas_y, canvas, 7, 9, wd)
+    w = search.w_buf[:16, :16].astype(np.float64)
+    assert (w[wd == 0] == 0).all() and (w[wd > 0] > wd[wd > 0]).all()  # W_d + W_s on the L only
+    t = canvas_y[7:23, 9:25].astype(np.float64)
+    for py, px in [(0, 0), (10, 20), (24, 34), (3, 30)]:
+        s = src_y[py:py + 16, px:px + 16].astype(np.float64)
+        direct = (w * (t - s) ** 2).sum()
+        assert cmap[py, px] + const == pytest.approx(direct, rel=1e-3, abs=1e-4)
