@@ -6,10 +6,10 @@ to the import below.
 
 from __future__ import annotations
 
-from . import fast, quilt
+from . import fast, nfpt, quilt
 from .base import Case, Input
 
-CASES: list[Case] = [*quilt.CASES, *fast.CASES]
+CASES: list[Case] = [*quilt.CASES, *fast.CASES, *nfpt.CASES]
 
 
 def by_name() -> dict[str, Case]:
