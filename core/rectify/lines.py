@@ -98,8 +98,9 @@ def _as_lines(value: Any, key: str) -> np.ndarray:
 
 
 def _as_size(value: Any, key: str) -> tuple[int, int]:
+    """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not)."""
     if (not isinstance(value, (list, tuple)) or len(value) != 2
-            or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in value)):
+            or not all(_num(v) and math.isfinite(float(v)) and float(v) == int(v) for v in value)):
         raise GeometryError(f"{key} = {_short(value)} must be [width, height] in whole pixels")
     w, h = int(value[0]), int(value[1])
     if not (2 <= w <= MAX_SIDE and 2 <= h <= MAX_SIDE):

@@ -194,6 +194,7 @@ def test_parse_errors_name_the_file_key_and_index(tmp_path):
         ({**good, "image_lines": SQUARE_SRC[:3]}, "3 image_lines but 4 frontal_lines"),
         ({**good, "frontal_size": [100, 0]}, "frontal_size = \\[100, 0\\] has a side outside"),
         ({**good, "frontal_size": "big"}, "frontal_size = \"big\" must be \\[width, height\\]"),
+        ({**good, "frontal_size": [100.5, 100]}, "frontal_size = \\[100.5, 100\\] must be \\[width, height\\] in whole"),
         ({**good, "image_lines": [[1, 2, 3, "x"]]}, r"image_lines\[0\]"),
     ]
     for data, fragment in cases:
@@ -209,6 +210,7 @@ def test_parse_errors_name_the_file_key_and_index(tmp_path):
         load_feature_lines(tmp_path / "nowhere.json")
     inline = load_feature_lines(json.dumps(good))  # JSON text works as well as a file
     assert inline.frontal_size == (100, 100) and len(inline) == 4
+    assert parse_feature_lines({**good, "frontal_size": [100.0, 80.0]}).frontal_size == (100, 80)
     with pytest.raises(GeometryError, match=r"image_lines\[0\] = \[NaN"):
         load_feature_lines('{"image_lines": [[NaN, 1, 2, 3]], "frontal_lines": [[0, 1, 2, 3]], "frontal_size": [9, 9]}')
 
@@ -229,3 +231,27 @@ def test_bad_options(photo, lines):
 def test_homography_fit_reports_residuals(lines):
     fit = fit_homography(lines.frontal_lines, lines.image_lines, lines.frontal_size, (480, 360))
     assert fit.points == 8 and fit.inliers == 8 and fit.rms_points < 0.01 and fit.rms_lines < 0.01
+
+
+def test_random_lines_never_crash(photo):
+    """Whatever lines a user drags: a result or one GeometryError line, never another exception."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    small = photo[::4, ::4]  # 120x90
+    coord = st.floats(-20, 140, allow_nan=False)
+    line = st.lists(coord, min_size=4, max_size=4)
+
+    @settings(max_examples=60, deadline=None, derandomize=True)
+    @given(st.lists(st.tuples(line, line), min_size=0, max_size=9), st.sampled_from(["homography", "morph", "lines"]))
+    def check(pairs, warp):
+        src = [p[0] for p in pairs]
+        dst = [p[1] for p in pairs]
+        try:
+            r = rectify(small, src, dst, (128, 96), warp=warp)
+        except GeometryError as e:
+            assert "\n" not in str(e) and str(e)
+        else:
+            assert r.image.shape == (96, 128, 3) and np.isfinite(r.image).all()
+
+    check()
