@@ -21,7 +21,7 @@ from PySide6.QtWidgets import QApplication  # noqa: E402
 from app.gui.document import InputImage  # noqa: E402
 from app.gui.main_window import MainWindow  # noqa: E402
 from core import registry  # noqa: E402
-from core.examples import example  # noqa: E402
+from core.examples import RESOURCES, example  # noqa: E402
 from core.image import load_image  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "images"
@@ -81,7 +81,19 @@ def quilt(window) -> None:
     window.compare_button.setChecked(False)
 
 
-SHOTS = {"fast": fast, "quilt": quilt}
+def nfpt(window) -> None:
+    import json
+
+    doc = window.doc
+    doc._put_input("photo", _input("perspective"))
+    doc._put_method("nfpt")
+    data = json.loads((RESOURCES / "perspective-lines.json").read_text())
+    doc.set_lines(data["image_lines"], data["frontal_lines"], frontal_size=data["frontal_size"])
+    doc.set_param("size", (640, 480))
+    window.input_tabs.setCurrentIndex(0)
+
+
+SHOTS = {"fast": fast, "quilt": quilt, "nfpt": nfpt}
 
 
 def main() -> int:

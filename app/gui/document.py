@@ -85,6 +85,22 @@ class Document(QObject):
             out[first] = crop_square(out[first], region, what=first)
         return out
 
+    def lines_json(self) -> str | None:
+        """The feature lines as DESIGN.md's JSON text (complete pairs only), or None if there are none."""
+        n = min(len(self.image_lines), len(self.frontal_lines))
+        if n == 0:
+            return None
+        return json.dumps({"image_lines": self.image_lines[:n], "frontal_lines": self.frontal_lines[:n],
+                           "frontal_size": list(self.frontal_size)})
+
+    def run_params(self) -> Params:
+        """The current method's parameters as a run uses them: a method with a ``lines`` parameter
+        (nfpt) gets the document's feature lines as JSON text, so its recipe needs no extra file."""
+        params = self.current_params
+        if any(s.name == "lines" for s in specs(self.current.params)):
+            params = params.replace(lines=self.lines_json())
+        return params
+
     def recipe(self, relative_to: str | Path | None = None) -> Recipe:
         """The recipe that reproduces the current result (``weft run`` gives the same pixels)."""
         names = {i.name for i in self.current.inputs}
@@ -92,7 +108,7 @@ class Document(QObject):
         for name, item in self.inputs.items():
             if name in names and item.path:
                 inputs[name] = _relative(item.path, relative_to)
-        return Recipe(method=self.method, params=self.current_params.to_dict(), inputs=inputs, seed=self.seed,
+        return Recipe(method=self.method, params=self.run_params().to_dict(), inputs=inputs, seed=self.seed,
                       region=self.source_region())
 
     # --- edits (undoable) ----------------------------------------------------------------------
@@ -116,10 +132,11 @@ class Document(QObject):
         if rect != self.prototype:
             self.push(SetPrototype(self, rect))
 
-    def set_lines(self, image_lines, frontal_lines, text: str = "Edit lines") -> None:
+    def set_lines(self, image_lines, frontal_lines, text: str = "Edit lines", frontal_size=None) -> None:
         new = ([list(map(float, ln)) for ln in image_lines], [list(map(float, ln)) for ln in frontal_lines])
-        if new != (self.image_lines, self.frontal_lines):
-            self.push(SetLines(self, *new, text))
+        size = tuple(frontal_size) if frontal_size is not None else self.frontal_size
+        if new != (self.image_lines, self.frontal_lines) or size != self.frontal_size:
+            self.push(SetLines(self, *new, text, frontal_size=size))
 
     # --- raw mutators (used by the commands) ---------------------------------------------------
     def _put_params(self, method: str, params: Params) -> None:
@@ -141,9 +158,11 @@ class Document(QObject):
         self.prototype = rect
         self.changed.emit("prototype")
 
-    def _put_lines(self, image_lines, frontal_lines) -> None:
+    def _put_lines(self, image_lines, frontal_lines, frontal_size=None) -> None:
         self.image_lines = [list(x) for x in image_lines]
         self.frontal_lines = [list(x) for x in frontal_lines]
+        if frontal_size is not None:
+            self.frontal_size = (int(frontal_size[0]), int(frontal_size[1]))
         self.changed.emit("lines")
 
     # --- sessions ------------------------------------------------------------------------------
@@ -278,11 +297,11 @@ class SetPrototype(QUndoCommand):
 
 
 class SetLines(QUndoCommand):
-    def __init__(self, doc: Document, image_lines, frontal_lines, text: str):
+    def __init__(self, doc: Document, image_lines, frontal_lines, text: str, frontal_size=None):
         super().__init__(text)
         self.doc = doc
-        self.new = (image_lines, frontal_lines)
-        self.old = ([list(x) for x in doc.image_lines], [list(x) for x in doc.frontal_lines])
+        self.new = (image_lines, frontal_lines, frontal_size or doc.frontal_size)
+        self.old = ([list(x) for x in doc.image_lines], [list(x) for x in doc.frontal_lines], doc.frontal_size)
 
     def redo(self):
         self.doc._put_lines(*self.new)

@@ -133,7 +133,7 @@ class Renderer(QObject):
         if doc.missing_inputs():
             return None
         inputs = doc.method_inputs()
-        params = doc.current_params
+        params = doc.run_params()
         if preview:
             inputs, params = reduced(inputs, params, PREVIEW_SIDE, FULL_PREVIEW_PIXELS.get(doc.method, 0))
         return inputs, params

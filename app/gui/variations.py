@@ -206,4 +206,4 @@ def _thumb_inputs(doc):
     """Thumbnail-size inputs and the current parameters, or None if inputs are missing."""
     if doc.missing_inputs():
         return None
-    return reduced(doc.method_inputs(), doc.current_params, THUMB_SIDE)
+    return reduced(doc.method_inputs(), doc.run_params(), THUMB_SIDE)
