@@ -18,7 +18,7 @@ from .errors import WeftError
 from .params import Params
 
 # Modules that define a module-level ``METHOD``; imported on first use.
-_MODULES = ("core.quilting", "core.fast", "core.blending", "core.rectify", "core.nfpt")
+_MODULES = ("core.quilting", "core.fast", "core.blending", "core.rectify", "core.nfpt", "core.affine")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,166 @@
+"""Parameters of the affine prototype model and the prototype rectangle ``X,Y,S``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import GeometryError, InvalidParameter
+from ..params import Params, out_of_range, param
+
+LOWPASS = ("add", "absorb")
+COLOURS = ("pca", "yuv")
+BOUNDARIES = ("auto", "none", "partial", "shaker")
+FIELDS = ("none", "swirl", "zoom", "rotate")
+SHAKER_STARTS = ("partial", "analysis")
+MIN_SIDE = 8
+
+Rect = tuple[int, int, int]
+
+
+def parse_rect(text: str | tuple | list, name: str = "prototype") -> Rect:
+    """Parse a prototype rectangle ``"X,Y,S"`` (top-left corner and side of a square, pixels).
+
+    Accepts a string or a sequence of three integers. The side must be even and at least 8 (the
+    prototype has a centre between pixels, like the target patches); the corner must not be
+    negative. Whether the square fits in an image is checked by :func:`check_rect`.
+
+    Raises
+    ------
+    InvalidParameter
+        Naming the parameter and the value.
+    """
+    if isinstance(text, str):
+        parts = [p.strip() for p in text.replace(" ", ",").split(",") if p.strip()]
+        try:
+            values = tuple(int(p) for p in parts)
+        except ValueError:
+            values = ()
+        shown = text
+    else:
+        try:
+            values = tuple(int(v) for v in text)
+        except (TypeError, ValueError):
+            values = ()
+        shown = ",".join(str(v) for v in text) if isinstance(text, (tuple, list)) else repr(text)
+    if len(values) != 3:
+        raise InvalidParameter(f"parameter '{name}' = {shown!r} must be X,Y,S (top-left corner and side "
+                               f"of a square in pixels, e.g. 96,96,64)", name=name, value=text)
+    x, y, s = values
+    if x < 0 or y < 0:
+        raise InvalidParameter(f"parameter '{name}' = {x},{y},{s}: the corner {x},{y} must not be negative",
+                               name=name, value=text)
+    if s < MIN_SIDE or s % 2:
+        raise InvalidParameter(f"parameter '{name}' = {x},{y},{s}: the side {s} must be even and at least {MIN_SIDE}",
+                               name=name, value=text)
+    return x, y, s
+
+
+def check_rect(rect: Rect, shape: tuple[int, ...], what: str = "texture", name: str = "prototype") -> Rect:
+    """Check that the square ``rect`` lies inside an image of ``shape``; ``GeometryError`` otherwise."""
+    x, y, s = rect
+    h, w = shape[:2]
+    if x + s > w or y + s > h:
+        if s > min(h, w):
+            why = f"its side {s} is larger than the {what} ({w}x{h})"
+        else:
+            why = f"it spans x {x}..{x + s - 1}, y {y}..{y + s - 1}, outside the {w}x{h} {what}"
+        raise GeometryError(f"parameter '{name}' = {x},{y},{s} does not fit: {why}")
+    return rect
+
+
+def default_rect(shape: tuple[int, ...], block: int) -> Rect:
+    """The default prototype: a square of side ``2B`` (64 for B = 32) in the middle of the image.
+
+    Its side is reduced to the largest even number the image holds (at least 8), so a small image
+    still gets a prototype; the paper uses a 64x64 prototype with 32x32 patches (§5).
+    """
+    h, w = shape[:2]
+    s = min(2 * block, (min(h, w) // 2) * 2)
+    if s < MIN_SIDE:
+        raise GeometryError(f"the image is {w}x{h}; a prototype needs at least {MIN_SIDE}x{MIN_SIDE} pixels")
+    return (w - s) // 2, (h - s) // 2, s
+
+
+@dataclass(frozen=True)
+class AffineParams(Params):
+    """Parameters of the affine prototype model (Smith & Bhalerao)."""
+
+    prototype: str = param(None, kind="str", optional=True,
+                           help="prototype square X,Y,S (top-left corner and side, pixels) in the "
+                                "prototype image or the texture; default a 2B square in the middle")
+    block: int = param(32, lo=8, hi=256, symbol="B", help="target patch side (even); patches overlap by B/2")
+    segments: int = param(32, lo=4, hi=128, symbol="N", help="angular segments of the spectrum (even)")
+    lowpass: str = param("add", choices=LOWPASS,
+                         help="add: synthesize the highpass and add the image's subsampled lowpass "
+                              "(and chroma) back; absorb: unfiltered (colour) prototype, the lowpass "
+                              "goes into the intensity factors (§3.3, §3.4)")
+    colour: str = param("pca", choices=COLOURS,
+                        help="grey channel the transforms are estimated on: pca = the principal "
+                             "component of the colours, yuv = luma Y (§3.4)")
+    propagate: bool = param(True,
+                            help="also try the neighbouring patches' transforms (top-down, then bottom-up), "
+                                 "as §6 suggests; off = the paper's eight candidates only")
+    refine: int = param(2, lo=0, hi=20,
+                        help="Levenberg-Marquardt steps refining each chosen transform and its translation "
+                             "to sub-pixel (0 = the paper's pipeline)")
+    reuse_transforms: bool = param(False,
+                                   help="compute the transforms with --analysis-prototype of the texture and "
+                                        "re-render them with --prototype (a prototype swap, §4)")
+    analysis_prototype: str = param(None, kind="str", optional=True,
+                                    help="with --reuse-transforms: the texture square X,Y,S the transforms are "
+                                         "computed for; default the default prototype")
+    boundary: str = param("auto", choices=BOUNDARIES,
+                          help="patch boundary matching (§4): none = translations from the target "
+                               "(§2.3); partial = raster partial correlation; shaker = shaker box; "
+                               "auto = shaker with a field, else none")
+    iterations: int = param(20, lo=1, hi=500, help="shaker box: most iterations")
+    per_radius: int = param(5, lo=1, hi=100,
+                            help="shaker box: iterations per search radius (B/4 down by one after each run)")
+    shaker_start: str = param("partial", choices=SHAKER_STARTS,
+                              help="shaker box: start from partial-correlation translations or the analysis ones")
+    field: str = param("none", choices=FIELDS,
+                       help="synthesize from a parametric transform field instead of the texture (Fig. 6)")
+    field_strength: float = param(1.0, lo=0.0, hi=2.0, step=0.05, help="amount of rotation / zoom of the field")
+    size: tuple = param(None, kind="size", lo=16, hi=8192, optional=True,
+                        help="output size WIDTHxHEIGHT with a field; default the texture's")
+
+    def check(self) -> None:
+        if self.block % 2:
+            raise InvalidParameter(f"parameter 'block' = {self.block} must be even (patches overlap by B/2)",
+                                   name="block", value=self.block)
+        if self.segments % 2:
+            raise InvalidParameter(f"parameter 'segments' = {self.segments} must be even (the spectrum's "
+                                   f"half-plane symmetry, eqs. 14-16)", name="segments", value=self.segments)
+        if self.prototype is not None:
+            parse_rect(self.prototype, "prototype")
+        if self.analysis_prototype is not None:
+            parse_rect(self.analysis_prototype, "analysis_prototype")
+            if not self.reuse_transforms:
+                raise InvalidParameter("parameter 'analysis_prototype' only applies with reuse_transforms "
+                                       "(--reuse-transforms true)", name="analysis_prototype",
+                                       value=self.analysis_prototype)
+        if self.field != "none" and self.reuse_transforms:
+            raise InvalidParameter(f"parameter 'reuse_transforms' has no meaning with field '{self.field}' "
+                                   f"(a field's transforms do not depend on the prototype)",
+                                   name="reuse_transforms", value=True)
+        if self.size is not None and self.field == "none":
+            raise InvalidParameter("parameter 'size' only applies with a field (--field swirl|zoom|rotate); "
+                                   "synthesis reproduces the texture at its own size", name="size", value=self.size)
+
+    def resolved_boundary(self) -> str:
+        """``boundary`` with ``auto`` made explicit: ``shaker`` with a field, else ``none``."""
+        if self.boundary == "auto":
+            return "shaker" if self.field != "none" else "none"
+        return self.boundary
+
+    def rect(self) -> Rect | None:
+        return None if self.prototype is None else parse_rect(self.prototype, "prototype")
+
+    def analysis_rect(self) -> Rect | None:
+        return None if self.analysis_prototype is None else parse_rect(self.analysis_prototype, "analysis_prototype")
+
+
+def check_block(block: int) -> int:
+    if isinstance(block, bool) or not isinstance(block, int) or block < 8 or block % 2:
+        raise out_of_range("block", block, 8, 256, "must be even")
+    return block
