@@ -56,7 +56,7 @@ class NfptParams(Params):
                         help="size WIDTHxHEIGHT of the synthesized frontal texture; default twice the rectified one")
     block: int = param(DEFAULT_BLOCK, lo=8, hi=512, symbol="B", help="side of the square patches in pixels")
     overlap: int = param(DEFAULT_OVERLAP, lo=2, hi=256,
-                         help="width of the L-shaped neighbourhood (overlap with the placed patches), below block/2")
+                         help="width of the L-shaped neighbourhood (overlap with the placed patches), at most block/2")
     sigma_d: float = param(None, kind="float", lo=0.1, hi=256.0, optional=True, symbol="σ_d", step=0.1,
                            help="eq. 1: spread in pixels of the weight of distance to the patch boundary "
                                 "(default overlap / 2)")
@@ -71,8 +71,8 @@ class NfptParams(Params):
     n: int = param(5, lo=3, hi=15, help="neighbourhood side for re-synthesizing a pixel (odd)")
     smooth: bool = param(False, help="step 7: Gaussian-filter the re-synthesized pixels")
     view: str = param(None, kind="str", optional=True,
-                      help="put the result into this view: a JSON file (or text) with a quad or feature lines "
-                           "in texture coordinates (see docs)")
+                      help="put the result into this view: a JSON file (or text), {\"quad\": [[x, y] x 4], \"size\": "
+                           "[w, h]} or view image_lines + texture frontal_lines; texture pixel coordinates")
     into_photo: bool = param(False, help="replace the textured plane in the photo with the larger synthesized one")
 
     def check(self) -> None:
