@@ -6,10 +6,10 @@ to the import below.
 
 from __future__ import annotations
 
-from . import fast, nfpt, quilt
+from . import affine, fast, nfpt, quilt
 from .base import Case, Input
 
-CASES: list[Case] = [*quilt.CASES, *fast.CASES, *nfpt.CASES]
+CASES: list[Case] = [*quilt.CASES, *fast.CASES, *nfpt.CASES, *affine.CASES]
 
 
 def by_name() -> dict[str, Case]:

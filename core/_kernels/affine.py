@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always", fastmath=True)
 def _sample(img, y, x, hm, wm):
     """Bilinear sample of a padded 2-D array (see ``pad``): coordinates are clamped, no branches."""
     y = min(max(y, 0.0), hm)
@@ -46,7 +46,7 @@ def _sample(img, y, x, hm, wm):
     return r0 + ay * (r1 - r0)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def warp_frames(pimg, cy, cx, mats, out):
     """``out[k]`` = the prototype sampled through ``mats[k]`` on an L x L frame centred on the
     prototype's centre (frame centre ``(L - 1) / 2``); unwindowed, no translation (§2.3).
@@ -338,7 +338,7 @@ def boundary_pass(frames, window, origins, mask, acc, acc2, wacc, placed, shifts
     return changed
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def _lk_system(proto, gy, gx, cy, cx, m, oy, ox, g, target, weights, JtJ, Jtr):
     """Error and normal equations of the refinement at (m, oy, ox, g) (sums kept in scalars);
     ``proto``, ``gy``, ``gx`` are padded alike."""
@@ -513,7 +513,7 @@ def _lk_system(proto, gy, gx, cy, cx, m, oy, ox, g, target, weights, JtJ, Jtr):
     return e
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def lk_systems(proto, gy, gx, cy, cx, params, targets, weights, JtJ, Jtr, err):
     """The refinement's error and normal equations for every patch i at ``params[i]`` =
     (M00, M01, M10, M11, offset y, offset x, gain): the residual is

@@ -59,7 +59,7 @@ def _hash(i: np.ndarray, j: np.ndarray, seed: int, salt: int) -> np.ndarray:
     return (v & 0xFFFFFF).astype(np.float64) / float(0x1000000)
 
 
-def cells(size=512, *, spacing: float = 16.0, drift: float = 0.4, jitter: float = 0.06, tone: float = 0.08,
+def cells(size=512, *, spacing: float = 16.0, drift: float = 0.4, jitter: float = 0.02, tone: float = 0.04,
           blur: float = 0.7, seed: int = 0) -> np.ndarray:
     """Reptile-like scales: Voronoi cells of a jittered hexagonal lattice with a drifting frame.
 
@@ -70,9 +70,9 @@ def cells(size=512, *, spacing: float = 16.0, drift: float = 0.4, jitter: float 
         Distance between neighbouring cell centres, pixels (at the image's centre).
     drift : float, default 0.4
         Orientation / scale drift across the image (see :func:`drift_coordinates`).
-    jitter : float, default 0.06
+    jitter : float, default 0.02
         Random displacement of the cell centres, as a fraction of the spacing.
-    tone : float, default 0.08
+    tone : float, default 0.04
         Random brightness variation from cell to cell (fraction).
     blur : float, default 0.7
         Gaussian blur σ in pixels, as a camera's optics would give (0: none).

@@ -207,12 +207,18 @@ def correlate_indexed(frames: np.ndarray, index: np.ndarray, flip: np.ndarray, t
     g[:, R:R + B, R:R + B] = targets
     G = sfft.rfft2(g)[:, None]
     F = sfft.rfft2(frames)
-    # rho[u] = sum g[v] f[v - u]: spectrum G conj(F); a turned frame has spectrum phase conj(F)
-    Fc = np.conj(F)
-    sel = Fc[index]  # (n, J, L, L//2+1)
-    if flip.any():
-        sel[flip] = F[index[flip]] * np.conj(_turn_phase(L))
-    spec = G * sel
+    # rho[u] = sum g[v] f[v - u]: spectrum G conj(F); a turned frame has spectrum phase conj(F),
+    # so its correlation has spectrum G F conj(phase)
+    h = J // 2
+    if (J % 2 == 0 and F_count == n * h and np.array_equal(index[:, :h].ravel(), np.arange(n * h))
+            and np.array_equal(index[:, h:], index[:, :h]) and not flip[:, :h].any() and flip[:, h:].all()):
+        Fr = F.reshape(n, h, L, -1)  # own frames, then the same turned: no gathering needed
+        spec = np.concatenate([G * np.conj(Fr), G * (Fr * np.conj(_turn_phase(L)))], axis=1)
+    else:
+        sel = np.conj(F)[index]  # (n, J, L, L//2+1)
+        if flip.any():
+            sel[flip] = F[index[flip]] * np.conj(_turn_phase(L))
+        spec = G * sel
     ey, ext = _pruned_inverse(L, R)
     rho = (ey @ spec @ ext).real  # (n, J, 2R+1, 2R+1)
     win = rho.reshape(n, J, -1)

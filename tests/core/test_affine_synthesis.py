@@ -36,7 +36,7 @@ def test_synthesis_reproduces_a_cell_texture(scales):
     assert out.shape == scales.shape and out.dtype == np.float32
     assert 0.0 <= out.min() and out.max() <= 1.0
     snr = metrics.snr_db(scales, out)
-    assert snr > 13.0  # 14.8 dB measured (the benchmark reports 512²)
+    assert snr > 15.0  # 16.3 dB measured here; 17.9 dB at 512² (the benchmark)
     # the paper's pipeline alone (eight candidates, no refinement) is far less accurate
     paper = metrics.snr_db(scales, synthesize(scales, propagate=False, refine=0))
     assert 3.0 < paper < snr - 5.0
