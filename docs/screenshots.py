@@ -93,7 +93,15 @@ def nfpt(window) -> None:
     window.input_tabs.setCurrentIndex(0)
 
 
-SHOTS = {"fast": fast, "quilt": quilt, "nfpt": nfpt}
+def affine(window) -> None:
+    doc = window.doc
+    doc._put_method("affine")
+    doc._put_input("texture", _input("cat-fur"))
+    doc.set_prototype((20, 20, 64))
+    doc.set_param("block", 16)
+
+
+SHOTS = {"fast": fast, "quilt": quilt, "affine": affine, "nfpt": nfpt}
 
 
 def main() -> int:

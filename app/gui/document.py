@@ -52,6 +52,8 @@ class Document(QObject):
         self.frontal_lines: list[list[float]] = []
         self.frontal_size: tuple[int, int] = (512, 512)
         self.seed = 1
+        # The prototype square while it is being dragged (not an edit yet: no undo step until release).
+        self.live_prototype: tuple[int, int, int] | None = None
 
     # --- reading -------------------------------------------------------------------------------
     @property
@@ -95,10 +97,16 @@ class Document(QObject):
 
     def run_params(self) -> Params:
         """The current method's parameters as a run uses them: a method with a ``lines`` parameter
-        (nfpt) gets the document's feature lines as JSON text, so its recipe needs no extra file."""
+        (nfpt) gets the document's feature lines as JSON text, one with a ``prototype`` parameter
+        (affine) the prototype square as ``"X,Y,S"`` (the one being dragged, if any), so recipes need
+        no extra file and the mouse is the one way to set them."""
         params = self.current_params
-        if any(s.name == "lines" for s in specs(self.current.params)):
+        names = {s.name for s in specs(self.current.params)}
+        if "lines" in names:
             params = params.replace(lines=self.lines_json())
+        if "prototype" in names:
+            rect = self.live_prototype or self.prototype
+            params = params.replace(prototype=",".join(str(int(v)) for v in rect) if rect else None)
         return params
 
     def recipe(self, relative_to: str | Path | None = None) -> Recipe:

@@ -26,6 +26,7 @@ from PySide6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QScrollArea,
+    QSizePolicy,
     QSpinBox,
     QSplitter,
     QStackedWidget,
@@ -94,6 +95,8 @@ class MainWindow(QMainWindow):
         self.texture_view = self._input_view("texture")
         self.patch_tool = PatchTool(self.texture_view, self.doc, on_drag=self._prototype_dragged)
         self.texture_view.tool = self.patch_tool
+        self.prototype_patch_tool = PatchTool(self._input_view("prototype_image"), self.doc,
+                                              on_drag=self._prototype_dragged)
         # nfpt: the photo with its feature lines, and the frontal frame (live rectification) with its own
         self.photo_view = self._input_view("photo")
         self.photo_lines = LineTool(self.photo_view, self.doc, "image", on_drag=self._lines_dragged)
@@ -150,6 +153,9 @@ class MainWindow(QMainWindow):
         lay.setSpacing(0)
         label = QLabel(f"  {title}")
         label.setStyleSheet("background:#2b2b2b; color:#ddd; padding:2px;")
+        label.setToolTip(title)
+        # A long title must not widen its pane: it is cut instead.
+        label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
         lay.addWidget(label)
         lay.addWidget(view)
         return box
@@ -372,6 +378,8 @@ class MainWindow(QMainWindow):
             if name == "texture":
                 self.patch_tool.refresh()
                 self._update_prototype_thumb()
+            if name in ("texture", "prototype_image"):
+                self._sync_patch_tools()
             if name == "photo":
                 self._rectifier = None
                 self.photo_lines.refresh()
@@ -393,7 +401,8 @@ class MainWindow(QMainWindow):
             if self.doc.method == "nfpt":
                 self.renderer.final()
         elif what == "prototype":
-            self.patch_tool.refresh()
+            self.doc.live_prototype = None
+            self._sync_patch_tools()
             self._update_prototype_thumb()
             self.renderer.final()
         elif what == "seed":
@@ -420,6 +429,7 @@ class MainWindow(QMainWindow):
             self.input_tabs.addTab(self._titled(view, inp.help), label)
             view.set_image(self.doc.image(inp.name))
         self.input_tabs.setVisible(self.input_tabs.count() > 0)
+        self._sync_patch_tools()
         self.open_other_menu.clear()
         for inp in method.inputs:
             act = self.open_other_menu.addAction(f"{inp.name.replace('_', ' ')}…")
@@ -462,10 +472,32 @@ class MainWindow(QMainWindow):
 
     def _prototype_dragged(self, rect) -> None:
         self._update_prototype_thumb(rect)
+        params = self.doc.current_params
+        if getattr(params, "reuse_transforms", False):
+            # affine with reused transforms: re-render live while the square moves (§4 prototype swap)
+            self.doc.live_prototype = rect
+            self.renderer.preview()
+
+    def _prototype_source(self) -> str:
+        """Which input the prototype square lies on: affine's prototype image when one is open."""
+        if self.doc.method == "affine" and "prototype_image" in self.doc.inputs:
+            return "prototype_image"
+        return "texture"
+
+    def _sync_patch_tools(self) -> None:
+        """The prototype square is drawn (and edited) on the image it belongs to."""
+        source = self._prototype_source()
+        for name, tool in (("texture", self.patch_tool), ("prototype_image", self.prototype_patch_tool)):
+            tool.view.tool = tool if name == source else None
+            tool.rect_item.setVisible(False)
+            for h in tool.handles:
+                h.setVisible(False)
+            if name == source:
+                tool.refresh()
 
     def _update_prototype_thumb(self, rect=None) -> None:
         rect = rect or self.doc.prototype
-        tex = self.doc.image("texture")
+        tex = self.doc.image(self._prototype_source())
         if rect is None or tex is None:
             self.prototype_label.clear()
             return
@@ -643,6 +675,7 @@ class MainWindow(QMainWindow):
             box_.valueChanged.connect(self._frontal_size_edited)
             row.addWidget(box_)
         self.rectify_status = QLabel("")
+        self.rectify_status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         row.addWidget(self.rectify_status, 1)
         lay.addLayout(row)
         lay.addWidget(self.frontal_view, 1)
@@ -746,6 +779,13 @@ class MainWindow(QMainWindow):
         dialog = getattr(self, "_variations", None)
         if dialog is not None:
             dialog.shutdown()
+
+    def showEvent(self, event):  # noqa: N802
+        super().showEvent(event)
+        if not getattr(self, "_sized", False):  # first show: give the result the larger share
+            self._sized = True
+            total = max(self.splitter.width(), 400)
+            self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
 
     def closeEvent(self, event):  # noqa: N802
         self.settings.setValue("geometry", self.saveGeometry())

@@ -100,3 +100,31 @@ def test_lines_file_round_trip(nfpt, tmp_path):
     nfpt.message.connect(messages.append)
     assert not nfpt.load_lines(str(bad))
     assert messages and "\n" not in messages[-1]
+
+
+def test_affine_prototype_by_mouse_and_live_swap(window, qtbot):
+    doc = window.doc
+    doc.set_method("affine")
+    doc.set_param("block", 16)
+    view = window.texture_view
+    view.actual_size()
+    view.zoom_by(2.0)
+    view.centerOn(50, 50)
+    drag(view, (20.2, 24.2), (52.2, 40.2))
+    assert doc.prototype == (20, 24, 32)
+    assert doc.run_params().prototype == "20,24,32"
+    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.figures.get("prototype") == [20, 24, 32],
+                    timeout=30000)
+    # With reuse_transforms, moving the square re-renders while the mouse moves (previews).
+    doc.set_param("reuse_transforms", True)
+    qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=30000)
+    shown = []
+    window.renderer.shown.connect(lambda s: shown.append(s))
+    mouse(view, "press", (30.0, 30.0))
+    for x in range(31, 40):
+        mouse(view, "move", (float(x), 30.0))
+        qtbot.wait(30)
+    qtbot.waitUntil(lambda: any(not s.final for s in shown), timeout=30000)
+    mouse(view, "release", (40.0, 30.0))
+    assert doc.prototype == (30, 24, 32)
+    qtbot.waitUntil(lambda: shown[-1].final and shown[-1].figures.get("prototype") == [30, 24, 32], timeout=30000)
