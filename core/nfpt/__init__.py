@@ -250,7 +250,7 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
     photo = validate_image(photo, "photo")
     ph, pw = photo.shape[:2]
     figures: dict[str, Any] = {}
-    if isinstance(lines, (str, bytes)) or hasattr(lines, "__fspath__"):
+    if isinstance(lines, str) or hasattr(lines, "__fspath__"):
         lines = rf.load_feature_lines(lines)
     if isinstance(view, str) or hasattr(view, "__fspath__"):
         view = rf.load_view(view)
@@ -309,14 +309,13 @@ def _run(inputs: Mapping[str, np.ndarray], params: NfptParams, *, rng=None, prog
 
 
 def warm_up() -> None:
-    """Load the kernels (numba's cache) on a tiny input: template, selection, repair, seams."""
+    """Load the synthesis kernels (numba's cache) on a tiny input: template, selection, repair, seams.
+
+    The Beier-Neely kernel of ``--warp lines``/``morph`` is ``core.rectify``'s warm-up."""
     rng = np.random.default_rng(0)
     tex = rng.random((20, 20), dtype=np.float32)
     synthesize(tex, size=(24, 24), block=8, overlap=3, threshold=0.0, rng=0)
     synthesize(np.repeat(tex[..., None], 3, axis=2), size=(24, 24), block=8, overlap=3, threshold=0.0, rng=0)
-    from .. import rectify
-
-    rectify.warm_up()
 
 
 METHOD = Method(
