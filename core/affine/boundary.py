@@ -131,7 +131,21 @@ class _Canvas:
 
 
 def total_boundary_error(model: AffineModel, prototype: Prototype | np.ndarray | None = None) -> float:
-    """The total boundary error of a model's current translations (see the module docstring)."""
+    """The total boundary error of a model with its current translations (§4).
+
+    Parameters
+    ----------
+    model : AffineModel
+        Its translations are rounded to whole pixels (as boundary matching uses them).
+    prototype : Prototype or patch, optional
+        What is rendered (default the model's prototype).
+
+    Returns
+    -------
+    float
+        ``Σ_image Σ_pairs W_a W_b (p_a - p_b)²`` over every pair of overlapping patches, with the
+        intensity factors applied: the quantity the shaker box never increases.
+    """
     proto = _as_prototype(model, prototype)
     canvas = _Canvas(model, proto, model.shifts)
     canvas.fill()

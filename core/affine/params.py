@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import GeometryError, InvalidParameter
-from ..params import Params, out_of_range, param
+from ..params import Params, param
 
 LOWPASS = ("add", "absorb")
 COLOURS = ("pca", "yuv")
@@ -56,7 +56,28 @@ def parse_rect(text: str | tuple | list, name: str = "prototype") -> Rect:
 
 
 def check_rect(rect: Rect, shape: tuple[int, ...], what: str = "texture", name: str = "prototype") -> Rect:
-    """Check that the square ``rect`` lies inside an image of ``shape``; ``GeometryError`` otherwise."""
+    """Check that a prototype square lies inside an image.
+
+    Parameters
+    ----------
+    rect : (x, y, s)
+        From :func:`parse_rect`.
+    shape : tuple
+        The image's shape (H, W[, C]).
+    what, name : str
+        The image and the parameter, for the message.
+
+    Returns
+    -------
+    (x, y, s), unchanged.
+
+    Raises
+    ------
+    GeometryError
+        One line naming the value, the pixels it spans and the image size, e.g.
+        ``parameter 'prototype' = 200,10,64 does not fit: it spans x 200..263, y 10..73, outside
+        the 256x256 texture``.
+    """
     x, y, s = rect
     h, w = shape[:2]
     if x + s > w or y + s > h:
@@ -160,7 +181,3 @@ class AffineParams(Params):
         return None if self.analysis_prototype is None else parse_rect(self.analysis_prototype, "analysis_prototype")
 
 
-def check_block(block: int) -> int:
-    if isinstance(block, bool) or not isinstance(block, int) or block < 8 or block % 2:
-        raise out_of_range("block", block, 8, 256, "must be even")
-    return block

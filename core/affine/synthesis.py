@@ -57,6 +57,7 @@ class Decomposition:
     channels (lowpassed: the "subsampled" chroma of §3.4) with what is needed to recombine."""
 
     grey: np.ndarray  # (H, W) float32
+    luminance: np.ndarray  # (H, W) float32, Rec. 601 (the intensity factors of 'absorb')
     low: np.ndarray  # (H, W) float32
     high: np.ndarray  # (H, W) float32
     chroma_low: np.ndarray | None  # (H, W, 2) float32, colour images only
@@ -66,7 +67,28 @@ class Decomposition:
 
 
 def decompose(image: np.ndarray, block: int, colour: str = "pca", *, need_chroma: bool = True) -> Decomposition:
-    """Split ``image`` into grey (Y of YIQ, or the first principal component) and chroma (§3.4)."""
+    """Split an image into the grey channel the model works on, its lowpass/highpass and chroma
+    (§3.3, §3.4).
+
+    Parameters
+    ----------
+    image : float32 (H, W) or (H, W, 3) in [0, 1]
+    block : int
+        B; sets the lowpass (see :func:`lowpass`).
+    colour : {"pca", "yuv"}, default "pca"
+        ``pca``: grey = the first principal component of the image's colours (offset by the mean's
+        projection, so it reads as brightness), chroma = the other two components; ``yuv``:
+        grey = Y, chroma = I and Q of YIQ (weft's YUV-family space, as in ``core.image``). Grey
+        images pass through.
+    need_chroma : bool, default True
+        Compute the lowpassed chroma (``add`` keeps it; ``absorb`` does not need it).
+
+    Returns
+    -------
+    Decomposition
+        ``grey = low + high`` exactly; ``chroma_low`` is the "subsampled" chroma of §3.4's first
+        way (the same lowpass as the grey's).
+    """
     if colour not in COLOURS:
         raise InvalidParameter(f"parameter 'colour' = {colour!r} is not one of {', '.join(COLOURS)}",
                                name="colour", value=colour)
@@ -84,7 +106,8 @@ def decompose(image: np.ndarray, block: int, colour: str = "pca", *, need_chroma
         chroma = comps[..., 1:]
     low = lowpass(grey, block)
     chroma_low = lowpass(chroma, block) if chroma is not None and need_chroma else None
-    return Decomposition(grey=grey.astype(np.float32, copy=False), low=low, high=(grey - low).astype(np.float32),
+    return Decomposition(grey=grey.astype(np.float32, copy=False), luminance=luminance(image), low=low,
+                         high=(grey - low).astype(np.float32),
                          chroma_low=chroma_low, colour=colour, basis=basis, offset=offset)
 
 
@@ -111,7 +134,10 @@ class Prototype:
     highpass : (S, S) float32
         Grey highpass: spectra and translations are always estimated on it; rendered in ``add``.
     grey : (S, S) float32
-        Grey, unfiltered: intensity factors and the choice of transform in ``absorb`` (§3.3).
+        Unfiltered luminance (Rec. 601): intensity factors and the choice of transform in
+        ``absorb`` (§3.3). Luminance rather than the PCA grey, so that a factor found between
+        greys scales the rendered colour prototype to the target's brightness whichever image
+        the prototype comes from (the first principal component of two images has two scales).
     colour : (S, S, 3) float32 or None
         The unfiltered colour patch, rendered in ``absorb`` (§3.4's colour prototype).
     rect : (x, y, s) or None
@@ -161,13 +187,30 @@ def make_prototype(image: np.ndarray, rect: Rect | str | None = None, *, block: 
     x, y, s = rect
     sl = (slice(y, y + s), slice(x, x + s))
     col = np.ascontiguousarray(image[sl]) if image.ndim == 3 else None
-    return Prototype(highpass=np.ascontiguousarray(dec.high[sl]), grey=np.ascontiguousarray(dec.grey[sl]),
+    return Prototype(highpass=np.ascontiguousarray(dec.high[sl]), grey=np.ascontiguousarray(luminance(image[sl])),
                      colour=col, rect=rect)
 
 
 def prototype_from_patch(patch: np.ndarray, *, block: int = 32, colour: str = "pca") -> Prototype:
-    """A prototype from a bare square patch (e.g. a swapped-in sample), its highpass taken
-    against the patch's own lowpass (mirrored at its borders)."""
+    """A prototype from a bare square patch (e.g. a swapped-in sample, §4).
+
+    Parameters
+    ----------
+    patch : float32 (S, S) or (S, S, 3) in [0, 1]
+        S even, >= 8.
+    block, colour
+        As for :func:`make_prototype`; the highpass is taken against the patch's own lowpass
+        (mirrored at its borders), since no surrounding image is known.
+
+    Returns
+    -------
+    Prototype
+
+    Raises
+    ------
+    ImageError
+        The patch is not a square with an even side of at least 8.
+    """
     patch = validate_image(patch, "prototype patch")
     h, w = patch.shape[:2]
     if h != w or h < 8 or h % 2:
@@ -327,8 +370,9 @@ def analyse(
     lowpass : {"add", "absorb"}, default "add"
         §3.3: ``add`` models the highpass and keeps the image's subsampled lowpass (and chroma,
         §3.4 first way) to add back; ``absorb`` estimates the transforms on the highpass but
-        chooses them and computes intensity factors on the unfiltered grey, and renders the
-        unfiltered (colour) prototype (§3.4 second way): the lowpass is absorbed in the factors.
+        chooses them and computes intensity factors on the unfiltered image (its luminance),
+        and renders the unfiltered (colour) prototype (§3.4 second way): the lowpass is absorbed
+        in the factors.
     colour : {"pca", "yuv"}, default "pca"
         Grey channel of colour images: the first principal component of the colours (§3.4, the
         paper's recommendation) or luma Y (of YIQ, weft's YUV-family space).
@@ -452,8 +496,20 @@ class _State:
 
 
 def padded(patch: np.ndarray) -> tuple[np.ndarray, float]:
-    """The prototype mirrored (reflect-101) by its own side on every side, as the kernels sample
-    it, and its centre there: ``((3S, 3S[, C]) float32, centre)``."""
+    """The prototype as the kernels sample it.
+
+    Parameters
+    ----------
+    patch : (S, S) or (S, S, C) array
+
+    Returns
+    -------
+    (ndarray (3S, 3S[, C]) float32, float)
+        The patch mirrored (reflect-101) by its own side on every side, and the patch's centre
+        ``S + (S - 1)/2`` in it. Choice where the paper is silent: a transformed prototype that
+        reaches past its square (a shrinking or turned transform near the patch corners) sees the
+        mirrored prototype, not zeros.
+    """
     s = patch.shape[0]
     pad = ((s, s), (s, s)) + ((0, 0),) * (patch.ndim - 2)
     return np.ascontiguousarray(np.pad(patch.astype(np.float32), pad, mode="reflect")), s + (s - 1) / 2.0
@@ -484,7 +540,7 @@ class _Context:
         if lowpass == "add":
             targets_cmp, cmp = targets_hp, proto.highpass
         else:
-            targets_cmp, cmp = _patches(grid.pad(dec.grey), grid), proto.grey
+            targets_cmp, cmp = _patches(grid.pad(dec.luminance), grid), proto.grey
         hp, c = padded(proto.highpass)
         return cls(grid, hp, padded(cmp)[0], c, lowpass == "add", targets_hp, targets_hp * win, targets_cmp,
                    weights)
@@ -647,6 +703,8 @@ def _check_geometry(shape, block: int, segments: int) -> None:
         raise InvalidParameter(f"parameter 'segments' = {segments!r} must be an even integer >= 4",
                                name="segments", value=segments)
     h, w = shape[:2]
+    if min(h, w) < 8:
+        raise ImageError(f"the texture is {w}x{h}; the affine model needs at least 8x8 pixels")
     if block > min(h, w):
         raise InvalidParameter(f"parameter 'block' = {block} is outside 8..{max(8, min(h, w))} (the patch must "
                                f"fit in the {w}x{h} image)", name="block", value=block)
@@ -688,8 +746,20 @@ def render_canvas(model: AffineModel, proto: Prototype, index: np.ndarray | None
 
 
 def compose(model: AffineModel, synth: np.ndarray) -> np.ndarray:
-    """The output image from a cropped synthesized signal (H, W, C): ``add`` adds the retained
-    lowpass and recombines with the retained chroma (§3.3, §3.4); ``absorb`` clips."""
+    """The output image from a synthesized signal (§3.3, §3.4).
+
+    Parameters
+    ----------
+    model : AffineModel
+    synth : float32 (H, W, C)
+        The cropped sum of windowed patches (:func:`render_canvas` cropped to the image).
+
+    Returns
+    -------
+    float32 (H, W) or (H, W, 3) in [0, 1]
+        ``add``: synth + the retained lowpass, recombined with the retained chroma;
+        ``absorb``: synth as it is. Clipped to [0, 1].
+    """
     if model.lowpass == "add" and model.decomposition is not None:
         return _recombine(model.decomposition, synth[..., 0] + model.decomposition.low)
     out = synth[..., 0] if synth.shape[2] == 1 else synth

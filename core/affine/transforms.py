@@ -73,7 +73,18 @@ def regularise_pairs(mu: np.ndarray) -> np.ndarray:
 
 
 def singular_values(T: np.ndarray) -> np.ndarray:
-    """Singular values (largest first) of a stack of 2x2 matrices, in closed form."""
+    """Singular values of a stack of 2x2 matrices in closed form.
+
+    Parameters
+    ----------
+    T : ndarray (..., 2, 2)
+
+    Returns
+    -------
+    ndarray (..., 2)
+        Largest first: ``(|q| + |r|) / 2`` and ``||q| - |r|| / 2`` with ``q = (a + d, c - b)``
+        and ``r = (a - d, c + b)`` (the rotation and reflection parts of ``[[a, b], [c, d]]``).
+    """
     a, b, c, d = T[..., 0, 0], T[..., 0, 1], T[..., 1, 0], T[..., 1, 1]
     s1 = np.hypot(a + d, c - b)
     s2 = np.hypot(a - d, c + b)
@@ -126,7 +137,18 @@ def candidate_transforms(mu_p: np.ndarray, mu_t: np.ndarray) -> np.ndarray:
 
 
 def sampling_matrices(T: np.ndarray) -> np.ndarray:
-    """``T⁻¹ = Aᵀ``: offsets in a target patch -> offsets in the prototype (what warping uses)."""
+    """The sampling matrices ``T⁻¹ = Aᵀ`` of spatial transforms (§2, eq. 22).
+
+    Parameters
+    ----------
+    T : ndarray (..., 2, 2)
+        Prototype -> target transforms (non-singular; :func:`candidate_transforms` guarantees it).
+
+    Returns
+    -------
+    ndarray (..., 2, 2) float64
+        Offsets in a target patch -> offsets in the prototype: what warping samples through.
+    """
     return np.linalg.inv(np.asarray(T, dtype=np.float64))
 
 
@@ -196,9 +218,27 @@ def correlate_shifts(frames: np.ndarray, targets: np.ndarray, radius: int, *,
 
 def correlate_indexed(frames: np.ndarray, index: np.ndarray, flip: np.ndarray, targets: np.ndarray,
                       radius: int) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`correlate_shifts` for candidates that share frames: candidate j of patch i is frame
-    ``index[i, j]`` of ``frames`` (F, L, L), turned by 180° where ``flip[i, j]``. Each frame is
-    Fourier-transformed once however many patches use it."""
+    """:func:`correlate_shifts` for candidates that share frames (§2.3, eq. 23).
+
+    Parameters
+    ----------
+    frames : ndarray (F, L, L) float32
+        Warped prototypes (a frame depends on its matrix only, not on the patch).
+    index : int ndarray (n, J)
+        Candidate j of patch i is frame ``index[i, j]`` ...
+    flip : bool ndarray (n, J)
+        ... turned by 180° where ``flip[i, j]``.
+    targets : ndarray (n, B, B) float32
+        The (windowed) target patches.
+    radius : int
+        Largest shift per axis (B/4).
+
+    Returns
+    -------
+    shifts, peak
+        As :func:`correlate_shifts`. Each frame is Fourier-transformed once however many patches
+        use it.
+    """
     F_count, L, _ = frames.shape
     n, J = index.shape
     B = targets.shape[-1]
