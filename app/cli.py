@@ -24,6 +24,7 @@ from typing import Sequence
 
 from core import __version__
 from core.errors import Cancelled, WeftError
+from core.params import specs
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -89,7 +90,6 @@ def build_parser() -> argparse.ArgumentParser:
                 p.add_argument("--" + inp.name.replace("_", "-"), dest=inp.name, metavar="IMAGE",
                                required=inp.required, help=inp.help)
         group = p.add_argument_group("method parameters")
-        from core.params import specs
 
         for spec in specs(method.params):
             bits = [spec.help or spec.name]
@@ -175,13 +175,13 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     seconds = time.perf_counter() - t0
 
     out_dir = out.resolve().parent
-    rel_inputs = {}
-    for name, path in input_paths.items():
-        try:
-            rel_inputs[name] = os.path.relpath(Path(path).resolve(), out_dir)
-        except ValueError:  # another drive on Windows
-            rel_inputs[name] = str(Path(path).resolve())
-    recipe = Recipe(method=method.name, params=params.to_dict(), inputs=rel_inputs, seed=seed, region=region)
+    rel_inputs = {name: _relative_to(path, out_dir) for name, path in input_paths.items()}
+    recipe_params = params.to_dict()
+    for spec in specs(method.params):  # text parameters naming files (nfpt's --lines, --view)
+        value = recipe_params.get(spec.name)
+        if spec.kind == "str" and isinstance(value, str) and Path(value).is_file():
+            recipe_params[spec.name] = _relative_to(value, out_dir)
+    recipe = Recipe(method=method.name, params=recipe_params, inputs=rel_inputs, seed=seed, region=region)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if args.report:
         h, w = result.image.shape[:2]
@@ -189,6 +189,24 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         line.update(result.figures)
         print(json.dumps(line), flush=True)
     return 0
+
+
+def _relative_to(path: str, folder: Path) -> str:
+    """``path`` relative to ``folder`` (recipes store paths relative to the file that carries them)."""
+    try:
+        return os.path.relpath(Path(path).resolve(), folder)
+    except ValueError:  # another drive on Windows
+        return str(Path(path).resolve())
+
+
+def _resolve_file_params(method, params: dict, base: Path) -> dict:
+    """Text parameters of a recipe that name files relative to it, made absolute."""
+    out = dict(params)
+    for spec in specs(method.params):
+        value = out.get(spec.name)
+        if spec.kind == "str" and isinstance(value, str) and not os.path.isabs(value) and (base / value).is_file():
+            out[spec.name] = str(base / value)
+    return out
 
 
 def _load_recipe(path: str):
@@ -224,10 +242,10 @@ def _dispatch(args: argparse.Namespace) -> int:
         else:
             seed = recipe.seed
         region = parse_square(args.region) if args.region is not None else recipe.region
-        return _execute(recipe.method, dict(recipe.params), dict(recipe.inputs), seed, args, region)
+        params = _resolve_file_params(method, dict(recipe.params), Path(args.recipe).resolve().parent)
+        return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region)
 
     method = registry.get(args.method)
-    from core.params import specs
 
     values = {}
     for spec in specs(method.params):

@@ -94,3 +94,27 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, fragment):
     code, _, err = run(argv, capsys)
     assert code == 2 and err.count("\n") == 1 and fragment in err, err
     assert not out.exists()
+
+
+def test_recipe_finds_the_lines_file_from_any_folder(tmp_path, monkeypatch):
+    """A recipe stores --lines relative to itself, so `weft run` works from another folder."""
+    import json
+    import shutil
+
+    import numpy as np
+
+    from app.cli import main
+    from core.examples import RESOURCES
+    from core.image import load_image, read_recipe
+
+    for name in ("perspective.png", "perspective-lines.json"):
+        shutil.copy(RESOURCES / name, tmp_path / name)
+    monkeypatch.chdir(tmp_path)
+    assert main(["nfpt", "perspective.png", "--lines", "perspective-lines.json", "--size", "96x96",
+                 "-o", "out.png", "--seed", "2"]) == 0
+    assert json.loads(read_recipe(tmp_path / "out.png"))["params"]["lines"] == "perspective-lines.json"
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    assert main(["run", str(tmp_path / "out.png"), "-o", "again.png"]) == 0
+    assert np.array_equal(load_image(tmp_path / "out.png").image, load_image(elsewhere / "again.png").image)
