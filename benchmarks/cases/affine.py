@@ -46,7 +46,7 @@ def _procedural(name: str, **kw) -> np.ndarray:
 def _procedural_figures(name: str):
     def figures(inputs, out):
         from core.affine import synthesize
-        from core.affine.synthesis import decompose
+        from core.affine.model import decompose
 
         tex = _procedural(name)
         s, img = _median_time(lambda: synthesize(tex))

@@ -518,7 +518,7 @@ def lk_systems(proto, gy, gx, cy, cx, params, targets, weights, JtJ, Jtr, err):
     """The refinement's error and normal equations for every patch i at ``params[i]`` =
     (M00, M01, M10, M11, offset y, offset x, gain): the residual is
     ``w (g P(c + M y + o) - s_t)`` over the patch (an addition to the paper, see
-    ``core.affine.synthesis``); the Levenberg-Marquardt steps are taken by the caller."""
+    ``core.affine.analysis``); the Levenberg-Marquardt steps are taken by the caller."""
     for i in range(params.shape[0]):
         err[i] = _lk_system(proto, gy, gx, cy, cx, params[i], params[i, 4], params[i, 5], params[i, 6],
                             targets[i], weights[i], JtJ[i], Jtr[i])

@@ -6,13 +6,14 @@ B/2), an affine transform and an intensity factor that map the prototype onto it
 per section of the paper:
 
 ==========================  =====================================================================
-§2.1 centroids              :func:`centroids` (:mod:`core.affine.centroids`)
+§2.1 centroids              :func:`centroids` (:mod:`core.affine.spectral`)
 §2.2 linear transforms      :func:`candidate_transforms` (:mod:`core.affine.transforms`)
 §2.3 translation            :func:`correlate_shifts`
-§2.4 best transform         :func:`analyse` (:mod:`core.affine.synthesis`)
+§2.4 best transform         :func:`analyse` (:mod:`core.affine.analysis`)
 §3.1 cos² windows           :func:`cos2_window`
 §3.2 intensity factors      :func:`analyse`
-§3.3 lowpass (add/absorb)   :func:`lowpass`, :func:`decompose`, ``analyse(lowpass=...)``
+§3 synthesis               :func:`render` (:mod:`core.affine.synthesis`), :class:`Grid`
+§3.3 lowpass (add/absorb)   :func:`lowpass`, :func:`decompose` (:mod:`core.affine.model`)
 §3.4 colour (YUV/PCA)       :func:`decompose`, :func:`make_prototype`
 §4 transfer                 ``analyse(prototype_image=...)``; :func:`render` with another prototype
 §4 boundary matching        :func:`match_boundaries` (partial correlation, shaker box)
@@ -36,18 +37,20 @@ Example
 """
 
 from .boundary import BoundaryReport, match_boundaries, total_boundary_error
-from .centroids import Centroids, centroid_pairs, centroids, cos2_window, segment_sums
+from .spectral import Centroids, centroid_pairs, centroids, cos2_window, segment_sums
 from .fields import field_model, field_transforms
 from .method import METHOD, synthesize, warm_up
 from .params import AffineParams, check_rect, default_rect, parse_rect
-from .synthesis import (AffineModel, Decomposition, Grid, Prototype, analyse, compose, decompose, lowpass,
-                        make_prototype, prototype_from_patch, render)
+from .analysis import analyse, levenberg_marquardt
+from .model import (AffineModel, Decomposition, Grid, Prototype, decompose, lowpass, make_prototype,
+                    prototype_from_patch)
+from .synthesis import compose, render
 from .transforms import candidate_transforms, correlate_shifts, regularise_pairs, sampling_matrices
 
 __all__ = [
     "METHOD", "AffineModel", "AffineParams", "BoundaryReport", "Centroids", "Decomposition", "Grid", "Prototype",
     "analyse", "candidate_transforms", "centroid_pairs", "centroids", "check_rect", "compose", "correlate_shifts",
-    "cos2_window", "decompose", "default_rect", "field_model", "field_transforms", "lowpass", "make_prototype",
-    "match_boundaries", "parse_rect", "prototype_from_patch", "regularise_pairs", "render", "sampling_matrices",
+    "cos2_window", "decompose", "default_rect", "field_model", "field_transforms", "levenberg_marquardt", "lowpass",
+    "make_prototype", "match_boundaries", "parse_rect", "prototype_from_patch", "regularise_pairs", "render", "sampling_matrices",
     "segment_sums", "synthesize", "total_boundary_error", "warm_up",
 ]

@@ -32,8 +32,9 @@ import numpy as np
 from ..errors import InvalidParameter
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
-from .centroids import cos2_window
-from .synthesis import AffineModel, Prototype, _as_prototype, compose, padded
+from .spectral import cos2_window
+from .model import AffineModel, Prototype, padded
+from .synthesis import _as_prototype, compose
 
 MODES = ("none", "partial", "shaker")
 STARTS = ("partial", "analysis")

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import InvalidParameter
 from .params import FIELDS
-from .synthesis import AffineModel, Grid, Prototype
+from .model import AffineModel, Grid, Prototype
 
 
 def field_transforms(grid: Grid, field: str, strength: float = 1.0) -> np.ndarray:

@@ -14,7 +14,9 @@ from ..registry import InputSpec, Method, Result
 from .boundary import BoundaryReport, match_boundaries
 from .fields import field_model
 from .params import AffineParams, check_rect, default_rect
-from .synthesis import AffineModel, analyse, decompose, make_prototype, render
+from .analysis import analyse
+from .model import AffineModel, _recombine, make_prototype
+from .synthesis import render
 
 
 def synthesize(
@@ -162,8 +164,6 @@ def _run(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=None, pr
         figures["snr_db"] = round(float(snr_db(ref, cmp)), 3)
         if model.lowpass == "add" and model.decomposition is not None and params.field == "none":
             # what the retained lowpass (and chroma) alone would score: the synthesis adds the rest
-            from .synthesis import _recombine
-
             base = _recombine(model.decomposition, model.decomposition.low)
             if base.ndim != ref.ndim:
                 base = luminance(base)

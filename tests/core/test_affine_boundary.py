@@ -7,7 +7,7 @@ from core.affine import (analyse, field_model, field_transforms, make_prototype,
                          synthesize, total_boundary_error)
 from core.affine.boundary import _Canvas
 from core.affine.procedural import cells
-from core.affine.synthesis import Grid
+from core.affine.model import Grid
 from core.errors import InvalidParameter
 from core.examples import example
 from core.image import load_image

@@ -57,7 +57,7 @@ def test_two_sinusoids_give_the_two_frequencies():
 
 def _brute_force(patch, segments):
     """Eqs. 3-6 directly: every split (k, l) of every half-plane, variances from the bins."""
-    from core.affine.centroids import _bins
+    from core.affine.spectral import _bins
 
     n = patch.shape[0]
     bins = _bins(n, segments, 1.0 / n)

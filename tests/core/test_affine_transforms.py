@@ -54,8 +54,9 @@ def _centre_patch(model):
 
 
 def test_rotation_by_30_scale_by_1_2_is_among_the_candidates_and_chosen(rotated_case):
-    from core.affine.centroids import centroids
-    from core.affine.synthesis import _central, decompose, make_prototype
+    from core.affine.spectral import centroids
+    from core.affine.analysis import _central
+    from core.affine.model import decompose, make_prototype
 
     proto_img, target, T, rect, B = rotated_case
     # §2.2: the eight candidates from the centroid pairs contain T (within the centroids' bias)
