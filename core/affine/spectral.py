@@ -123,7 +123,9 @@ def segment_sums(patches: np.ndarray, *, segments: int = 32, lowcut: float | Non
     if p.ndim != 3 or p.shape[1] != n:
         raise InvalidParameter(f"patches must be square, shape (K, n, n); got {np.shape(patches)}")
     # A flat patch has an empty spectrum; keep float32 round-off of the mean removal out of it.
-    flat = p.std(axis=(1, 2), dtype=np.float64) <= 1e-6 * (1.0 + np.abs(p).max(axis=(1, 2)))
+    hi = p.max(axis=(1, 2))
+    lo = p.min(axis=(1, 2))
+    flat = (hi - lo) <= 1e-6 * (1.0 + np.maximum(np.abs(hi), np.abs(lo)))
     if not windowed:
         p = (p - p.mean(axis=(1, 2), keepdims=True, dtype=np.float64).astype(np.float32)) * cos2_window(n)
     lowcut = 1.0 / n if lowcut is None else float(lowcut)
