@@ -111,7 +111,6 @@ CASES: list[Case] = [
         params={},
         metrics=("snr_db",),
         figures=_brick_figures,
-        quick={"block": 64},
         note="analysis + synthesis at 512² (target 0.5 s), B = 32, prototype 64; paper-only SNR as a figure",
     ),
     Case(
@@ -120,7 +119,6 @@ CASES: list[Case] = [
         inputs={"texture": Input("brick", resize=(512, 512))},
         params={},
         figures=_procedural_figures("cells"),
-        quick={"block": 64},
         note="procedural scales 512², jitter 2 % (figures; target SNR 17.5 dB; also jitter 0-10 %); timed: brick 512²",
     ),
     Case(
@@ -129,7 +127,6 @@ CASES: list[Case] = [
         inputs={"texture": Input("brick", resize=(512, 512))},
         params={},
         figures=_procedural_figures("weave"),
-        quick={"block": 64},
         note="procedural basket weave 512² (figures; target SNR 15.2 dB); timed run: brick 512²",
     ),
     Case(
@@ -139,7 +136,6 @@ CASES: list[Case] = [
         params={"boundary": "shaker", "iterations": 20},
         metrics=("snr_db",),
         figures=_shaker_figures,
-        quick={"block": 64},
         note="analysis + partial pass + shaker box (at most 20 iterations) + synthesis at 512² (shaker target 3 s)",
     ),
     Case(
@@ -155,7 +151,6 @@ CASES: list[Case] = [
         method="affine",
         inputs={"texture": Input("chelsea"), "prototype_image": Input("brick")},
         params={"boundary": "shaker", "prototype": "96,96,64"},
-        quick={"block": 64},
         note="brick highpass onto the cat photo keeping its lowpass and colour (Fig. 5 middle), shaker box",
     ),
 ]
