@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
 from typing import Callable, Mapping
 
 import numpy as np
@@ -129,9 +132,7 @@ def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=Non
     elif params.reuse_transforms:
         arect = params.analysis_rect() or default_rect(texture.shape, B)
         check_rect(arect, texture.shape, "texture", "analysis_prototype")
-        model = analyse(texture, prototype=arect, block=B, segments=params.segments, lowpass=params.lowpass,
-                        colour=params.colour, propagate=params.propagate, refine=params.refine,
-                        progress=progress, cancel=cancel)
+        model = _cached_analysis(texture, arect, params, progress, cancel)
         rect = params.rect() or default_rect(source.shape, B)
         dec = model.decomposition if other is None else None
         render_proto = make_prototype(source, check_rect(rect, source.shape, source_name), block=B,
@@ -151,6 +152,33 @@ def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=Non
                                      start=params.shaker_start, rng=rng, progress=progress, cancel=cancel)
     out = render(model, render_proto)
     return out, model, report, info
+
+
+# The last few analyses made for reused transforms: the studio re-runs the method for every move
+# of the prototype square, and with "reuse transforms" only the rendering has to be redone.
+_CACHE_SIZE = 2
+_cache: OrderedDict = OrderedDict()
+_cache_lock = threading.Lock()
+
+
+def _cached_analysis(texture: np.ndarray, arect, params: AffineParams, progress, cancel) -> AffineModel:
+    """:func:`analyse` of the texture for ``arect``, remembered by content and parameters (models
+    are never modified, so threads may share them)."""
+    key = (hashlib.blake2b(texture.tobytes(), digest_size=16).digest(), texture.shape, tuple(arect), params.block,
+           params.segments, params.lowpass, params.colour, params.propagate, params.refine)
+    with _cache_lock:
+        model = _cache.get(key)
+        if model is not None:
+            _cache.move_to_end(key)
+            return model
+    model = analyse(texture, prototype=arect, block=params.block, segments=params.segments, lowpass=params.lowpass,
+                    colour=params.colour, propagate=params.propagate, refine=params.refine,
+                    progress=progress, cancel=cancel)
+    with _cache_lock:
+        _cache[key] = model
+        while len(_cache) > _CACHE_SIZE:
+            _cache.popitem(last=False)
+    return model
 
 
 def _run(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=None, progress=None, cancel=None) -> Result:

@@ -227,3 +227,24 @@ def test_method_is_registered_with_its_inputs():
     assert [i.name for i in m.inputs] == ["texture", "prototype_image"]
     assert not m.inputs[1].required
     AffineParams()  # defaults validate (the GUI builds its panel from them)
+
+
+def test_reused_transforms_are_cached_between_runs(scales):
+    """The studio re-runs the method for every move of the prototype square: with reused
+    transforms the analysis is remembered (by content and parameters) and only the render redone."""
+    from core.affine import method
+
+    method._cache.clear()
+    params = AffineParams(reuse_transforms=True, prototype="40,40,64")
+    first = METHOD.run({"texture": scales}, params, rng=0).image
+    assert len(method._cache) == 1
+    moved = METHOD.run({"texture": scales}, params.replace(prototype="60,50,64"), rng=0).image
+    assert len(method._cache) == 1  # the same analysis served the move
+    method._cache.clear()
+    fresh = METHOD.run({"texture": scales}, params.replace(prototype="60,50,64"), rng=0).image
+    np.testing.assert_array_equal(moved, fresh)
+    assert not np.array_equal(first, moved)
+    other = scales[::-1].copy()  # other content: another analysis
+    METHOD.run({"texture": other}, params, rng=0)
+    METHOD.run({"texture": scales}, params.replace(block=16), rng=0)  # other parameters: another one
+    assert len(method._cache) == 2  # at most two are kept
