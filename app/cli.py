@@ -74,14 +74,17 @@ def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The ``weft`` parser; with ``only``, just that method's subcommand (and ``run``) is built, so
+    only that method's module is imported."""
     from core import registry
 
     parser = _Parser(prog="weft", description="Example-based texture synthesis and transfer. "
                      "Without arguments, opens the desktop studio.")
     parser.add_argument("--version", action="version", version=f"weft {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    for method in registry.methods().values():
+    chosen = [registry.get(only)] if only is not None else list(registry.methods().values())
+    for method in chosen:
         p = sub.add_parser(method.name, help=method.summary, description=method.summary)
         for inp in method.inputs:
             if inp.is_positional:
@@ -179,7 +182,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     recipe_params = params.to_dict()
     for spec in specs(method.params):  # text parameters naming files (nfpt's --lines, --view)
         value = recipe_params.get(spec.name)
-        if spec.kind == "str" and isinstance(value, str) and Path(value).is_file():
+        if spec.kind == "str" and _names_file(value):
             recipe_params[spec.name] = _relative_to(value, out_dir)
     recipe = Recipe(method=method.name, params=recipe_params, inputs=rel_inputs, seed=seed, region=region)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
@@ -189,6 +192,16 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         line.update(result.figures)
         print(json.dumps(line), flush=True)
     return 0
+
+
+def _names_file(value) -> bool:
+    """Whether a text parameter names an existing file (JSON given inline, e.g. ``{...}``, does not)."""
+    if not isinstance(value, str) or not value or value.lstrip().startswith(("{", "[")):
+        return False
+    try:
+        return Path(value).is_file()
+    except (OSError, ValueError):  # too long for a file name, or a NUL in it
+        return False
 
 
 def _relative_to(path: str, folder: Path) -> str:
@@ -204,7 +217,7 @@ def _resolve_file_params(method, params: dict, base: Path) -> dict:
     out = dict(params)
     for spec in specs(method.params):
         value = out.get(spec.name)
-        if spec.kind == "str" and isinstance(value, str) and not os.path.isabs(value) and (base / value).is_file():
+        if spec.kind == "str" and isinstance(value, str) and not os.path.isabs(value) and _names_file(str(base / value)):
             out[spec.name] = str(base / value)
     return out
 
@@ -271,7 +284,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         return run_gui()
     try:
-        parser = build_parser()
+        from core import registry
+
+        parser = build_parser(only=argv[0] if argv[0] in registry.names() else None)
         args = parser.parse_args(argv)
         if args.command is None:
             raise UsageError("weft: no command given (see 'weft --help')")

@@ -17,8 +17,16 @@ import numpy as np
 from .errors import WeftError
 from .params import Params
 
-# Modules that define a module-level ``METHOD``; imported on first use.
-_MODULES = ("core.quilting", "core.fast", "core.blending", "core.rectify", "core.nfpt", "core.affine")
+# Method name -> the module that defines it as a module-level ``METHOD``; imported on first use, one
+# at a time where possible (``weft quilt`` need not import the affine model's FFT machinery).
+_MODULES = {
+    "quilt": "core.quilting",
+    "fast": "core.fast",
+    "blend": "core.blending",
+    "rectify": "core.rectify",
+    "nfpt": "core.nfpt",
+    "affine": "core.affine",
+}
 
 
 @dataclass(frozen=True)
@@ -69,27 +77,29 @@ class Method:
     warm_up_in_cli: bool = True
 
 
-_registry: dict[str, Method] | None = None
+_loaded: dict[str, Method] = {}
+
+
+def names() -> tuple[str, ...]:
+    """The registered method names, without importing any method module."""
+    return tuple(_MODULES)
 
 
 def methods() -> dict[str, Method]:
-    """All registered methods by name, in registration order."""
-    global _registry
-    if _registry is None:
-        reg = {}
-        for mod in _MODULES:
-            m = importlib.import_module(mod).METHOD
-            reg[m.name] = m
-        _registry = reg
-    return _registry
+    """All registered methods by name, in registration order (imports every method module)."""
+    return {name: get(name) for name in _MODULES}
 
 
 def get(name: str) -> Method:
-    """The method called ``name``; ``WeftError`` listing the known ones otherwise."""
-    reg = methods()
-    if name not in reg:
-        raise WeftError(f"unknown method {name!r} (known: {', '.join(reg)})")
-    return reg[name]
+    """The method called ``name`` (importing its module only); ``WeftError`` listing the known ones."""
+    if name not in _MODULES:
+        raise WeftError(f"unknown method {name!r} (known: {', '.join(_MODULES)})")
+    if name not in _loaded:
+        method = importlib.import_module(_MODULES[name]).METHOD
+        if method.name != name:
+            raise RuntimeError(f"{_MODULES[name]} defines method {method.name!r}, registered as {name!r}")
+        _loaded[name] = method
+    return _loaded[name]
 
 
 def warm_up_all() -> None:

@@ -120,3 +120,17 @@ def test_recipe_finds_the_lines_file_from_any_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(elsewhere)
     assert main(["run", str(tmp_path / "out.png"), "-o", "again.png"]) == 0
     assert np.array_equal(load_image(tmp_path / "out.png").image, load_image(elsewhere / "again.png").image)
+
+
+def test_lines_given_as_json_text_on_the_command_line(tmp_path):
+    """--lines also takes the JSON itself; the recipe keeps it as text (no file to find later)."""
+    import json
+
+    from app.cli import main
+    from core.examples import RESOURCES
+    from core.image import read_recipe
+
+    text = (RESOURCES / "perspective-lines.json").read_text()
+    out = tmp_path / "r.png"
+    assert main(["rectify", str(RESOURCES / "perspective.png"), "--lines", text, "-o", str(out)]) == 0
+    assert json.loads(json.loads(read_recipe(out))["params"]["lines"])["frontal_size"] == [512, 384]

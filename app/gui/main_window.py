@@ -46,7 +46,8 @@ from .convert import to_qimage
 from .document import Document, InputImage, read_session
 from .params_panel import ParamsPanel
 from .render import Renderer, describe
-from .tools import LineTool, PatchTool, QuadTool
+from .lines_panel import FeatureLinesPanel
+from .tools import PatchTool
 from .views import ImageView, ResultView, is_image_path
 
 OPEN_FILTER = "Images (*.png *.jpg *.jpeg *.tif *.tiff *.bmp *.webp);;All files (*)"
@@ -71,7 +72,6 @@ class MainWindow(QMainWindow):
 
     message = Signal(str)
     _opened = Signal(object)
-    _rectified = Signal(object)
 
     def __init__(self, parent=None, *, settings: QSettings | None = None, load_defaults: bool = True):
         super().__init__(parent)
@@ -99,15 +99,8 @@ class MainWindow(QMainWindow):
                                               on_drag=self._prototype_dragged)
         # nfpt: the photo with its feature lines, and the frontal frame (live rectification) with its own
         self.photo_view = self._input_view("photo")
-        self.photo_lines = LineTool(self.photo_view, self.doc, "image", on_drag=self._lines_dragged)
-        self.photo_view.tool = self.photo_lines
-        self.frontal_view = ImageView(self, title="frontal")
-        self.frontal_lines = LineTool(self.frontal_view, self.doc, "frontal", on_drag=self._lines_dragged)
-        self.frontal_view.tool = self.frontal_lines
-        self.frontal_panel = self._build_frontal_panel()
-        self.rectifier_runner = JobRunner(max_workers=1, on_result=self._rectified.emit)
-        self._rectified.connect(self._on_rectified)
-        self._rectifier = None
+        self.lines_panel = FeatureLinesPanel(self.doc, self.photo_view, self)
+        self.lines_panel.message.connect(self.show_message)
         self.first_input = QStackedWidget()
         self.first_input.addWidget(self._titled(self.texture_view, "texture — drag a square: prototype / source region"))
         self.first_input.addWidget(self._titled(self.photo_view, "photo — drag to draw feature lines; drag an end to "
@@ -287,8 +280,8 @@ class MainWindow(QMainWindow):
         self.save_result_action = self._action(m, "&Export Result…", self.save_result_dialog, "Ctrl+E")
         self._action(m, "Export &Recipe…", self.export_recipe_dialog, "Ctrl+Shift+E")
         m.addSeparator()
-        self._action(m, "Load Feature &Lines…", self.load_lines_dialog)
-        self._action(m, "Save Feature Li&nes…", self.save_lines_dialog)
+        self._action(m, "Load Feature &Lines…", lambda: self.lines_panel.load_lines_dialog())
+        self._action(m, "Save Feature Li&nes…", lambda: self.lines_panel.save_lines_dialog())
         m.addSeparator()
         self._action(m, "&Quit", self.close, QKeySequence.StandardKey.Quit)
         e = self.menuBar().addMenu("&Edit")
@@ -381,9 +374,7 @@ class MainWindow(QMainWindow):
             if name in ("texture", "prototype_image"):
                 self._sync_patch_tools()
             if name == "photo":
-                self._rectifier = None
-                self.photo_lines.refresh()
-                self._update_rectified()
+                self.lines_panel.photo_changed()
             self._update_compare()
             self.renderer.final()
         elif what == "method":
@@ -394,10 +385,7 @@ class MainWindow(QMainWindow):
             if not self._dragging:
                 self.renderer.final()
         elif what == "lines":
-            self.photo_lines.refresh()
-            self.frontal_lines.refresh()
-            self._sync_frontal_size()
-            self._update_rectified()
+            self.lines_panel.lines_changed()
             if self.doc.method == "nfpt":
                 self.renderer.final()
         elif what == "prototype":
@@ -420,9 +408,9 @@ class MainWindow(QMainWindow):
         self._show_params()
         self.first_input.setCurrentIndex(1 if method.inputs[0].name == "photo" else 0)
         self.input_tabs.clear()
+        self.lines_panel.set_active(method.inputs[0].name == "photo")
         if method.inputs[0].name == "photo":
-            self.input_tabs.addTab(self.frontal_panel, "frontal frame (live rectification)")
-            self._update_rectified()
+            self.input_tabs.addTab(self.lines_panel, "frontal frame (live rectification)")
         for inp in method.inputs[1:]:
             view = self._input_view(inp.name)
             label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")
@@ -655,127 +643,11 @@ class MainWindow(QMainWindow):
         dirty = "" if self.doc.undo_stack.isClean() else " *"
         self.setWindowTitle(f"weft — {self.doc.method}{dirty}")
 
-    # --- feature lines (nfpt) ----------------------------------------------------------------------
-    def _build_frontal_panel(self) -> QWidget:
-        box = QWidget()
-        lay = QVBoxLayout(box)
-        lay.setContentsMargins(0, 0, 0, 0)
-        row = QHBoxLayout()
-        self.quad_button = QPushButton("Quad…")
-        self.quad_button.setCheckable(True)
-        self.quad_button.setToolTip("click the plane's four corners on the photo, clockwise from top-left: "
-                                    "four line pairs (the frontal rectangle's edges)")
-        self.quad_button.toggled.connect(self._quad_mode)
-        row.addWidget(self.quad_button)
-        row.addWidget(QLabel("frontal size"))
-        self.frontal_w, self.frontal_h = QSpinBox(), QSpinBox()
-        for box_ in (self.frontal_w, self.frontal_h):
-            box_.setRange(16, 8192)
-            box_.setKeyboardTracking(False)
-            box_.valueChanged.connect(self._frontal_size_edited)
-            row.addWidget(box_)
-        self.rectify_status = QLabel("")
-        self.rectify_status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
-        row.addWidget(self.rectify_status, 1)
-        lay.addLayout(row)
-        lay.addWidget(self.frontal_view, 1)
-        self._sync_frontal_size()
-        return box
-
-    def _sync_frontal_size(self) -> None:
-        for box_, v in ((self.frontal_w, self.doc.frontal_size[0]), (self.frontal_h, self.doc.frontal_size[1])):
-            box_.blockSignals(True)
-            box_.setValue(int(v))
-            box_.blockSignals(False)
-
-    def _frontal_size_edited(self, _v) -> None:
-        size = (self.frontal_w.value(), self.frontal_h.value())
-        if size != self.doc.frontal_size:
-            self.doc.set_lines(self.doc.image_lines, self.doc.frontal_lines, text="Frontal size", frontal_size=size)
-
-    def _quad_mode(self, on: bool) -> None:
-        self.photo_view.tool = QuadTool(self.photo_view, self.doc, on_done=lambda: self.quad_button.setChecked(False)) \
-            if on else self.photo_lines
-
-    def _lines_dragged(self, image_lines, frontal_lines) -> None:
-        self._update_rectified(image_lines, frontal_lines)
-
-    def _update_rectified(self, image_lines=None, frontal_lines=None) -> None:
-        """Rectify the photo with the current (or the dragged) lines on the worker (latest wins)."""
-        if self.doc.method != "nfpt":
-            return
-        photo = self.doc.image("photo")
-        image_lines = self.doc.image_lines if image_lines is None else image_lines
-        frontal_lines = self.doc.frontal_lines if frontal_lines is None else frontal_lines
-        n = min(len(image_lines), len(frontal_lines))
-        w, h = self.doc.frontal_size
-        if photo is None or n == 0:
-            self.frontal_view.set_image(np.full((h, w), 0.25, np.float32))
-            self.frontal_lines.refresh()
-            self.rectify_status.setText("draw line pairs: line i on the photo, line i here")
-            return
-        if self._rectifier is None:
-            from core.rectify import Rectifier
-
-            self._rectifier = Rectifier(photo, interpolation="linear")
-        rectifier, size = self._rectifier, self.doc.frontal_size
-        lines = ([list(x) for x in image_lines[:n]], [list(x) for x in frontal_lines[:n]])
-
-        def job(*, progress=None, cancel=None):
-            return rectifier.rectify(lines[0], lines[1], size).image
-
-        self.rectifier_runner.submit("rectify", job)
-
-    def _on_rectified(self, result) -> None:
-        if result.error is not None:
-            self.rectify_status.setText(str(result.error))
-            return
-        first = self.frontal_view.image is None or self.frontal_view.image.shape[:2] != result.value.shape[:2]
-        self.frontal_view.set_image(result.value, fit=first)
-        self.frontal_lines.refresh()
-        self.rectify_status.setText("rectified")
-
-    def load_lines_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Load feature lines", "", "Feature lines (*.json)")
-        if path:
-            self.load_lines(path)
-
-    def load_lines(self, path: str) -> bool:
-        from core.rectify import load_feature_lines
-
-        try:
-            fl = load_feature_lines(path)
-        except WeftError as e:
-            self.show_message(str(e))
-            return False
-        self.doc.set_lines(fl.image_lines.tolist(), fl.frontal_lines.tolist(), text="Load lines",
-                           frontal_size=fl.frontal_size)
-        return True
-
-    def save_lines_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save feature lines", "", "Feature lines (*.json)")
-        if path:
-            self.save_lines(path)
-
-    def save_lines(self, path: str) -> bool:
-        from core.image import atomic_write_bytes
-
-        text = self.doc.lines_json()
-        if text is None:
-            self.show_message("no complete line pairs to save")
-            return False
-        try:
-            atomic_write_bytes(Path(path), (text + "\n").encode("utf-8"))
-        except WeftError as e:
-            self.show_message(str(e))
-            return False
-        return True
-
     # --- shutdown --------------------------------------------------------------------------------
     def shutdown(self) -> None:
         self.renderer.shutdown()
         self.loader.shutdown(wait=True, cancel=True)
-        self.rectifier_runner.shutdown(wait=True, cancel=True)
+        self.lines_panel.shutdown()
         dialog = getattr(self, "_variations", None)
         if dialog is not None:
             dialog.shutdown()

@@ -25,7 +25,7 @@ def _key(widget, key):
 
 
 def test_draw_edit_delete_lines_with_undo(nfpt):
-    doc, photo, frontal = nfpt.doc, nfpt.photo_view, nfpt.frontal_view
+    doc, photo, frontal = nfpt.doc, nfpt.photo_view, nfpt.lines_panel.frontal_view
     photo.actual_size()
     photo.zoom_by(2.0)
     photo.centerOn(100, 100)
@@ -43,7 +43,7 @@ def test_draw_edit_delete_lines_with_undo(nfpt):
     # Click the line to select it, Delete removes the pair from both views.
     mouse(photo, "press", (110.0, 100.0))
     mouse(photo, "release", (110.0, 100.0))
-    assert nfpt.photo_lines.selected == 0
+    assert nfpt.lines_panel.photo_lines.selected == 0
     _key(photo, Qt.Key.Key_Delete)
     assert doc.image_lines == [] and doc.frontal_lines == []
     doc.undo_stack.undo()
@@ -63,17 +63,17 @@ def test_escape_cancels_a_line_in_progress(nfpt):
 def test_quad_preset_and_live_rectification(nfpt, qtbot):
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     corners = [line[:2] for line in data["image_lines"][:4]]  # the plane's corners, clockwise
-    nfpt.quad_button.setChecked(True)
+    nfpt.lines_panel.quad_button.setChecked(True)
     for x, y in corners:
         mouse(nfpt.photo_view, "press", (x, y))
         mouse(nfpt.photo_view, "release", (x, y))
-    assert not nfpt.quad_button.isChecked()
+    assert not nfpt.lines_panel.quad_button.isChecked()
     doc = nfpt.doc
     assert len(doc.image_lines) == 4 and len(doc.frontal_lines) == 4
     w, h = doc.frontal_size
     assert doc.frontal_lines[1] == pytest.approx([w - 1, 0, w - 1, h - 1])
-    qtbot.waitUntil(lambda: nfpt.rectify_status.text() == "rectified", timeout=10000)
-    assert nfpt.frontal_view.image.shape[:2] == (h, w)
+    qtbot.waitUntil(lambda: nfpt.lines_panel.rectify_status.text() == "rectified", timeout=10000)
+    assert nfpt.lines_panel.frontal_view.image.shape[:2] == (h, w)
     # The render uses the lines: the recipe carries them as JSON text.
     recipe = doc.recipe()
     assert json.loads(recipe.params["lines"])["image_lines"] == doc.image_lines
@@ -82,23 +82,23 @@ def test_quad_preset_and_live_rectification(nfpt, qtbot):
 def test_too_few_lines_say_why(nfpt, qtbot):
     doc = nfpt.doc
     doc.set_lines([[10, 10, 100, 12]], [[0, 0, 200, 0]])
-    qtbot.waitUntil(lambda: nfpt.rectify_status.text() not in ("", "rectified"), timeout=10000)
-    assert "line" in nfpt.rectify_status.text()
+    qtbot.waitUntil(lambda: nfpt.lines_panel.rectify_status.text() not in ("", "rectified"), timeout=10000)
+    assert "line" in nfpt.lines_panel.rectify_status.text()
 
 
 def test_lines_file_round_trip(nfpt, tmp_path):
     doc = nfpt.doc
-    assert nfpt.load_lines(str(RESOURCES / "perspective-lines.json"))
+    assert nfpt.lines_panel.load_lines(str(RESOURCES / "perspective-lines.json"))
     assert len(doc.image_lines) == 6 and doc.frontal_size == (512, 384)
     out = tmp_path / "lines.json"
-    assert nfpt.save_lines(str(out))
+    assert nfpt.lines_panel.save_lines(str(out))
     saved = json.loads(out.read_text())
     assert saved["image_lines"] == doc.image_lines and saved["frontal_size"] == [512, 384]
     bad = tmp_path / "bad.json"
     bad.write_text('{"image_lines": [[0, 0, 1]], "frontal_size": [10, 10]}')
     messages = []
     nfpt.message.connect(messages.append)
-    assert not nfpt.load_lines(str(bad))
+    assert not nfpt.lines_panel.load_lines(str(bad))
     assert messages and "\n" not in messages[-1]
 
 

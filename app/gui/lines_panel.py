@@ -1,0 +1,176 @@
+"""Feature lines of the nfpt method: the photo's line tool and the frontal frame with live rectification.
+
+Line i drawn on the photo goes with line i drawn in the frontal frame (numbered and coloured alike).
+While an end point is dragged, the photo is rectified on a worker (latest wins) and shown in the
+frontal frame, so the user sees the effect of every move; *Quad…* makes four pairs from four clicked
+corners; the frontal size sets the frame the lines live in. Lines load from and save to DESIGN.md's
+JSON; the document holds them (undoable) and the nfpt render takes them from there.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PySide6.QtCore import Signal
+from PySide6.QtWidgets import QFileDialog, QHBoxLayout, QLabel, QPushButton, QSizePolicy, QSpinBox, QVBoxLayout, QWidget
+
+from core.errors import WeftError
+from core.jobs import JobResult, JobRunner
+
+from .tools import LineTool, QuadTool
+from .views import ImageView
+
+
+class FeatureLinesPanel(QWidget):
+    """The frontal frame tab (see the module docstring); ``message(text)`` reports problems."""
+
+    message = Signal(str)
+    _rectified = Signal(object)
+
+    def __init__(self, doc, photo_view: ImageView, parent=None):
+        super().__init__(parent)
+        self.doc = doc
+        self.photo_view = photo_view
+        self.active = False  # rectify only while the nfpt method is shown
+        self.photo_lines = LineTool(photo_view, doc, "image", on_drag=self._lines_dragged)
+        photo_view.tool = self.photo_lines
+        self.frontal_view = ImageView(self, title="frontal")
+        self.frontal_lines = LineTool(self.frontal_view, doc, "frontal", on_drag=self._lines_dragged)
+        self.frontal_view.tool = self.frontal_lines
+        self.runner = JobRunner(max_workers=1, on_result=self._rectified.emit)
+        self._rectified.connect(self._on_rectified)
+        self._rectifier = None
+        self._build()
+
+    def photo_changed(self) -> None:
+        self._rectifier = None
+        self.photo_lines.refresh()
+        self._update_rectified()
+
+    def lines_changed(self) -> None:
+        self.photo_lines.refresh()
+        self.frontal_lines.refresh()
+        self._sync_frontal_size()
+        self._update_rectified()
+
+    def set_active(self, on: bool) -> None:
+        self.active = on
+        if on:
+            self._update_rectified()
+
+    def shutdown(self) -> None:
+        self.runner.shutdown(wait=True, cancel=True)
+
+    def _build(self) -> None:
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        row = QHBoxLayout()
+        self.quad_button = QPushButton("Quad…")
+        self.quad_button.setCheckable(True)
+        self.quad_button.setToolTip("click the plane's four corners on the photo, clockwise from top-left: "
+                                    "four line pairs (the frontal rectangle's edges)")
+        self.quad_button.toggled.connect(self._quad_mode)
+        row.addWidget(self.quad_button)
+        row.addWidget(QLabel("frontal size"))
+        self.frontal_w, self.frontal_h = QSpinBox(), QSpinBox()
+        for box_ in (self.frontal_w, self.frontal_h):
+            box_.setRange(16, 8192)
+            box_.setKeyboardTracking(False)
+            box_.valueChanged.connect(self._frontal_size_edited)
+            row.addWidget(box_)
+        self.rectify_status = QLabel("")
+        self.rectify_status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        row.addWidget(self.rectify_status, 1)
+        lay.addLayout(row)
+        lay.addWidget(self.frontal_view, 1)
+        self._sync_frontal_size()
+
+    def _sync_frontal_size(self) -> None:
+        for box_, v in ((self.frontal_w, self.doc.frontal_size[0]), (self.frontal_h, self.doc.frontal_size[1])):
+            box_.blockSignals(True)
+            box_.setValue(int(v))
+            box_.blockSignals(False)
+
+    def _frontal_size_edited(self, _v) -> None:
+        size = (self.frontal_w.value(), self.frontal_h.value())
+        if size != self.doc.frontal_size:
+            self.doc.set_lines(self.doc.image_lines, self.doc.frontal_lines, text="Frontal size", frontal_size=size)
+
+    def _quad_mode(self, on: bool) -> None:
+        self.photo_view.tool = QuadTool(self.photo_view, self.doc, on_done=lambda: self.quad_button.setChecked(False)) \
+            if on else self.photo_lines
+
+    def _lines_dragged(self, image_lines, frontal_lines) -> None:
+        self._update_rectified(image_lines, frontal_lines)
+
+    def _update_rectified(self, image_lines=None, frontal_lines=None) -> None:  # noqa: C901
+        """Rectify the photo with the current (or the dragged) lines on the worker (latest wins)."""
+        if not self.active:
+            return
+        photo = self.doc.image("photo")
+        image_lines = self.doc.image_lines if image_lines is None else image_lines
+        frontal_lines = self.doc.frontal_lines if frontal_lines is None else frontal_lines
+        n = min(len(image_lines), len(frontal_lines))
+        w, h = self.doc.frontal_size
+        if photo is None or n == 0:
+            self.frontal_view.set_image(np.full((h, w), 0.25, np.float32))
+            self.frontal_lines.refresh()
+            self.rectify_status.setText("draw line pairs: line i on the photo, line i here")
+            return
+        if self._rectifier is None:
+            from core.rectify import Rectifier
+
+            self._rectifier = Rectifier(photo, interpolation="linear")
+        rectifier, size = self._rectifier, self.doc.frontal_size
+        lines = ([list(x) for x in image_lines[:n]], [list(x) for x in frontal_lines[:n]])
+
+        def job(*, progress=None, cancel=None):
+            return rectifier.rectify(lines[0], lines[1], size).image
+
+        self.runner.submit("rectify", job)
+
+    def _on_rectified(self, result: JobResult) -> None:
+        if result.error is not None:
+            self.rectify_status.setText(str(result.error))
+            return
+        first = self.frontal_view.image is None or self.frontal_view.image.shape[:2] != result.value.shape[:2]
+        self.frontal_view.set_image(result.value, fit=first)
+        self.frontal_lines.refresh()
+        self.rectify_status.setText("rectified")
+
+    def load_lines_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Load feature lines", "", "Feature lines (*.json)")
+        if path:
+            self.load_lines(path)
+
+    def load_lines(self, path: str) -> bool:
+        from core.rectify import load_feature_lines
+
+        try:
+            fl = load_feature_lines(path)
+        except WeftError as e:
+            self.message.emit(str(e))
+            return False
+        self.doc.set_lines(fl.image_lines.tolist(), fl.frontal_lines.tolist(), text="Load lines",
+                           frontal_size=fl.frontal_size)
+        return True
+
+    def save_lines_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save feature lines", "", "Feature lines (*.json)")
+        if path:
+            self.save_lines(path)
+
+    def save_lines(self, path: str) -> bool:
+        from core.image import atomic_write_bytes
+
+        text = self.doc.lines_json()
+        if text is None:
+            self.message.emit("no complete line pairs to save")
+            return False
+        try:
+            atomic_write_bytes(Path(path), (text + "\n").encode("utf-8"))
+        except WeftError as e:
+            self.message.emit(str(e))
+            return False
+        return True
