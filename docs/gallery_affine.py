@@ -25,40 +25,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from core.affine import (analyse, field_model, make_prototype, match_boundaries, prototype_from_patch,  # noqa: E402
+from core.affine import (analyse, field_model, make_prototype, match_boundaries,  # noqa: E402
                          render, synthesize)
 from core.affine.procedural import cells, weave  # noqa: E402
+from panels import grid, label  # noqa: E402 (docs/panels.py)
 from core.examples import example  # noqa: E402
 from core.image import load_image, save_image  # noqa: E402
 from core.metrics import snr_db  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "images"
-
-
-def _rgb(img: np.ndarray) -> np.ndarray:
-    return np.repeat(img[..., None], 3, axis=2) if img.ndim == 2 else img
-
-
-def _label(img: np.ndarray, text: str, width: int | None = None) -> np.ndarray:
-    """The panel with a caption strip underneath (two lines if the text has a '|')."""
-    img = _rgb(img)
-    lines = text.split("|")
-    strip = np.full((8 + 17 * len(lines), img.shape[1], 3), 255, np.uint8)
-    for i, line in enumerate(lines):
-        cv2.putText(strip, line.strip(), (6, 17 + 17 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.42, (20, 20, 20), 1,
-                    cv2.LINE_AA)
-    return np.concatenate([img, strip.astype(np.float32) / 255.0], axis=0)
-
-
-def _grid(panels: list[np.ndarray], cols: int, gap: int = 6) -> np.ndarray:
-    h = max(p.shape[0] for p in panels)
-    w = max(p.shape[1] for p in panels)
-    rows = -(-len(panels) // cols)
-    out = np.ones((rows * h + (rows - 1) * gap, cols * w + (cols - 1) * gap, 3), np.float32)
-    for i, p in enumerate(panels):
-        r, c = divmod(i, cols)
-        out[r * (h + gap):r * (h + gap) + p.shape[0], c * (w + gap):c * (w + gap) + p.shape[1]] = p
-    return out
 
 
 def _textures() -> list[tuple[str, np.ndarray]]:
@@ -71,11 +46,11 @@ def synthesis() -> np.ndarray:
         paper = synthesize(tex, propagate=False, refine=0)
         ours = synthesize(tex)
         panels += [
-            _label(tex, f"{name} 256x256 (prototype: the|middle 64x64)"),
-            _label(paper, f"paper's pipeline: 8 candidates|SNR {snr_db(tex, paper):.1f} dB"),
-            _label(ours, f"+ neighbours' transforms, refined|SNR {snr_db(tex, ours):.1f} dB"),
+            label(tex, f"{name} 256x256 (prototype: the|middle 64x64)"),
+            label(paper, f"paper's pipeline: 8 candidates|SNR {snr_db(tex, paper):.1f} dB"),
+            label(ours, f"+ neighbours' transforms, refined|SNR {snr_db(tex, ours):.1f} dB"),
         ]
-    return _grid(panels, 3)
+    return grid(panels, 3)
 
 
 def boundary() -> np.ndarray:
@@ -88,11 +63,11 @@ def boundary() -> np.ndarray:
 
         e0 = total_boundary_error(model.with_shifts(np.round(model.shifts)))
         panels += [
-            _label(render(model), f"{name}: analysis translations|boundary error {e0:.0f}"),
-            _label(render(start), f"new translations, partial|correlation: error {rep.errors[0]:.0f}"),
-            _label(render(shaken), f"shaker box, {rep.iterations} iterations|error {rep.errors[-1]:.0f}"),
+            label(render(model), f"{name}: analysis translations|boundary error {e0:.0f}"),
+            label(render(start), f"new translations, partial|correlation: error {rep.errors[0]:.0f}"),
+            label(render(shaken), f"shaker box, {rep.iterations} iterations|error {rep.errors[-1]:.0f}"),
         ]
-    return _grid(panels, 3)
+    return grid(panels, 3)
 
 
 def _snakeskin() -> np.ndarray:
@@ -120,17 +95,17 @@ def transfer() -> np.ndarray:
     x, y, s = proto_rect
     snake_proto = cv2.resize(snake[y:y + s, x:x + s], (256, 256), interpolation=cv2.INTER_NEAREST)
     panels = [
-        _label(scales, "scales (transforms analysed)"),
-        _label(snake_proto, "colour prototype 64x64|from another texture"),
-        _label(swapped, "swapped into the existing|transforms (reuse, absorb)"),
-        _label(recomputed, "transforms recomputed|for the new prototype"),
-        _label(crop(photo), "photo 300x200"),
-        _label(crop(plain), "scales onto the photo, its|lowpass and colour kept"),
-        _label(crop(shaken), "... with the shaker box"),
-        _label(crop(synthesize(photo, prototype_image=weave(512), prototype=(224, 224, 64), boundary="shaker",
+        label(scales, "scales (transforms analysed)"),
+        label(snake_proto, "colour prototype 64x64|from another texture"),
+        label(swapped, "swapped into the existing|transforms (reuse, absorb)"),
+        label(recomputed, "transforms recomputed|for the new prototype"),
+        label(crop(photo), "photo 300x200"),
+        label(crop(plain), "scales onto the photo, its|lowpass and colour kept"),
+        label(crop(shaken), "... with the shaker box"),
+        label(crop(synthesize(photo, prototype_image=weave(512), prototype=(224, 224, 64), boundary="shaker",
                                rng=1)), "basket weave onto the photo,|shaker box"),
     ]
-    return _grid(panels, 4)
+    return grid(panels, 4)
 
 
 def fields() -> np.ndarray:
@@ -142,8 +117,8 @@ def fields() -> np.ndarray:
         for field in ("swirl", "zoom", "rotate"):
             model = field_model((256, 256), proto, field, block=32)
             matched, rep = match_boundaries(model, "shaker", rng=1)
-            panels.append(_label(render(matched), f"{name}: {field} field|shaker box, {rep.iterations} iterations"))
-    return _grid(panels, 3)
+            panels.append(label(render(matched), f"{name}: {field} field|shaker box, {rep.iterations} iterations"))
+    return grid(panels, 3)
 
 
 def main() -> int:

@@ -13,52 +13,28 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from core.examples import example
 from core.fast import transfer
 from core.image import load_image, resize, save_image
+from panels import grid, label  # docs/panels.py
 
 OUT = Path(__file__).resolve().parent / "images"
-
-
-def _rgb(img: np.ndarray) -> np.ndarray:
-    return np.repeat(img[..., None], 3, axis=2) if img.ndim == 2 else img
-
-
-def _label(img: np.ndarray, text: str) -> np.ndarray:
-    """The panel with a caption strip underneath."""
-    img = _rgb(img)
-    strip = np.full((26, img.shape[1], 3), 1.0, np.float32)
-    u8 = (strip * 255).astype(np.uint8)
-    cv2.putText(u8, text, (6, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (20, 20, 20), 1, cv2.LINE_AA)
-    return np.concatenate([img, u8.astype(np.float32) / 255.0], axis=0)
-
-
-def _grid(panels: list[np.ndarray], cols: int, gap: int = 6) -> np.ndarray:
-    h = max(p.shape[0] for p in panels)
-    w = max(p.shape[1] for p in panels)
-    rows = -(-len(panels) // cols)
-    out = np.ones((rows * h + (rows - 1) * gap, cols * w + (cols - 1) * gap, 3), np.float32)
-    for i, p in enumerate(panels):
-        r, c = divmod(i, cols)
-        out[r * (h + gap):r * (h + gap) + p.shape[0], c * (w + gap):c * (w + gap) + p.shape[1]] = p
-    return out
 
 
 def styles() -> np.ndarray:
     photo = load_image(example("chelsea")).image
     tile = (photo.shape[1], photo.shape[0])
     settings = [(1, 0.1, 0.0), (2, 0.0, 0.03), (4, 1.0, 0.1), (8, 0.5, 0.01), (2, 0.2, 0.0)]
-    panels = [_label(photo, "original")]
+    panels = [label(photo, "original")]
     for m, p, p_l in settings:
         out = transfer(photo, mode="novel", magnify=m, p=p, p_l=p_l, rng=7)
         # Show the same region at the photo's scale x2: the middle of the magnified result.
         h, w = out.shape[:2]
         crop = out[h // 4:h // 4 + h // 2, w // 4:w // 4 + w // 2] if m > 1 else out
-        panels.append(_label(resize(crop, tile, interpolation="area"), f"m={m}  p={p}  p_l={p_l}"))
-    return _grid(panels, 3)
+        panels.append(label(resize(crop, tile, interpolation="area"), f"m={m}  p={p}  p_l={p_l}"))
+    return grid(panels, 3)
 
 
 def transfers() -> np.ndarray:
@@ -70,14 +46,14 @@ def transfers() -> np.ndarray:
     gravel = load_image(example("gravel")).image[:128, :128]
     size = (300, 300)
     panels = [
-        _label(resize(hatch[:171], (300, 200)), "hatching sample"),
-        _label(transfer(hatch, cat, metric="artistic", p=0.2, colour="source", rng=1), "artistic metric, p=0.2"),
-        _label(resize(wood, size, interpolation="linear"), "wood grain sample"),
-        _label(transfer(wood, astro, metric="full", rng=1), "full metric (eq. 1), p=0.05"),
-        _label(resize(gravel, size, interpolation="linear"), "gravel sample"),
-        _label(transfer(gravel, camera, metric="target", p=0.05, rng=1), "target metric, p=0.05"),
+        label(resize(hatch[:171], (300, 200)), "hatching sample"),
+        label(transfer(hatch, cat, metric="artistic", p=0.2, colour="source", rng=1), "artistic metric, p=0.2"),
+        label(resize(wood, size, interpolation="linear"), "wood grain sample"),
+        label(transfer(wood, astro, metric="full", rng=1), "full metric (eq. 1), p=0.05"),
+        label(resize(gravel, size, interpolation="linear"), "gravel sample"),
+        label(transfer(gravel, camera, metric="target", p=0.05, rng=1), "target metric, p=0.05"),
     ]
-    return _grid(panels, 2)
+    return grid(panels, 2)
 
 
 def superres() -> np.ndarray:
@@ -86,12 +62,12 @@ def superres() -> np.ndarray:
     cubic = resize(small, (256, 256), interpolation="cubic")
     fast = transfer(small, magnify=4, rng=1)
     panels = [
-        _label(resize(small, (256, 256), interpolation="nearest"), "input 64x64"),
-        _label(cubic, "cubic x4"),
-        _label(fast, "texture transfer x4 (p=0, p_l=0.03)"),
-        _label(original, "original 256x256"),
+        label(resize(small, (256, 256), interpolation="nearest"), "input 64x64"),
+        label(cubic, "cubic x4"),
+        label(fast, "texture transfer x4 (p=0, p_l=0.03)"),
+        label(original, "original 256x256"),
     ]
-    return _grid(panels, 4)
+    return grid(panels, 4)
 
 
 def main() -> int:

@@ -17,8 +17,6 @@ from functools import lru_cache
 
 import numpy as np
 
-from core.examples import example
-from core.image import load_image, resize
 from core.metrics import snr_db
 
 from .base import Case, Input

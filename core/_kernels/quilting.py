@@ -503,7 +503,6 @@ def place_block(canvas, filled, tex, cross, sq, iparams, fparams):
 def _poisson_band(canvas, old, label, win_y, win_x, wrap, band):
     ws = label.shape[0]
     nc = canvas.shape[2]
-    hc, wc = canvas.shape[0], canvas.shape[1]
     big = 1 << 20
     # Chebyshev distance of each labelled pixel to the nearest pixel of the other label (<= band)
     dist = np.full((ws, ws), big, dtype=np.int64)

@@ -13,7 +13,7 @@ from app.cli import main as cli_main
 from core.errors import Cancelled, WeftError
 from core.examples import example
 from core.image import load_image, read_recipe
-from core.registry import Method, Result
+from core.registry import Method
 
 from .helpers import drag, mouse, no_job_threads
 
