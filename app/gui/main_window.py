@@ -613,7 +613,8 @@ class MainWindow(QMainWindow):
         doc = self.doc
         self.renderer.enabled = False
         try:
-            doc.inputs = {}
+            for name in [n for n in doc.inputs if n not in images]:
+                doc._put_input(name, None)  # an input the session does not have is closed, and its view cleared
             for name, item in images.items():
                 doc._put_input(name, item)
             for name, params in data["params"].items():
