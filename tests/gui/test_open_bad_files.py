@@ -1,0 +1,28 @@
+"""Issue 8.1, GUI side: opening a broken file keeps the document and says, in one line, which file."""
+
+import pytest
+
+from tests.data.make_corpus import BROKEN, make_corpus
+
+
+@pytest.fixture(scope="module")
+def corpus(tmp_path_factory):
+    return make_corpus(tmp_path_factory.mktemp("corpus"))
+
+
+@pytest.mark.parametrize("item", BROKEN)
+def test_gui_open_keeps_document_and_says_which_file(corpus, window, qtbot, item):
+    path = corpus[item]
+    before = {name: (inp.path, inp.image) for name, inp in window.doc.inputs.items()}
+    undo_count = window.doc.undo_stack.count()
+    messages = []
+    window.message.connect(messages.append)
+    window.open_input("texture", str(path))
+    qtbot.waitUntil(lambda: bool(messages), timeout=10000)
+    qtbot.wait(50)
+    assert len(messages) == 1
+    assert path.name in messages[0] and "\n" not in messages[0]
+    after = {name: (inp.path, inp.image) for name, inp in window.doc.inputs.items()}
+    assert after.keys() == before.keys()
+    assert all(after[k][0] == before[k][0] and after[k][1] is before[k][1] for k in before)
+    assert window.doc.undo_stack.count() == undo_count
