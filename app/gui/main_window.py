@@ -8,11 +8,13 @@ pool (``app.gui.render``); the GUI thread only decodes nothing larger than a fra
 
 from __future__ import annotations
 
+import json
+import os
 from pathlib import Path
 
 import numpy as np
 from PIL import Image as PILImage
-from PySide6.QtCore import QMimeData, QSettings, QSize, Qt, QUrl, Signal
+from PySide6.QtCore import QMimeData, QSettings, QSize, QStandardPaths, Qt, QTimer, QUrl, Signal
 from PySide6.QtGui import QAction, QIcon, QKeySequence, QPixmap
 from PySide6.QtWidgets import (
     QComboBox,
@@ -23,6 +25,7 @@ from PySide6.QtWidgets import (
     QListWidget,
     QListWidgetItem,
     QMainWindow,
+    QMessageBox,
     QProgressBar,
     QPushButton,
     QScrollArea,
@@ -39,7 +42,7 @@ from PySide6.QtWidgets import (
 from core import registry
 from core.errors import WeftError
 from core.examples import example, examples
-from core.image import load_image, save_image
+from core.image import atomic_write_bytes, load_image, save_image
 from core.jobs import JobRunner
 
 from .convert import to_qimage
@@ -56,6 +59,15 @@ DEFAULT_INPUTS = {"texture": "wood-grain", "target": "astronaut", "photo": "pers
 MAX_RECENT = 8
 # The methods the studio offers (those registered): "blend" and "rectify" are command-line steps.
 STUDIO_METHODS = ("fast", "quilt", "affine", "nfpt")
+AUTOSAVE_MS = 2000  # unsaved edits reach the recovery file at most this long after they are made
+RECOVERY_FILE = "recovery.weft.json"
+
+
+def recovery_path() -> Path:
+    """The crash-recovery session file: in ``WEFT_RECOVERY_DIR`` if set, else the app data folder."""
+    folder = os.environ.get("WEFT_RECOVERY_DIR") or QStandardPaths.writableLocation(
+        QStandardPaths.StandardLocation.AppDataLocation) or str(Path.home() / ".weft")
+    return Path(folder) / RECOVERY_FILE
 
 
 class _ExampleList(QListWidget):
@@ -124,6 +136,12 @@ class MainWindow(QMainWindow):
 
         self.doc.changed.connect(self._on_doc_changed)
         self.doc.undo_stack.indexChanged.connect(self._update_title)
+        # Crash recovery: while the document has unsaved edits, it is autosaved (atomically) at most
+        # every AUTOSAVE_MS; a clean document has no recovery file.
+        self.recovery_file = recovery_path()
+        self._autosave_timer = QTimer(self, singleShot=True, interval=AUTOSAVE_MS)
+        self._autosave_timer.timeout.connect(self.autosave)
+        self._owns_recovery = False  # only a file this window wrote (or restored) is removed by it
         self.renderer.shown.connect(self._on_shown)
         self.renderer.partial.connect(lambda img: self.result_view.set_image(img))
         self.renderer.progress.connect(self._on_progress)
@@ -137,6 +155,11 @@ class MainWindow(QMainWindow):
         self.renderer.runner.submit("warm-up", _warm_up_job)
         if load_defaults:
             self.load_examples()
+        self.offer_recovery()  # before the autosave is connected: opening the examples must not remove it
+        self.doc.undo_stack.indexChanged.connect(self._schedule_autosave)
+        self.doc.undo_stack.cleanChanged.connect(self._schedule_autosave)
+        self.doc.changed.connect(self._schedule_autosave)
+        self._schedule_autosave()
 
     # --- construction --------------------------------------------------------------------------
     def _titled(self, view: ImageView, title: str) -> QWidget:
@@ -565,6 +588,9 @@ class MainWindow(QMainWindow):
             if item.path and Path(item.path).resolve() == p.resolve():
                 self.show_message(f"{p.name}: refusing to overwrite an input image")
                 return False
+        if p.exists() and not self._confirm(f"{p.name} exists. Replace it?"):
+            self.show_message(f"{p.name}: not exported (the existing file is kept)")
+            return False
         recipe = self.doc.recipe(relative_to=p.resolve().parent).to_json()
         try:
             save_image(p, shown.image, recipe=recipe, bit_depth=16 if p.suffix.lower() in (".tif", ".tiff") else 8)
@@ -603,13 +629,24 @@ class MainWindow(QMainWindow):
             self.open_session(path)
 
     def open_session(self, path: str) -> bool:
-        """Replace the document with a saved session (inputs re-read from their files)."""
+        """Replace the document with a saved session (inputs re-read from their files).
+
+        Unsaved edits are discarded only if the user agrees (:meth:`_confirm`).
+        """
+        if not self.doc.undo_stack.isClean() and not self._confirm("Discard your unsaved edits and open the session?"):
+            return False
         try:
             data = read_session(path)
             images = {name: InputImage(p, load_image(p).image) for name, p in data["inputs"].items()}
         except WeftError as e:
             self.show_message(str(e))
             return False
+        self._apply_session(data, images)
+        self.statusBar().showMessage(f"session {Path(path).name} opened", 4000)
+        return True
+
+    def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
+        """Put a read session into the document (one clean state, no undo history) and render it."""
         doc = self.doc
         self.renderer.enabled = False
         try:
@@ -630,7 +667,76 @@ class MainWindow(QMainWindow):
         finally:
             self.renderer.enabled = True
         self.renderer.final(now=True)
-        self.statusBar().showMessage(f"session {Path(path).name} opened", 4000)
+
+    # --- asking, autosave, recovery --------------------------------------------------------------
+    def _confirm(self, question: str) -> bool:
+        """Ask a yes/no question in a modal box; True for yes. The one place the window asks
+        (tests replace it)."""
+        answer = QMessageBox.question(self, "weft", question,
+                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+                                      QMessageBox.StandardButton.No)
+        return answer == QMessageBox.StandardButton.Yes
+
+    def _schedule_autosave(self, *_args) -> None:
+        if self.doc.undo_stack.isClean():
+            self._autosave_timer.stop()
+            if self._owns_recovery:
+                self.discard_recovery()
+        elif not self._autosave_timer.isActive():
+            self._autosave_timer.start()
+
+    def autosave(self) -> bool:
+        """Write the session (absolute paths) to :attr:`recovery_file` now, atomically.
+
+        Returns
+        -------
+        bool
+            True if written; False if the document is clean (nothing to recover) or the write
+            failed (said once in the status bar; the next edit tries again).
+        """
+        if self.doc.undo_stack.isClean():
+            return False
+        data = self.doc.session_dict()
+        data["inputs"] = {name: os.path.abspath(p) for name, p in data["inputs"].items()}
+        try:
+            self.recovery_file.parent.mkdir(parents=True, exist_ok=True)
+            atomic_write_bytes(self.recovery_file, (json.dumps(data, indent=1) + "\n").encode("utf-8"))
+        except (OSError, WeftError) as e:
+            self.show_message(f"{self.recovery_file}: autosave failed ({' '.join(str(e).split())})")
+            return False
+        self._owns_recovery = True
+        return True
+
+    def discard_recovery(self) -> None:
+        """Remove the recovery file (the document is saved, clean, or its edits were discarded)."""
+        try:
+            self.recovery_file.unlink(missing_ok=True)
+        except OSError:
+            pass
+        self._owns_recovery = False
+
+    def offer_recovery(self) -> bool:
+        """If a recovery file exists (the last run ended with unsaved edits), ask to restore it.
+
+        Restores inputs, method, parameters, prototype, feature lines and seed; the restored document
+        counts as unsaved. Declined: the file is removed. Unreadable: said in one line, and kept.
+        """
+        path = self.recovery_file
+        if not path.is_file():
+            return False
+        if not self._confirm("weft did not close normally. Restore the unsaved session?"):
+            self.discard_recovery()
+            return False
+        try:
+            data = read_session(path)
+            images = {name: InputImage(p, load_image(p).image) for name, p in data["inputs"].items()}
+        except WeftError as e:
+            self.show_message(f"could not restore the session: {' '.join(str(e).split())}")
+            return False
+        self._apply_session(data, images)
+        self._owns_recovery = True
+        self.doc.undo_stack.resetClean()  # the restored edits are still unsaved
+        self.statusBar().showMessage("unsaved session restored", 4000)
         return True
 
     def open_variations(self) -> None:
@@ -661,6 +767,12 @@ class MainWindow(QMainWindow):
             self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
 
     def closeEvent(self, event):  # noqa: N802
+        if not self.doc.undo_stack.isClean() and not self._confirm("Discard your unsaved edits and quit?"):
+            event.ignore()
+            return
+        self._autosave_timer.stop()
+        if self._owns_recovery:
+            self.discard_recovery()
         self.settings.setValue("geometry", self.saveGeometry())
         self.settings.setValue("state", self.saveState())
         self.shutdown()

@@ -6,6 +6,16 @@ from PySide6.QtCore import QSettings
 from app.gui.main_window import MainWindow
 
 
+@pytest.fixture(autouse=True)
+def private_recovery(tmp_path, monkeypatch):
+    """Every GUI test autosaves into its own folder, and the window's questions are answered yes
+    (a test that cares replaces ``MainWindow._confirm`` itself)."""
+    folder = tmp_path / "recovery"
+    monkeypatch.setenv("WEFT_RECOVERY_DIR", str(folder))
+    monkeypatch.setattr(MainWindow, "_confirm", lambda self, question: True)
+    return folder
+
+
 @pytest.fixture
 def settings(tmp_path):
     return QSettings(str(tmp_path / "weft.ini"), QSettings.Format.IniFormat)
