@@ -158,3 +158,21 @@ def test_kill_9_then_restart_offers_to_restore(qtbot, tmp_path, private_recovery
     w.close()
     assert not recovery.exists()
     assert no_job_threads()
+
+
+def test_export_to_a_full_disk_keeps_the_old_file_and_says_why(window, tmp_path, monkeypatch):
+    if not os.path.exists("/dev/full"):
+        pytest.skip("no /dev/full on this system")
+    out = tmp_path / "old.png"
+    out.write_bytes(b"precious")
+
+    def to_dev_full(fd, mode="r", *a, **k):
+        os.close(fd)
+        return open("/dev/full", mode, buffering=0)
+
+    monkeypatch.setattr("core.image.files.os.fdopen", to_dev_full)
+    messages = []
+    window.message.connect(messages.append)
+    assert window.export_result(str(out)) is False
+    assert out.read_bytes() == b"precious"
+    assert len(messages) == 1 and "old.png" in messages[0] and "No space left" in messages[0]
