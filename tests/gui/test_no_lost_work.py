@@ -176,3 +176,16 @@ def test_export_to_a_full_disk_keeps_the_old_file_and_says_why(window, tmp_path,
     assert window.export_result(str(out)) is False
     assert out.read_bytes() == b"precious"
     assert len(messages) == 1 and "old.png" in messages[0] and "No space left" in messages[0]
+
+
+def test_export_over_an_input_is_refused_without_asking(window, tmp_path, monkeypatch):
+    texture = tmp_path / "texture.png"
+    save_image(texture, window.doc.image("texture"))
+    window.doc.set_input("texture", str(texture), window.doc.image("texture"))
+    before = texture.read_bytes()
+    asked = answer(monkeypatch, True)
+    messages = []
+    window.message.connect(messages.append)
+    assert window.export_result(str(texture)) is False
+    assert asked == [] and texture.read_bytes() == before
+    assert len(messages) == 1 and "texture.png" in messages[0] and "input" in messages[0]
