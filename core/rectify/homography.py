@@ -211,6 +211,10 @@ def _normalise_sign(h: np.ndarray, dst_size: tuple[int, int]) -> np.ndarray:
     return h / s
 
 
+# Degenerate line sets can send a point to infinity (under the first estimate, a trial step of the
+# refinement, or the fit itself): the refinement rejects non-finite costs, so numpy need not warn
+# (a warning would be a second line on the CLI's stderr).
+@np.errstate(divide="ignore", invalid="ignore", over="ignore")
 def fit_homography(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int, int],
                    src_size: tuple[int, int], *, robust: bool = True, min_angle: float = MIN_ANGLE_DEG,
                    margin: float = FAR_MARGIN) -> HomographyFit:
