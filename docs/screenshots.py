@@ -43,6 +43,7 @@ def _input(name: str) -> InputImage:
 
 def shoot(app, name: str, setup) -> Path:
     with tempfile.TemporaryDirectory() as tmp:
+        os.environ["WEFT_RECOVERY_DIR"] = tmp  # never touch the user's recovery file
         window = MainWindow(settings=QSettings(os.path.join(tmp, "s.ini"), QSettings.Format.IniFormat),
                             load_defaults=False)
         window.resize(1440, 860)
@@ -57,6 +58,7 @@ def shoot(app, name: str, setup) -> Path:
             app.processEvents()
         path = OUT / f"studio-{name}.png"
         window.grab().save(str(path))
+        window.doc.undo_stack.setClean()
         window.close()
     return path
 
