@@ -387,7 +387,7 @@ def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bott
                          w_overlap, w_prev, w_corr, mean, mean_c, tbuf, tcorr):
     """The kernel's ``make_template`` for synthesis (overlap term only), in numpy (same values)."""
     if w_prev or w_corr:
-        raise NotImplementedError("the numpy engine quilts synthesis only")
+        raise RuntimeError("internal: the numpy engine quilts synthesis only (_quilt_pass never sends it transfer terms)")
     hc, wc, nc = canvas.shape
     iy = (y0 + np.arange(b)) % hc
     ix = (x0 + np.arange(b)) % wc
