@@ -1,0 +1,197 @@
+"""The studio's files: export, recipes, sessions, and never losing work (ask, autosave, recover).
+
+A mixin of ``MainWindow`` (it uses the window's document, renderer, settings, status bar and
+``show_message``): every question goes through :meth:`FilesMixin._confirm`, so tests can answer it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from PySide6.QtWidgets import QFileDialog, QMessageBox
+
+from core.errors import WeftError
+from core.image import atomic_write_bytes, load_image, save_image
+
+from .document import InputImage, read_session
+
+SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
+
+
+class FilesMixin:
+    """Export, recipes, sessions, autosave and recovery of :class:`~app.gui.main_window.MainWindow`."""
+
+    # --- export, sessions ------------------------------------------------------------------------
+    def save_result_dialog(self) -> None:
+        if self.renderer.last is None or not self.renderer.last.final:
+            self.show_message("nothing to export yet: wait for the full-size result")
+            return
+        path, _ = QFileDialog.getSaveFileName(self, "Export result", str(self.settings.value("last_dir", "")), SAVE_FILTER)
+        if path:
+            self.export_result(path)
+
+    def export_result(self, path: str) -> bool:
+        """Save the shown full-size result: PNG carries the recipe, TIFF is 16-bit, JPEG 8-bit."""
+        shown = self.renderer.last
+        if shown is None or not shown.final:
+            self.show_message("nothing to export yet: wait for the full-size result")
+            return False
+        p = Path(path)
+        if p.suffix.lower() not in (".png", ".jpg", ".jpeg", ".tif", ".tiff"):
+            p = p.with_suffix(".png")
+        for item in self.doc.inputs.values():
+            if item.path and Path(item.path).resolve() == p.resolve():
+                self.show_message(f"{p.name}: refusing to overwrite an input image")
+                return False
+        if p.exists() and not self._confirm(f"{p.name} exists. Replace it?"):
+            self.show_message(f"{p.name}: not exported (the existing file is kept)")
+            return False
+        recipe = self.doc.recipe(relative_to=p.resolve().parent).to_json()
+        try:
+            save_image(p, shown.image, recipe=recipe, bit_depth=16 if p.suffix.lower() in (".tif", ".tiff") else 8)
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
+        self.statusBar().showMessage(f"exported {p}", 5000)
+        return True
+
+    def export_recipe_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Export recipe", "", "Recipe (*.json)")
+        if path:
+            try:
+                self.doc.recipe(relative_to=Path(path).resolve().parent).save(path)
+            except WeftError as e:
+                self.show_message(str(e))
+
+    def save_session_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save session", "", "weft session (*.weft.json *.json)")
+        if path:
+            self.save_session(path)
+
+    def save_session(self, path: str) -> bool:
+        try:
+            self.doc.save_session(path)
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
+        self.doc.undo_stack.setClean()
+        self.statusBar().showMessage(f"session saved to {path}", 4000)
+        return True
+
+    def open_session_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Open session", "", "weft session (*.json)")
+        if path:
+            self.open_session(path)
+
+    def open_session(self, path: str) -> bool:
+        """Replace the document with a saved session (inputs re-read from their files).
+
+        Unsaved edits are discarded only if the user agrees (:meth:`_confirm`).
+        """
+        if not self.doc.undo_stack.isClean() and not self._confirm("Discard your unsaved edits and open the session?"):
+            return False
+        try:
+            data = read_session(path)
+            images = {name: InputImage(p, load_image(p).image) for name, p in data["inputs"].items()}
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
+        self._apply_session(data, images)
+        self.statusBar().showMessage(f"session {Path(path).name} opened", 4000)
+        return True
+
+    def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
+        """Put a read session into the document (one clean state, no undo history) and render it."""
+        doc = self.doc
+        self.renderer.enabled = False
+        try:
+            for name in [n for n in doc.inputs if n not in images]:
+                doc._put_input(name, None)  # an input the session does not have is closed, and its view cleared
+            for name, item in images.items():
+                doc._put_input(name, item)
+            for name, params in data["params"].items():
+                doc.params[name] = params
+            doc._put_method(data["method"])
+            doc._put_prototype(data["prototype"])
+            doc.frontal_size = data["frontal_size"]
+            doc._put_lines(data["image_lines"], data["frontal_lines"])
+            doc.seed = data["seed"]
+            doc.changed.emit("seed")
+            doc.undo_stack.clear()
+            self._show_params()
+        finally:
+            self.renderer.enabled = True
+        self.renderer.final(now=True)
+
+    # --- asking, autosave, recovery --------------------------------------------------------------
+    def _confirm(self, question: str) -> bool:
+        """Ask a yes/no question in a modal box; True for yes. The one place the window asks
+        (tests replace it)."""
+        answer = QMessageBox.question(self, "weft", question,
+                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+                                      QMessageBox.StandardButton.No)
+        return answer == QMessageBox.StandardButton.Yes
+
+    def _schedule_autosave(self, *_args) -> None:
+        if self.doc.undo_stack.isClean():
+            self._autosave_timer.stop()
+            if self._owns_recovery:
+                self.discard_recovery()
+        elif not self._autosave_timer.isActive():
+            self._autosave_timer.start()
+
+    def autosave(self) -> bool:
+        """Write the session (absolute paths) to :attr:`recovery_file` now, atomically.
+
+        Returns
+        -------
+        bool
+            True if written; False if the document is clean (nothing to recover) or the write
+            failed (said once in the status bar; the next edit tries again).
+        """
+        if self.doc.undo_stack.isClean():
+            return False
+        data = self.doc.session_dict()
+        data["inputs"] = {name: os.path.abspath(p) for name, p in data["inputs"].items()}
+        try:
+            self.recovery_file.parent.mkdir(parents=True, exist_ok=True)
+            atomic_write_bytes(self.recovery_file, (json.dumps(data, indent=1) + "\n").encode("utf-8"))
+        except (OSError, WeftError) as e:
+            self.show_message(f"{self.recovery_file}: autosave failed ({' '.join(str(e).split())})")
+            return False
+        self._owns_recovery = True
+        return True
+
+    def discard_recovery(self) -> None:
+        """Remove the recovery file (the document is saved, clean, or its edits were discarded)."""
+        try:
+            self.recovery_file.unlink(missing_ok=True)
+        except OSError:
+            pass
+        self._owns_recovery = False
+
+    def offer_recovery(self) -> bool:
+        """If a recovery file exists (the last run ended with unsaved edits), ask to restore it.
+
+        Restores inputs, method, parameters, prototype, feature lines and seed; the restored document
+        counts as unsaved. Declined: the file is removed. Unreadable: said in one line, and kept.
+        """
+        path = self.recovery_file
+        if not path.is_file():
+            return False
+        if not self._confirm("weft did not close normally. Restore the unsaved session?"):
+            self.discard_recovery()
+            return False
+        try:
+            data = read_session(path)
+            images = {name: InputImage(p, load_image(p).image) for name, p in data["inputs"].items()}
+        except WeftError as e:
+            self.show_message(f"could not restore the session: {' '.join(str(e).split())}")
+            return False
+        self._apply_session(data, images)
+        self._owns_recovery = True
+        self.doc.undo_stack.resetClean()  # the restored edits are still unsaved
+        self.statusBar().showMessage("unsaved session restored", 4000)
+        return True
