@@ -84,8 +84,8 @@ class Renderer(QObject):
         self._preview_running: int | None = None
         self._preview_dirty = False
         self.last: Shown | None = None
-        self.submitted_at: dict[int, float] = {}
         self.latest_final: int | None = None
+        self._final_running = False  # the latest final job has not delivered yet
         self._preview_timer = QTimer(self, singleShot=True, interval=16)
         self._preview_timer.timeout.connect(self._submit_preview)
         self._final_timer = QTimer(self, singleShot=True, interval=60)
@@ -114,6 +114,7 @@ class Renderer(QObject):
         self._preview_timer.stop()
         self._final_timer.stop()
         self._preview_running, self._preview_dirty = None, False
+        self._final_running = False
         self.runner.cancel("preview")
         self.runner.cancel("final")
         self._busy_timer.stop()
@@ -162,9 +163,9 @@ class Renderer(QObject):
         if slot == "preview":
             self._preview_running = handle.id
             handle.future.add_done_callback(lambda _f, jid=handle.id: self._preview_finished.emit(jid))
-        self.submitted_at[handle.id] = time.perf_counter()
         if slot == "final":
             self.latest_final = handle.id
+            self._final_running = True
             self._busy_timer.start()
         return handle.id
 
@@ -187,12 +188,12 @@ class Renderer(QObject):
 
     # --- results -------------------------------------------------------------------------------
     def _on_result(self, result: JobResult) -> None:
-        self.submitted_at.pop(result.job_id, None)
         if result.slot not in ("preview", "final"):  # e.g. the kernels' warm-up
             if result.error is not None:
                 self.failed.emit(f"{result.slot} failed: {result.error}")
             return
         if result.slot == "final" and result.job_id == self.latest_final:
+            self._final_running = False
             self._busy_timer.stop()
             self.busy.emit(False)
         if result.error is not None:
@@ -213,7 +214,7 @@ class Renderer(QObject):
             self.partial.emit(p.preview)
 
     def _maybe_busy(self) -> None:
-        if self.latest_final is not None and self.latest_final in self.submitted_at:
+        if self._final_running:
             self.busy.emit(True)
 
 
