@@ -26,22 +26,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-# place_block integer parameters
-P_Y0, P_X0, P_B, P_TOP, P_LEFT, P_RIGHT, P_BOTTOM, P_WRAP = 0, 1, 2, 3, 4, 5, 6, 7
-P_MODE, P_RULE, P_TOL, P_SEED, P_POISSON, P_BAND, P_FIX_Y, P_FIX_X = 8, 9, 10, 11, 12, 13, 14, 15
-N_IPARAMS = 16
-# place_block float parameters
-F_CONST, F_EPS, F_U = 0, 1, 2
-N_FPARAMS = 3
-
-MODE_RANDOM, MODE_OVERLAP, MODE_MINCUT = 0, 1, 2
-RULE_TOL, RULE_EPSILON, RULE_SAMPLED = 0, 1, 2
+from .quilting_codes import (  # noqa: F401 (re-exported: the codes of place_block's arrays)
+    F_CONST, F_EPS, F_U, MODE_MINCUT, MODE_OVERLAP, MODE_RANDOM, N_FPARAMS, N_IPARAMS, P_B, P_BAND, P_BOTTOM,
+    P_FIX_X, P_FIX_Y, P_LEFT, P_MODE, P_POISSON, P_RIGHT, P_RULE, P_SEED, P_TOL, P_TOP, P_WRAP, P_X0, P_Y0,
+    RULE_EPSILON, RULE_SAMPLED, RULE_TOL, SAMPLE_FRACTION, TOP_FRACTION,
+)
 
 _DY = (1, -1, 0, 0)
 _DX = (0, 0, 1, -1)
-
-SAMPLE_FRACTION = 0.1  # the Poisson write-up: a random 10% of the positions ...
-TOP_FRACTION = 0.1  # ... of which the best 10% are candidates
 
 
 # --------------------------------------------------------------------------------------------

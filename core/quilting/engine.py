@@ -13,23 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._kernels import quilting_codes as _K  # the kernel's array codes, without importing numba
 from ..jobs import CancelToken, ProgressReporter
 
 RULES = ("tol", "epsilon", "sampled")  # the order is the kernel's rule codes
-
-
-class _K:
-    """Indices and codes of the kernel's parameter arrays (the same as ``core._kernels.quilting``'s,
-    repeated here so that the numpy engine runs without importing numba; a test checks they agree)."""
-
-    P_Y0, P_X0, P_B, P_TOP, P_LEFT, P_RIGHT, P_BOTTOM, P_WRAP = 0, 1, 2, 3, 4, 5, 6, 7
-    P_MODE, P_RULE, P_TOL, P_SEED, P_POISSON, P_BAND, P_FIX_Y, P_FIX_X = 8, 9, 10, 11, 12, 13, 14, 15
-    N_IPARAMS = 16
-    F_CONST, F_EPS, F_U = 0, 1, 2
-    N_FPARAMS = 3
-    MODE_RANDOM, MODE_OVERLAP, MODE_MINCUT = 0, 1, 2
-    RULE_TOL, RULE_EPSILON, RULE_SAMPLED = 0, 1, 2
-    SAMPLE_FRACTION = TOP_FRACTION = 0.1
 
 
 # Below this many blocks a synthesis without Poisson runs the per-block step in numpy when numba
@@ -202,16 +189,16 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     us = rng.random((rows, cols))
     seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
     first = (int(rng.integers(0, src.ph)), int(rng.integers(0, src.pw)))
-    ip = np.zeros(_k.N_IPARAMS, dtype=np.int64)
-    fp = np.zeros(_k.N_FPARAMS, dtype=np.float64)
-    ip[_k.P_B] = b
-    ip[_k.P_WRAP] = int(p.tile)
-    ip[_k.P_MODE] = {"overlap": _k.MODE_OVERLAP, "mincut": _k.MODE_MINCUT}[p.mode]
-    ip[_k.P_RULE] = RULES.index(p.rule)
-    ip[_k.P_TOL] = p.tol
-    ip[_k.P_POISSON] = int(p.poisson)
-    ip[_k.P_BAND] = p.band
-    fp[_k.F_EPS] = p.epsilon
+    ip = np.zeros(_K.N_IPARAMS, dtype=np.int64)
+    fp = np.zeros(_K.N_FPARAMS, dtype=np.float64)
+    ip[_K.P_B] = b
+    ip[_K.P_WRAP] = int(p.tile)
+    ip[_K.P_MODE] = {"overlap": _K.MODE_OVERLAP, "mincut": _K.MODE_MINCUT}[p.mode]
+    ip[_K.P_RULE] = RULES.index(p.rule)
+    ip[_K.P_TOL] = p.tol
+    ip[_K.P_POISSON] = int(p.poisson)
+    ip[_K.P_BAND] = p.band
+    fp[_K.F_EPS] = p.epsilon
     has_static = p.w_prev != 0.0 or (p.w_corr != 0.0 and corr is not None)
     dummy_cross = np.zeros((1, 1), dtype=np.float32)
     dummy_sq = np.zeros((1, 1), dtype=np.float32)
@@ -252,15 +239,15 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                 row_static = ahead.result()
                 ahead = static_rows.submit(static_row, i + 1) if i + 1 < rows else None
             y0, top, bottom = ys[i], tops[i], bottoms[i]
-            ip[_k.P_Y0], ip[_k.P_TOP], ip[_k.P_BOTTOM] = y0, top, bottom
+            ip[_K.P_Y0], ip[_K.P_TOP], ip[_K.P_BOTTOM] = y0, top, bottom
             for j in range(cols):
                 x0, left, right = xs[j], lefts[j], rights[j]
-                ip[_k.P_X0], ip[_k.P_LEFT], ip[_k.P_RIGHT] = x0, left, right
-                ip[_k.P_SEED] = seeds[i, j]
-                fp[_k.F_U] = us[i, j]
+                ip[_K.P_X0], ip[_K.P_LEFT], ip[_K.P_RIGHT] = x0, left, right
+                ip[_K.P_SEED] = seeds[i, j]
+                fp[_K.F_U] = us[i, j]
                 overlaps = top or left or right or bottom
                 if overlaps or row_static is not None:
-                    ip[_k.P_FIX_Y] = ip[_k.P_FIX_X] = -1
+                    ip[_K.P_FIX_Y] = ip[_K.P_FIX_X] = -1
                     spec, const = (None, 0.0) if row_static is None else row_static[j]
                     if overlaps:
                         const += template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
@@ -268,11 +255,11 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                         for c in range(nc):
                             part = cv2.mulSpectrums(spectra[c], cv2.dft(tbuf[c]), 0, conjB=True)
                             spec = part if spec is None else spec + part
-                    fp[_k.F_CONST] = const
+                    fp[_K.F_CONST] = const
                     cross = cv2.idft(spec, flags=flags)
                     sq = src.sq((top, left, right, bottom), p)
                 else:  # synthesis, first block: a random position
-                    ip[_k.P_FIX_Y], ip[_k.P_FIX_X] = first
+                    ip[_K.P_FIX_Y], ip[_K.P_FIX_X] = first
                     cross, sq = dummy_cross, dummy_sq
                 place(canvas, filled, tex, cross, sq, ip, fp)
             if report is not None:
