@@ -22,13 +22,13 @@ import numpy as np
 from ..errors import GeometryError, InvalidParameter
 from ..image import validate_image
 from ..jobs import CancelToken, Progress
-from ..params import Params, out_of_range, param
+from ..params import out_of_range, param
+from ..rectify import WarpParams
 from ..registry import InputSpec, Method, Result
 from .synthesis import SMOOTH_SIGMA, Synthesis, distance_weights, synthesize_patches
 
 __all__ = ["NfptParams", "NfptResult", "Synthesis", "distance_weights", "nfpt", "synthesize", "METHOD"]
 
-WARPS = ("homography", "morph", "lines")
 DEFAULT_BLOCK = 48
 DEFAULT_OVERLAP = 12
 # the frontal area kept from a rectification: pixels this far from the photo's edge or from the
@@ -37,21 +37,10 @@ _MASK_ERODE = 2
 
 
 @dataclass(frozen=True)
-class NfptParams(Params):
-    """Parameters of ``weft nfpt`` (Yan, Lee & Lin): rectification, synthesis, repair, re-projection."""
+class NfptParams(WarpParams):
+    """Parameters of ``weft nfpt`` (Yan, Lee & Lin): rectification (the fields of ``WarpParams``),
+    synthesis, repair, re-projection."""
 
-    lines: str = param(None, kind="str", optional=True,
-                       help="feature lines: a JSON file {image_lines, frontal_lines, frontal_size} (DESIGN.md), or "
-                            "that JSON text; without it the photo is taken as frontal")
-    warp: str = param("homography", choices=WARPS,
-                      help="rectification: homography (exact for a plane), morph (the paper's view morph; needs "
-                           "points off one plane), lines (Beier-Neely, gently curved surfaces)")
-    a: float = param(1.0, lo=0.001, hi=1000.0, symbol="a", step=0.1, log=True,
-                     help="Beier-Neely: distance offset in pixels of the weight (length^p / (a + dist))^b")
-    b: float = param(2.0, lo=0.0, hi=4.0, symbol="b", step=0.1,
-                     help="Beier-Neely: how fast a line's influence falls off with distance")
-    p: float = param(0.5, lo=0.0, hi=2.0, symbol="p", step=0.1,
-                     help="Beier-Neely: how much longer lines weigh more (0 = all equal)")
     size: tuple = param(None, kind="size", lo=8, hi=16384, optional=True,
                         help="size WIDTHxHEIGHT of the synthesized frontal texture; default twice the rectified one")
     block: int = param(DEFAULT_BLOCK, lo=8, hi=512, symbol="B", help="side of the square patches in pixels")

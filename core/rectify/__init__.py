@@ -43,7 +43,7 @@ from .view import View, load_view
 from .warps import PLANAR_TOL_PX, WARPS, WarpPlan, homography_plan, plan_warp
 
 __all__ = [
-    "FeatureLines", "HomographyFit", "Rectified", "Rectifier", "RectifyParams", "View", "WARPS", "WarpPlan",
+    "FeatureLines", "HomographyFit", "Rectified", "Rectifier", "RectifyParams", "View", "WARPS", "WarpParams", "WarpPlan",
     "apply_homography", "fit_homography", "line_correspondences", "load_feature_lines", "load_view",
     "parse_feature_lines", "plan_warp", "rectify", "rectify_feature_lines", "scale_lines", "METHOD",
 ]
@@ -52,12 +52,12 @@ INTERPOLATIONS = ("cubic", "linear", "lanczos")
 
 
 @dataclass(frozen=True)
-class RectifyParams(Params):
-    """Parameters of ``weft rectify`` (and the rectification step of ``weft nfpt``)."""
+class WarpParams(Params):
+    """The rectification parameters, shared by ``weft rectify`` and ``weft nfpt`` (which add theirs)."""
 
     lines: str = param(None, kind="str", optional=True,
                        help="feature lines: a JSON file {image_lines, frontal_lines, frontal_size} "
-                            "(DESIGN.md), or that JSON text itself")
+                            "(DESIGN.md), or that JSON text itself (nfpt without lines: the photo is frontal)")
     warp: str = param("homography", choices=WARPS,
                       help="homography: exact for a plane (least squares + robust refinement); morph: the paper's "
                            "view morph (fundamental matrix, needs points off one plane); lines: Beier-Neely field "
@@ -69,6 +69,12 @@ class RectifyParams(Params):
                      help="Beier-Neely: how fast a line's influence falls off with distance (morph, lines)")
     p: float = param(0.5, lo=0.0, hi=2.0, symbol="p", step=0.1,
                      help="Beier-Neely: how much longer lines weigh more (0 = all equal) (morph, lines)")
+
+
+@dataclass(frozen=True)
+class RectifyParams(WarpParams):
+    """Parameters of ``weft rectify`` (and the rectification step of ``weft nfpt``)."""
+
     size: tuple = param(None, kind="size", lo=2, hi=16384, optional=True,
                         help="size WIDTHxHEIGHT of the rectified image; default the lines' frontal_size "
                              "(frontal coordinates are scaled to it)")
