@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Sequence
 
 from core import __version__
-from core.errors import Cancelled, WeftError
+from core.errors import Cancelled, ImageError, WeftError
 from core.params import specs
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
@@ -167,12 +167,24 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     if region is not None:
         first = method.inputs[0].name
         images[first] = crop_square(images[first], region, what=first)
+    for spec in method.inputs:
+        if spec.name in images and min(images[spec.name].shape[:2]) < spec.min_side:
+            h, w = images[spec.name].shape[:2]
+            cropped = " (the --region crop)" if region is not None and spec is method.inputs[0] else ""
+            raise ImageError(f"{input_paths[spec.name]}: the {spec.name} is {w}x{h}{cropped}; weft {method.name} "
+                             f"needs at least {spec.min_side}x{spec.min_side} pixels", path=input_paths[spec.name])
     if method.warm_up is not None and method.warm_up_in_cli:
         method.warm_up()  # load compiled kernels now, so "seconds" is the compute alone
     bar = _TerminalProgress(not args.quiet)
     t0 = time.perf_counter()
     try:
         result = method.run(images, params, rng=seed, progress=bar, cancel=None)
+    except WeftError as e:
+        if e.input in input_paths:  # about one image (a block that does not fit it): say which file
+            named = type(e)(f"{input_paths[e.input]}: {e}")
+            named.__dict__.update(e.__dict__)
+            raise named from None
+        raise
     finally:
         bar.close()
     seconds = time.perf_counter() - t0

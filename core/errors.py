@@ -10,7 +10,14 @@ from __future__ import annotations
 
 
 class WeftError(ValueError):
-    """Base of every error caused by user input (a file, a parameter, a geometry)."""
+    """Base of every error caused by user input (a file, a parameter, a geometry).
+
+    ``input`` names the method input (e.g. ``"texture"``) the error is about when it concerns one
+    image, such as a block that does not fit it; a front end that knows the file behind that input
+    names it (the CLI prefixes the path).
+    """
+
+    input: str | None = None
 
 
 class InvalidParameter(WeftError):

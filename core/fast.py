@@ -124,7 +124,8 @@ def _valid_region(source_shape: tuple[int, int], n: int, mask: np.ndarray | None
     hs, ws = source_shape
     h = n // 2
     if hs < n or ws < n:
-        raise out_of_range("n", n, 3, min(hs, ws), f"the neighbourhood must fit in the source, {ws}x{hs}")
+        raise out_of_range("n", n, 3, min(hs, ws), f"the neighbourhood must fit in the source, {ws}x{hs}",
+                           input="texture")
     allowed = np.zeros((hs, ws), dtype=np.uint8)
     allowed[h:hs - h, h:ws - h] = 1
     if mask is not None:
@@ -315,7 +316,8 @@ METHOD = Method(
     summary="fast texture transfer (Ashikhmin): live artistic styles, synthesis, super-resolution",
     params=FastParams,
     inputs=(
-        InputSpec("texture", "the source texture (for superres and novel styles: the picture itself)"),
+        InputSpec("texture", "the source texture (for superres and novel styles: the picture itself)",
+                  min_side=3),
         InputSpec("target", "the picture to render in the texture (transfer)", required=False),
         InputSpec("mask", "source mask: candidates come only from its white part", required=False),
     ),

@@ -171,15 +171,21 @@ def _fmt(x: float) -> str:
     return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
-def out_of_range(name: str, value: Any, lo: float | None, hi: float | None, why: str = "") -> InvalidParameter:
-    """Build the standard message: ``parameter 'overlap' = 40 is outside 1..31 (why)``."""
+def out_of_range(name: str, value: Any, lo: float | None, hi: float | None, why: str = "",
+                 input: str | None = None) -> InvalidParameter:
+    """Build the standard message: ``parameter 'overlap' = 40 is outside 1..31 (why)``.
+
+    ``input`` names the method input whose size set the bound (see ``WeftError.input``).
+    """
     lo_t = "-inf" if lo is None else _fmt(lo)
     hi_t = "inf" if hi is None else _fmt(hi)
     shown = _fmt(value) if isinstance(value, (int, float)) else repr(value)
     msg = f"parameter '{name}' = {shown} is outside {lo_t}..{hi_t}"
     if why:
         msg += f" ({why})"
-    return InvalidParameter(msg, name=name, value=value)
+    error = InvalidParameter(msg, name=name, value=value)
+    error.input = input
+    return error
 
 
 def parse_size(text: str, name: str = "size") -> tuple[int, int]:

@@ -42,6 +42,9 @@ class InputSpec:
     help: str
     required: bool = True
     positional: bool | None = None
+    #: The smallest width and height the method can use at all (with its most permissive
+    #: parameters); front ends refuse a smaller image up front, naming its file.
+    min_side: int = 1
 
     @property
     def is_positional(self) -> bool:

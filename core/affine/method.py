@@ -16,7 +16,7 @@ from ..metrics import snr_db
 from ..registry import InputSpec, Method, Result
 from .boundary import BoundaryReport, match_boundaries
 from .fields import field_model
-from .params import AffineParams, check_rect, default_rect
+from .params import MIN_SIDE, AffineParams, check_rect, default_rect
 from .analysis import analyse
 from .model import AffineModel, _recombine, make_prototype
 from .synthesis import render
@@ -218,9 +218,9 @@ METHOD = Method(
     summary="affine prototype model (Smith & Bhalerao): synthesis, transfer by prototype swap, shaker box",
     params=AffineParams,
     inputs=(
-        InputSpec("texture", "the texture to model (or the picture to transfer a texture onto)"),
+        InputSpec("texture", "the texture to model (or the picture to transfer a texture onto)", min_side=MIN_SIDE),
         InputSpec("prototype_image", "take the prototype from this picture instead (texture transfer, §4)",
-                  required=False),
+                  required=False, min_side=MIN_SIDE),
     ),
     run=_run,
     warm_up=warm_up,

@@ -312,7 +312,7 @@ METHOD = Method(
     summary="NFPT (Yan, Lee & Lin): rectify a texture photo from feature lines, synthesize it patch by patch "
             "with feature-weighted matching and seam repair, put it back into a view",
     params=NfptParams,
-    inputs=(InputSpec("photo", "the photo of the texture (or a frontal texture, without --lines)"),),
+    inputs=(InputSpec("photo", "the photo of the texture (or a frontal texture, without --lines)", min_side=8),),
     run=_run,
     warm_up=warm_up,
 )

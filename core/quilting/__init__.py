@@ -173,7 +173,8 @@ def _check_texture(texture) -> np.ndarray:
 def _check_block_fits(block: int, tex: np.ndarray) -> None:
     h, w = tex.shape[:2]
     if block > min(h, w):
-        raise out_of_range("block", block, 2, min(h, w), f"must fit in the texture, {w}x{h}")
+        raise out_of_range("block", block, 2, min(h, w), f"must fit in the texture, {w}x{h}",
+                           input="texture")
 
 
 def _check_overlap(block: int, overlap: int) -> None:
@@ -512,7 +513,7 @@ METHOD = Method(
             "or transfer it onto a target",
     params=QuiltParams,
     inputs=(
-        InputSpec("texture", "the sample texture image"),
+        InputSpec("texture", "the sample texture image", min_side=2),
         InputSpec("target", "transfer: the picture to re-render with the texture", required=False),
         InputSpec("source_map", "transfer: the texture's correspondence map (with --target-map)", required=False),
         InputSpec("target_map", "transfer: the target's correspondence map (with --source-map)", required=False),
