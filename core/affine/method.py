@@ -124,16 +124,16 @@ def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=Non
             w, h = params.size
         if B > min(h, w):
             raise ImageError(f"the output is {w}x{h}; it must be at least the block, {B} pixels, on each side")
-        rect = params.rect() or default_rect(source.shape, B)
+        rect = params.rect() or default_rect(source.shape, B, source_name)
         proto = make_prototype(source, check_rect(rect, source.shape, source_name), block=B, colour=params.colour,
                                what=source_name)
         model = field_model((h, w), proto, params.field, strength=params.field_strength, block=B)
         render_proto = proto
     elif params.reuse_transforms:
-        arect = params.analysis_rect() or default_rect(texture.shape, B)
+        arect = params.analysis_rect() or default_rect(texture.shape, B, "texture")
         check_rect(arect, texture.shape, "texture", "analysis_prototype")
         model = _cached_analysis(texture, arect, params, progress, cancel)
-        rect = params.rect() or default_rect(source.shape, B)
+        rect = params.rect() or default_rect(source.shape, B, source_name)
         dec = model.decomposition if other is None else None
         render_proto = make_prototype(source, check_rect(rect, source.shape, source_name), block=B,
                                       colour=params.colour, decomposition=dec, what=source_name)

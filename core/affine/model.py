@@ -171,7 +171,7 @@ def make_prototype(image: np.ndarray, rect: Rect | str | None = None, *, block: 
         The square does not fit in the image.
     """
     image = validate_image(image, what)
-    rect = default_rect(image.shape, block) if rect is None else parse_rect(rect)
+    rect = default_rect(image.shape, block, what) if rect is None else parse_rect(rect)
     check_rect(rect, image.shape, what)
     dec = decomposition or decompose(image, block, colour, need_chroma=False)
     x, y, s = rect

@@ -39,7 +39,9 @@ def parse_rect(text: str | tuple | list, name: str = "prototype") -> Rect:
     else:
         try:
             values = tuple(int(v) for v in text)
-        except (TypeError, ValueError):
+            if any(v != w for v, w in zip(values, text)):  # 8.5 is not a pixel count: no silent rounding
+                values = ()
+        except (TypeError, ValueError, OverflowError):
             values = ()
         shown = ",".join(str(v) for v in text) if isinstance(text, (tuple, list)) else repr(text)
     if len(values) != 3:
@@ -80,7 +82,7 @@ def check_rect(rect: Rect, shape: tuple[int, ...], what: str = "texture", name: 
     """
     x, y, s = rect
     h, w = shape[:2]
-    if x + s > w or y + s > h:
+    if x < 0 or y < 0 or x + s > w or y + s > h:
         if s > min(h, w):
             why = f"its side {s} is larger than the {what} ({w}x{h})"
         else:
@@ -89,16 +91,17 @@ def check_rect(rect: Rect, shape: tuple[int, ...], what: str = "texture", name: 
     return rect
 
 
-def default_rect(shape: tuple[int, ...], block: int) -> Rect:
+def default_rect(shape: tuple[int, ...], block: int, what: str = "image") -> Rect:
     """The default prototype: a square of side ``2B`` (64 for B = 32) in the middle of the image.
 
     Its side is reduced to the largest even number the image holds (at least 8), so a small image
-    still gets a prototype; the paper uses a 64x64 prototype with 32x32 patches (§5).
+    still gets a prototype; the paper uses a 64x64 prototype with 32x32 patches (§5). ``what``
+    names the image in the error (``"texture"``, ``"prototype image"``).
     """
     h, w = shape[:2]
     s = min(2 * block, (min(h, w) // 2) * 2)
     if s < MIN_SIDE:
-        raise GeometryError(f"the image is {w}x{h}; a prototype needs at least {MIN_SIDE}x{MIN_SIDE} pixels")
+        raise GeometryError(f"the {what} is {w}x{h}; a prototype needs at least {MIN_SIDE}x{MIN_SIDE} pixels")
     return (w - s) // 2, (h - s) // 2, s
 
 
