@@ -225,12 +225,19 @@ def _relative_to(path: str, folder: Path) -> str:
 
 
 def _resolve_file_params(method, params: dict, base: Path) -> dict:
-    """Text parameters of a recipe that name files relative to it, made absolute."""
+    """Text parameters of a recipe that name files (nfpt's lines, view), made absolute against the
+    recipe's folder ``base``, never the current directory; a ``.json`` one that is not there is an error
+    naming the parameter and the file."""
     out = dict(params)
     for spec in specs(method.params):
         value = out.get(spec.name)
-        if spec.kind == "str" and isinstance(value, str) and not os.path.isabs(value) and _names_file(str(base / value)):
-            out[spec.name] = str(base / value)
+        if spec.kind != "str" or not isinstance(value, str) or not value or value.lstrip().startswith(("{", "[")):
+            continue  # not text, or JSON given inline
+        path = value if os.path.isabs(value) else str(base / value)
+        if _names_file(path):
+            out[spec.name] = path
+        elif Path(value).suffix.lower() == ".json" and not os.path.exists(path):
+            raise WeftError(f"parameter '{spec.name}' names {value}, but {path} does not exist")
     return out
 
 
@@ -258,16 +265,28 @@ def _dispatch(args: argparse.Namespace) -> int:
 
     if args.command == "run":
         recipe = _load_recipe(args.recipe)
-        method = registry.get(recipe.method)
-        missing = [i.name for i in method.inputs if i.required and i.name not in recipe.inputs]
-        if missing:
-            raise WeftError(f"{args.recipe}: recipe names no {', '.join(missing)} image for {method.name}")
+        try:  # what the recipe itself gets wrong is said with the recipe's name in front
+            method = registry.get(recipe.method)
+            takes = [i.name for i in method.inputs]
+            unknown = sorted(set(recipe.inputs) - set(takes))
+            if unknown:
+                raise WeftError(f"recipe names input {', '.join(map(repr, unknown))}, which {method.name} does not "
+                                f"take (it takes {', '.join(takes)})")
+            missing = [i.name for i in method.inputs if i.required and i.name not in recipe.inputs]
+            if missing:
+                raise WeftError(f"recipe names no {', '.join(missing)} image for {method.name}")
+            method.params.from_dict(recipe.params)
+            for name, path in recipe.inputs.items():
+                if not os.path.exists(path):
+                    raise WeftError(f"the {name} image {path} does not exist")
+            params = _resolve_file_params(method, dict(recipe.params), Path(args.recipe).resolve().parent)
+        except WeftError as e:
+            raise WeftError(f"{args.recipe}: {e}") from None
         if args.seed is not None:
             seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
         else:
             seed = recipe.seed
         region = parse_square(args.region) if args.region is not None else recipe.region
-        params = _resolve_file_params(method, dict(recipe.params), Path(args.recipe).resolve().parent)
         return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region)
 
     method = registry.get(args.method)

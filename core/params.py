@@ -318,6 +318,63 @@ def as_rng(rng: None | int | np.random.Generator) -> np.random.Generator:
     raise InvalidParameter(f"parameter 'rng' = {rng!r} must be None, an integer seed or a numpy Generator", name="rng")
 
 
+MAX_FILE_BYTES = 10 * 1024 * 1024
+"""The largest recipe or session weft reads (real ones are a few kB): a larger file is refused unread."""
+
+
+def parse_json(text: str) -> Any:
+    """Parse ``text`` as strict JSON, the only format of weft's recipes and sessions.
+
+    Stricter than :func:`json.loads`: ``NaN`` and ``Infinity`` (not JSON) are refused, and every
+    failure (bad syntax, nesting too deep for the parser, a number with thousands of digits) is a
+    :class:`~core.errors.WeftError` saying so in one line. Nothing is evaluated.
+    """
+    def no_constant(name: str):
+        raise WeftError(f"not valid JSON: {name} is not a JSON number")
+
+    if len(text) > MAX_FILE_BYTES:
+        raise WeftError(f"longer than the {MAX_FILE_BYTES // 2**20} MB limit")
+    try:
+        return json.loads(text, parse_constant=no_constant)
+    except json.JSONDecodeError as e:
+        raise WeftError(f"not valid JSON: {e.msg} at line {e.lineno} column {e.colno}") from None
+    except RecursionError:
+        raise WeftError("not valid JSON: nested too deeply") from None
+    except WeftError:
+        raise
+    except ValueError as e:  # e.g. an integer longer than Python converts
+        raise WeftError(f"not valid JSON: {' '.join(str(e).split(';')[0].split())}") from None
+
+
+def read_json_file(path: str | os.PathLike, what: str) -> Any:
+    """Read a weft JSON file (``what``: "recipe", "weft session"); one-line ``WeftError`` naming the
+    file if it is missing, a folder, larger than :data:`MAX_FILE_BYTES`, not UTF-8 text or not JSON."""
+    name = os.fsdecode(path)
+    limit = f"the limit is {MAX_FILE_BYTES // 2**20} MB"
+    try:
+        with open(name, "rb") as f:
+            size = os.fstat(f.fileno()).st_size
+            raw = f.read(MAX_FILE_BYTES + 1) if size <= MAX_FILE_BYTES else b""
+    except FileNotFoundError:
+        raise WeftError(f"{name}: no such {what} file") from None
+    except IsADirectoryError:
+        raise WeftError(f"{name}: is a directory, not a {what} file") from None
+    except (OSError, ValueError) as e:  # ValueError: a NUL in the name
+        raise WeftError(f"{name}: cannot read {what} ({getattr(e, 'strerror', None) or e})") from None
+    if size > MAX_FILE_BYTES:
+        raise WeftError(f"{name}: {size / 2**20:.1f} MB is too large for a {what} file ({limit}); not read")
+    if len(raw) > MAX_FILE_BYTES:  # grew since, or a device without a size
+        raise WeftError(f"{name}: too large for a {what} file ({limit}); not read")
+    try:
+        text = raw.decode("utf-8-sig")  # a byte-order mark (Windows editors) is not an error
+    except UnicodeDecodeError as e:
+        raise WeftError(f"{name}: not a {what} file (not UTF-8 JSON text: byte {e.start} is 0x{raw[e.start]:02x})") from None
+    try:
+        return parse_json(text)
+    except WeftError as e:
+        raise WeftError(f"{name}: not a {what} file ({e})") from None
+
+
 @dataclass(frozen=True)
 class Recipe:
     """Everything needed to reproduce a result: method, parameters, input paths and seed.
@@ -350,9 +407,14 @@ class Recipe:
     @classmethod
     def from_json(cls, text: str, *, base: str | os.PathLike | None = None) -> "Recipe":
         try:
-            data = json.loads(text)
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            raise WeftError(f"recipe is not valid JSON: {e}") from None
+            data = parse_json(text)
+        except WeftError as e:
+            raise WeftError(f"recipe is {e}") from None
+        return cls.from_data(data, base=base)
+
+    @classmethod
+    def from_data(cls, data: Any, *, base: str | os.PathLike | None = None) -> "Recipe":
+        """Validate a parsed recipe; relative input paths are joined to ``base`` when given."""
         if not isinstance(data, dict):
             raise WeftError("recipe must be a JSON object")
         version = data.get("weft")
@@ -368,8 +430,11 @@ class Recipe:
             raise WeftError("recipe \"params\" must be a JSON object")
         if not isinstance(inputs, dict) or not all(isinstance(v, str) for v in inputs.values()):
             raise WeftError("recipe \"inputs\" must map input names to file paths")
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
-            raise WeftError(f"recipe \"seed\" = {seed!r} must be a non-negative integer or null")
+        for name, value in inputs.items():
+            if not value or "\0" in value:
+                raise WeftError(f"recipe input {name!r} = {value!r} is not a file path")
+        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63):
+            raise WeftError(f"recipe \"seed\" = {seed!r} must be a non-negative integer below 2**63, or null")
         region = data.get("region")
         if region is not None:
             if (not isinstance(region, list) or len(region) != 3
@@ -382,15 +447,11 @@ class Recipe:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "Recipe":
+        """Read a recipe JSON file (at most :data:`MAX_FILE_BYTES`); messages start with its name."""
         path = Path(path)
+        data = read_json_file(path, "recipe")
         try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise WeftError(f"{path}: no such recipe file") from None
-        except (OSError, UnicodeDecodeError) as e:
-            raise WeftError(f"{path}: cannot read recipe ({getattr(e, 'strerror', None) or e})") from None
-        try:
-            return cls.from_json(text, base=path.resolve().parent)
+            return cls.from_data(data, base=path.resolve().parent)
         except WeftError as e:
             raise WeftError(f"{path}: {e}") from None
 
