@@ -9,6 +9,7 @@ one undo step (a slider drag is one step). Names emitted: ``"input:<name>"``, ``
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,7 +22,7 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 from core import registry
 from core.errors import WeftError
 from core.image import crop_square
-from core.params import Params, Recipe, specs
+from core.params import MAX_SIDE, Params, Recipe, read_json_file, specs
 
 SESSION_VERSION = 1
 _MERGE_PARAM = 1001
@@ -194,38 +195,86 @@ class Document(QObject):
         atomic_write_bytes(path, (text + "\n").encode("utf-8"))
 
 
+MAX_SEED = 2**31 - 1  # the studio's seed box
+FRONTAL_SIDES = (2, MAX_SIDE)  # what a feature-lines file may give (core.rectify)
+
+
 def read_session(path: str | Path) -> dict:
-    """Parse and validate a session file; input paths come back absolute. ``WeftError`` if bad."""
+    """Parse and validate a session file (JSON only, at most ``core.params.MAX_FILE_BYTES``); input
+    paths come back absolute, relative ones resolved against the session's folder. ``WeftError`` with
+    one line naming the file if anything is wrong, so a bad file never half-replaces a document."""
     path = Path(path)
+    data = read_json_file(path, "weft session")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise WeftError(f"{path}: no such session file") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise WeftError(f"{path}: not a weft session ({e})") from None
+        return _session_from_data(data, path.resolve().parent)
+    except WeftError as e:
+        raise WeftError(f"{path}: {e}") from None
+
+
+def _session_from_data(data: Any, base: Path) -> dict:
     if not isinstance(data, dict) or data.get("weft_session") != SESSION_VERSION:
-        raise WeftError(f"{path}: not a weft session file (version {SESSION_VERSION})")
+        raise WeftError(f"not a weft session file (version {SESSION_VERSION})")
     methods = registry.methods()
     if data.get("method") not in methods:
-        raise WeftError(f"{path}: unknown method {data.get('method')!r}")
+        raise WeftError(f"unknown method {data.get('method')!r}")
+    raw_params = _get(data, "params", dict, "an object of method name -> parameters", {})
     params = {}
-    for name, values in (data.get("params") or {}).items():
+    for name, values in raw_params.items():
         if name in methods:  # a method this version lacks is skipped, not fatal
-            params[name] = methods[name].params.from_dict(values)
-    base = path.resolve().parent
-    inputs = {k: str(base / v) if not os.path.isabs(v) else v for k, v in (data.get("inputs") or {}).items()
-              if isinstance(v, str)}
+            try:
+                params[name] = methods[name].params.from_dict(values)
+            except WeftError as e:
+                raise WeftError(f"{name}: {e}") from None
+    known_inputs = {i.name for m in methods.values() for i in m.inputs}
+    inputs = {}
+    for name, value in _get(data, "inputs", dict, "an object of input name -> image file", {}).items():
+        if name not in known_inputs:
+            raise WeftError(f"unknown input {name!r} (known: {', '.join(sorted(known_inputs))})")
+        if not isinstance(value, str) or not value or "\0" in value:
+            raise WeftError(f"input {name!r} = {value!r} is not a file path")
+        inputs[name] = value if os.path.isabs(value) else str(base / value)
     proto = data.get("prototype")
-    if proto is not None and (not isinstance(proto, list) or len(proto) != 3):
-        raise WeftError(f"{path}: prototype must be [x, y, side]")
-    lines = data.get("lines") or {}
+    if proto is not None and (not isinstance(proto, list) or len(proto) != 3 or not _ints(proto, 0)
+                              or proto[2] < 1):
+        raise WeftError(f"prototype = {proto!r} must be [x, y, side] in pixels, or null")
+    lines = _get(data, "lines", dict, "an object {image_lines, frontal_lines, frontal_size}", {})
+    image_lines = _lines(lines, "image_lines")
+    frontal_lines = _lines(lines, "frontal_lines")
+    lo, hi = FRONTAL_SIDES
+    frontal_size = lines.get("frontal_size", [512, 512])
+    if not isinstance(frontal_size, list) or len(frontal_size) != 2 or not _ints(frontal_size, lo, hi):
+        raise WeftError(f"frontal_size = {frontal_size!r} must be [width, height], each {lo}..{hi}")
     seed = data.get("seed", 1)
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-        raise WeftError(f"{path}: seed must be a non-negative integer")
+    if not _ints([seed], 0, MAX_SEED):
+        raise WeftError(f"seed = {seed!r} must be an integer in 0..{MAX_SEED}")
     return {"method": data["method"], "params": params, "inputs": inputs,
-            "prototype": tuple(int(v) for v in proto) if proto else None,
-            "image_lines": lines.get("image_lines", []), "frontal_lines": lines.get("frontal_lines", []),
-            "frontal_size": tuple(lines.get("frontal_size", (512, 512))), "seed": seed}
+            "prototype": tuple(proto) if proto else None,
+            "image_lines": image_lines, "frontal_lines": frontal_lines,
+            "frontal_size": tuple(frontal_size), "seed": seed}
+
+
+def _get(data: dict, key: str, kind: type, what: str, default):
+    value = data.get(key)
+    if value is None:
+        return default
+    if not isinstance(value, kind):
+        raise WeftError(f"{key} must be {what}")
+    return value
+
+
+def _ints(values, lo: int, hi: int | None = None) -> bool:
+    return all(isinstance(v, int) and not isinstance(v, bool) and lo <= v and (hi is None or v <= hi)
+               for v in values)
+
+
+def _lines(lines: dict, key: str) -> list[list[float]]:
+    value = lines.get(key, [])
+    if (not isinstance(value, list)
+            or not all(isinstance(ln, list) and len(ln) == 4
+                       and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in ln)
+                       for ln in value)):
+        raise WeftError(f"{key} must be a list of [x1, y1, x2, y2] in pixels")
+    return [[float(v) for v in ln] for ln in value]
 
 
 def _relative(path: str | None, base: str | Path | None) -> str | None:

@@ -13,7 +13,7 @@ from pathlib import Path
 from PySide6.QtWidgets import QFileDialog, QMessageBox
 
 from core.errors import WeftError
-from core.image import atomic_write_bytes, load_image, save_image
+from core.image import atomic_write_bytes, crop_square, load_image, save_image
 
 from .document import InputImage, read_session
 
@@ -93,14 +93,39 @@ class FilesMixin:
         if not self.doc.undo_stack.isClean() and not self._confirm("Discard your unsaved edits and open the session?"):
             return False
         try:
-            data = read_session(path)
-            images = {name: InputImage(p, load_image(p).image) for name, p in data["inputs"].items()}
+            data, images = self._read_session_files(path)
         except WeftError as e:
-            self.show_message(str(e))
+            self.show_message(" ".join(str(e).split()))
             return False
         self._apply_session(data, images)
         self.statusBar().showMessage(f"session {Path(path).name} opened", 4000)
         return True
+
+    def _read_session_files(self, path: str | Path) -> tuple[dict, dict[str, InputImage]]:
+        """Read a session and its images, checking everything before the document is touched.
+
+        Raises ``WeftError`` naming the session file and, for an image, which input it is.
+        """
+        from .main_window import STUDIO_METHODS
+
+        data = read_session(path)
+        if data["method"] not in STUDIO_METHODS:
+            raise WeftError(f"{path}: the studio does not offer method {data['method']!r} "
+                            f"(it offers {', '.join(STUDIO_METHODS)}; use 'weft {data['method']}')")
+        images = {}
+        for name, p in data["inputs"].items():
+            try:
+                images[name] = InputImage(p, load_image(p).image)
+            except WeftError as e:
+                raise WeftError(f"{path}: the {name.replace('_', ' ')} image: {e}") from None
+        proto = data["prototype"]
+        on = "prototype_image" if data["method"] == "affine" and "prototype_image" in images else "texture"
+        if proto is not None and on in images:
+            try:
+                crop_square(images[on].image, proto, what=on.replace("_", " "))
+            except WeftError as e:
+                raise WeftError(f"{path}: prototype: {e}") from None
+        return data, images
 
     def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
         """Put a read session into the document (one clean state, no undo history) and render it."""
@@ -185,8 +210,7 @@ class FilesMixin:
             self.discard_recovery()
             return False
         try:
-            data = read_session(path)
-            images = {name: InputImage(p, load_image(p).image) for name, p in data["inputs"].items()}
+            data, images = self._read_session_files(path)
         except WeftError as e:
             self.show_message(f"could not restore the session: {' '.join(str(e).split())}")
             return False
