@@ -1,0 +1,144 @@
+"""Issue 8.7, studio side: sessions are JSON with paths relative to the session file, so a project
+folder can move; a session that names a missing image, or is not a session at all, is one message
+naming the file, and the document (inputs, parameters, undo history) stays as it was."""
+
+import json
+import os
+import pickle
+import shutil
+
+import numpy as np
+import pytest
+
+from core.image import load_image, save_image
+
+
+def _image(path, seed, side=24):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    save_image(path, np.random.default_rng(seed).random((side, side, 3)).astype(np.float32))
+    return path
+
+
+def _state(doc):
+    """What must not change when a session is refused (images by identity: not even re-read)."""
+    return ({name: (item.path, id(item.image)) for name, item in doc.inputs.items()}, doc.method,
+            dict(doc.params), doc.prototype, doc.seed, [list(x) for x in doc.image_lines],
+            [list(x) for x in doc.frontal_lines], doc.frontal_size,
+            doc.undo_stack.count(), doc.undo_stack.index(), doc.undo_stack.isClean())
+
+
+class _Exploit:
+    """Unpickling this creates a file."""
+
+    def __init__(self, path):
+        self.path = str(path)
+
+    def __reduce__(self):
+        return (open, (self.path, "w"))
+
+
+@pytest.fixture
+def edited(window):
+    """The window with unsaved edits: a parameter and a prototype (two undo steps)."""
+    doc = window.doc
+    doc.set_param("p", 0.3)
+    doc.set_prototype((2, 4, 16))
+    assert doc.undo_stack.count() == 2 and not doc.undo_stack.isClean()
+    return window
+
+
+def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_moves(window, qtbot, tmp_path):
+    doc = window.doc
+    project = tmp_path / "project"
+    files = {"texture": project / "tex.png", "target": project / "img" / "target.png", "photo": project / "photo.png"}
+    for i, (name, path) in enumerate(files.items()):
+        doc.set_input(name, str(_image(path, i)), load_image(path).image)
+    doc.set_param("p", 0.3)
+    session = project / "s.weft.json"
+    assert window.save_session(str(session))
+
+    data = json.loads(session.read_text(encoding="utf-8"))  # plain JSON, nothing else
+    assert data["inputs"] == {"texture": "tex.png", "target": os.path.join("img", "target.png"), "photo": "photo.png"}
+    assert data["weft_session"] == 1 and data["method"] == "fast" and data["params"]["fast"]["p"] == 0.3
+    assert doc.undo_stack.isClean()
+
+    moved = tmp_path / "elsewhere" / "deeper" / "project"
+    moved.parent.mkdir(parents=True)
+    shutil.move(project, moved)
+    assert not project.exists()
+    doc.set_param("p", 0.7)
+    assert window.open_session(str(moved / "s.weft.json"))
+    for name, path in files.items():
+        new = moved / path.relative_to(project)
+        assert doc.inputs[name].path == str(new)
+        assert np.array_equal(doc.inputs[name].image, load_image(new).image)
+    assert doc.current_params.p == 0.3 and doc.undo_stack.count() == 0
+    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.image.shape == (24, 24, 3),
+                    timeout=20000)
+
+
+def test_a_session_naming_a_missing_image_says_which_and_keeps_the_document(edited, qtbot, tmp_path):
+    window, doc = edited, edited.doc
+    _image(tmp_path / "tex.png", 0)
+    session = tmp_path / "s.weft.json"
+    data = doc.session_dict(relative_to=tmp_path)
+    data["inputs"] = {"texture": "tex.png", "target": "gone.png"}
+    session.write_text(json.dumps(data))
+    before = _state(doc)
+    messages = []
+    window.message.connect(messages.append)
+    assert window.open_session(str(session)) is False
+    qtbot.wait(50)
+    assert messages == [f"{session}: the target image: {tmp_path / 'gone.png'}: no such file"]
+    assert _state(doc) == before
+    # the undo history still works, and a good session still opens: the studio goes on
+    doc.undo_stack.undo()
+    assert doc.prototype is None and doc.current_params.p == 0.3
+    data["inputs"] = {"texture": "tex.png", "target": "tex.png"}
+    session.write_text(json.dumps(data))
+    assert window.open_session(str(session))
+    assert doc.inputs["target"].path == str(tmp_path / "tex.png") and len(messages) == 1
+
+
+def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_path):
+    window, doc = edited, edited.doc
+    sentinel = tmp_path / "EXECUTED"
+    _image(tmp_path / "tex.png", 0)
+    good = doc.session_dict(relative_to=tmp_path)
+    good["inputs"] = {"texture": "tex.png", "target": "tex.png"}
+
+    def field(**kw):
+        return json.dumps(dict(good, **kw)).encode()
+
+    cases = {
+        "pickle": (pickle.dumps(_Exploit(sentinel)), "not UTF-8"),
+        "code": (f"__import__('os').system('touch {sentinel}')".encode(), "not valid JSON"),
+        "truncated": (json.dumps(good).encode()[:60], "not valid JSON"),
+        "yaml": (b"weft_session: 1\nmethod: fast\n", "not valid JSON"),
+        "nan": (json.dumps(good).replace(f'"seed": {good["seed"]}', '"seed": NaN').encode(), "NaN"),
+        "deep": (b"[" * 100_000 + b"]" * 100_000, "nested too deeply"),
+        "list": (b"[]", "not a weft session file"),
+        "inputs_list": (field(inputs=["tex.png"]), "inputs must be an object"),
+        "prototype_outside": (field(prototype=[100, 100, 16]), "leaves the texture (24x24)"),
+        "bad_lines": (field(lines={"image_lines": [[1]], "frontal_lines": [], "frontal_size": [64, 64]}),
+                      "image_lines must be a list"),
+        "huge_seed": (field(seed=2**40), "seed = 1099511627776 must be an integer"),
+        "not_a_studio_method": (field(method="blend"), "the studio does not offer method 'blend'"),
+    }
+    messages = []
+    window.message.connect(messages.append)
+    before = _state(doc)
+    for name, (data, fragment) in cases.items():
+        path = tmp_path / f"{name}.weft.json"
+        path.write_bytes(data)
+        del messages[:]
+        assert window.open_session(str(path)) is False, name
+        qtbot.wait(10)
+        assert len(messages) == 1 and "\n" not in messages[0], (name, messages)
+        assert messages[0].startswith(f"{path}: ") and fragment in messages[0], (name, messages)
+        assert _state(doc) == before, name
+    assert not sentinel.exists()
+    assert window.isVisible()
+    path = tmp_path / "good.weft.json"
+    path.write_text(json.dumps(good))
+    assert window.open_session(str(path))  # and a good one still opens
