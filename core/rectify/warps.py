@@ -96,17 +96,25 @@ class WarpPlan:
             raise GeometryError(f"the warp was fitted for a {sw}x{sh} image, not {image.shape[1]}x{image.shape[0]}")
         dw, dh = self.dst_size
         s = int(supersample)
+        # One sample per pixel: the pixels whose centre maps inside are interpolated from the image
+        # continued by its edge (a black frame would ring into them: a cubic kernel's negative lobes
+        # over the step to 0), the others are 0. Supersampled: outside samples count as black, so
+        # that the average is the colour premultiplied by the coverage.
+        border = cv2.BORDER_REPLICATE if s == 1 else cv2.BORDER_CONSTANT
         if self.kind == "homography" and s == 1 and _all_in_front(self.homography, self.dst_size):
             out = cv2.warpPerspective(image, self.homography, (dw, dh), flags=flags | cv2.WARP_INVERSE_MAP,
-                                      borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+                                      borderMode=border, borderValue=0)
             ones = np.ones((sh, sw), np.uint8)
             cover = cv2.warpPerspective(ones, self.homography, (dw, dh), flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
                                         borderMode=cv2.BORDER_CONSTANT, borderValue=0)
             mask = cover.astype(bool)
+            out[~mask] = 0.0
         else:
             mx, my = self._maps(s)
-            out = cv2.remap(image, mx, my, flags, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+            out = cv2.remap(image, mx, my, flags, borderMode=border, borderValue=0)
             inside = ((mx >= -0.5) & (mx <= sw - 0.5) & (my >= -0.5) & (my <= sh - 0.5))
+            if s == 1:
+                out[~inside] = 0.0
             if s > 1:
                 out = cv2.resize(out, (dw, dh), interpolation=cv2.INTER_AREA)
                 cov = cv2.resize(inside.astype(np.float32), (dw, dh), interpolation=cv2.INTER_AREA)
@@ -272,10 +280,11 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
         eye = np.eye(3)
         _k.field_map(dst_lines, src_lines, float(a), float(b), float(p), eye, eye, mx, my)
         return WarpPlan("lines", tuple(dst_size), tuple(src_size), maps=(mx, my), figures={"lines": len(dst_lines)})
-    return _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, mx, my)
+    return _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, mx, my, dst_name, src_name)
 
 
-def _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, mx, my) -> WarpPlan:
+def _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, mx, my,
+                dst_name="the frontal frame", src_name="the photo") -> WarpPlan:
     import cv2
 
     from .._kernels import nfpt as _k
@@ -287,9 +296,20 @@ def _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, m
             f"--warp morph needs at least 8 feature points for the fundamental matrix; the {len(dst_lines)} lines "
             f"cross at only {k} usable points ({corr.skipped_parallel} pairs parallel, {corr.skipped_far} meeting far "
             f"outside the frame, {corr.skipped_off_segment} not crossing on the segments)")
+    for pts, frame in ((corr.dst, dst_name), (corr.src, src_name)):
+        # several lines crossing at one point give one point, however many pairs they make
+        distinct = len(np.unique(np.round(pts, 2), axis=0))
+        if distinct < 8:
+            raise GeometryError(
+                f"--warp morph needs at least 8 distinct feature points for the fundamental matrix; the {k} crossings "
+                f"of the {len(dst_lines)} lines are only {distinct} distinct points in {frame}")
     h = homography_from_points(corr.dst, corr.src)
-    res = apply_homography(h, corr.dst) - corr.src
+    with np.errstate(divide="ignore", invalid="ignore"):  # a degenerate fit may send a point to infinity
+        res = apply_homography(h, corr.dst) - corr.src
     rms = float(np.sqrt((res ** 2).sum(axis=1).mean()))
+    if not math.isfinite(rms):
+        raise GeometryError(f"--warp morph: the {k} feature points do not determine a fundamental matrix "
+                            f"(no homography of them is finite: a degenerate configuration)")
     if rms <= planar_tol:
         raise GeometryError(
             f"--warp morph: all {k} feature points fit one homography within {rms:.2f} px, so they lie on one plane, "
