@@ -276,10 +276,11 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
         else:
             plan = rv.into_photo_plan(rect.plan, lines.image_lines, lines.frontal_lines, lines.frontal_size,
                                       (pw, ph), (tw, th), warp=params.warp, a=params.a, b=params.b, p=params.p)
+            # warped is premultiplied (black outside, edge pixels scaled by their coverage): "over"
             warped, alpha = plan.apply(syn.image, supersample=rv.SUPERSAMPLE, alpha=True)
             if warped.ndim == 3:
                 alpha = alpha[..., None]
-            out = (photo * (1.0 - alpha) + warped * alpha).astype(np.float32)
+            out = np.clip(photo * (1.0 - alpha) + warped, 0.0, 1.0).astype(np.float32)
             figures["photo_replaced_fraction"] = round(float(alpha.mean()), 4)
         rep.update(1, preview=out)
     return NfptResult(out, source, syn.image, homography, figures)

@@ -96,14 +96,12 @@ class WarpPlan:
             raise GeometryError(f"the warp was fitted for a {sw}x{sh} image, not {image.shape[1]}x{image.shape[0]}")
         dw, dh = self.dst_size
         s = int(supersample)
-        # One sample per pixel: the pixels whose centre maps inside are interpolated from the image
-        # continued by its edge (a black frame would ring into them: a cubic kernel's negative lobes
-        # over the step to 0), the others are 0. Supersampled: outside samples count as black, so
-        # that the average is the colour premultiplied by the coverage.
-        border = cv2.BORDER_REPLICATE if s == 1 else cv2.BORDER_CONSTANT
+        # Samples that land inside are interpolated from the image continued by its edge (a black
+        # frame would ring into them: a cubic kernel's negative lobes over the step to 0); samples
+        # outside are 0, so a supersampled pixel is its colour premultiplied by its coverage.
         if self.kind == "homography" and s == 1 and _all_in_front(self.homography, self.dst_size):
             out = cv2.warpPerspective(image, self.homography, (dw, dh), flags=flags | cv2.WARP_INVERSE_MAP,
-                                      borderMode=border, borderValue=0)
+                                      borderMode=cv2.BORDER_REPLICATE)
             ones = np.ones((sh, sw), np.uint8)
             cover = cv2.warpPerspective(ones, self.homography, (dw, dh), flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
                                         borderMode=cv2.BORDER_CONSTANT, borderValue=0)
@@ -111,10 +109,9 @@ class WarpPlan:
             out[~mask] = 0.0
         else:
             mx, my = self._maps(s)
-            out = cv2.remap(image, mx, my, flags, borderMode=border, borderValue=0)
+            out = cv2.remap(image, mx, my, flags, borderMode=cv2.BORDER_REPLICATE)
             inside = ((mx >= -0.5) & (mx <= sw - 0.5) & (my >= -0.5) & (my <= sh - 0.5))
-            if s == 1:
-                out[~inside] = 0.0
+            out[~inside] = 0.0
             if s > 1:
                 out = cv2.resize(out, (dw, dh), interpolation=cv2.INTER_AREA)
                 cov = cv2.resize(inside.astype(np.float32), (dw, dh), interpolation=cv2.INTER_AREA)

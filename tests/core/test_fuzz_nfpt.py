@@ -266,8 +266,13 @@ def test_nfpt_pipeline_with_degenerate_lines(lines, warp, kind, colour, target, 
     check_image(res.image, out_hw, channels)
     if res.homography is not None:
         assert res.homography.shape == (3, 3) and np.isfinite(res.homography).all()
-    if kind in ("flat", "black") and target == "plain":  # flat patches: the constant, nothing invented
-        assert np.allclose(res.image, photo[0, 0], atol=1e-5)
+    if kind in ("flat", "black"):  # flat patches: the constant, nothing invented, no ringing or dark seam
+        c = photo[0, 0]
+        if target in ("plain", "into_photo"):
+            assert np.allclose(res.image, c, atol=1e-5), (res.image.min(), res.image.max())
+        else:  # in a view: the constant times the coverage (black outside)
+            ratio = res.image / np.where(c > 0, c, 1.0)
+            assert ratio.max() <= 1.0 + 1e-5 and (np.isclose(ratio, 1.0, atol=1e-5) | (ratio < 1.0)).all()
 
 
 @fuzz(60)
@@ -417,3 +422,14 @@ def test_frame_reaching_the_photo_edge_is_not_darkened(warp):
     assert inside.mean() > 0.9
     assert np.allclose(out.image[inside], 0.7, atol=1e-5), (out.image[inside].min(), out.image[inside].max())
     assert (out.image[~inside] == 0).all()
+
+
+@pytest.mark.parametrize("warp", ["homography", "lines"])
+def test_into_photo_of_a_flat_photo_is_the_photo(warp):
+    """Found by the fuzzing: the texture put back into the photo was composited with its coverage
+    twice (a dark seam, down to 0.53 for 0.8) and rang against a black frame (up to 0.93)."""
+    photo = np.full((PHOTO_H, PHOTO_W), 0.8, np.float32)
+    res = nfpt(photo, FeatureLines(GOOD_I, GOOD_F, FRONTAL), into_photo=True, warp=warp, size=(20, 16), block=8,
+               overlap=2, rng=0)
+    assert 0.3 < res.figures["photo_replaced_fraction"] < 1.0  # the plane's edge crosses the photo
+    assert np.allclose(res.image, 0.8, atol=1e-5), (res.image.min(), res.image.max())
