@@ -96,7 +96,7 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, mask: np.ndarray, *, t
         The region to solve; values > 0.5 count as inside.
     tol : float, default 1e-6
         Conjugate-gradient stop: residual norm <= tol * norm of the right-hand side (0 < tol < 1).
-    max_iter : int, optional
+    max_iter : int >= 1, optional
         Iteration limit per channel; default 20 * sqrt(masked pixels) + 200.
     wrap : bool, default False
         Neighbours wrap around the image borders (for tileable images).
@@ -115,8 +115,12 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, mask: np.ndarray, *, t
     t, s = _check_pair(target, source, ("target", "source"))
     h, w = t.shape[:2]
     m = _check_mask(mask, (h, w)) > 0.5
-    if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not 0 < tol < 1:
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)) or not 0 < tol < 1:
         raise InvalidParameter(f"parameter 'tol' = {tol!r} is outside 0..1", name="tol", value=tol)
+    if max_iter is not None and (isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer))
+                                 or max_iter < 1):
+        raise InvalidParameter(f"parameter 'max_iter' = {max_iter!r} must be an integer >= 1 (or None: the default)",
+                               name="max_iter", value=max_iter)
     t3 = t.reshape(h, w, -1).astype(np.float64)
     s3 = s.reshape(h, w, -1).astype(np.float64)
     n = int(m.sum())

@@ -79,8 +79,10 @@ def pca_basis(rgb: np.ndarray) -> PcaBasis:
     variances = np.maximum(variances[order], 0.0)
     axes = vectors[:, order].T.copy()
     if variances[0] <= 1e-18:
-        # Flat colour: no preferred direction, use luminance so the grey still means brightness.
-        axes[0] = _LUMA / np.linalg.norm(_LUMA)
+        # Flat colour: no preferred direction, use luminance so the grey still means brightness
+        # (and two directions orthogonal to it, so the basis stays orthonormal).
+        q, _ = np.linalg.qr(np.column_stack([_LUMA.astype(np.float64), np.eye(3)[:, :2]]))
+        axes = q.T.copy()
     for i in range(3):
         ref = _LUMA if i == 0 else axes[i]
         if np.dot(axes[i], ref) < 0:

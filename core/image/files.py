@@ -82,7 +82,7 @@ def crop_square(image: np.ndarray, square: tuple[int, int, int], what: str = "te
     """The ``(x, y, side)`` square of ``image``; ``InvalidParameter`` if it leaves the image."""
     x, y, s = square
     h, w = image.shape[:2]
-    if x + s > w or y + s > h:
+    if x < 0 or y < 0 or s < 1 or x + s > w or y + s > h:
         raise InvalidParameter(f"parameter '{name}' = {x},{y},{s} leaves the {what} ({w}x{h})",
                                name=name, value=square)
     return np.ascontiguousarray(image[y:y + s, x:x + s])
