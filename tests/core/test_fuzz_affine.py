@@ -212,7 +212,7 @@ def test_default_rect(h, w, block):
 
 # --- synthesize end to end ---------------------------------------------------------------------
 
-@fuzz(150)
+@fuzz(300)
 @given(tex=textures(small=True), data=st.data(),
        block=st.sampled_from([8] * 16 + [10, 12, 16] + [0, 7, 30]),
        segments=st.sampled_from([8] * 16 + [4, 6, 32] + [0, 2, 5]),
@@ -285,7 +285,7 @@ def test_synthesize_fuzz(tex, data, block, segments, lowpass, colour, propagate,
 
 # --- analyse and render with swapped prototypes -------------------------------------------------
 
-@fuzz(40)
+@fuzz(80)
 @given(tex=textures(), block=st.sampled_from([8, 8, 10, 12]), lowpass=st.sampled_from(["add", "absorb"]),
        refine=st.integers(0, 3), data=st.data())
 def test_analyse_and_render_any_prototype(tex, block, lowpass, refine, data):
@@ -381,7 +381,7 @@ def test_cos2_window(n):
 
 # --- boundary matching and fields --------------------------------------------------------------
 
-@fuzz(40)
+@fuzz(60)
 @given(tex=textures(), mode=st.sampled_from(["none", "partial", "shaker", "bogus"]),
        start=st.sampled_from(["partial", "analysis", "x"]), iterations=st.integers(-1, 4),
        per_radius=st.integers(-1, 3), seed=st.integers(0, 99))

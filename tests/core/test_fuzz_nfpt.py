@@ -101,7 +101,7 @@ _PARAMS = {
 }
 
 
-@fuzz(100)
+@fuzz(200)
 @given(kind=st.sampled_from(KINDS), hs=_sides, ws=_sides, colour=st.booleans(), seed=st.integers(0, 2**16),
        repair=st.booleans(), smooth=st.booleans(), data=st.data(),
        broken=st.lists(st.sampled_from(sorted(_PARAMS)), max_size=2).map(set) | st.just(set()),
@@ -227,7 +227,7 @@ def feature_lines(draw):
     return image, frontal
 
 
-@fuzz(60)
+@fuzz(150)
 @given(lines=feature_lines(), warp=st.sampled_from(["homography", "morph", "lines"]),
        kind=st.sampled_from(KINDS), colour=st.booleans(),
        target=st.sampled_from(["plain", "plain", "into_photo", "quad", "view_lines"]), data=st.data(),
@@ -275,7 +275,7 @@ def test_nfpt_pipeline_with_degenerate_lines(lines, warp, kind, colour, target, 
             assert ratio.max() <= 1.0 + 1e-5 and (np.isclose(ratio, 1.0, atol=1e-5) | (ratio < 1.0)).all()
 
 
-@fuzz(60)
+@fuzz(120)
 @given(image_lines=st.lists(_line, min_size=0, max_size=9), data=st.data(),
        warp=st.sampled_from(["morph", "morph", "lines", "homography"]))
 def test_rectify_degenerate_lines_warn_nothing(image_lines, data, warp):
