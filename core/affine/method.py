@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import ImageError
 from ..image import luminance, validate_image
 from ..jobs import CancelToken, Progress
+from ..limits import check_output_size
 from ..metrics import snr_db
 from ..registry import InputSpec, Method, Result
 from .boundary import BoundaryReport, match_boundaries
@@ -122,6 +123,7 @@ def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=Non
         h, w = texture.shape[:2]
         if params.size is not None:
             w, h = params.size
+            check_output_size(w, h)
         if B > min(h, w):
             raise ImageError(f"the output is {w}x{h}; it must be at least the block, {B} pixels, on each side")
         rect = params.rect() or default_rect(source.shape, B, source_name)

@@ -154,9 +154,44 @@ def synthesize(
     return syn if return_details else syn.image
 
 
+#: Seconds per source position per patch besides the DFTs (tol choice, cut, repair); measured ~4 ns
+#: on the 2-core machine (``python -m benchmarks.estimates``).
+SELECT_SECONDS_PER_POSITION = 4e-9
+
+
+def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], block: int, overlap: int) -> float:
+    """Estimated running time of the patch synthesis on the 2-core reference machine (:mod:`core.limits`).
+
+    Every patch but the first costs three DFTs of the padded source luminance (eqs. 1-3 for all
+    positions at once: two spectra of the weighted template and the inverse) and a choice over every
+    source position; measured within 0.5..2x of real runs (``python -m benchmarks.estimates``).
+    """
+    from ..limits import dft_seconds
+    from .synthesis import _grid
+
+    h, w = texture_shape[:2]
+    width, height = out_size
+    patches = len(_grid(height, block, overlap)[0]) * len(_grid(width, block, overlap)[0])
+    positions = max(1, h - block + 1) * max(1, w - block + 1)
+    return patches * (3 * dft_seconds(h, w) + SELECT_SECONDS_PER_POSITION * positions)
+
+
+def _check_limits(tex: np.ndarray, size: tuple[int, int], params: NfptParams) -> None:
+    """Refuse up front an output over the pixel limit or one that would take too long."""
+    from ..limits import check_duration, check_output_size
+
+    width, height = size
+    check_output_size(width, height)
+    h, w = tex.shape[:2]
+    seconds = estimate_seconds(tex.shape, size, params.block, params.overlap)
+    check_duration(seconds, f"NFPT synthesis of {width}x{height} from a {w}x{h} texture with {params.block} px patches",
+                   "use a larger block, a smaller size or a smaller texture")
+
+
 def _synthesize(tex: np.ndarray, params: NfptParams, *, mask=None, rng=None, progress=None, cancel=None) -> Synthesis:
     h, w = tex.shape[:2]
     size = params.size if params.size is not None else (2 * w, 2 * h)
+    _check_limits(tex, size, params)
     sigma_d = params.sigma_d if params.sigma_d is not None else params.overlap / 2.0
     return synthesize_patches(tex, size, block=params.block, overlap=params.overlap, sigma_d=sigma_d,
                               sigma_s=params.sigma_s, tol=params.tol, repair=params.repair, band=params.band,

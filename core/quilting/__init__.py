@@ -198,6 +198,63 @@ def _finish(img: np.ndarray, channels: int) -> np.ndarray:
 # synthesis
 
 
+#: Seconds per source position per block for choosing a position and pasting (rule, cut), besides
+#: the DFTs: measured ~3 ns on the 2-core machine (a 256x256 source: 0.56 ms per 32-pixel block,
+#: of which 0.36 ms are its four DFTs).
+SELECT_SECONDS_PER_POSITION = 3e-9
+#: Bytes per output pixel of a job's peak memory (canvas, previous pass, correspondence maps and
+#: preview copies, float32; measured with /usr/bin/time -v on `weft quilt` of a 256x256 texture: 2048x2048
+#: synthesis 245 MB peak RSS, transfer 477 MB, of which ~100 MB are Python, NumPy, OpenCV and numba).
+BYTES_PER_OUTPUT_PIXEL = {"synthesis": 40, "transfer": 100}
+#: Bytes per texture pixel: its spectra (one per channel and the correspondence map) and the
+#: squared-sum maps cached per overlap shape (up to nine), float32.
+BYTES_PER_SOURCE_PIXEL = 60
+
+
+def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
+                     passes: list[tuple[int, int]], *, tile: bool = False) -> float:
+    """Estimated running time of quilting on the 2-core reference machine (see :mod:`core.limits`).
+
+    Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel
+    and the inverse; a transfer adds its correspondence and previous-pass spectra, computed on a
+    second thread one row ahead, so they do not add up) plus a position choice over every source
+    position. ``passes`` are the (block, overlap) of each pass. Against real runs (``python -m
+    benchmarks.estimates``) it comes within 0.4..1.5x.
+    """
+    from ..limits import dft_seconds
+
+    h, w = texture_shape[:2]
+    channels = texture_shape[2] if len(texture_shape) == 3 else 1
+    width, height = out_size
+    dft = dft_seconds(h, w)
+    total = 0.0
+    for block, overlap in passes:
+        blocks = _blocks(height, width, block, overlap, tile)
+        positions = (h - block + 1) * (w - block + 1)
+        total += blocks * ((channels + 1) * dft + SELECT_SECONDS_PER_POSITION * positions)
+    return total
+
+
+def _check_limits(tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[int, int]], *,
+                  tile: bool, transfer: bool) -> None:
+    """Refuse up front an output over the pixel limit, beyond available memory, or too long to quilt."""
+    from ..limits import check_duration, check_memory, check_output_size
+
+    check_output_size(out_w, out_h, "the target" if transfer else "parameter 'size'")
+    h, w = tex.shape[:2]
+    check_memory(BYTES_PER_OUTPUT_PIXEL["transfer" if transfer else "synthesis"] * out_w * out_h
+                 + BYTES_PER_SOURCE_PIXEL * h * w, f"quilting {out_w}x{out_h} from a {w}x{h} texture")
+    seconds = estimate_seconds(tex.shape, (out_w, out_h), passes, tile=tile)
+    blocks = sum(_blocks(out_h, out_w, b, o, tile) for b, o in passes)
+    first = passes[0][0]
+    what = (f"{'transfer' if transfer else 'quilting'} of {out_w}x{out_h} from a {w}x{h} texture "
+            f"({blocks:,} blocks of {first if len(passes) == 1 else f'{first} to {passes[-1][0]}'} px"
+            f"{f' in {len(passes)} passes' if len(passes) > 1 else ''})")
+    advice = ("use a larger block, fewer iterations, a smaller target or a smaller texture (--region)" if transfer
+              else "use a larger block, a smaller size or a smaller texture (--region)")
+    check_duration(seconds, what, advice)
+
+
 def synthesize(
     texture: np.ndarray,
     *,
@@ -287,6 +344,12 @@ def synthesize(
     out_w, out_h = params.size if params.size is not None else (2 * w, 2 * h)
     if params.tile and params.mode != "random":
         _check_tile_size(b, out_w, out_h)
+    if params.mode != "random":
+        _check_limits(tex, out_w, out_h, [(b, ov)], tile=params.tile, transfer=False)
+    else:
+        from ..limits import check_output_size
+
+        check_output_size(out_w, out_h)
     p = _Pass(params.mode, b, ov, params.rule, params.tol, params.epsilon, params.tile,
               params.poisson, params.band)
     rng = as_rng(rng)
@@ -429,13 +492,15 @@ def transfer(
         ov = max(1, min(b - 1, _round_half_up(b / 3 if n == 1 else 2 * b / 3)))
     if params.tile:
         _check_tile_size(b, W, H)
+    schedule = transfer_schedule(n, block=b, overlap=ov, alpha=params.alpha)
+    _check_limits(tex, W, H, [(bi, oi) for bi, oi, _ in schedule], tile=params.tile, transfer=True)
     cs, ct = _correspondence_maps(tex, tgt, params.correspondence, source_map, target_map)
     if params.remap:
         ct = _remap(cs, ct)
     rng = as_rng(rng)
     results = []
     prev = None
-    for i, (bi, oi, ai) in enumerate(transfer_schedule(n, block=b, overlap=ov, alpha=params.alpha)):
+    for i, (bi, oi, ai) in enumerate(schedule):
         p = _Pass(params.mode, bi, oi, params.rule, params.tol, params.epsilon, params.tile,
                   params.poisson, params.band, w_overlap=ai, w_prev=ai if i > 0 else 0.0, w_corr=1.0 - ai)
         rows = len(_grid(H, bi, oi, params.tile)[0])

@@ -1,0 +1,91 @@
+"""Peak memory of large jobs run through the `weft` command (issue 8: under 2 GiB).
+
+    python -m benchmarks.memory [--repeat N] [--json FILE]
+
+Runs each job as its own process and reads the child's peak resident set size from ``wait4`` -- the
+figure ``/usr/bin/time -v`` prints as "Maximum resident set size" -- the median of ``--repeat`` runs
+(default 3). Inputs are made in a temporary folder: the astronaut example (colour) resized to 2048²
+and 4096² (cubic) as targets, the gravel example (256x256) as the texture.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+LIMIT = 2 * 2**30
+
+
+def _inputs(folder: Path) -> dict[str, str]:
+    import cv2
+
+    from core.examples import example
+
+    picture = cv2.imread(str(example("astronaut")), cv2.IMREAD_COLOR)
+    out = {"texture": str(example("gravel"))}
+    for side in (2048, 4096):
+        path = folder / f"astronaut{side}.png"
+        cv2.imwrite(str(path), cv2.resize(picture, (side, side), interpolation=cv2.INTER_CUBIC))
+        out[f"target{side}"] = str(path)
+    return out
+
+
+def _jobs(files: dict[str, str]) -> list[tuple[str, list[str]]]:
+    tex = files["texture"]
+    return [
+        ("fast transfer 4096x4096", ["fast", tex, "--target", files["target4096"]]),
+        ("quilt synthesis 2048x2048", ["quilt", tex, "--size", "2048x2048"]),
+        ("quilt transfer 2048x2048", ["quilt", tex, "--target", files["target2048"]]),
+    ]
+
+
+def peak_rss(argv: list[str]) -> tuple[int, float, int]:
+    """Run ``argv``; return (peak RSS in bytes, wall seconds, exit status)."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    seconds = time.perf_counter() - t0
+    if proc.returncode:
+        sys.stderr.write(proc.stderr.read().decode(errors="replace"))
+    proc.stderr.close()
+    return usage.ru_maxrss * 1024, seconds, proc.returncode  # ru_maxrss is in KiB on Linux
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--json", help="also write the figures to this file")
+    args = parser.parse_args(argv)
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="weft-memory-") as tmp:
+        files = _inputs(Path(tmp))
+        out = str(Path(tmp) / "out.png")
+        print("| job | peak RSS (median) | runs | wall s (median) | under 2 GiB |")
+        print("|---|---:|---|---:|---|")
+        for name, cmd in _jobs(files):
+            full = [sys.executable, "-m", "app.cli", *cmd, "-o", out, "-q", "--seed", "1"]
+            runs = [peak_rss(full) for _ in range(args.repeat)]
+            if any(code for _, _, code in runs):
+                print(f"| {name} | failed | | | |")
+                continue
+            peak = statistics.median(r[0] for r in runs)
+            wall = statistics.median(r[1] for r in runs)
+            each = ", ".join(f"{r[0] / 2**20:.0f}" for r in runs)
+            print(f"| {name} | {peak / 2**20:.0f} MiB | {each} | {wall:.1f} | {'yes' if peak < LIMIT else 'NO'} |",
+                  flush=True)
+            rows.append({"job": name, "peak_bytes": peak, "runs_bytes": [r[0] for r in runs], "seconds": wall})
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+    return 0 if all(r["peak_bytes"] < LIMIT for r in rows) and len(rows) == 3 else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

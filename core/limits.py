@@ -1,0 +1,126 @@
+"""Up-front limits: refuse a job that is too large before doing any of it.
+
+Three checks, each one line when it refuses (``LimitError``, a ``WeftError``):
+
+* :func:`check_output_size`: an output may not have more pixels than an input may
+  (:func:`core.image.get_max_pixels`, 50 Mpx unless ``WEFT_MAX_PIXELS`` says otherwise).
+* :func:`check_memory`: a method's estimate of its peak memory must fit in the memory the system
+  has available (``MemAvailable`` of ``/proc/meminfo``; no check where it cannot be read).
+* :func:`check_duration`: a method's estimate of its running time on this machine must not exceed
+  :func:`get_max_seconds` (10 minutes unless ``WEFT_MAX_SECONDS`` or :func:`set_max_seconds` says
+  otherwise). Patch-search methods (quilting, NFPT) cost one or more DFTs of the whole source per
+  block, so a small block on a large output from a large texture can take hours; they are refused
+  with the estimate and what to change, instead of after minutes.
+
+The estimates are models calibrated on a 2-core machine (figures in the README's performance
+section); they are meant to be right within a factor of two or three, enough to tell ten minutes from
+ten hours, not to predict seconds.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+
+from .errors import WeftError
+
+#: Default longest estimated running time of one job, seconds.
+DEFAULT_MAX_SECONDS = 600.0
+_max_seconds_override: float | None = None
+
+#: Seconds per (pixel x log2(pixels)) of one real 2-D DFT with OpenCV, float32 (measured on the
+#: 2-core machine: a 256x256 DFT ~0.09 ms, 1024x1024 ~2 ms, 2048x2048 ~13 ms).
+DFT_SECONDS_PER_UNIT = 1.2e-10
+
+
+class LimitError(WeftError):
+    """A job refused before it starts: too many pixels, too much memory or too long."""
+
+
+def _positive(value: object, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise WeftError(f"parameter '{name}' = {value!r} must be a positive number")
+    return float(value)
+
+
+def get_max_seconds() -> float:
+    """The longest estimated running time a job may have.
+
+    :func:`set_max_seconds` wins if called; else ``WEFT_MAX_SECONDS`` when it holds a positive number
+    (``inf`` disables the check; invalid values are ignored); else :data:`DEFAULT_MAX_SECONDS`.
+    """
+    if _max_seconds_override is not None:
+        return _max_seconds_override
+    with contextlib.suppress(ValueError):
+        if (value := float(os.environ.get("WEFT_MAX_SECONDS", "").strip())) > 0:
+            return value
+    return DEFAULT_MAX_SECONDS
+
+
+def set_max_seconds(seconds: float | None) -> None:
+    """Set the process-wide limit on estimated running time (seconds > 0, ``inf`` for none);
+    ``None`` restores the environment variable / default."""
+    global _max_seconds_override
+    _max_seconds_override = None if seconds is None else _positive(seconds, "max_seconds")
+
+
+def available_memory() -> int | None:
+    """Bytes of memory available to a new allocation (Linux ``MemAvailable``), or ``None`` if unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} hours"
+
+
+def _bytes(n: float) -> str:
+    return f"{n / 2**30:.1f} GiB" if n >= 2**30 else f"{n / 2**20:.0f} MiB"
+
+
+def check_output_size(width: int, height: int, source: str = "parameter 'size'") -> None:
+    """Refuse an output of more pixels than the pixel limit; ``source`` names what set its size."""
+    from .image import get_max_pixels
+
+    limit = get_max_pixels()
+    if width * height > limit:
+        raise LimitError(f"{source}: an output of {width}x{height} = {width * height / 1e6:.1f} megapixels "
+                         f"exceeds the limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)")
+
+
+def check_memory(nbytes: float, what: str) -> None:
+    """Refuse a job whose estimated peak memory ``nbytes`` exceeds the memory available now."""
+    available = available_memory()
+    if available is not None and nbytes > available:
+        raise LimitError(f"{what} needs about {_bytes(nbytes)} of memory, {_bytes(available)} is available: "
+                         f"make the output smaller")
+
+
+def check_duration(seconds: float, what: str, advice: str) -> None:
+    """Refuse a job whose estimated running time exceeds :func:`get_max_seconds`.
+
+    ``what`` describes the job (sizes, counts), ``advice`` says which parameters shorten it.
+    """
+    limit = get_max_seconds()
+    if seconds > limit:
+        raise LimitError(f"{what} would take about {_duration(seconds)} (limit {_duration(limit)}): {advice}, "
+                         f"or set WEFT_MAX_SECONDS to allow it")
+
+
+def dft_seconds(h: int, w: int) -> float:
+    """Estimated seconds of one real DFT of an ``h`` x ``w`` float32 image padded to OpenCV's optimal size."""
+    import cv2
+
+    n = cv2.getOptimalDFTSize(int(h)) * cv2.getOptimalDFTSize(int(w))
+    return DFT_SECONDS_PER_UNIT * n * math.log2(max(n, 2))

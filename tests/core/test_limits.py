@@ -1,0 +1,138 @@
+"""Issue 8.6: jobs too large are refused up front (pixels, memory, running time), in one line."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from app import cli
+from core import fast, limits, nfpt, quilting
+from core.errors import WeftError
+from core.image import set_max_pixels
+from core.limits import LimitError
+
+
+@pytest.fixture(autouse=True)
+def _restore_limits():
+    yield
+    limits.set_max_seconds(None)
+    set_max_pixels(None)
+
+
+def _tex(side: int = 64, colour: bool = True) -> np.ndarray:
+    rng = np.random.default_rng(0)
+    return rng.random((side, side, 3) if colour else (side, side), dtype=np.float32)
+
+
+def _never_called(_progress) -> None:
+    raise AssertionError("the job started: it should have been refused before any work")
+
+
+def test_quilting_too_long_is_refused_before_any_block():
+    tex = _tex(256)
+    est = quilting.estimate_seconds(tex.shape, (1024, 1024), [(8, 2)])
+    limits.set_max_seconds(est / 2)
+    with pytest.raises(LimitError) as info:
+        quilting.synthesize(tex, size=(1024, 1024), block=8, overlap=2, progress=_never_called)
+    msg = str(info.value)
+    assert "\n" not in msg
+    assert msg.startswith("quilting of 1024x1024 from a 256x256 texture (29,241 blocks of 8 px) would take about")
+    assert "use a larger block" in msg and "WEFT_MAX_SECONDS" in msg
+    # at the limit it runs (a cheaper job under the same limit)
+    out = quilting.synthesize(tex, size=(64, 64), block=16, overlap=3, rng=1)
+    assert out.shape == (64, 64, 3)
+
+
+def test_iterative_transfer_counts_every_pass():
+    tex, target = _tex(64), _tex(128)
+    passes = [(b, o) for b, o, _ in quilting.transfer_schedule(5)]
+    five = quilting.estimate_seconds(tex.shape, (128, 128), passes)
+    one = quilting.estimate_seconds(tex.shape, (128, 128), passes[:1])
+    assert five > 4 * one  # the later passes have smaller blocks, so more of them
+    limits.set_max_seconds((five + one) / 2)
+    quilting.transfer(tex, target, iterations=1, block=31, overlap=21, rng=1)  # one pass fits the limit
+    with pytest.raises(LimitError, match=r"^transfer of 128x128 from a 64x64 texture \(.* blocks of 31 to 9 px in 5 "
+                                         r"passes\) would take about .*fewer iterations"):
+        quilting.transfer(tex, target, iterations=5, progress=_never_called)
+
+
+def test_quilting_estimate_scales_with_blocks_and_texture():
+    small = quilting.estimate_seconds((128, 128, 3), (512, 512), [(32, 6)])
+    assert quilting.estimate_seconds((128, 128, 3), (1024, 1024), [(32, 6)]) == pytest.approx(4 * small, rel=0.1)
+    assert quilting.estimate_seconds((128, 128, 3), (512, 512), [(16, 3)]) > 3 * small
+    assert quilting.estimate_seconds((512, 512, 3), (512, 512), [(32, 6)]) > 10 * small
+
+
+def test_output_over_the_pixel_limit_is_refused_naming_what_set_it():
+    set_max_pixels(10_000)
+    with pytest.raises(LimitError, match=r"^parameter 'size': an output of 200x100 = 0\.0 megapixels exceeds the limit "
+                                         r"of 0\.01 megapixels"):
+        quilting.synthesize(_tex(), size=(200, 100), block=16, progress=_never_called)
+    with pytest.raises(LimitError, match=r"^parameter 'size': an output of 128x128"):
+        quilting.synthesize(_tex(), block=16, mode="random")  # default size: twice the texture
+    with pytest.raises(LimitError, match=r"^parameter 'magnify': an output of 256x256"):
+        fast.transfer(_tex(), None, mode="superres", magnify=4, progress=_never_called)
+    with pytest.raises(LimitError, match=r"^the target: an output of 120x110"):
+        fast.transfer(_tex(), _tex(1)[:1, :1].repeat(110, 0).repeat(120, 1), progress=_never_called)
+    with pytest.raises(LimitError, match=r"^parameter 'size': an output of 128x128"):
+        nfpt.synthesize(_tex(), block=16, overlap=4, progress=_never_called)
+    set_max_pixels(None)
+    out = fast.transfer(_tex(), None, mode="superres", magnify=2, rng=1)
+    assert out.shape == (128, 128, 3)
+
+
+def test_more_memory_than_available_is_refused(monkeypatch):
+    monkeypatch.setattr(limits, "available_memory", lambda: 20 * 2**20)  # 20 MiB free
+    target = np.zeros((1024, 1024, 3), np.float32)  # 1 Mpx x 50 B > 20 MiB
+    with pytest.raises(LimitError, match=r"^fast transfer of 1024x1024 needs about 50 MiB of memory, 20 MiB is "
+                                         r"available: make the output smaller$"):
+        fast.transfer(_tex(), target, progress=_never_called)
+    with pytest.raises(LimitError, match=r"^quilting 1024x1024 from a 64x64 texture needs about"):
+        quilting.synthesize(_tex(), size=(1024, 1024), block=32, progress=_never_called)
+    monkeypatch.setattr(limits, "available_memory", lambda: None)  # unknown: no check
+    assert quilting.synthesize(_tex(), size=(64, 64), block=32, rng=1).shape == (64, 64, 3)
+
+
+def test_nfpt_too_long_is_refused():
+    tex = _tex(128, colour=False)
+    est = nfpt.estimate_seconds(tex.shape, (256, 256), 16, 4)
+    assert est > 0
+    limits.set_max_seconds(est / 2)
+    with pytest.raises(LimitError, match=r"^NFPT synthesis of 256x256 from a 128x128 texture with 16 px patches "
+                                         r"would take about"):
+        nfpt.synthesize(tex, size=(256, 256), block=16, overlap=4, progress=_never_called)
+
+
+def test_max_seconds_from_environment(monkeypatch):
+    monkeypatch.setenv("WEFT_MAX_SECONDS", "42")
+    assert limits.get_max_seconds() == 42.0
+    monkeypatch.setenv("WEFT_MAX_SECONDS", "inf")
+    assert limits.get_max_seconds() == float("inf")
+    for junk in ("", "soon", "-5", "0"):
+        monkeypatch.setenv("WEFT_MAX_SECONDS", junk)
+        assert limits.get_max_seconds() == limits.DEFAULT_MAX_SECONDS
+    limits.set_max_seconds(3)
+    assert limits.get_max_seconds() == 3.0
+    for bad in (0, -1, float("nan"), "10", True):
+        with pytest.raises(WeftError, match="parameter 'max_seconds'"):
+            limits.set_max_seconds(bad)
+
+
+def test_cli_refuses_a_long_job_in_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    from core.examples import example
+
+    monkeypatch.setenv("WEFT_MAX_SECONDS", "5")
+    out = tmp_path / "out.png"
+    code = cli.main(["quilt", str(example("gravel")), "--size", "4096x4096", "--block", "4", "--overlap", "1",
+                     "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and not out.exists()
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert err.startswith("weft: quilting of 4096x4096 from a 256x256 texture (1,863,225 blocks of 4 px) would take "
+                          "about "), err
+    assert "(limit 5 s)" in err
+
+
+def test_available_memory_reads_the_system():
+    free = limits.available_memory()
+    assert free is None or free > 0
