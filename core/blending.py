@@ -207,7 +207,8 @@ def pyramid_blend(foreground: np.ndarray, background: np.ndarray, mask: np.ndarr
     if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)):
         raise InvalidParameter(f"parameter 'levels' = {levels!r} must be an integer", name="levels", value=levels)
     if not 1 <= levels <= top:
-        raise out_of_range("levels", int(levels), 1, top, f"a {w}x{h} image has at most {top} pyramid levels")
+        raise out_of_range("levels", int(levels), 1, top, f"a {w}x{h} image has at most {top} pyramid levels",
+                           input="foreground")
     fg = fg.astype(np.float32)
     bg = bg.astype(np.float32)
     gm = [m.astype(np.float32)]

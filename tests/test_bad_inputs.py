@@ -81,9 +81,9 @@ def test_odd_image_works_or_is_refused_in_one_line(corpus, tmp_path, capsys, met
         assert code == 2, err
         assert len(err.strip().splitlines()) == 1, err
         assert not out.exists()
-        # the line names the file, or (a parameter that cannot fit it) the image by its size
+        # the line names the file and its size (too small for the method, or for a parameter)
         h, w = load_image(path).image.shape[:2]
-        assert path.name in err or f"{w}x{h}" in err, err
+        assert path.name in err and f"{w}x{h}" in err, err
 
 
 @pytest.mark.parametrize("method", SUBCOMMANDS)
@@ -136,3 +136,23 @@ def test_real_process_reads_non_ascii_path(corpus, tmp_path):
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert out.is_file()
+
+
+@pytest.mark.parametrize("method, minimum", [("quilt", 2), ("fast", 3), ("affine", 8), ("nfpt", 8)])
+def test_too_small_texture_names_file_size_and_minimum(corpus, tmp_path, capsys, method, minimum):
+    path = corpus["tiny_1x1"]
+    out = tmp_path / "out.png"
+    code = cli.main(argv(method, str(path), str(out)))
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and not out.exists()
+    assert err.startswith(f"weft: {path}: ") and "1x1" in err, err
+    assert f"at least {minimum}x{minimum} pixels" in err, err
+
+
+def test_parameter_that_does_not_fit_names_the_file(corpus, tmp_path, capsys):
+    path = corpus["thin_2x3000"]  # wide enough for quilting's minimum block (2), not for the default 32
+    out = tmp_path / "out.png"
+    code = cli.main(["quilt", str(path), "--size", "24x24", "-o", str(out), "-q"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and not out.exists()
+    assert err == f"weft: {path}: parameter 'block' = 32 is outside 2..2 (must fit in the texture, 2x3000)"

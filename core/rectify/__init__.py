@@ -148,7 +148,7 @@ class Rectifier:
         """Fit the warp only (see :func:`rectify` for the parameters)."""
         frontal_size = _check_size(frontal_size)
         return plan_warp(np.asarray(frontal_lines, dtype=np.float64), np.asarray(image_lines, dtype=np.float64),
-                         frontal_size, self.size, warp=warp, a=a, b=b, p=p)
+                         frontal_size, self.size, warp=warp, a=a, b=b, p=p, src_input="photo")
 
     def rectify(self, image_lines, frontal_lines, frontal_size, *, warp: str = "homography", a: float = 1.0,
                 b: float = 2.0, p: float = 0.5) -> Rectified:

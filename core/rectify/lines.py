@@ -190,7 +190,7 @@ def load_feature_lines(path_or_json: str | Path) -> FeatureLines:
 
 
 def check_lines(lines: np.ndarray, size: tuple[int, int], *, key: str, frame: str,
-                tolerance: float = OUTSIDE_TOLERANCE) -> None:
+                tolerance: float = OUTSIDE_TOLERANCE, input: str | None = None) -> None:
     """Raise GeometryError if a line is shorter than :data:`MIN_LENGTH` or leaves the frame.
 
     Parameters
@@ -203,6 +203,9 @@ def check_lines(lines: np.ndarray, size: tuple[int, int], *, key: str, frame: st
         Name of the frame in messages (``"the photo"``).
     tolerance : float, default 2
         How far (pixels) an end point may lie beyond the frame's edge, ``[-0.5, w - 0.5]``.
+    input : str, optional
+        The method input that is the frame (``"photo"``): set as ``WeftError.input`` on an end
+        point outside it, so that front ends name the image file (lines drawn for another photo).
     """
     w, h = size
     lo_x, hi_x = -0.5 - tolerance, w - 0.5 + tolerance
@@ -214,7 +217,9 @@ def check_lines(lines: np.ndarray, size: tuple[int, int], *, key: str, frame: st
             raise GeometryError(f"{key} {i} has {what}: ({x1:g}, {y1:g}) to ({x2:g}, {y2:g})")
         for x, y in ((x1, y1), (x2, y2)):
             if not (lo_x <= x <= hi_x and lo_y <= y <= hi_y):
-                raise GeometryError(f"{key} {i} end ({x:g}, {y:g}) is outside {frame} ({w}x{h})")
+                error = GeometryError(f"{key} {i} end ({x:g}, {y:g}) is outside {frame} ({w}x{h})")
+                error.input = input
+                raise error
 
 
 @dataclass(frozen=True)

@@ -216,7 +216,7 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
               src_size: tuple[int, int], *, warp: str = "homography", a: float = 1.0, b: float = 2.0,
               p: float = 0.5, robust: bool = True, planar_tol: float = PLANAR_TOL_PX,
               check: bool = True, dst_name: str = "the frontal frame", src_name: str = "the photo",
-              dst_key: str = "frontal line", src_key: str = "image line") -> WarpPlan:
+              dst_key: str = "frontal line", src_key: str = "image line", src_input: str | None = None) -> WarpPlan:
     """Fit a warp that maps the source frame onto the destination frame from corresponding lines.
 
     Parameters
@@ -242,6 +242,8 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
         Reject zero-length lines and lines outside their frames.
     dst_name, src_name, dst_key, src_key : str
         How the frames and lines are named in error messages.
+    src_input : str, optional
+        The method input the source frame is (see :func:`~core.rectify.lines.check_lines`).
 
     Returns
     -------
@@ -262,7 +264,7 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
     if len(dst_lines) == 0:
         raise GeometryError("no feature lines: draw lines on the photo and their positions in the frontal frame")
     if check:
-        check_lines(src_lines, src_size, key=src_key, frame=src_name)
+        check_lines(src_lines, src_size, key=src_key, frame=src_name, input=src_input)
         check_lines(dst_lines, dst_size, key=dst_key, frame=dst_name)
     if warp == "homography":
         fit = fit_homography(dst_lines, src_lines, dst_size, src_size, robust=robust)
