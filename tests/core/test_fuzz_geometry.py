@@ -6,11 +6,15 @@ or raises ``WeftError`` in one line; never another exception, never NaN.
 """
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from core.errors import WeftError
 from core.rectify import rectify
+
+# a NumPy warning would print extra lines on stderr, breaking the one-line promise
+pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
 
 PHOTO = np.random.default_rng(3).random((24, 32, 3), dtype=np.float32)
 # mostly inside the 32x24 photo (a point outside now and then), few values: repeats are likely

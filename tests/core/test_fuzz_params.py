@@ -19,6 +19,9 @@ from core import registry
 from core.errors import InvalidParameter, WeftError
 from core.params import specs
 
+# a NumPy warning would print extra lines on stderr, breaking the one-line promise
+pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
+
 METHODS = registry.methods()
 
 _junk = st.one_of(
