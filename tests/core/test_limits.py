@@ -130,7 +130,7 @@ def test_cli_refuses_a_long_job_in_one_line_and_writes_nothing(tmp_path, capsys,
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert err.startswith("weft: quilting of 4096x4096 from a 256x256 texture (1,863,225 blocks of 4 px) would take "
                           "about "), err
-    assert "(limit 5 s)" in err
+    assert "(limit 5.0 s)" in err
 
 
 def test_available_memory_reads_the_system():
