@@ -167,3 +167,50 @@ def test_quilting_synthesize_fuzz(seed, hs, ws, colour, mode, rule, tol, block, 
     assert out.ndim == (3 if colour else 2)
     assert out.dtype == np.float32 and np.isfinite(out).all()
     assert out.min() >= 0.0 and out.max() <= 1.0
+
+
+@settings(max_examples=15, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**16), hs=st.integers(6, 20), ws=st.integers(6, 20), colour=st.booleans(),
+       th=st.integers(1, 24), tw=st.integers(1, 24), block=st.integers(2, 8), iterations=st.integers(1, 3),
+       alpha=st.floats(0, 1), mode=st.sampled_from(["overlap", "mincut"]),
+       correspondence=st.sampled_from(["blur", "luminance"]), remap=st.booleans(), poisson=st.booleans())
+def test_quilting_transfer_fuzz(seed, hs, ws, colour, th, tw, block, iterations, alpha, mode, correspondence, remap,
+                                poisson):
+    from core.quilting import transfer
+
+    texture = _image(seed, hs, ws, colour)
+    target = _image(seed + 1, th, tw, colour)
+    try:
+        outs = transfer(texture, target, block=block, overlap=max(1, block // 3), alpha=alpha, iterations=iterations,
+                        mode=mode, correspondence=correspondence, remap=remap, poisson=poisson, return_all=True,
+                        rng=seed)
+    except WeftError as e:
+        assert "\n" not in str(e)
+        assert any(k in str(e) for k in ("block", "overlap", "tile")), str(e)
+        return
+    assert len(outs) == iterations
+    for out in outs:
+        assert out.shape[:2] == (th, tw)
+        assert out.ndim == (3 if colour else 2)
+        assert out.dtype == np.float32 and np.isfinite(out).all()
+        assert out.min() >= 0.0 and out.max() <= 1.0
+
+
+@settings(max_examples=15, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**16), hs=st.integers(3, 12), ws=st.integers(3, 12), colour=st.booleans(),
+       mode=st.sampled_from(["superres", "novel"]), magnify=st.integers(1, 4), p_l=st.floats(0, 1),
+       iterations=st.integers(1, 2))
+def test_fast_superres_and_novel_fuzz(seed, hs, ws, colour, mode, magnify, p_l, iterations):
+    from core.fast import transfer as fast_transfer
+
+    texture = _image(seed, hs, ws, colour)
+    n = 3
+    try:
+        out = fast_transfer(texture, None, mode=mode, magnify=magnify, n=n, p_l=p_l, iterations=iterations, rng=seed)
+    except WeftError as e:
+        assert "\n" not in str(e) and "parameter '" in str(e), str(e)
+        return
+    assert out.shape[:2] == (hs * magnify, ws * magnify)
+    assert out.ndim == (3 if colour else 2)
+    assert out.dtype == np.float32 and np.isfinite(out).all()
+    assert out.min() >= 0.0 and out.max() <= 1.0
