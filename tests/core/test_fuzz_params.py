@@ -3,7 +3,8 @@
 Every registered method's ``Params`` class, built from arbitrary values (in and out of range, wrong
 types, None, non-finite numbers, odd text), either builds (and round-trips through to_dict/from_dict)
 or raises ``WeftError`` whose one-line message names the parameter; never another exception. Then a
-small bounded end-to-end fuzz of ``core.fast.transfer`` and ``core.quilting.synthesize``.
+small bounded end-to-end fuzz of ``core.fast.transfer`` (all modes) and ``core.quilting.synthesize``
+and ``transfer``.
 """
 
 from __future__ import annotations
