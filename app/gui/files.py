@@ -8,8 +8,11 @@ from __future__ import annotations
 
 import json
 import os
+import threading
 from pathlib import Path
+from typing import Callable, TypeVar
 
+from PySide6.QtCore import QEventLoop, QMetaObject, Qt
 from PySide6.QtWidgets import QFileDialog, QMessageBox
 
 from core.errors import WeftError
@@ -17,7 +20,36 @@ from core.image import atomic_write_bytes, crop_square, load_image, save_image
 
 from .document import InputImage, read_session
 
+T = TypeVar("T")
+
 SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
+
+
+def off_gui_thread(fn: Callable[[], T]) -> T:
+    """Run ``fn()`` on a worker thread and return its value (or raise its exception).
+
+    For work the caller must wait for (a session's images are decoded before the document is
+    touched): meanwhile the GUI thread runs a local event loop that keeps painting and running timers
+    but holds back user input, so the window stays alive and nothing can be started twice.
+    """
+    loop = QEventLoop()
+    box: dict = {}
+
+    def work() -> None:
+        try:
+            box["value"] = fn()
+        except BaseException as e:  # handed to the GUI thread and raised there
+            box["error"] = e
+        finally:
+            QMetaObject.invokeMethod(loop, "quit", Qt.ConnectionType.QueuedConnection)
+
+    thread = threading.Thread(target=work, name="weft-open", daemon=True)
+    thread.start()
+    loop.exec(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)
+    thread.join()
+    if "error" in box:
+        raise box["error"]
+    return box["value"]
 
 
 class FilesMixin:
@@ -112,12 +144,17 @@ class FilesMixin:
         if data["method"] not in STUDIO_METHODS:
             raise WeftError(f"{path}: the studio does not offer method {data['method']!r} "
                             f"(it offers {', '.join(STUDIO_METHODS)}; use 'weft {data['method']}')")
-        images = {}
-        for name, p in data["inputs"].items():
-            try:
-                images[name] = InputImage(p, load_image(p).image)
-            except WeftError as e:
-                raise WeftError(f"{path}: the {name.replace('_', ' ')} image: {e}") from None
+        def decode() -> dict[str, InputImage]:
+            images = {}
+            for name, p in data["inputs"].items():
+                try:
+                    images[name] = InputImage(p, load_image(p).image)
+                except WeftError as e:
+                    raise WeftError(f"{path}: the {name.replace('_', ' ')} image: {e}") from None
+            return images
+
+        self.statusBar().showMessage(f"opening {Path(path).name}…")
+        images = off_gui_thread(decode)
         proto = data["prototype"]
         on = "prototype_image" if data["method"] == "affine" and "prototype_image" in images else "texture"
         if proto is not None and on in images:

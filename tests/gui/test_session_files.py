@@ -142,3 +142,38 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
     path = tmp_path / "good.weft.json"
     path.write_text(json.dumps(good))
     assert window.open_session(str(path))  # and a good one still opens
+
+
+def test_session_images_are_decoded_off_the_gui_thread_while_it_keeps_running(window, qtbot, tmp_path, monkeypatch):
+    """A session's images may be large: the GUI thread keeps running its event loop while they decode."""
+    import threading
+
+    from PySide6.QtCore import QTimer
+
+    import app.gui.files as files
+
+    texture = _image(tmp_path / "tex.png", 7)
+    window.doc.set_input("texture", str(texture), load_image(texture).image)
+    session = tmp_path / "s.weft.json"
+    assert window.save_session(str(session))
+
+    decoding, gui_ran = threading.Event(), threading.Event()
+    decoders = []
+
+    def slow_load(path, *args, **kwargs):
+        decoders.append(threading.current_thread() is threading.main_thread())
+        decoding.set()
+        assert gui_ran.wait(10), "the GUI thread was blocked while the image decoded"
+        return load_image(path, *args, **kwargs)
+
+    # a timer of the GUI thread: it fires only if that thread runs its event loop during the decoding
+    timer = QTimer()
+    timer.timeout.connect(lambda: decoding.is_set() and gui_ran.set())
+    timer.start(5)
+    monkeypatch.setattr(files, "load_image", slow_load)
+    try:
+        assert window.open_session(str(session))
+    finally:
+        timer.stop()
+    assert decoders and not any(decoders)  # every image of the session, none on the GUI thread
+    assert window.doc.inputs["texture"].path == str(texture)
