@@ -29,7 +29,7 @@ def off_gui_thread(fn: Callable[[], T]) -> T:
     """Run ``fn()`` on a worker thread and return its value (or raise its exception).
 
     For work the caller must wait for (a session's images are decoded before the document is
-    touched): meanwhile the GUI thread runs a local event loop that keeps painting and running timers
+    touched, an export is written before it is reported): meanwhile the GUI thread runs a local event loop that keeps painting and running timers
     but holds back user input, so the window stays alive and nothing can be started twice.
     """
     loop = QEventLoop()
@@ -81,8 +81,10 @@ class FilesMixin:
             self.show_message(f"{p.name}: not exported (the existing file is kept)")
             return False
         recipe = self.doc.recipe(relative_to=p.resolve().parent).to_json()
-        try:
-            save_image(p, shown.image, recipe=recipe, bit_depth=16 if p.suffix.lower() in (".tif", ".tiff") else 8)
+        depth = 16 if p.suffix.lower() in (".tif", ".tiff") else 8
+        self.statusBar().showMessage(f"exporting {p.name}…")
+        try:  # encoding a large PNG takes a second: off the GUI thread
+            off_gui_thread(lambda: save_image(p, shown.image, recipe=recipe, bit_depth=depth))
         except WeftError as e:
             self.show_message(str(e))
             return False

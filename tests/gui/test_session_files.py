@@ -144,36 +144,57 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
     assert window.open_session(str(path))  # and a good one still opens
 
 
-def test_session_images_are_decoded_off_the_gui_thread_while_it_keeps_running(window, qtbot, tmp_path, monkeypatch):
-    """A session's images may be large: the GUI thread keeps running its event loop while they decode."""
+
+def _runs_off_gui_thread(monkeypatch, module, name, action):
+    """Run ``action()`` with ``module.name`` replaced by a wrapper that records its thread and waits until
+    a timer of the GUI thread has fired, which happens only if that thread keeps running its event loop;
+    return the recorded "was it the GUI thread" flags."""
     import threading
 
     from PySide6.QtCore import QTimer
 
+    real = getattr(module, name)
+    working, gui_ran = threading.Event(), threading.Event()
+    on_gui_thread = []
+
+    def slow(*args, **kwargs):
+        on_gui_thread.append(threading.current_thread() is threading.main_thread())
+        working.set()
+        assert gui_ran.wait(10), "the GUI thread was blocked meanwhile"
+        return real(*args, **kwargs)
+
+    timer = QTimer()
+    timer.timeout.connect(lambda: working.is_set() and gui_ran.set())
+    timer.start(5)
+    monkeypatch.setattr(module, name, slow)
+    try:
+        assert action()
+    finally:
+        timer.stop()
+        monkeypatch.setattr(module, name, real)
+    return on_gui_thread
+
+
+def test_session_images_are_decoded_off_the_gui_thread_while_it_keeps_running(window, qtbot, tmp_path, monkeypatch):
+    """A session's images may be large: the GUI thread keeps running its event loop while they decode."""
     import app.gui.files as files
 
     texture = _image(tmp_path / "tex.png", 7)
     window.doc.set_input("texture", str(texture), load_image(texture).image)
     session = tmp_path / "s.weft.json"
     assert window.save_session(str(session))
-
-    decoding, gui_ran = threading.Event(), threading.Event()
-    decoders = []
-
-    def slow_load(path, *args, **kwargs):
-        decoders.append(threading.current_thread() is threading.main_thread())
-        decoding.set()
-        assert gui_ran.wait(10), "the GUI thread was blocked while the image decoded"
-        return load_image(path, *args, **kwargs)
-
-    # a timer of the GUI thread: it fires only if that thread runs its event loop during the decoding
-    timer = QTimer()
-    timer.timeout.connect(lambda: decoding.is_set() and gui_ran.set())
-    timer.start(5)
-    monkeypatch.setattr(files, "load_image", slow_load)
-    try:
-        assert window.open_session(str(session))
-    finally:
-        timer.stop()
-    assert decoders and not any(decoders)  # every image of the session, none on the GUI thread
+    flags = _runs_off_gui_thread(monkeypatch, files, "load_image", lambda: window.open_session(str(session)))
+    assert flags and not any(flags)  # every image of the session, none on the GUI thread
     assert window.doc.inputs["texture"].path == str(texture)
+
+
+def test_export_is_encoded_off_the_gui_thread(window, qtbot, tmp_path, monkeypatch):
+    import app.gui.files as files
+
+    qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
+    out = tmp_path / "out.png"
+    flags = _runs_off_gui_thread(monkeypatch, files, "save_image", lambda: window.export_result(str(out)))
+    assert flags == [False]
+    written, shown = load_image(out).image, window.renderer.last.image
+    assert written.shape == shown.shape
+    assert float(np.abs(written - shown).max()) <= 0.5 / 255 + 1e-6  # the shown result, to 8 bits
