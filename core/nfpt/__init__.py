@@ -185,7 +185,7 @@ def _check_limits(tex: np.ndarray, size: tuple[int, int], params: NfptParams) ->
     h, w = tex.shape[:2]
     seconds = estimate_seconds(tex.shape, size, params.block, params.overlap)
     check_duration(seconds, f"NFPT synthesis of {width}x{height} from a {w}x{h} texture with {params.block} px patches",
-                   "use a larger block, a smaller size or a smaller texture")
+                   "use a larger block, a smaller size or a smaller part of the texture")
 
 
 def _synthesize(tex: np.ndarray, params: NfptParams, *, mask=None, rng=None, progress=None, cancel=None) -> Synthesis:

@@ -250,8 +250,8 @@ def _check_limits(tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[in
     what = (f"{'transfer' if transfer else 'quilting'} of {out_w}x{out_h} from a {w}x{h} texture "
             f"({blocks:,} blocks of {first if len(passes) == 1 else f'{first} to {passes[-1][0]}'} px"
             f"{f' in {len(passes)} passes' if len(passes) > 1 else ''})")
-    advice = ("use a larger block, fewer iterations, a smaller target or a smaller texture (--region)" if transfer
-              else "use a larger block, a smaller size or a smaller texture (--region)")
+    advice = ("use a larger block, fewer iterations, a smaller target or a smaller part of the texture" if transfer
+              else "use a larger block, a smaller size or a smaller part of the texture")
     check_duration(seconds, what, advice)
 
 

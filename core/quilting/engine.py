@@ -185,6 +185,10 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     if corr is not None:
         corr_t = _pad_to(corr[1], hc, wc)
     tbuf = np.zeros((nc, src.n_h, src.n_w), dtype=np.float32)
+    # Per-block spectra and correlation written into these, not into fresh arrays: freeing a few
+    # hundred kB per block made glibc trim and re-fault the heap (9.7 M page faults, 40 % of the time
+    # in the kernel, for 1024² from 256² with block 6).
+    fwd, part, acc, cross_buf = (np.empty((src.n_h, src.n_w), dtype=np.float32) for _ in range(4))
     tcorr = np.zeros((src.n_h, src.n_w), dtype=np.float32)
     us = rng.random((rows, cols))
     seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
@@ -253,10 +257,14 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                         const += template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
                                           p.w_overlap, 0.0, 0.0, src.mean, src.mean_c, tbuf, tcorr)
                         for c in range(nc):
-                            part = cv2.mulSpectrums(spectra[c], cv2.dft(tbuf[c]), 0, conjB=True)
-                            spec = part if spec is None else spec + part
+                            cv2.dft(tbuf[c], dst=fwd)
+                            if spec is None:
+                                spec = cv2.mulSpectrums(spectra[c], fwd, 0, c=acc, conjB=True)
+                            else:
+                                cv2.mulSpectrums(spectra[c], fwd, 0, c=part, conjB=True)
+                                spec = np.add(spec, part, out=acc)
                     fp[_K.F_CONST] = const
-                    cross = cv2.idft(spec, flags=flags)
+                    cross = cv2.idft(spec, dst=cross_buf, flags=flags)
                     sq = src.sq((top, left, right, bottom), p)
                 else:  # synthesis, first block: a random position
                     ip[_K.P_FIX_Y], ip[_K.P_FIX_X] = first
