@@ -189,6 +189,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     # hundred kB per block made glibc trim and re-fault the heap (9.7 M page faults, 40 % of the time
     # in the kernel, for 1024² from 256² with block 6).
     fwd, part, acc, cross_buf = (np.empty((src.n_h, src.n_w), dtype=np.float32) for _ in range(4))
+    cost_buf = np.empty(src.ph * src.pw, dtype=np.float64)
     tcorr = np.zeros((src.n_h, src.n_w), dtype=np.float32)
     us = rng.random((rows, cols))
     seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
@@ -269,7 +270,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                 else:  # synthesis, first block: a random position
                     ip[_K.P_FIX_Y], ip[_K.P_FIX_X] = first
                     cross, sq = dummy_cross, dummy_sq
-                place(canvas, filled, tex, cross, sq, ip, fp)
+                place(canvas, filled, tex, cross, sq, ip, fp, cost_buf)
             if report is not None:
                 report.update(i + 1, preview=preview)
     finally:
@@ -397,8 +398,12 @@ def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bott
     return float(np.cumsum(terms.ravel())[-1]) if terms.size else 0.0
 
 
-def _place_block_numpy(canvas, filled, tex, cross, sq, ip, fp):
-    """``core._kernels.quilting.place_block`` without the Poisson band, in numpy (same pixels)."""
+def _place_block_numpy(canvas, filled, tex, cross, sq, ip, fp, cost_buf=None):
+    """``core._kernels.quilting.place_block`` without the Poisson band, in numpy (same pixels).
+
+    ``cost_buf`` is the kernel's work buffer; numpy makes its own arrays (this engine only runs small
+    jobs, where reuse does not matter).
+    """
     hc, wc, nc = canvas.shape
     b = int(ip[_K.P_B])
     y0, x0 = int(ip[_K.P_Y0]), int(ip[_K.P_X0])
