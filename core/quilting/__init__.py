@@ -199,9 +199,8 @@ def _finish(img: np.ndarray, channels: int) -> np.ndarray:
 
 
 #: Seconds per source position per block for choosing a position and pasting (rule, cut), besides
-#: the DFTs: measured ~3 ns on the 2-core machine (a 256x256 source: 0.56 ms per 32-pixel block,
-#: of which 0.36 ms are its four DFTs).
-SELECT_SECONDS_PER_POSITION = 3e-9
+#: the DFTs: ~1 ns on the 2-core machine (fitted to ``python -m benchmarks.estimates``).
+SELECT_SECONDS_PER_POSITION = 1e-9
 #: Bytes per output pixel of a job's peak memory (canvas, previous pass, correspondence maps and
 #: preview copies, float32; measured with /usr/bin/time -v on `weft quilt` of a 256x256 texture: 2048x2048
 #: synthesis 245 MB peak RSS, transfer 477 MB, of which ~100 MB are Python, NumPy, OpenCV and numba).
@@ -219,7 +218,7 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
     and the inverse; a transfer adds its correspondence and previous-pass spectra, computed on a
     second thread one row ahead, so they do not add up) plus a position choice over every source
     position. ``passes`` are the (block, overlap) of each pass. Against real runs (``python -m
-    benchmarks.estimates``) it comes within 0.4..1.6x.
+    benchmarks.estimates``) it comes within 0.9..1.6x.
     """
     from ..limits import dft_seconds
 
