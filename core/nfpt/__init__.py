@@ -154,9 +154,9 @@ def synthesize(
     return syn if return_details else syn.image
 
 
-#: Seconds per source position per patch besides the DFTs (tol choice, cut, repair); measured ~4 ns
-#: on the 2-core machine (``python -m benchmarks.estimates``).
-SELECT_SECONDS_PER_POSITION = 4e-9
+#: Seconds per source position per patch besides the DFTs (tol choice, cut, repair); ~1 ns on the
+#: 2-core machine (fitted to ``python -m benchmarks.estimates``).
+SELECT_SECONDS_PER_POSITION = 1e-9
 
 
 def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], block: int, overlap: int) -> float:
@@ -164,7 +164,7 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], 
 
     Every patch but the first costs three DFTs of the padded source luminance (eqs. 1-3 for all
     positions at once: two spectra of the weighted template and the inverse) and a choice over every
-    source position; measured within 0.5..2x of real runs (``python -m benchmarks.estimates``).
+    source position; within 0.4..1.6x of real runs (``python -m benchmarks.estimates``).
     """
     from ..limits import dft_seconds
     from .synthesis import _grid

@@ -218,7 +218,7 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
     and the inverse; a transfer adds its correspondence and previous-pass spectra, computed on a
     second thread one row ahead, so they do not add up) plus a position choice over every source
     position. ``passes`` are the (block, overlap) of each pass. Against real runs (``python -m
-    benchmarks.estimates``) it comes within 0.9..1.6x.
+    benchmarks.estimates``) it comes within 0.8..1.8x.
     """
     from ..limits import dft_seconds
 
