@@ -219,16 +219,21 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
 
         tbuf_s = np.zeros_like(tbuf)
         tcorr_s = np.zeros_like(tcorr)
+        fwd_s, part_s = np.empty_like(fwd), np.empty_like(part)
+        # two rows of spectra, written alternately: the row being used and the one computed ahead
+        row_specs = [np.empty((cols, src.n_h, src.n_w), dtype=np.float32) for _ in range(2)]
 
         def static_row(i):
             out = []
+            specs = row_specs[i % 2]
             for j in range(cols):
                 cst = template(prev_c, prev_c, corr_t, ys[i], xs[j], b, 0, 0, 0, 0, wrap,
                                0.0, p.w_prev, p.w_corr, src.mean, src.mean_c, tbuf_s, tcorr_s)
-                spec = cv2.mulSpectrums(spectrum_c, cv2.dft(tcorr_s), 0, conjB=True)
+                spec = cv2.mulSpectrums(spectrum_c, cv2.dft(tcorr_s, dst=fwd_s), 0, c=specs[j], conjB=True)
                 if p.w_prev:
                     for c in range(nc):
-                        spec += cv2.mulSpectrums(spectra[c], cv2.dft(tbuf_s[c]), 0, conjB=True)
+                        cv2.mulSpectrums(spectra[c], cv2.dft(tbuf_s[c], dst=fwd_s), 0, c=part_s, conjB=True)
+                        spec = np.add(spec, part_s, out=spec)
                 out.append((spec, cst))
             return out
 
