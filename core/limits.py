@@ -101,12 +101,11 @@ def check_output_size(width: int, height: int, source: str = "parameter 'size'")
                          f"exceeds the limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)")
 
 
-def check_memory(nbytes: float, what: str) -> None:
+def check_memory(nbytes: float, what: str, advice: str = "make the output smaller") -> None:
     """Refuse a job whose estimated peak memory ``nbytes`` exceeds the memory available now."""
     available = available_memory()
     if available is not None and nbytes > available:
-        raise LimitError(f"{what} needs about {_bytes(nbytes)} of memory, {_bytes(available)} is available: "
-                         f"make the output smaller")
+        raise LimitError(f"{what} needs about {_bytes(nbytes)} of memory, {_bytes(available)} is available: {advice}")
 
 
 def check_duration(seconds: float, what: str, advice: str) -> None:

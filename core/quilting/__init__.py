@@ -203,8 +203,9 @@ def _finish(img: np.ndarray, channels: int) -> np.ndarray:
 SELECT_SECONDS_PER_POSITION = 1e-9
 #: Bytes per output pixel of a job's peak memory (canvas, previous pass, correspondence maps and
 #: preview copies, float32; measured with /usr/bin/time -v on `weft quilt` of a 256x256 texture: 2048x2048
-#: synthesis 245 MB peak RSS, transfer 477 MB, of which ~100 MB are Python, NumPy, OpenCV and numba).
-BYTES_PER_OUTPUT_PIXEL = {"synthesis": 40, "transfer": 100}
+#: synthesis 245 MB peak RSS, transfer 477 MB, of which ~100 MB are Python, NumPy, OpenCV and numba
+#: and, for the transfer, 175 MB its two rows of spectra, counted separately in ``_check_limits``).
+BYTES_PER_OUTPUT_PIXEL = {"synthesis": 40, "transfer": 50}
 #: Bytes per texture pixel: its spectra (one per channel and the correspondence map) and the
 #: squared-sum maps cached per overlap shape (up to nine), float32.
 BYTES_PER_SOURCE_PIXEL = 60
@@ -241,8 +242,15 @@ def _check_limits(tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[in
 
     check_output_size(out_w, out_h, "the target" if transfer else "parameter 'size'")
     h, w = tex.shape[:2]
-    check_memory(BYTES_PER_OUTPUT_PIXEL["transfer" if transfer else "synthesis"] * out_w * out_h
-                 + BYTES_PER_SOURCE_PIXEL * h * w, f"quilting {out_w}x{out_h} from a {w}x{h} texture")
+    need = (BYTES_PER_OUTPUT_PIXEL["transfer" if transfer else "synthesis"] * out_w * out_h
+            + BYTES_PER_SOURCE_PIXEL * h * w)
+    if transfer:  # two block rows of texture-sized spectra (the row in use and the one computed ahead)
+        import cv2
+
+        cols = max(len(_grid(out_w, b, o, tile)[0]) for b, o in passes)
+        need += 2 * cols * cv2.getOptimalDFTSize(h) * cv2.getOptimalDFTSize(w) * 4
+    check_memory(need, f"quilting {out_w}x{out_h} from a {w}x{h} texture",
+                 f"use a smaller {'target' if transfer else 'size'} or a smaller part of the texture")
     seconds = estimate_seconds(tex.shape, (out_w, out_h), passes, tile=tile)
     blocks = sum(_blocks(out_h, out_w, b, o, tile) for b, o in passes)
     first = passes[0][0]

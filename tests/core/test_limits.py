@@ -136,3 +136,17 @@ def test_cli_refuses_a_long_job_in_one_line_and_writes_nothing(tmp_path, capsys,
 def test_available_memory_reads_the_system():
     free = limits.available_memory()
     assert free is None or free > 0
+
+
+def test_transfer_memory_counts_its_rows_of_spectra(monkeypatch):
+    """A transfer keeps two block rows of texture-sized spectra: 2 x 85 x 256² x 4 B = 43 MiB here, on top
+    of 50 B per output pixel and 60 B per texture pixel; a synthesis of the same size has no rows."""
+    monkeypatch.setattr(limits, "available_memory", lambda: 30 * 2**20)
+    tex, target = _tex(256, colour=False), _tex(512, colour=False)
+    with pytest.raises(LimitError, match=r"^quilting 512x512 from a 256x256 texture needs about 59 MiB of memory, "
+                                         r"30 MiB is available: use a smaller target or a smaller part of the texture$"):
+        quilting.transfer(tex, target, progress=_never_called)
+    monkeypatch.setattr(limits, "available_memory", lambda: 10 * 2**20)
+    with pytest.raises(LimitError, match=r"^quilting 512x512 from a 256x256 texture needs about 14 MiB of memory, "
+                                         r"10 MiB is available: use a smaller size or"):
+        quilting.synthesize(tex, size=(512, 512), block=32, progress=_never_called)
