@@ -69,6 +69,31 @@ def warp_frames(pimg, cy, cx, mats, out):
                 out[k, u, v] = _sample(pimg, by + m01 * dx, bx + m11 * dx, hm, wm)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _target_energy(weights, target):
+    """``||W t||²`` of one windowed target patch and how many of its pixels are inside the image."""
+    et = 0.0
+    count = 0
+    B = target.shape[0]
+    for a in range(B):
+        for b in range(B):
+            v = weights[a, b] * target[a, b]
+            et += v * v
+            if weights[a, b] > 0.0:
+                count += 1
+    return et, count
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _normalised_error(et, ep, cross, count):
+    """§3.2's intensity factor ``alpha = ||W t|| / ||W p'||`` and the RMS error of ``alpha p'`` against
+    ``t`` over ``count`` pixels, from ``ep = ||W p'||²`` and ``cross = <W p', W t>``:
+    ``sum (alpha p - t)² = alpha² ep - 2 alpha cross + et``."""
+    al = math.sqrt(et / ep) if ep > 1e-20 else 0.0
+    e2 = al * al * ep - 2.0 * al * cross + et
+    return al, math.sqrt(max(e2, 0.0) / max(count, 1))
+
+
 @njit(cache=True, nogil=True)
 def score_frames(frames, index, flip, shifts, R, targets, weights, alpha, err):
     """§2.4 from warped frames (no resampling): candidate j of patch i is frame ``index[i, j]``
@@ -79,14 +104,7 @@ def score_frames(frames, index, flip, shifts, R, targets, weights, alpha, err):
     L = frames.shape[1]
     B = targets.shape[1]
     for i in range(n):
-        et = 0.0
-        count = 0
-        for a in range(B):
-            for b in range(B):
-                v = weights[i, a, b] * targets[i, a, b]
-                et += v * v
-                if weights[i, a, b] > 0.0:
-                    count += 1
+        et, count = _target_energy(weights[i], targets[i])
         for j in range(J):
             ty = shifts[i, j, 0]
             tx = shifts[i, j, 1]
@@ -105,10 +123,7 @@ def score_frames(frames, index, flip, shifts, R, targets, weights, alpha, err):
                     p *= wgt
                     ep += p * p
                     cross += p * wgt * targets[i, a, b]
-            al = math.sqrt(et / ep) if ep > 1e-20 else 0.0
-            e2 = al * al * ep - 2.0 * al * cross + et
-            alpha[i, j] = al
-            err[i, j] = math.sqrt(max(e2, 0.0) / max(count, 1))
+            alpha[i, j], err[i, j] = _normalised_error(et, ep, cross, count)
 
 
 @njit(cache=True, nogil=True)
@@ -123,14 +138,7 @@ def score_candidates(proto, cy, cx, mats, shifts, targets, weights, alpha, err):
     hm = proto.shape[0] - 1.0001
     wm = proto.shape[1] - 1.0001
     for i in range(n):
-        et = 0.0
-        count = 0
-        for a in range(B):
-            for b in range(B):
-                v = weights[i, a, b] * targets[i, a, b]
-                et += v * v
-                if weights[i, a, b] > 0.0:
-                    count += 1
+        et, count = _target_energy(weights[i], targets[i])
         for j in range(J):
             m00 = mats[i, j, 0, 0]
             m01 = mats[i, j, 0, 1]
@@ -152,11 +160,7 @@ def score_candidates(proto, cy, cx, mats, shifts, targets, weights, alpha, err):
                     p = wgt * _sample(proto, by + m01 * dx, bx + m11 * dx, hm, wm)
                     ep += p * p
                     cross += p * wgt * targets[i, a, b]
-            al = math.sqrt(et / ep) if ep > 1e-20 else 0.0
-            # sum (al p - t)^2 = al^2 ep - 2 al cross + et
-            e2 = al * al * ep - 2.0 * al * cross + et
-            alpha[i, j] = al
-            err[i, j] = math.sqrt(max(e2, 0.0) / max(count, 1))
+            alpha[i, j], err[i, j] = _normalised_error(et, ep, cross, count)
 
 
 @njit(cache=True, nogil=True)

@@ -61,21 +61,9 @@ def _vertical_acc(err, r0, r1, c0, c1):
 
 @njit(cache=True, nogil=True)
 def _horizontal_acc(err, r0, r1, c0, c1):
-    """Accumulated cost from the right column leftwards, rows [r0, r1): E[:, x] = e + min of 3 right."""
-    h = r1 - r0
-    w = c1 - c0
-    acc = np.empty((h, w), dtype=np.float64)
-    for y in range(h):
-        acc[y, w - 1] = err[r0 + y, c1 - 1]
-    for x in range(w - 2, -1, -1):
-        for y in range(h):
-            m = acc[y, x + 1]
-            if y > 0 and acc[y - 1, x + 1] < m:
-                m = acc[y - 1, x + 1]
-            if y < h - 1 and acc[y + 1, x + 1] < m:
-                m = acc[y + 1, x + 1]
-            acc[y, x] = err[r0 + y, c0 + x] + m
-    return acc
+    """Accumulated cost from the right column leftwards, rows [r0, r1): the vertical program on the
+    transpose (same ties: the neighbour above wins over the one below), viewed back as (rows, cols)."""
+    return _vertical_acc(err.T, c0, c1, r0, r1).T
 
 
 @njit(cache=True, nogil=True)
@@ -99,19 +87,7 @@ def _trace_down(acc, y_start, x_start, path, c0):
 @njit(cache=True, nogil=True)
 def _trace_right(acc, y_start, x_start, path, r0):
     """Follow ``acc`` (from _horizontal_acc) rightwards from (y_start, x_start); path[x] = row + r0."""
-    h, w = acc.shape
-    y = y_start
-    path[x_start] = y + r0
-    for x in range(x_start + 1, w):
-        best = y
-        m = acc[y, x]
-        if y > 0 and acc[y - 1, x] < m:
-            m = acc[y - 1, x]
-            best = y - 1
-        if y < h - 1 and acc[y + 1, x] < m:
-            best = y + 1
-        y = best
-        path[x] = y + r0
+    _trace_down(acc.T, x_start, y_start, path, r0)
 
 
 @njit(cache=True, nogil=True)
