@@ -16,11 +16,9 @@ stderr would break the CLI's one-line promise).
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
 from core.affine import (
@@ -44,16 +42,10 @@ from core.affine import (
     total_boundary_error,
 )
 from core.affine.transforms import MAX_SCALE, MIN_SCALE, singular_values
-from core.errors import InvalidParameter, WeftError
+from core.errors import WeftError
+from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
-# Per example: generous enough for the first example to compile numba kernels in a fresh clone
-# (measured 14.7 s in CI, cold cache), still a bound that turns a hang into a failure.
-COLD_DEADLINE_MS = 60_000
-
-
-def fuzz(examples: int) -> settings:
-    return settings(max_examples=examples, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
-
+pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
 
 KINDS = ("flat", "black", "white", "noise", "grating", "dot", "step", "nearly_flat", "checker")
 
@@ -126,32 +118,6 @@ def rect_problem(rect, shape) -> bool:
     x, y, s = rect
     h, w = shape[:2]
     return x < 0 or y < 0 or s < 8 or s % 2 == 1 or x + s > w or y + s > h
-
-
-def one_line_naming(error: WeftError, names) -> None:
-    message = str(error)
-    assert "\n" not in message, message
-    assert message.strip(), "empty message"
-    assert any(n in message for n in names), f"{message!r} names none of {sorted(names)}"
-    if isinstance(error, InvalidParameter) and error.name is not None:
-        assert error.name in message, message
-
-
-def check_image(out, shape, channels: int | None) -> None:
-    assert isinstance(out, np.ndarray)
-    assert out.dtype == np.float32
-    assert out.shape[:2] == tuple(shape), (out.shape, shape)
-    if channels is not None:
-        assert out.ndim == (3 if channels == 3 else 2), out.shape
-    assert np.isfinite(out).all()
-    assert out.min() >= 0.0 and out.max() <= 1.0
-
-
-@pytest.fixture(autouse=True)
-def _runtime_warnings_are_errors():
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)
-        yield
 
 
 # --- the prototype rectangle -------------------------------------------------------------------

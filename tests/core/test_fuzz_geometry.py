@@ -6,15 +6,14 @@ or raises ``WeftError`` in one line; never another exception, never NaN.
 """
 
 import numpy as np
-import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from core.errors import WeftError
 from core.rectify import rectify
+from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, fuzz
 
-# a NumPy warning would print extra lines on stderr, breaking the one-line promise
-pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
+pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
 
 PHOTO = np.random.default_rng(3).random((24, 32, 3), dtype=np.float32)
 # mostly inside the 32x24 photo (a point outside now and then), few values: repeats are likely
@@ -25,11 +24,8 @@ _fx, _fy = st.sampled_from([0.0, 4.0, 8.0, 15.0]), st.sampled_from([0.0, 4.0, 8.
 _frontal_line = st.tuples(_fx, _fy, _fx, _fy).map(list)
 
 
-# Per example: generous enough for the first example to compile numba kernels in a fresh clone
-# (measured 14.7 s in CI, cold cache), still a bound that turns a hang into a failure.
-COLD_DEADLINE_MS = 60_000
 
-@settings(max_examples=80, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
+@fuzz(80)
 @given(image_lines=st.lists(_line, min_size=0, max_size=6), data=st.data(),
        warp=st.sampled_from(["homography", "morph", "lines"]))
 def test_rectify_with_degenerate_lines(image_lines, data, warp):

@@ -12,11 +12,10 @@ inputs give finite results of the documented shape and range; invalid ones a one
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from core import metrics
@@ -34,29 +33,9 @@ from core.image import (
     yiq_to_rgb,
 )
 from core.seams import min_cut_mask, min_error_path, overlap_error
+from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
-# Per example: generous enough for the first example to compile numba kernels in a fresh clone
-# (measured 14.7 s in CI, cold cache), still a bound that turns a hang into a failure.
-COLD_DEADLINE_MS = 60_000
-
-
-def fuzz(examples: int) -> settings:
-    return settings(max_examples=examples, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
-
-
-@pytest.fixture(autouse=True)
-def _runtime_warnings_are_errors():
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)
-        yield
-
-
-def one_line_naming(error: WeftError, names) -> None:
-    message = str(error)
-    assert "\n" not in message, message
-    assert any(n in message for n in names), f"{message!r} names none of {sorted(names)}"
-    if isinstance(error, InvalidParameter) and error.name is not None:
-        assert error.name in message, message
+pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
 
 
 def image(kind: str, h: int, w: int, colour: bool, seed: int) -> np.ndarray:
@@ -76,12 +55,6 @@ def image(kind: str, h: int, w: int, colour: bool, seed: int) -> np.ndarray:
 
 KINDS = ("noise", "flat", "black", "white", "ramp")
 _kind = st.sampled_from(KINDS)
-
-
-def check_image(out, shape) -> None:
-    assert isinstance(out, np.ndarray) and out.dtype == np.float32
-    assert out.shape == tuple(shape), (out.shape, shape)
-    assert np.isfinite(out).all() and out.min() >= 0.0 and out.max() <= 1.0
 
 
 # --- blending ----------------------------------------------------------------------------------
@@ -135,7 +108,7 @@ def test_pyramid_blend_fuzz(h, w, fg_kind, bg_kind, fg_colour, bg_colour, levels
         return
     out = pyramid_blend(fg, bg, mask, levels=levels)
     colour = fg_colour or bg_colour
-    check_image(out, (h, w, 3) if colour else (h, w))
+    check_image(out, (h, w), 3 if colour else 1)
     m = mask_values(mask)
     f3 = fg if fg.ndim == 3 or not colour else np.repeat(fg[..., None], 3, axis=2)
     b3 = bg if bg.ndim == 3 or not colour else np.repeat(bg[..., None], 3, axis=2)
@@ -173,7 +146,7 @@ def test_poisson_blend_fuzz(h, w, t_kind, s_kind, t_colour, s_colour, wrap, data
         return
     assert not problems, f"accepted although {sorted(problems)} is wrong"
     colour = t_colour or s_colour
-    check_image(out, (h, w, 3) if colour else (h, w))
+    check_image(out, (h, w), 3 if colour else 1)
     t3 = target if target.ndim == 3 or not colour else np.repeat(target[..., None], 3, axis=2)
     outside = mask_values(mask) <= 0.5
     assert np.array_equal(out[outside], t3[outside])  # the target is kept outside the mask

@@ -16,33 +16,18 @@ encountered in divide" on stderr would break the CLI's one-line promise.
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import event, given
 from hypothesis import strategies as st
 
-from core.errors import GeometryError, InvalidParameter, WeftError
+from core.errors import GeometryError, WeftError
 from core.nfpt import nfpt, synthesize
 from core.rectify import FeatureLines, rectify
 from core.rectify.view import View
+from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
-# Per example: generous enough for the first example to compile numba kernels in a fresh clone
-# (measured 14.7 s in CI, cold cache), still a bound that turns a hang into a failure.
-COLD_DEADLINE_MS = 60_000
-
-
-def fuzz(examples: int) -> settings:
-    return settings(max_examples=examples, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
-
-
-@pytest.fixture(autouse=True)
-def _runtime_warnings_are_errors():
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)
-        yield
-
+pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
 
 KINDS = ("flat", "black", "noise", "dot", "stripes")
 
@@ -63,23 +48,6 @@ def texture(kind: str, h: int, w: int, colour: bool, seed: int) -> np.ndarray:
     if colour:
         img = img[..., None] * rng.uniform(0.2, 1.0, 3).astype(np.float32)
     return np.ascontiguousarray(img, dtype=np.float32)
-
-
-def one_line_naming(error: WeftError, names) -> None:
-    message = str(error)
-    assert "\n" not in message, message
-    assert message.strip(), "empty message"
-    assert any(n in message for n in names), f"{message!r} names none of {sorted(names)}"
-    if isinstance(error, InvalidParameter) and error.name is not None:
-        assert error.name in message, message
-
-
-def check_image(out, hw, channels) -> None:
-    assert isinstance(out, np.ndarray) and out.dtype == np.float32
-    assert out.shape[:2] == tuple(hw), (out.shape, hw)
-    assert out.ndim == (3 if channels == 3 else 2), out.shape
-    assert np.isfinite(out).all()
-    assert out.min() >= 0.0 and out.max() <= 1.0
 
 
 # --- synthesis (§2) ----------------------------------------------------------------------------

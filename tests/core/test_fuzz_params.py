@@ -19,9 +19,9 @@ from hypothesis import strategies as st
 from core import registry
 from core.errors import InvalidParameter, WeftError
 from core.params import specs
+from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, fuzz
 
-# a NumPy warning would print extra lines on stderr, breaking the one-line promise
-pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
+pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
 
 METHODS = registry.methods()
 
@@ -54,11 +54,6 @@ def _valid(spec) -> st.SearchStrategy:
         return st.sampled_from(["", "0,0,8", "1,2,16", "x", "{", "[]", lines, "/nonexistent/lines.json", "-1,0,8"]) \
             | st.text(max_size=16)
     raise AssertionError(f"unknown kind {spec.kind}")
-
-
-# Per example: generous enough for the first example to compile numba kernels in a fresh clone
-# (measured 14.7 s in CI, cold cache), still a bound that turns a hang into a failure.
-COLD_DEADLINE_MS = 60_000
 
 
 @st.composite
@@ -128,7 +123,7 @@ def _image(seed: int, h: int, w: int, colour: bool) -> np.ndarray:
     return rng.random(shape, dtype=np.float32)
 
 
-@settings(max_examples=20, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
+@fuzz(20)
 @given(seed=st.integers(0, 2**16), hs=st.integers(6, 16), ws=st.integers(6, 16), colour=st.booleans(),
        transfer=st.booleans(), n=st.sampled_from([3, 5]), p=st.floats(0, 1), p_l=st.floats(0, 1),
        metric=st.sampled_from(["full", "target", "artistic"]), iterations=st.integers(1, 2))
@@ -148,7 +143,7 @@ def test_fast_transfer_fuzz(seed, hs, ws, colour, transfer, n, p, p_l, metric, i
     assert out.min() >= 0.0 and out.max() <= 1.0
 
 
-@settings(max_examples=20, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
+@fuzz(20)
 @given(seed=st.integers(0, 2**16), hs=st.integers(6, 20), ws=st.integers(6, 20), colour=st.booleans(),
        mode=st.sampled_from(["random", "overlap", "mincut"]), rule=st.sampled_from(["tol", "epsilon", "sampled"]),
        tol=st.integers(1, 4), block=st.integers(2, 6), width=st.integers(1, 30), height=st.integers(1, 30),
@@ -170,7 +165,7 @@ def test_quilting_synthesize_fuzz(seed, hs, ws, colour, mode, rule, tol, block, 
     assert out.min() >= 0.0 and out.max() <= 1.0
 
 
-@settings(max_examples=15, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
+@fuzz(15)
 @given(seed=st.integers(0, 2**16), hs=st.integers(6, 20), ws=st.integers(6, 20), colour=st.booleans(),
        th=st.integers(1, 24), tw=st.integers(1, 24), block=st.integers(2, 8), iterations=st.integers(1, 3),
        alpha=st.floats(0, 1), mode=st.sampled_from(["overlap", "mincut"]),
@@ -197,7 +192,7 @@ def test_quilting_transfer_fuzz(seed, hs, ws, colour, th, tw, block, iterations,
         assert out.min() >= 0.0 and out.max() <= 1.0
 
 
-@settings(max_examples=15, deadline=COLD_DEADLINE_MS, suppress_health_check=[HealthCheck.too_slow])
+@fuzz(15)
 @given(seed=st.integers(0, 2**16), hs=st.integers(3, 12), ws=st.integers(3, 12), colour=st.booleans(),
        mode=st.sampled_from(["superres", "novel"]), magnify=st.integers(1, 4), p_l=st.floats(0, 1),
        iterations=st.integers(1, 2))
