@@ -4,7 +4,7 @@
   the mask the result has the source's gradients, on the mask's border it meets the target. The
   quilting write-up (``image-quilting-poisson-blending.txt``, "Poisson Blending") runs it on a
   band of at most 5 pixels around every seam; ``core.quilting`` does that block by block with the
-  same solver (``core._kernels.quilting.poisson_cg``).
+  same solver (``core._kernels.poisson.poisson_cg``).
 * :func:`pyramid_blend` -- Burt & Adelson's multiresolution spline: the Laplacian pyramids of the
   two images are mixed level by level with a Gaussian pyramid of the mask and collapsed, the
   "face in toast" compositing step of Ngo's write-up.
@@ -151,7 +151,7 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, mask: np.ndarray, *, t
         nbr[i[inside], k] = j[inside]
         rhs[i[~inside]] += t3[qy[~inside], qx[~inside]]
     x = t3[ys, xs].copy()
-    from ._kernels import quilting as _k  # numba loads on first use
+    from ._kernels import poisson as _k  # numba loads on first use
 
     _k.poisson_cg(nbr, ndeg, rhs, x, float(tol), int(max_iter))
     out = t3.copy()

@@ -103,7 +103,7 @@ def min_cut_mask(error: np.ndarray, *, left: int = 0, top: int = 0, right: int =
     top = _check_width("top", top, h, "high")
     bottom = _check_width("bottom", bottom, h, "high")
     mask = np.ones((h, w), dtype=np.uint8)
-    from ._kernels import quilting as _k  # numba loads on first use
+    from ._kernels import seams as _k  # numba loads on first use
 
     _k.cut_mask(err, top, left, right, bottom, mask)
     return mask.astype(bool)
@@ -131,7 +131,7 @@ def min_error_path(error: np.ndarray) -> np.ndarray:
     err = _check_error(error)
     h, w = err.shape
     mask = np.ones((h, w), dtype=np.uint8)
-    from ._kernels import quilting as _k
+    from ._kernels import seams as _k
 
     _k.cut_mask(err, 0, w, 0, 0, mask)
     return np.argmax(mask, axis=1).astype(np.int64)

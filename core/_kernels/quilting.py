@@ -1,15 +1,8 @@
-"""numba kernels of image quilting (``core.quilting``), its seams (``core.seams``) and its Poisson
-seam blending (``core.blending``).
+"""numba kernels of image quilting (``core.quilting``).
 
-Three public kernels, so that few signatures compile:
-
-* :func:`cut_mask` -- the minimum-error boundary cut of one block (dynamic programming over the
-  overlap strips, the vertical and the horizontal cut joined at the best corner pixel).
-* :func:`poisson_cg` -- a conjugate-gradient solve of the discrete Poisson equation on an arbitrary
-  set of pixels (matrix-free, 4-neighbours, Dirichlet values from the image, Neumann at invalid
-  neighbours), used by ``core.blending.poisson_blend`` and by :func:`place_block`.
 * :func:`place_block` -- one block of quilting: pick a source position from the SSD map of every
-  position, cut, paste, and optionally Poisson-blend a band around the seam.
+  position, cut (``core._kernels.seams.cut_mask``), paste, and optionally Poisson-blend a band
+  around the seam (``core._kernels.poisson.poisson_cg``).
 * :func:`make_template` -- writes the correlation templates of one block (the overlap, the previous
   iteration and the correspondence terms) into the zero-padded FFT buffers.
 
@@ -26,220 +19,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .poisson import poisson_cg
 from .quilting_codes import (  # noqa: F401 (re-exported: the codes of place_block's arrays)
     F_CONST, F_EPS, F_U, MODE_MINCUT, MODE_OVERLAP, MODE_RANDOM, N_FPARAMS, N_IPARAMS, P_B, P_BAND, P_BOTTOM,
     P_FIX_X, P_FIX_Y, P_LEFT, P_MODE, P_POISSON, P_RIGHT, P_RULE, P_SEED, P_TOL, P_TOP, P_WRAP, P_X0, P_Y0,
     RULE_EPSILON, RULE_SAMPLED, RULE_TOL, SAMPLE_FRACTION, TOP_FRACTION,
 )
+from .seams import cut_mask
 
 _DY = (1, -1, 0, 0)
 _DX = (0, 0, 1, -1)
-
-
-# --------------------------------------------------------------------------------------------
-# minimum-error boundary cut
-
-
-@njit(cache=True, nogil=True)
-def _vertical_acc(err, r0, r1, c0, c1):
-    """Accumulated cost from the bottom row up, columns [c0, c1): E[y] = e[y] + min of 3 below."""
-    h = r1 - r0
-    w = c1 - c0
-    acc = np.empty((h, w), dtype=np.float64)
-    for x in range(w):
-        acc[h - 1, x] = err[r1 - 1, c0 + x]
-    for y in range(h - 2, -1, -1):
-        for x in range(w):
-            m = acc[y + 1, x]
-            if x > 0 and acc[y + 1, x - 1] < m:
-                m = acc[y + 1, x - 1]
-            if x < w - 1 and acc[y + 1, x + 1] < m:
-                m = acc[y + 1, x + 1]
-            acc[y, x] = err[r0 + y, c0 + x] + m
-    return acc
-
-
-@njit(cache=True, nogil=True)
-def _horizontal_acc(err, r0, r1, c0, c1):
-    """Accumulated cost from the right column leftwards, rows [r0, r1): the vertical program on the
-    transpose (same ties: the neighbour above wins over the one below), viewed back as (rows, cols)."""
-    return _vertical_acc(err.T, c0, c1, r0, r1).T
-
-
-@njit(cache=True, nogil=True)
-def _trace_down(acc, y_start, x_start, path, c0):
-    """Follow ``acc`` (from _vertical_acc) downwards from (y_start, x_start); path[y] = column + c0."""
-    h, w = acc.shape
-    x = x_start
-    path[y_start] = x + c0
-    for y in range(y_start + 1, h):
-        best = x
-        m = acc[y, x]
-        if x > 0 and acc[y, x - 1] < m:
-            m = acc[y, x - 1]
-            best = x - 1
-        if x < w - 1 and acc[y, x + 1] < m:
-            best = x + 1
-        x = best
-        path[y] = x + c0
-
-
-@njit(cache=True, nogil=True)
-def _trace_right(acc, y_start, x_start, path, r0):
-    """Follow ``acc`` (from _horizontal_acc) rightwards from (y_start, x_start); path[x] = row + r0."""
-    _trace_down(acc.T, x_start, y_start, path, r0)
-
-
-@njit(cache=True, nogil=True)
-def cut_mask(err, top, left, right, bottom, mask):
-    """Minimum-error boundary cut of a block; ``mask[y, x] = 1`` where the new block shows.
-
-    ``err`` (h, w) is the squared difference between the existing pixels and the new block; only the
-    overlap strips are read: rows [0, top), columns [0, left), columns [w-right, w), rows
-    [h-bottom, h). The left and top cuts are one path through the L-shaped overlap: both dynamic
-    programs end in the top-left corner, and the corner pixel minimising the sum of the two
-    accumulated costs joins them. Right and bottom cuts (tileable output) are separate paths and
-    the new region is the intersection of the four sides. Path pixels belong to the new block.
-    """
-    h, w = err.shape
-    for y in range(h):
-        for x in range(w):
-            mask[y, x] = 1
-    if left > 0 and top > 0:
-        ev = _vertical_acc(err, 0, h, 0, left)
-        eh = _horizontal_acc(err, 0, top, 0, w)
-        best = np.inf
-        r = 0
-        c = 0
-        for y in range(top):
-            for x in range(left):
-                v = ev[y, x] + eh[y, x] - err[y, x]
-                if v < best:
-                    best = v
-                    r = y
-                    c = x
-        vpath = np.empty(h, dtype=np.int64)
-        hpath = np.empty(w, dtype=np.int64)
-        _trace_down(ev, r, c, vpath, 0)
-        _trace_right(eh, r, c, hpath, 0)
-        for y in range(h):
-            for x in range(w):
-                a = x >= vpath[y] if y >= r else x >= c
-                b = y >= hpath[x] if x >= c else y >= r
-                if not (a and b):
-                    mask[y, x] = 0
-    elif left > 0:
-        ev = _vertical_acc(err, 0, h, 0, left)
-        x0 = 0
-        for x in range(left):
-            if ev[0, x] < ev[0, x0]:
-                x0 = x
-        vpath = np.empty(h, dtype=np.int64)
-        _trace_down(ev, 0, x0, vpath, 0)
-        for y in range(h):
-            for x in range(vpath[y]):
-                mask[y, x] = 0
-    elif top > 0:
-        eh = _horizontal_acc(err, 0, top, 0, w)
-        y0 = 0
-        for y in range(top):
-            if eh[y, 0] < eh[y0, 0]:
-                y0 = y
-        hpath = np.empty(w, dtype=np.int64)
-        _trace_right(eh, y0, 0, hpath, 0)
-        for x in range(w):
-            for y in range(hpath[x]):
-                mask[y, x] = 0
-    if right > 0:
-        c0 = w - right
-        ev = _vertical_acc(err, 0, h, c0, w)
-        x0 = 0
-        for x in range(right):
-            if ev[0, x] < ev[0, x0]:
-                x0 = x
-        vpath = np.empty(h, dtype=np.int64)
-        _trace_down(ev, 0, x0, vpath, c0)
-        for y in range(h):
-            for x in range(vpath[y] + 1, w):
-                mask[y, x] = 0
-    if bottom > 0:
-        r0 = h - bottom
-        eh = _horizontal_acc(err, r0, h, 0, w)
-        y0 = 0
-        for y in range(bottom):
-            if eh[y, 0] < eh[y0, 0]:
-                y0 = y
-        hpath = np.empty(w, dtype=np.int64)
-        _trace_right(eh, y0, 0, hpath, r0)
-        for x in range(w):
-            for y in range(hpath[x] + 1, h):
-                mask[y, x] = 0
-
-
-# --------------------------------------------------------------------------------------------
-# Poisson solve (conjugate gradient, matrix-free)
-
-
-@njit(cache=True, nogil=True)
-def poisson_cg(nbr, ndeg, rhs, x, tol, max_iter):
-    """Solve ``A x = rhs`` for the discrete Poisson system of a pixel set, by conjugate gradient.
-
-    ``nbr`` (n, 4) int64 lists each unknown's neighbours that are unknowns too (-1: none);
-    ``ndeg`` (n,) the number of valid neighbours (unknown or Dirichlet), so
-    ``(A x)_p = ndeg_p x_p - sum_{q in nbr_p} x_q``. ``rhs`` (n, C) holds, per channel, the guidance
-    divergence plus the Dirichlet neighbours' values; ``x`` (n, C) is the initial guess and is
-    overwritten with the solution. Stops when ``||r|| <= tol * ||rhs||`` or after ``max_iter``
-    iterations. Returns the largest iteration count over the channels.
-    """
-    n, nc = rhs.shape
-    r = np.empty(n)
-    p = np.empty(n)
-    ap = np.empty(n)
-    most = 0
-    for c in range(nc):
-        bnorm = 0.0
-        for i in range(n):
-            bnorm += rhs[i, c] * rhs[i, c]
-        bnorm = np.sqrt(bnorm)
-        if bnorm == 0.0:
-            bnorm = 1.0
-        rr = 0.0
-        for i in range(n):
-            s = ndeg[i] * x[i, c]
-            for k in range(4):
-                q = nbr[i, k]
-                if q >= 0:
-                    s -= x[q, c]
-            r[i] = rhs[i, c] - s
-            p[i] = r[i]
-            rr += r[i] * r[i]
-        it = 0
-        while it < max_iter and np.sqrt(rr) > tol * bnorm:
-            pap = 0.0
-            for i in range(n):
-                s = ndeg[i] * p[i]
-                for k in range(4):
-                    q = nbr[i, k]
-                    if q >= 0:
-                        s -= p[q]
-                ap[i] = s
-                pap += p[i] * s
-            if pap <= 0.0:
-                break
-            a = rr / pap
-            rr_new = 0.0
-            for i in range(n):
-                x[i, c] += a * p[i]
-                r[i] -= a * ap[i]
-                rr_new += r[i] * r[i]
-            beta = rr_new / rr
-            rr = rr_new
-            for i in range(n):
-                p[i] = r[i] + beta * p[i]
-            it += 1
-        if it > most:
-            most = it
-    return most
 
 
 # --------------------------------------------------------------------------------------------

@@ -273,7 +273,7 @@ def homography_figure(h: np.ndarray) -> list[list[float]]:
 
 def warm_up() -> None:
     """Load the Beier-Neely kernel (numba's cache) on a tiny frame."""
-    from .._kernels import nfpt as _k
+    from .._kernels import warps as _k
 
     mx = np.empty((2, 2), np.float32)
     my = np.empty((2, 2), np.float32)

@@ -270,7 +270,7 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
         fit = fit_homography(dst_lines, src_lines, dst_size, src_size, robust=robust)
         return homography_plan(fit.matrix, dst_size, src_size, fit)  # the fit is positive at the frame centre
     _check_beier_neely(a, b, p)
-    from .._kernels import nfpt as _k
+    from .._kernels import warps as _k
 
     dw, dh = dst_size
     mx = np.empty((dh, dw), np.float32)
@@ -286,7 +286,7 @@ def _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, m
                 dst_name="the frontal frame", src_name="the photo") -> WarpPlan:
     import cv2
 
-    from .._kernels import nfpt as _k
+    from .._kernels import warps as _k
 
     corr = line_correspondences(dst_lines, src_lines, dst_size, src_size, segments_only=True)
     k = len(corr)
