@@ -49,21 +49,101 @@ def _splitmix(state):
 def _kth_smallest(cost, k):
     """The k-th smallest value of ``cost`` (1-based), as ``np.partition(cost, k - 1)[k - 1]``.
 
-    For the small k of the tol rule, one pass keeping the k smallest in order, without the copy of
-    the whole array that ``np.partition`` makes (7 MB per block for a 1024² texture).
+    For the small k of the tol rule, one pass keeping the k smallest in order, without a copy of
+    the whole array (7 MB per block for a 1024² texture). Larger k (tol > 32, rare) select on a
+    copy by three-way quickselect: ``np.partition`` itself took 7 s of numba compile for it.
     """
-    if k > 32:
-        return np.partition(cost, k - 1)[k - 1]
-    best = np.full(k, np.inf)
-    for i in range(cost.size):
-        v = cost[i]
-        if v < best[k - 1]:
-            j = k - 1
-            while j > 0 and best[j - 1] > v:
-                best[j] = best[j - 1]
-                j -= 1
-            best[j] = v
-    return best[k - 1]
+    n = cost.size
+    if k <= 32:
+        best = np.empty(k)
+        for j in range(k):
+            best[j] = np.inf
+        for i in range(n):
+            v = cost[i]
+            if v < best[k - 1]:
+                j = k - 1
+                while j > 0 and best[j - 1] > v:
+                    best[j] = best[j - 1]
+                    j -= 1
+                best[j] = v
+        return best[k - 1]
+    work = np.empty(n)
+    for i in range(n):
+        work[i] = cost[i]
+    t = k - 1
+    lo = 0
+    hi = n - 1
+    while lo < hi:
+        # median of three as the pivot, then [lo, lt) < pivot, [lt, gt] == pivot, (gt, hi] > pivot
+        a = work[lo]
+        b = work[(lo + hi) // 2]
+        c = work[hi]
+        pivot = max(min(a, b), min(max(a, b), c))
+        lt = lo
+        i = lo
+        gt = hi
+        while i <= gt:
+            v = work[i]
+            if v < pivot:
+                work[i] = work[lt]
+                work[lt] = v
+                lt += 1
+                i += 1
+            elif v > pivot:
+                work[i] = work[gt]
+                work[gt] = v
+                gt -= 1
+            else:
+                i += 1
+        if t < lt:
+            hi = lt - 1
+        elif t > gt:
+            lo = gt + 1
+        else:
+            return pivot
+    return work[t]
+
+
+@njit(cache=True, nogil=True)
+def _argmin(cost):
+    """The first index of the smallest value (``np.argmin`` without NaN; ``cost`` has none)."""
+    best = 0
+    for i in range(1, cost.size):
+        if cost[i] < cost[best]:
+            best = i
+    return best
+
+
+@njit(cache=True, nogil=True)
+def _ranked(cost, k, pick):
+    """Index of candidate ``pick`` (0-based) in this order: the values below the k-th smallest, in
+    index order, then the ties with it, in index order.
+
+    With ``pick == k - 1`` that is the element at ``pick`` of a stable sort (the k-th smallest
+    value, the ties with it in index order), so the sampled rule uses it instead of a stable
+    ``np.argsort`` (a merge sort, 2 s of numba compile).
+    """
+    n = cost.size
+    kth = _kth_smallest(cost, k)
+    seen = 0
+    below = 0
+    for i in range(n):
+        if cost[i] < kth:
+            below += 1
+    if pick < below:
+        for i in range(n):
+            if cost[i] < kth:
+                if seen == pick:
+                    return i
+                seen += 1
+    pick -= below
+    seen = 0
+    for i in range(n):
+        if cost[i] == kth:
+            if seen == pick:
+                return i
+            seen += 1
+    return _argmin(cost)
 
 
 @njit(cache=True, nogil=True)
@@ -72,31 +152,12 @@ def _select(cost, rule, tol, eps, u, seed):
     n = cost.size
     if rule == RULE_TOL:
         if tol <= 1:
-            return np.argmin(cost)
+            return _argmin(cost)
         k = min(tol, n)
-        kth = _kth_smallest(cost, k)
-        pick = min(int(u * k), k - 1)
-        seen = 0
-        # candidates strictly better than the k-th, then ties with it, in index order
-        below = 0
-        for i in range(n):
-            if cost[i] < kth:
-                below += 1
-        if pick < below:
-            for i in range(n):
-                if cost[i] < kth:
-                    if seen == pick:
-                        return i
-                    seen += 1
-        pick -= below
-        for i in range(n):
-            if cost[i] == kth:
-                if seen == pick:
-                    return i
-                seen += 1
-        return np.argmin(cost)
+        # the k best: candidates strictly better than the k-th, then ties with it, in index order
+        return _ranked(cost, k, min(int(u * k), k - 1))
     if rule == RULE_EPSILON:
-        m = max(cost.min(), 0.0)
+        m = max(cost[_argmin(cost)], 0.0)
         thr = (1.0 + eps) * m
         count = 0
         for i in range(n):
@@ -109,7 +170,7 @@ def _select(cost, rule, tol, eps, u, seed):
                 if seen == pick:
                     return i
                 seen += 1
-        return np.argmin(cost)
+        return _argmin(cost)
     # RULE_SAMPLED: a random SAMPLE_FRACTION of the positions, a random one of their best TOP_FRACTION
     state = np.uint64(seed)
     limit = np.uint64(int(SAMPLE_FRACTION * 18446744073709551615.0))
@@ -128,9 +189,9 @@ def _select(cost, rule, tol, eps, u, seed):
     for i in range(m):
         vals[i] = cost[idx[i]]
     k = max(1, int(np.ceil(TOP_FRACTION * m)))
-    order = np.argsort(vals, kind="mergesort")  # stable, as the numpy engine's
     pick = min(int(u * k), k - 1)
-    return idx[order[pick]]
+    # the element at ``pick`` of a stable sort of vals (as the numpy engine's argsort, kind="stable")
+    return idx[_ranked(vals, pick + 1, pick)]
 
 
 @njit(cache=True, nogil=True)

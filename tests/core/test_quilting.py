@@ -259,3 +259,18 @@ def test_numpy_and_numba_engines_give_the_same_pixels(brick, monkeypatch, kw):
                             original(tex, h, w, dataclasses.replace(p, engine=_e), rng, **k2))
         outs[engine] = q.synthesize(colour, size=(90, 70), block=16, overlap=5, rng=3, **kw)
     assert np.array_equal(outs["numba"], outs["numpy"])
+
+
+def test_kernel_selection_matches_numpy_partition_and_stable_sort():
+    """The quilting kernel's hand-written selection (insertion for k <= 32, quickselect above, the
+    stable-order pick of the sampled rule) agrees with np.partition / a stable argsort, ties included."""
+    from core._kernels import quilting as k
+
+    rng = np.random.default_rng(4)
+    for n, levels in ((1, 3), (7, 2), (50, 3), (500, 1000), (3000, 4)):
+        cost = np.floor(rng.random(n) * levels).astype(np.float64)  # many exact ties
+        order = np.argsort(cost, kind="stable")
+        for kk in {1, min(n, 2), min(n, 32), min(n, 33), min(n, 40), (n + 1) // 2, n}:
+            assert k._kth_smallest(cost, kk) == np.partition(cost, kk - 1)[kk - 1]
+            assert k._ranked(cost, kk, kk - 1) == order[kk - 1]
+        assert k._argmin(cost) == np.argmin(cost)
