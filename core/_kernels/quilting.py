@@ -1,8 +1,10 @@
 """numba kernels of image quilting (``core.quilting``).
 
-* :func:`place_block` -- one block of quilting: pick a source position from the SSD map of every
-  position, cut (``core._kernels.seams.cut_mask``), paste, and optionally Poisson-blend a band
-  around the seam (``core._kernels.poisson.poisson_cg``).
+* :func:`choose_best`, :func:`choose_tol`, :func:`choose_epsilon`, :func:`choose_sampled` -- the
+  source position of one block from the SSD map of every position, one kernel per selection rule.
+* :func:`place_block` -- cut (``core._kernels.seams.cut_mask``) and paste one block.
+* :func:`poisson_band` -- Poisson-blend a band around the seam of the block just placed
+  (``core._kernels.poisson.poisson_cg``).
 * :func:`make_template` -- writes the correlation templates of one block (the overlap, the previous
   iteration and the correspondence terms) into the zero-padded FFT buffers.
 
@@ -11,7 +13,12 @@ Everything is float32 in, float64 inside sums. Random numbers come from the call
 pixels on any thread.
 
 Integer parameters of :func:`place_block` travel in one int64 array (fewer arguments to dispatch
-per block; see the ``P_*`` indices below).
+per block; see the ``P_*`` indices in ``quilting_codes``).
+
+Compile cost (numba compiles a kernel and everything it calls on first use, ~0.1-3 s a function
+when the cache is cold): the selection rules and the Poisson band are separate kernels so that a
+run compiles only what it uses; no ``np.partition``/``np.argsort`` (seconds each to compile; a
+hand-written selection instead); work buffers come from the caller instead of ``np.full``.
 """
 
 from __future__ import annotations
@@ -20,10 +27,9 @@ import numpy as np
 from numba import njit
 
 from .poisson import poisson_cg
-from .quilting_codes import (  # noqa: F401 (re-exported: the codes of place_block's arrays)
-    F_CONST, F_EPS, F_U, MODE_MINCUT, MODE_OVERLAP, MODE_RANDOM, N_FPARAMS, N_IPARAMS, P_B, P_BAND, P_BOTTOM,
-    P_FIX_X, P_FIX_Y, P_LEFT, P_MODE, P_POISSON, P_RIGHT, P_RULE, P_SEED, P_TOL, P_TOP, P_WRAP, P_X0, P_Y0,
-    RULE_EPSILON, RULE_SAMPLED, RULE_TOL, SAMPLE_FRACTION, TOP_FRACTION,
+from .quilting_codes import (  # noqa: F401 (re-exported: the codes of place_block's array)
+    MODE_MINCUT, MODE_OVERLAP, MODE_RANDOM, N_IPARAMS, P_B, P_BAND, P_BOTTOM, P_LEFT, P_MODE, P_POISSON, P_RIGHT,
+    P_SX, P_SY, P_TOP, P_WRAP, P_X0, P_Y0, SAMPLE_FRACTION, TOP_FRACTION,
 )
 from .seams import cut_mask
 
@@ -147,31 +153,69 @@ def _ranked(cost, k, pick):
 
 
 @njit(cache=True, nogil=True)
-def _select(cost, rule, tol, eps, u, seed):
-    """Index into the flat ``cost`` of the chosen candidate (see core.quilting for the rules)."""
+def _cost_map(cross, sq, const, cost):
+    """``cost[py * pw + px] = max(sq - 2 cross + const, 0)`` for the (ph, pw) positions of ``sq``;
+    returns the filled prefix of the work buffer ``cost``."""
+    ph, pw = sq.shape
+    cost = cost[:ph * pw]
+    for py in range(ph):
+        for px in range(pw):
+            v = sq[py, px] - 2.0 * cross[py, px] + const
+            cost[py * pw + px] = v if v > 0.0 else 0.0
+    return cost
+
+
+# One kernel per rule, called from Python: a run compiles only the rule it uses (a transfer, tol 1,
+# needs none of the selection machinery). Each returns the flat index ``py * pw + px`` of the chosen
+# source position; ``cross`` (N, N) is the cross-correlation of the centred source with the block's
+# template and ``sq`` (Ph, Pw) the weighted sum of squares of the source under the template's
+# weights, so that the SSD of candidate (py, px) is ``sq - 2 cross + const``. ``cost`` is a float64
+# work buffer of at least Ph * Pw elements (reused across blocks: a fresh one per block made the heap
+# trim and re-fault).
+
+
+@njit(cache=True, nogil=True)
+def choose_best(cross, sq, const, cost):
+    """The tol rule with tol 1: the best position (the first one on ties)."""
+    return _argmin(_cost_map(cross, sq, const, cost))
+
+
+@njit(cache=True, nogil=True)
+def choose_tol(cross, sq, const, cost, tol, u):
+    """The tol rule: one of the ``tol`` best at random (``u`` uniform in [0, 1)): the candidates
+    strictly better than the tol-th, then the ties with it, in index order."""
+    cost = _cost_map(cross, sq, const, cost)
+    k = min(tol, cost.size)
+    return _ranked(cost, k, min(int(u * k), k - 1))
+
+
+@njit(cache=True, nogil=True)
+def choose_epsilon(cross, sq, const, cost, eps, u):
+    """The epsilon rule: one at random of the positions within ``(1 + eps)`` times the best."""
+    cost = _cost_map(cross, sq, const, cost)
     n = cost.size
-    if rule == RULE_TOL:
-        if tol <= 1:
-            return _argmin(cost)
-        k = min(tol, n)
-        # the k best: candidates strictly better than the k-th, then ties with it, in index order
-        return _ranked(cost, k, min(int(u * k), k - 1))
-    if rule == RULE_EPSILON:
-        m = max(cost[_argmin(cost)], 0.0)
-        thr = (1.0 + eps) * m
-        count = 0
-        for i in range(n):
-            if cost[i] <= thr:
-                count += 1
-        pick = min(int(u * count), count - 1)
-        seen = 0
-        for i in range(n):
-            if cost[i] <= thr:
-                if seen == pick:
-                    return i
-                seen += 1
-        return _argmin(cost)
-    # RULE_SAMPLED: a random SAMPLE_FRACTION of the positions, a random one of their best TOP_FRACTION
+    m = max(cost[_argmin(cost)], 0.0)
+    thr = (1.0 + eps) * m
+    count = 0
+    for i in range(n):
+        if cost[i] <= thr:
+            count += 1
+    pick = min(int(u * count), count - 1)
+    seen = 0
+    for i in range(n):
+        if cost[i] <= thr:
+            if seen == pick:
+                return i
+            seen += 1
+    return _argmin(cost)
+
+
+@njit(cache=True, nogil=True)
+def choose_sampled(cross, sq, const, cost, u, seed):
+    """The sampled rule: a random SAMPLE_FRACTION of the positions (splitmix64 of ``seed``), a random
+    one (``u``) of their best TOP_FRACTION."""
+    cost = _cost_map(cross, sq, const, cost)
+    n = cost.size
     state = np.uint64(seed)
     limit = np.uint64(int(SAMPLE_FRACTION * 18446744073709551615.0))
     idx = np.empty(n, dtype=np.int64)
@@ -236,19 +280,18 @@ def make_template(canvas, prev, corr_t, y0, x0, bsz, top, left, right, bottom, w
 
 
 @njit(cache=True, nogil=True)
-def place_block(canvas, filled, tex, cross, sq, iparams, fparams, cost):
-    """Choose, cut, paste (and Poisson-blend) one block; returns the chosen source (y, x).
+def place_block(canvas, filled, tex, iparams, err, mask, win, label, old):
+    """Cut and paste one block: the source block at (P_SY, P_SX) onto the canvas at (P_Y0, P_X0).
 
-    ``canvas`` (Hc, Wc, C) float32 and ``filled`` (Hc, Wc) uint8 are updated in place. ``cross``
-    (N, N) is the cross-correlation of the centred source with the block's template and ``sq``
-    (Ph, Pw) the weighted sum of squares of the source under the template's weights, so that the
-    SSD of candidate (py, px) is ``sq - 2 cross + const``. ``iparams``/``fparams``: see ``P_*`` and
-    ``F_*``. With ``P_FIX_Y >= 0`` the source position is given (random mode, first block).
-    ``cost`` is a float64 work buffer of at least Ph * Pw elements (reused across blocks: a fresh one
-    per block made the heap trim and re-fault).
+    ``canvas`` (Hc, Wc, C) float32 and ``filled`` (Hc, Wc) uint8 are updated in place;
+    ``iparams``: see ``P_*``. Work buffers, allocated once per pass: ``err`` (B, B) float64 and
+    ``mask`` (B, B) uint8 for the cut; ``win`` (2, S) int64, ``label`` (S, S) int8 and ``old``
+    (S, S, C) float32 get the window of the canvas around the block (S = B + 2 margin, the margin
+    ``P_BAND + 2`` with ``P_POISSON``, else 0): its rows and columns (-1 outside), the labels (-1
+    outside or empty, 0 old pixel, 1 new pixel) and the old pixels (NaN where empty), which
+    :func:`poisson_band` reads next when the pass blends its seams.
     """
     hc, wc, nc = canvas.shape
-    th, tw = tex.shape[0], tex.shape[1]
     y0 = iparams[P_Y0]
     x0 = iparams[P_X0]
     bsz = iparams[P_B]
@@ -258,29 +301,14 @@ def place_block(canvas, filled, tex, cross, sq, iparams, fparams, cost):
     bottom = iparams[P_BOTTOM]
     wrap = iparams[P_WRAP] != 0
     mode = iparams[P_MODE]
-    ph = th - bsz + 1
-    pw = tw - bsz + 1
+    sy = iparams[P_SY]
+    sx = iparams[P_SX]
 
-    # 1. the source position
-    if iparams[P_FIX_Y] >= 0:
-        sy = iparams[P_FIX_Y]
-        sx = iparams[P_FIX_X]
-    else:
-        const = fparams[F_CONST]
-        cost = cost[:ph * pw]
-        for py in range(ph):
-            for px in range(pw):
-                v = sq[py, px] - 2.0 * cross[py, px] + const
-                cost[py * pw + px] = v if v > 0.0 else 0.0
-        k = _select(cost, iparams[P_RULE], iparams[P_TOL], fparams[F_EPS], fparams[F_U],
-                    iparams[P_SEED])
-        sy = k // pw
-        sx = k % pw
-
-    # 2. the cut: which pixels of the footprint show the new block
-    mask = np.ones((bsz, bsz), dtype=np.uint8)
+    # the cut: which pixels of the footprint show the new block
     if mode == MODE_MINCUT and (top > 0 or left > 0 or right > 0 or bottom > 0):
-        err = np.zeros((bsz, bsz))
+        for by in range(bsz):
+            for bx in range(bsz):
+                err[by, bx] = 0.0
         for by in range(bsz):
             cy = (y0 + by) % hc if wrap else y0 + by
             for bx in range(bsz):
@@ -293,14 +321,18 @@ def place_block(canvas, filled, tex, cross, sq, iparams, fparams, cost):
                             e += d * d
                         err[by, bx] = e
         cut_mask(err, top, left, right, bottom, mask)
+    else:
+        for by in range(bsz):
+            for bx in range(bsz):
+                mask[by, bx] = 1
 
-    # 3. paste (keeping a window of the old pixels for the Poisson band)
+    # paste (keeping a window of the old pixels for the Poisson band)
     poisson = iparams[P_POISSON] != 0 and mode != MODE_RANDOM
     band = iparams[P_BAND]
     margin = band + 2 if poisson else 0
     ws = bsz + 2 * margin
-    win_y = np.empty(ws, dtype=np.int64)
-    win_x = np.empty(ws, dtype=np.int64)
+    win_y = win[0]
+    win_x = win[1]
     for i in range(ws):
         cy = y0 - margin + i
         cx = x0 - margin + i
@@ -309,21 +341,25 @@ def place_block(canvas, filled, tex, cross, sq, iparams, fparams, cost):
             cx %= wc
         win_y[i] = cy if 0 <= cy < hc else -1
         win_x[i] = cx if 0 <= cx < wc else -1
-    # label: -1 outside canvas or empty, 0 old pixel, 1 new pixel (after the paste)
-    label = np.full((ws, ws), -1, dtype=np.int8)
-    old = np.full((ws, ws, nc), np.nan, dtype=np.float32)
-    for wy in range(ws):
-        cy = win_y[wy]
-        if cy < 0:
-            continue
-        for wx in range(ws):
-            cx = win_x[wx]
-            if cx < 0:
-                continue
-            if filled[cy, cx]:
-                label[wy, wx] = 0
+    if poisson:
+        # label: -1 outside canvas or empty, 0 old pixel, 1 new pixel (after the paste)
+        for wy in range(ws):
+            for wx in range(ws):
+                label[wy, wx] = -1
                 for c in range(nc):
-                    old[wy, wx, c] = canvas[cy, cx, c]
+                    old[wy, wx, c] = np.nan
+        for wy in range(ws):
+            cy = win_y[wy]
+            if cy < 0:
+                continue
+            for wx in range(ws):
+                cx = win_x[wx]
+                if cx < 0:
+                    continue
+                if filled[cy, cx]:
+                    label[wy, wx] = 0
+                    for c in range(nc):
+                        old[wy, wx, c] = canvas[cy, cx, c]
     for by in range(bsz):
         cy = win_y[by + margin]
         for bx in range(bsz):
@@ -332,16 +368,18 @@ def place_block(canvas, filled, tex, cross, sq, iparams, fparams, cost):
                 for c in range(nc):
                     canvas[cy, cx, c] = tex[sy + by, sx + bx, c]
                 filled[cy, cx] = 1
-                label[by + margin, bx + margin] = 1
-
-    # 4. Poisson band: ceil(band/2) pixels on the old side of the seam, floor(band/2) on the new side
-    if poisson:
-        _poisson_band(canvas, old, label, win_y, win_x, wrap, band)
-    return sy, sx
+                if poisson:
+                    label[by + margin, bx + margin] = 1
 
 
 @njit(cache=True, nogil=True)
-def _poisson_band(canvas, old, label, win_y, win_x, wrap, band):
+def poisson_band(canvas, old, label, win, band):
+    """Blend the seam of the block just placed (``place_block`` with ``P_POISSON``) by a Poisson
+    solve over a band: ceil(band/2) pixels on the old side of the seam, floor(band/2) on the new
+    side; ``old``, ``label`` and ``win`` as ``place_block`` left them. A separate kernel, so that a
+    pass without Poisson blending never compiles it."""
+    win_y = win[0]
+    win_x = win[1]
     ws = label.shape[0]
     nc = canvas.shape[2]
     big = 1 << 20

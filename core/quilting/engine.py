@@ -2,9 +2,11 @@
 
 For every block: the SSD of its template against every source position (the squared-sum term once
 per overlap shape with ``cv2.filter2D``, the cross-term as one FFT product with the source spectra
-computed once per pass), then choosing, cutting, pasting and the Poisson band in one call of the
-numba kernel (``core._kernels.quilting``) -- or, for small syntheses while numba is not loaded yet,
-the same steps in numpy (``_place_block_numpy``, pixel for pixel the same; a test checks it).
+computed once per pass), then the numba kernels of ``core._kernels.quilting``: the choice (one
+kernel per selection rule), the cut and paste, the Poisson band (only with ``poisson``), so that a
+run compiles only the kernels it uses -- or, for small syntheses while numba is not loaded yet, the
+same steps in numpy (``_choose_*_numpy``, ``_place_block_numpy``, pixel for pixel the same; a test
+checks it).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import numpy as np
 from .._kernels import quilting_codes as _K  # the kernel's array codes, without importing numba
 from ..jobs import CancelToken, ProgressReporter
 
-RULES = ("tol", "epsilon", "sampled")  # the order is the kernel's rule codes
+RULES = ("tol", "epsilon", "sampled")
 
 
 # Below this many blocks a synthesis without Poisson runs the per-block step in numpy when numba
@@ -171,12 +173,23 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and prev is None and corr is None
                  and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "core._kernels.quilting" not in sys.modules)
     if use_numpy:
-        _k = _K
-        place, template = _place_block_numpy, _make_template_numpy
+        place, template, blend = _place_block_numpy, _make_template_numpy, None
+        by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,
+                                               _choose_sampled_numpy)
     else:
         from .._kernels import quilting as _k  # numba loads on first use, not with the CLI
 
-        place, template = _k.place_block, _k.make_template
+        place, template, blend = _k.place_block, _k.make_template, _k.poisson_band
+        by_best, by_tol, by_eps, by_sampled = _k.choose_best, _k.choose_tol, _k.choose_epsilon, _k.choose_sampled
+    # one kernel per rule (a run compiles only the one it uses); all take (cross, sq, const, cost, u, seed)
+    if p.rule == "sampled":
+        choose = by_sampled
+    elif p.rule == "epsilon":
+        choose = lambda cross, sq, const, cost, u, seed: by_eps(cross, sq, const, cost, p.epsilon, u)  # noqa: E731
+    elif p.tol > 1:
+        choose = lambda cross, sq, const, cost, u, seed: by_tol(cross, sq, const, cost, p.tol, u)  # noqa: E731
+    else:
+        choose = lambda cross, sq, const, cost, u, seed: by_best(cross, sq, const, cost)  # noqa: E731
     src = _Source(tex, corr[0] if corr is not None else None, b)
     prev_c = np.zeros((1, 1, nc), dtype=np.float32)
     corr_t = np.zeros((1, 1), dtype=np.float32)
@@ -195,18 +208,17 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
     first = (int(rng.integers(0, src.ph)), int(rng.integers(0, src.pw)))
     ip = np.zeros(_K.N_IPARAMS, dtype=np.int64)
-    fp = np.zeros(_K.N_FPARAMS, dtype=np.float64)
     ip[_K.P_B] = b
     ip[_K.P_WRAP] = int(p.tile)
     ip[_K.P_MODE] = {"overlap": _K.MODE_OVERLAP, "mincut": _K.MODE_MINCUT}[p.mode]
-    ip[_K.P_RULE] = RULES.index(p.rule)
-    ip[_K.P_TOL] = p.tol
     ip[_K.P_POISSON] = int(p.poisson)
     ip[_K.P_BAND] = p.band
-    fp[_K.F_EPS] = p.epsilon
+    # place_block's work buffers: the cut, and the window around the block for the Poisson band
+    ws = b + 2 * (p.band + 2 if p.poisson else 0)
+    err, mask = np.empty((b, b), dtype=np.float64), np.empty((b, b), dtype=np.uint8)
+    win = np.empty((2, ws), dtype=np.int64)
+    label, old = np.empty((ws, ws), dtype=np.int8), np.empty((ws, ws, nc), dtype=np.float32)
     has_static = p.w_prev != 0.0 or (p.w_corr != 0.0 and corr is not None)
-    dummy_cross = np.zeros((1, 1), dtype=np.float32)
-    dummy_sq = np.zeros((1, 1), dtype=np.float32)
     flags = cv2.DFT_REAL_OUTPUT | cv2.DFT_SCALE
     spectra, spectrum_c = src.spectra, src.spectrum_c
     wrap = bool(p.tile)
@@ -253,11 +265,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
             for j in range(cols):
                 x0, left, right = xs[j], lefts[j], rights[j]
                 ip[_K.P_X0], ip[_K.P_LEFT], ip[_K.P_RIGHT] = x0, left, right
-                ip[_K.P_SEED] = seeds[i, j]
-                fp[_K.F_U] = us[i, j]
                 overlaps = top or left or right or bottom
                 if overlaps or row_static is not None:
-                    ip[_K.P_FIX_Y] = ip[_K.P_FIX_X] = -1
                     spec, const = (None, 0.0) if row_static is None else row_static[j]
                     if overlaps:
                         const += template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
@@ -269,13 +278,15 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                             else:
                                 cv2.mulSpectrums(spectra[c], fwd, 0, c=part, conjB=True)
                                 spec = np.add(spec, part, out=acc)
-                    fp[_K.F_CONST] = const
                     cross = cv2.idft(spec, dst=cross_buf, flags=flags)
                     sq = src.sq((top, left, right, bottom), p)
+                    ip[_K.P_SY], ip[_K.P_SX] = divmod(int(choose(cross, sq, float(const), cost_buf, us[i, j],
+                                                                 seeds[i, j])), src.pw)
                 else:  # synthesis, first block: a random position
-                    ip[_K.P_FIX_Y], ip[_K.P_FIX_X] = first
-                    cross, sq = dummy_cross, dummy_sq
-                place(canvas, filled, tex, cross, sq, ip, fp, cost_buf)
+                    ip[_K.P_SY], ip[_K.P_SX] = first
+                place(canvas, filled, tex, ip, err, mask, win, label, old)
+                if blend is not None and p.poisson:
+                    blend(canvas, old, label, win, p.band)
             if report is not None:
                 report.update(i + 1, preview=preview)
     finally:
@@ -285,7 +296,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
 
 
 # --------------------------------------------------------------------------------------------
-# the numpy engine: the kernel's place_block (without the Poisson band), step for step
+# the numpy engine: the kernels' selection rules and place_block (no Poisson band), step for step
 
 
 def _splitmix_numpy(seed: int, n: int) -> np.ndarray:
@@ -298,20 +309,35 @@ def _splitmix_numpy(seed: int, n: int) -> np.ndarray:
     return z ^ (z >> np.uint64(31))
 
 
-def _select_numpy(cost: np.ndarray, rule: int, tol: int, eps: float, u: float, seed: int) -> int:
+def _cost_numpy(cross, sq, const):
+    ph, pw = sq.shape
+    cost = sq.astype(np.float64) - 2.0 * cross[:ph, :pw].astype(np.float64) + const
+    return np.maximum(cost, 0.0).ravel()
+
+
+def _choose_best_numpy(cross, sq, const, cost_buf=None) -> int:
+    return int(np.argmin(_cost_numpy(cross, sq, const)))
+
+
+def _choose_tol_numpy(cross, sq, const, cost_buf, tol: int, u: float) -> int:
+    cost = _cost_numpy(cross, sq, const)
+    k = min(tol, cost.size)
+    kth = np.partition(cost, k - 1)[k - 1]
+    order = np.concatenate([np.flatnonzero(cost < kth), np.flatnonzero(cost == kth)])
+    return int(order[min(int(u * k), k - 1)])
+
+
+def _choose_epsilon_numpy(cross, sq, const, cost_buf, eps: float, u: float) -> int:
+    cost = _cost_numpy(cross, sq, const)
+    thr = (1.0 + eps) * max(float(cost.min()), 0.0)
+    cand = np.flatnonzero(cost <= thr)
+    return int(cand[min(int(u * len(cand)), len(cand) - 1)])
+
+
+def _choose_sampled_numpy(cross, sq, const, cost_buf, u: float, seed: int) -> int:
+    cost = _cost_numpy(cross, sq, const)
     n = cost.size
-    if rule == _K.RULE_TOL:
-        if tol <= 1:
-            return int(np.argmin(cost))
-        k = min(tol, n)
-        kth = np.partition(cost, k - 1)[k - 1]
-        order = np.concatenate([np.flatnonzero(cost < kth), np.flatnonzero(cost == kth)])
-        return int(order[min(int(u * k), k - 1)])
-    if rule == _K.RULE_EPSILON:
-        thr = (1.0 + eps) * max(float(cost.min()), 0.0)
-        cand = np.flatnonzero(cost <= thr)
-        return int(cand[min(int(u * len(cand)), len(cand) - 1)])
-    z = _splitmix_numpy(seed, n + 1)
+    z = _splitmix_numpy(int(seed), n + 1)
     limit = np.uint64(int(_K.SAMPLE_FRACTION * 18446744073709551615.0))
     idx = np.flatnonzero(z[:n] < limit)
     if idx.size == 0:
@@ -403,25 +429,17 @@ def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bott
     return float(np.cumsum(terms.ravel())[-1]) if terms.size else 0.0
 
 
-def _place_block_numpy(canvas, filled, tex, cross, sq, ip, fp, cost_buf=None):
+def _place_block_numpy(canvas, filled, tex, ip, *work):
     """``core._kernels.quilting.place_block`` without the Poisson band, in numpy (same pixels).
 
-    ``cost_buf`` is the kernel's work buffer; numpy makes its own arrays (this engine only runs small
+    ``work`` are the kernel's work buffers; numpy makes its own arrays (this engine only runs small
     jobs, where reuse does not matter).
     """
     hc, wc, nc = canvas.shape
     b = int(ip[_K.P_B])
     y0, x0 = int(ip[_K.P_Y0]), int(ip[_K.P_X0])
     top, left, right, bottom = (int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM))
-    ph, pw = tex.shape[0] - b + 1, tex.shape[1] - b + 1
-    if ip[_K.P_FIX_Y] >= 0:
-        sy, sx = int(ip[_K.P_FIX_Y]), int(ip[_K.P_FIX_X])
-    else:
-        cost = sq[:ph, :pw].astype(np.float64) - 2.0 * cross[:ph, :pw].astype(np.float64) + fp[_K.F_CONST]
-        cost = np.maximum(cost, 0.0).ravel()
-        k = _select_numpy(cost, int(ip[_K.P_RULE]), int(ip[_K.P_TOL]), float(fp[_K.F_EPS]), float(fp[_K.F_U]),
-                          int(ip[_K.P_SEED]))
-        sy, sx = divmod(k, pw)
+    sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
     iy = (y0 + np.arange(b)) % hc
     ix = (x0 + np.arange(b)) % wc
     block = tex[sy:sy + b, sx:sx + b]
@@ -443,7 +461,6 @@ def _place_block_numpy(canvas, filled, tex, cross, sq, ip, fp, cost_buf=None):
     else:
         canvas[np.ix_(iy, ix)] = block
         filled[np.ix_(iy, ix)] = 1
-    return sy, sx
 
 
 def _pad_to(img: np.ndarray, h: int, w: int) -> np.ndarray:
