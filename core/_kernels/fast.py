@@ -72,13 +72,22 @@ def coherent_rows(src, src_mean, tgt, tgt_mean, res, pos, allowed, mask, res_off
     meanf = src_mean.ravel()
     resf = res.ravel()
     tgtf = tgt.ravel()
-    # Flat offsets: neighbour k of pixel i is i + off[k] in each image's own row stride.
-    r_dy = res_offs[:, 0].copy()
-    r_dx = res_offs[:, 1].copy()
-    r_src = r_dy * Ws + r_dx
-    r_res = r_dy * W + r_dx
-    t_src = tgt_offs[:, 0] * Ws + tgt_offs[:, 1]
-    t_tgt = tgt_offs[:, 0] * Wp + tgt_offs[:, 1]
+    # Flat offsets: neighbour k of pixel i is i + off[k] in each image's own row stride. (Loops, not
+    # array expressions: those compile numba's ufunc machinery, a third of this kernel's compile.)
+    r_dy = np.empty(n_res, np.int64)
+    r_dx = np.empty(n_res, np.int64)
+    r_src = np.empty(n_res, np.int64)
+    r_res = np.empty(n_res, np.int64)
+    for k in range(n_res):
+        r_dy[k] = res_offs[k, 0]
+        r_dx[k] = res_offs[k, 1]
+        r_src[k] = r_dy[k] * Ws + r_dx[k]
+        r_res[k] = r_dy[k] * W + r_dx[k]
+    t_src = np.empty(n_tgt, np.int64)
+    t_tgt = np.empty(n_tgt, np.int64)
+    for k in range(n_tgt):
+        t_src[k] = tgt_offs[k, 0] * Ws + tgt_offs[k, 1]
+        t_tgt[k] = tgt_offs[k, 0] * Wp + tgt_offs[k, 1]
     use_res = metric != METRIC_TARGET
     use_tgt = has_target and metric != METRIC_ARTISTIC and (metric == METRIC_TARGET or target_weight > 0.0)
     t_w = 1.0 if metric == METRIC_TARGET else target_weight
