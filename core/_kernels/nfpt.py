@@ -42,8 +42,13 @@ def l_template(canvas_y, canvas, y0, x0, bsz, wd, sigma_s, levels, mean, w_buf, 
     nbins = 1
     for _ in range(nc):
         nbins *= levels
-    counts = np.zeros(nbins, np.int64)
-    sums = np.zeros((nbins, nc))
+    # np.empty and loops rather than np.zeros/np.full: each of those is one more numba compile
+    counts = np.empty(nbins, np.int64)
+    sums = np.empty((nbins, nc))
+    for k in range(nbins):
+        counts[k] = 0
+        for c in range(nc):
+            sums[k, c] = 0.0
     for by in range(bsz):
         for bx in range(bsz):
             if wd[by, bx] > 0.0:
@@ -62,10 +67,9 @@ def l_template(canvas_y, canvas, y0, x0, bsz, wd, sigma_s, levels, mean, w_buf, 
     for k in range(nbins):
         if counts[k] > counts[mode]:
             mode = k
-    m = np.zeros(nc)
-    if counts[mode] > 0:
-        for c in range(nc):
-            m[c] = sums[mode, c] / counts[mode]
+    m = np.empty(nc)
+    for c in range(nc):
+        m[c] = sums[mode, c] / counts[mode] if counts[mode] > 0 else 0.0
     norm = 1.0 / (_SQRT_2PI * sigma_s)
     inv2s2 = 1.0 / (2.0 * sigma_s * sigma_s)
     const = 0.0
@@ -95,8 +99,11 @@ def select(cmap, const, valid, tol, u):
     lowest costs ``cmap[py, px] + const`` among positions with ``valid[py, px] != 0``; -1 if none."""
     ph, pw = valid.shape
     k = max(1, tol)
-    best_c = np.full(k, np.inf)
-    best_i = np.full(k, -1, np.int64)
+    best_c = np.empty(k)
+    best_i = np.empty(k, np.int64)
+    for j in range(k):
+        best_c[j] = np.inf
+        best_i[j] = -1
     for py in range(ph):
         for px in range(pw):
             if valid[py, px] == 0:
