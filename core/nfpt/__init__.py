@@ -334,9 +334,11 @@ def _run(inputs: Mapping[str, np.ndarray], params: NfptParams, *, rng=None, prog
 
 
 def warm_up() -> None:
-    """Load the synthesis kernels (numba's cache) on a tiny input: template, selection, repair, seams.
+    """Load (or compile) every kernel a run can use, on a tiny input: template, selection, repair,
+    seams, and the Beier-Neely field morph of ``--warp lines``/``morph`` (``core.rectify``'s)."""
+    from .. import rectify
 
-    The Beier-Neely kernel of ``--warp lines``/``morph`` is ``core.rectify``'s warm-up."""
+    rectify.warm_up()
     rng = np.random.default_rng(0)
     tex = rng.random((20, 20), dtype=np.float32)
     synthesize(tex, size=(24, 24), block=8, overlap=3, threshold=0.0, rng=0)
