@@ -383,8 +383,14 @@ def poisson_band(canvas, old, label, win, band):
     ws = label.shape[0]
     nc = canvas.shape[2]
     big = 1 << 20
+    # np.empty and loops rather than np.full/np.zeros (each of those is one more numba compile)
+    dist = np.empty((ws, ws), dtype=np.int64)
+    index = np.empty((ws, ws), dtype=np.int64)
+    for wy in range(ws):
+        for wx in range(ws):
+            dist[wy, wx] = big
+            index[wy, wx] = -1
     # Chebyshev distance of each labelled pixel to the nearest pixel of the other label (<= band)
-    dist = np.full((ws, ws), big, dtype=np.int64)
     for wy in range(ws):
         for wx in range(ws):
             lab = label[wy, wx]
@@ -416,7 +422,6 @@ def poisson_band(canvas, old, label, win, band):
     old_side = (band + 1) // 2
     new_side = band // 2
     # the unknowns: the band, except next to empty canvas pixels (nothing to meet there yet)
-    index = np.full((ws, ws), -1, dtype=np.int64)
     n = 0
     for wy in range(1, ws - 1):
         for wx in range(1, ws - 1):
@@ -439,10 +444,16 @@ def poisson_band(canvas, old, label, win, band):
                 n += 1
     if n == 0:
         return
-    nbr = np.full((n, 4), -1, dtype=np.int64)
-    ndeg = np.zeros(n)
-    rhs = np.zeros((n, nc))
+    nbr = np.empty((n, 4), dtype=np.int64)
+    ndeg = np.empty(n)
+    rhs = np.empty((n, nc))
     x = np.empty((n, nc))
+    for i in range(n):
+        ndeg[i] = 0.0
+        for k in range(4):
+            nbr[i, k] = -1
+        for c in range(nc):
+            rhs[i, c] = 0.0
     for wy in range(1, ws - 1):
         for wx in range(1, ws - 1):
             i = index[wy, wx]
