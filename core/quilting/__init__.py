@@ -22,9 +22,10 @@ place, the target's correspondence map, the previous pass) against every source 
 ``sum w F² - 2 sum w G F + sum w G²``. The first sum depends only on the template's weights and is
 computed once per overlap shape (``cv2.filter2D`` of the squared source); the cross-correlation
 is one FFT product with source spectra computed once per pass (``cv2.dft``); the per-block work
--- choosing, the dynamic-programming cut, pasting and the Poisson band -- is one call of a numba
-kernel (``core._kernels.quilting``). Source and templates are centred on the source's mean so
-the float32 FFT loses little to cancellation.
+-- choosing, the dynamic-programming cut, pasting and the Poisson band -- is done by numba kernels
+(``core._kernels.quilting``; one per selection rule and a separate Poisson band, so that a run
+compiles only what it uses). Source and templates are centred on the source's mean so the float32
+FFT loses little to cancellation.
 """
 from __future__ import annotations
 
