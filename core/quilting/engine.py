@@ -3,8 +3,8 @@
 For every block: the SSD of its template against every source position (the squared-sum term once
 per overlap shape with ``cv2.filter2D``, the cross-term as one FFT product with the source spectra
 computed once per pass), then the numba kernels of ``core._kernels.quilting``: the choice (one
-kernel per selection rule), the cut and paste, the Poisson band (only with ``poisson``), so that a
-run compiles only the kernels it uses -- or, for small syntheses while numba is not loaded yet, the
+kernel per selection rule), the overlap error, the cut (``core._kernels.seams``), the paste, the
+Poisson band (only with ``poisson``), so that a run compiles only the kernels it uses -- or, for small syntheses while numba is not loaded yet, the
 same steps in numpy (``_choose_*_numpy``, ``_place_block_numpy``, pixel for pixel the same; a test
 checks it).
 """
@@ -173,13 +173,15 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and prev is None and corr is None
                  and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "core._kernels.quilting" not in sys.modules)
     if use_numpy:
-        place, template, blend = _place_block_numpy, _make_template_numpy, None
+        place, template, blend, error, cut = _place_block_numpy, _make_template_numpy, None, None, None
         by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,
                                                _choose_sampled_numpy)
     else:
         from .._kernels import quilting as _k  # numba loads on first use, not with the CLI
+        from .._kernels import seams as _seams
 
         place, template, blend = _k.place_block, _k.make_template, _k.poisson_band
+        error, cut = _k.block_error, _seams.cut_mask
         by_best, by_tol, by_eps, by_sampled = _k.choose_best, _k.choose_tol, _k.choose_epsilon, _k.choose_sampled
     # one kernel per rule (a run compiles only the one it uses); all take (cross, sq, const, cost, u, seed)
     if p.rule == "sampled":
@@ -216,6 +218,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     # place_block's work buffers: the cut, and the window around the block for the Poisson band
     ws = b + 2 * (p.band + 2 if p.poisson else 0)
     err, mask = np.empty((b, b), dtype=np.float64), np.empty((b, b), dtype=np.uint8)
+    mincut = p.mode == "mincut"
     win = np.empty((2, ws), dtype=np.int64)
     label, old = np.empty((ws, ws), dtype=np.int8), np.empty((ws, ws, nc), dtype=np.float32)
     has_static = p.w_prev != 0.0 or (p.w_corr != 0.0 and corr is not None)
@@ -284,7 +287,10 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                                                                  seeds[i, j])), src.pw)
                 else:  # synthesis, first block: a random position
                     ip[_K.P_SY], ip[_K.P_SX] = first
-                place(canvas, filled, tex, ip, err, mask, win, label, old)
+                if mincut and overlaps and cut is not None:
+                    error(canvas, filled, tex, ip, err)
+                    cut(err, top, left, right, bottom, mask)
+                place(canvas, filled, tex, ip, mask, win, label, old)
                 if blend is not None and p.poisson:
                     blend(canvas, old, label, win, p.band)
             if report is not None:
@@ -430,7 +436,8 @@ def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bott
 
 
 def _place_block_numpy(canvas, filled, tex, ip, *work):
-    """``core._kernels.quilting.place_block`` without the Poisson band, in numpy (same pixels).
+    """The kernels' ``block_error``, ``cut_mask`` and ``place_block`` (no Poisson band), in numpy
+    (same pixels).
 
     ``work`` are the kernel's work buffers; numpy makes its own arrays (this engine only runs small
     jobs, where reuse does not matter).
