@@ -2,7 +2,8 @@
 
 ``weft`` with no arguments opens the desktop studio; ``weft METHOD INPUT... -o OUT [options]`` runs a
 method headless; ``weft run RECIPE -o OUT`` reproduces a recipe (a ``.json`` file, or a PNG exported
-by weft, which carries its recipe). Method options are generated from the method's ``Params`` specs,
+by weft, which carries its recipe); ``weft batch RECIPE --over INPUT FILES -o PATTERN`` applies it to
+many files (:mod:`app.batch_cli`). Method options are generated from the method's ``Params`` specs,
 so the CLI and the GUI share one definition of every parameter and its range.
 
 Contract: any bad input (a file, a parameter, a geometry) prints exactly one line on stderr and exits
@@ -113,6 +114,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     r.add_argument("recipe", metavar="RECIPE", help="recipe JSON file, or a PNG exported by weft")
     _add_common(r)
     r.set_defaults(method=None)
+    from app.batch_cli import add_batch_parser
+
+    add_batch_parser(sub)
     return parser
 
 
@@ -146,57 +150,34 @@ def _parse_int(text: str | None, name: str, lo: int, hi: int) -> int | None:
     return value
 
 
-def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
-             args: argparse.Namespace, region: tuple[int, int, int] | None = None) -> int:
-    from core import registry
-    from core.image import crop_square, load_image, save_image
-    from core.params import Recipe
-
-    method = registry.get(method_name)
-    params = method.params.from_dict(params_dict)
+def _parse_bit_depth(args: argparse.Namespace) -> int:
     bit_depth = _parse_int(args.bit_depth, "bit-depth", 8, 16)
     if bit_depth not in (8, 16):
         raise WeftError(f"parameter 'bit-depth' = {bit_depth} must be 8 or 16")
+    return bit_depth
+
+
+def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
+             args: argparse.Namespace, region: tuple[int, int, int] | None = None) -> int:
+    from core import registry
+    from core.image import save_image
+    from core.run import output_recipe, render
+
+    method = registry.get(method_name)
+    params = method.params.from_dict(params_dict)
+    bit_depth = _parse_bit_depth(args)
     out = _check_output(args.output, list(input_paths.values()))
     if bit_depth == 16 and out.suffix.lower() in (".jpg", ".jpeg"):
         raise WeftError(f"{args.output}: JPEG cannot hold 16 bits per channel (use .png or .tif)")
     if seed is None:
         seed = secrets.randbits(31)
 
-    images = {name: load_image(path).image for name, path in input_paths.items()}
-    if region is not None:
-        first = method.inputs[0].name
-        images[first] = crop_square(images[first], region, what=first)
-    for spec in method.inputs:
-        if spec.name in images and min(images[spec.name].shape[:2]) < spec.min_side:
-            h, w = images[spec.name].shape[:2]
-            cropped = " (the --region crop)" if region is not None and spec is method.inputs[0] else ""
-            raise ImageError(f"{input_paths[spec.name]}: the {spec.name} is {w}x{h}{cropped}; weft {method.name} "
-                             f"needs at least {spec.min_side}x{spec.min_side} pixels", path=input_paths[spec.name])
-    if method.warm_up is not None and method.warm_up_in_cli:
-        method.warm_up()  # load compiled kernels now, so "seconds" is the compute alone
     bar = _TerminalProgress(not args.quiet)
-    t0 = time.perf_counter()
     try:
-        result = method.run(images, params, rng=seed, progress=bar, cancel=None)
-    except WeftError as e:
-        if e.input in input_paths:  # about one image (a block that does not fit it): say which file
-            named = type(e)(f"{input_paths[e.input]}: {e}")
-            named.__dict__.update(e.__dict__)
-            raise named from None
-        raise
+        result, seconds = render(method, params, input_paths, seed, region, progress=bar)
     finally:
         bar.close()
-    seconds = time.perf_counter() - t0
-
-    out_dir = out.resolve().parent
-    rel_inputs = {name: _relative_to(path, out_dir) for name, path in input_paths.items()}
-    recipe_params = params.to_dict()
-    for spec in specs(method.params):  # text parameters naming files (nfpt's --lines, --view)
-        value = recipe_params.get(spec.name)
-        if spec.kind == "str" and _names_file(value):
-            recipe_params[spec.name] = _relative_to(value, out_dir)
-    recipe = Recipe(method=method.name, params=recipe_params, inputs=rel_inputs, seed=seed, region=region)
+    recipe = output_recipe(method, params, input_paths, seed, region, out)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if args.report:
         h, w = result.image.shape[:2]
@@ -206,80 +187,20 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     return 0
 
 
-def _names_file(value) -> bool:
-    """Whether a text parameter names an existing file (JSON given inline, e.g. ``{...}``, does not)."""
-    if not isinstance(value, str) or not value or value.lstrip().startswith(("{", "[")):
-        return False
-    try:
-        return Path(value).is_file()
-    except (OSError, ValueError):  # too long for a file name, or a NUL in it
-        return False
-
-
-def _relative_to(path: str, folder: Path) -> str:
-    """``path`` relative to ``folder`` (recipes store paths relative to the file that carries them)."""
-    try:
-        return os.path.relpath(Path(path).resolve(), folder)
-    except ValueError:  # another drive on Windows
-        return str(Path(path).resolve())
-
-
-def _resolve_file_params(method, params: dict, base: Path) -> dict:
-    """Text parameters of a recipe that name files (nfpt's lines, view), made absolute against the
-    recipe's folder ``base``, never the current directory; a ``.json`` one that is not there is an error
-    naming the parameter and the file."""
-    out = dict(params)
-    for spec in specs(method.params):
-        value = out.get(spec.name)
-        if spec.kind != "str" or not isinstance(value, str) or not value or value.lstrip().startswith(("{", "[")):
-            continue  # not text, or JSON given inline
-        path = value if os.path.isabs(value) else str(base / value)
-        if _names_file(path):
-            out[spec.name] = path
-        elif Path(value).suffix.lower() == ".json" and not os.path.exists(path):
-            raise WeftError(f"parameter '{spec.name}' names {value}, but {path} does not exist")
-    return out
-
-
-def _load_recipe(path: str):
-    from core.image import read_recipe
-    from core.params import Recipe
-
-    p = Path(path)
-    if not p.exists():
-        raise WeftError(f"{path}: no such file")
-    if p.suffix.lower() == ".png":
-        text = read_recipe(p)
-        if text is None:
-            raise WeftError(f"{path}: this PNG carries no weft recipe")
-        try:
-            return Recipe.from_json(text, base=p.resolve().parent)
-        except WeftError as e:
-            raise WeftError(f"{path}: {e}") from None
-    return Recipe.load(p)
-
-
 def _dispatch(args: argparse.Namespace) -> int:
     from core import registry
     from core.image import parse_square
 
+    if args.command == "batch":
+        from app.batch_cli import run_batch
+
+        return run_batch(args)
     if args.command == "run":
-        recipe = _load_recipe(args.recipe)
+        from core.run import check_recipe, load_recipe
+
+        recipe = load_recipe(args.recipe)
         try:  # what the recipe itself gets wrong is said with the recipe's name in front
-            method = registry.get(recipe.method)
-            takes = [i.name for i in method.inputs]
-            unknown = sorted(set(recipe.inputs) - set(takes))
-            if unknown:
-                raise WeftError(f"recipe names input {', '.join(map(repr, unknown))}, which {method.name} does not "
-                                f"take (it takes {', '.join(takes)})")
-            missing = [i.name for i in method.inputs if i.required and i.name not in recipe.inputs]
-            if missing:
-                raise WeftError(f"recipe names no {', '.join(missing)} image for {method.name}")
-            method.params.from_dict(recipe.params)
-            for name, path in recipe.inputs.items():
-                if not os.path.exists(path):
-                    raise WeftError(f"the {name} image {path} does not exist")
-            params = _resolve_file_params(method, dict(recipe.params), Path(args.recipe).resolve().parent)
+            params = check_recipe(recipe, Path(args.recipe).resolve().parent)
         except WeftError as e:
             raise WeftError(f"{args.recipe}: {e}") from None
         if args.seed is not None:

@@ -285,6 +285,19 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
 BYTES_PER_OUTPUT_PIXEL = 50
 
 
+def _output_size(texture_shape: tuple[int, ...], target_shape: tuple[int, ...] | None,
+                 params: FastParams) -> tuple[int, int, str]:
+    """Width, height and what sets them (for messages) of a run on inputs of these shapes;
+    ``params`` are resolved (:meth:`FastParams.resolved`)."""
+    hs, ws = texture_shape[:2]
+    if params.mode in ("superres", "novel"):
+        return ws * params.magnify, hs * params.magnify, "parameter 'magnify'"
+    if target_shape is not None:
+        return target_shape[1], target_shape[0], "the target"
+    width, height = params.size if params.size is not None else (2 * ws, 2 * hs)
+    return width, height, "parameter 'size'"
+
+
 def _check_limits(texture: np.ndarray, target: np.ndarray | None, params: FastParams) -> None:
     """Refuse up front an output over the pixel limit or beyond the memory available.
 
@@ -293,16 +306,16 @@ def _check_limits(texture: np.ndarray, target: np.ndarray | None, params: FastPa
     """
     from .limits import check_memory, check_output_size
 
-    hs, ws = texture.shape[:2]
-    if params.mode in ("superres", "novel"):
-        width, height, source = ws * params.magnify, hs * params.magnify, "parameter 'magnify'"
-    elif target is not None:
-        (height, width), source = target.shape[:2], "the target"
-    else:
-        width, height = params.size if params.size is not None else (2 * ws, 2 * hs)
-        source = "parameter 'size'"
+    width, height, source = _output_size(texture.shape, None if target is None else target.shape, params)
     check_output_size(width, height, source)
     check_memory(BYTES_PER_OUTPUT_PIXEL * width * height, f"fast transfer of {width}x{height}")
+
+
+def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: FastParams) -> float:
+    """Estimated peak bytes of one run on inputs of these shapes (what :func:`_check_limits` checks)."""
+    target = shapes.get("target")
+    width, height, _ = _output_size(shapes["texture"], target, params.resolved(target is not None))
+    return BYTES_PER_OUTPUT_PIXEL * width * height
 
 
 def _colourize(pos, src_y, texture, target, tgt_y, colour) -> np.ndarray:
@@ -350,4 +363,5 @@ METHOD = Method(
     ),
     run=_run,
     warm_up=warm_up,
+    memory=memory_estimate,
 )

@@ -78,6 +78,10 @@ class Method:
     run: Callable[..., Result]
     warm_up: Callable[[], None] | None = None
     warm_up_in_cli: bool = True
+    #: ``memory(shapes, params) -> bytes``: the estimated peak memory of one run on inputs of these
+    #: shapes (input name -> array shape), the figure the run checks against the memory available;
+    #: a batch multiplies it by its workers to refuse up front (:mod:`core.batch`). None: no estimate.
+    memory: Callable[[Mapping[str, tuple[int, ...]], Params], float] | None = None
 
 
 _loaded: dict[str, Method] = {}

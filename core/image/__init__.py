@@ -12,6 +12,7 @@ from .files import (
     Loaded,
     atomic_write_bytes,
     crop_square,
+    encode_image,
     get_max_pixels,
     load_image,
     parse_square,
@@ -23,7 +24,8 @@ from .files import (
 )
 
 __all__ = [
-    "DEFAULT_MAX_PIXELS", "ImageInfo", "Loaded", "PcaBasis", "atomic_write_bytes", "crop_square", "from_pca",
+    "DEFAULT_MAX_PIXELS", "ImageInfo", "Loaded", "PcaBasis", "atomic_write_bytes", "crop_square", "encode_image",
+    "from_pca",
     "get_max_pixels", "load_image", "luminance", "parse_square", "pca_basis", "pca_grey", "read_recipe", "resize",
     "rgb_to_yiq", "save_image", "set_max_pixels", "to_pca", "validate_image", "yiq_to_rgb",
 ]

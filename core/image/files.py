@@ -413,6 +413,15 @@ def save_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | None
                bit_depth: int = 8, quality: int = 95) -> None:
     """Save an image atomically (see :func:`atomic_write_bytes`) in the format of its extension.
 
+    The bytes are :func:`encode_image`'s (same parameters); this only adds the atomic write.
+    """
+    atomic_write_bytes(Path(path), encode_image(path, image, recipe=recipe, bit_depth=bit_depth, quality=quality))
+
+
+def encode_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | None = None,
+                 bit_depth: int = 8, quality: int = 95) -> bytes:
+    """The bytes :func:`save_image` writes to ``path`` (format from its extension; nothing is written).
+
     Parameters
     ----------
     path : str or PathLike
@@ -464,7 +473,7 @@ def save_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | None
         except UnicodeEncodeError:  # iTXt: keyword, 0, no compression, method 0, no language/translation
             chunk = _png_chunk(b"iTXt", _RECIPE_KEY + b"\0\0\0\0\0" + recipe.encode("utf-8"))
         data = data[:33] + chunk + data[33:]  # OpenCV writes signature (8) + IHDR (25) first
-    atomic_write_bytes(target, data)
+    return data
 
 
 def read_recipe(path: str | os.PathLike) -> str | None:

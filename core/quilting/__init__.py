@@ -236,13 +236,10 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
     return total
 
 
-def _check_limits(tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[int, int]], *,
-                  tile: bool, transfer: bool) -> None:
-    """Refuse up front an output over the pixel limit, beyond available memory, or too long to quilt."""
-    from ..limits import check_duration, check_memory, check_output_size
-
-    check_output_size(out_w, out_h, "the target" if transfer else "parameter 'size'")
-    h, w = tex.shape[:2]
+def _memory_need(tex_shape: tuple[int, ...], out_w: int, out_h: int, passes: list[tuple[int, int]], *,
+                 tile: bool, transfer: bool) -> float:
+    """Estimated peak bytes of quilting ``out_w`` x ``out_h`` from a texture of ``tex_shape``."""
+    h, w = tex_shape[:2]
     need = (BYTES_PER_OUTPUT_PIXEL["transfer" if transfer else "synthesis"] * out_w * out_h
             + BYTES_PER_SOURCE_PIXEL * h * w)
     if transfer:  # two block rows of texture-sized spectra (the row in use and the one computed ahead)
@@ -250,6 +247,41 @@ def _check_limits(tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[in
 
         cols = max(len(_grid(out_w, b, o, tile)[0]) for b, o in passes)
         need += 2 * cols * cv2.getOptimalDFTSize(h) * cv2.getOptimalDFTSize(w) * 4
+    return need
+
+
+def _transfer_passes(params: QuiltParams) -> list[tuple[int, int, float]]:
+    """Block, overlap and alpha of each pass of a transfer with these parameters (defaults resolved)."""
+    n = params.iterations
+    b = params.block if params.block is not None else (TRANSFER_BLOCK if n == 1 else ITERATIVE_BLOCK)
+    ov = params.overlap if params.overlap is not None else max(1, min(b - 1, _round_half_up(b / 3 if n == 1 else 2 * b / 3)))
+    return transfer_schedule(n, block=b, overlap=ov, alpha=params.alpha)
+
+
+def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: QuiltParams) -> float:
+    """Estimated peak bytes of one run on inputs of these shapes (what the run's own check uses);
+    0 for a random-mode synthesis, which has no such check."""
+    tex = shapes["texture"]
+    if shapes.get("target") is not None:
+        out_h, out_w = shapes["target"][:2]
+        passes = [(b, o) for b, o, _ in _transfer_passes(params)]
+        return _memory_need(tex, out_w, out_h, passes, tile=params.tile, transfer=True)
+    if params.mode == "random":
+        return 0.0
+    b = params.block or SYNTH_BLOCK
+    ov = params.overlap if params.overlap is not None else max(1, -(-b // 6))
+    out_w, out_h = params.size if params.size is not None else (2 * tex[1], 2 * tex[0])
+    return _memory_need(tex, out_w, out_h, [(b, ov)], tile=params.tile, transfer=False)
+
+
+def _check_limits(tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[int, int]], *,
+                  tile: bool, transfer: bool) -> None:
+    """Refuse up front an output over the pixel limit, beyond available memory, or too long to quilt."""
+    from ..limits import check_duration, check_memory, check_output_size
+
+    check_output_size(out_w, out_h, "the target" if transfer else "parameter 'size'")
+    h, w = tex.shape[:2]
+    need = _memory_need(tex.shape, out_w, out_h, passes, tile=tile, transfer=transfer)
     check_memory(need, f"quilting {out_w}x{out_h} from a {w}x{h} texture",
                  f"use a smaller {'target' if transfer else 'size'} or a smaller part of the texture")
     seconds = estimate_seconds(tex.shape, (out_w, out_h), passes, tile=tile)
@@ -491,16 +523,13 @@ def transfer(
     tgt = validate_image(target, "target")
     H, W = tgt.shape[:2]
     n = params.iterations
-    b = params.block if params.block is not None else (TRANSFER_BLOCK if n == 1 else ITERATIVE_BLOCK)
+    schedule = _transfer_passes(params)
+    b, ov = schedule[0][:2]
     _check_block_fits(b, tex)
     if params.overlap is not None:
-        ov = params.overlap
-        _check_overlap(b, ov)
-    else:
-        ov = max(1, min(b - 1, _round_half_up(b / 3 if n == 1 else 2 * b / 3)))
+        _check_overlap(b, params.overlap)
     if params.tile:
         _check_tile_size(b, W, H)
-    schedule = transfer_schedule(n, block=b, overlap=ov, alpha=params.alpha)
     _check_limits(tex, W, H, [(bi, oi) for bi, oi, _ in schedule], tile=params.tile, transfer=True)
     cs, ct = _correspondence_maps(tex, tgt, params.correspondence, source_map, target_map)
     if params.remap:
@@ -600,4 +629,5 @@ METHOD = Method(
     run=_run,
     warm_up=warm_up,
     warm_up_in_cli=False,
+    memory=memory_estimate,
 )
