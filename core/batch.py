@@ -58,6 +58,8 @@ MAX_ATTEMPTS = 3
 IN_FLIGHT_PER_WORKER = 2
 #: Environment variable naming a Dask scheduler when none is given.
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
+#: How long to try reaching a Dask scheduler before giving up.
+CONNECT_TIMEOUT = "10s"
 
 
 # --------------------------------------------------------------------------------------------------
@@ -567,6 +569,7 @@ class LocalPool:
         self.ctx = multiprocessing.get_context("spawn")
         self.cancel_event = self.ctx.Event()
         self.executor = None
+        self.restarts = 0  # times a dead worker took the pool down and it was started again
         self._start()
 
     def _start(self) -> None:
@@ -592,12 +595,15 @@ class LocalPool:
 
     def after_death(self) -> None:
         self.executor.shutdown(wait=True, cancel_futures=True)
+        self.restarts += 1
         self._start()
 
     def cancel(self, futures) -> None:
+        """Stop: queued items never start, running ones stop at their next cancel check."""
         self.cancel_event.set()
         for f in futures:
             f.cancel()
+        cf.wait(futures)
 
     def close(self) -> None:
         self.executor.shutdown(wait=True, cancel_futures=True)
@@ -612,7 +618,7 @@ class DaskPool:
         except ImportError:
             raise WeftError("a scheduler address needs Dask: pip install -e '.[cluster]'") from None
         try:
-            self.client = Client(address, timeout="10s")
+            self.client = Client(address, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError, ValueError) as e:
             raise WeftError(f"cannot reach the Dask scheduler at {address} ({_one_line(e)})") from None
         self.method = method
@@ -732,6 +738,14 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
             if cancel is not None and cancel.cancelled:
                 summary.cancelled = True
                 pool.cancel(inflight)
+                for future, item in inflight.items():  # items that finished meanwhile still count
+                    if future.done() and not future.cancelled():
+                        try:
+                            outcome = pool.outcome(future)
+                        except Exception:  # noqa: BLE001 - a dead worker: not done
+                            continue
+                        if outcome.status == "written":
+                            _finish(outcome, item, summary, state, on_outcome, progress)
                 break
             while todo and len(inflight) < limit:
                 item = todo.popleft()
