@@ -300,6 +300,7 @@ class MainWindow(FilesMixin, QMainWindow):
         m.addSeparator()
         self.save_result_action = self._action(m, "&Export Result…", self.save_result_dialog, "Ctrl+E")
         self._action(m, "Export &Recipe…", self.export_recipe_dialog, "Ctrl+Shift+E")
+        self._action(m, "Apply to &Folder…", self.open_batch_dialog, "Ctrl+Shift+B")
         m.addSeparator()
         self._action(m, "Load Feature &Lines…", lambda: self.lines_panel.load_lines_dialog())
         self._action(m, "Save Feature Li&nes…", lambda: self.lines_panel.save_lines_dialog())
@@ -570,6 +571,11 @@ class MainWindow(FilesMixin, QMainWindow):
         dialog = VariationsDialog(self.doc, self)
         dialog.show()
         self._variations = dialog
+
+    def open_batch_dialog(self) -> None:
+        from .batch_dialog import open_batch_dialog
+
+        open_batch_dialog(self)
 
     def _update_title(self, *_args) -> None:
         dirty = "" if self.doc.undo_stack.isClean() else " *"
