@@ -84,11 +84,11 @@ class BatchDialog(QDialog):
         self.folder = QLineEdit()
         self.folder.setPlaceholderText("folder of images (PNG, JPEG, TIFF, …)")
         self.folder.textChanged.connect(self._folder_changed)
-        browse = QPushButton("Browse…")
+        self.browse = browse = QPushButton("Browse…")
         browse.clicked.connect(self._browse_folder)
         self.output = QLineEdit()
         self.output.setPlaceholderText(f"output folder (default: a '{OUTPUT_SUBFOLDER}' folder inside the input folder)")
-        browse_out = QPushButton("Browse…")
+        self.browse_out = browse_out = QPushButton("Browse…")
         browse_out.clicked.connect(self._browse_output)
         self.names = QLineEdit(DEFAULT_NAMES)
         self.names.setToolTip("{stem}: the input file's name without extension, {name}: with it, {index}: "
@@ -228,14 +228,15 @@ class BatchDialog(QDialog):
     def _set_running(self, running: bool) -> None:
         self.run_button.setEnabled(not running)
         self.cancel_button.setEnabled(running)
-        for w in (self.over, self.folder, self.output, self.names, self.workers, self.seed_per_item, self.force):
+        for w in (self.over, self.folder, self.browse, self.output, self.browse_out, self.names, self.workers,
+                  self.seed_per_item, self.force):
             w.setEnabled(not running)
 
     def _on_progress(self, done: int, total: int, failed: int, seconds_left: float) -> None:
-        if self._cancel is not None and self._cancel.cancelled:
-            return
         self.progress.setRange(0, max(1, total))
         self.progress.setValue(done)
+        if self._cancel is not None and self._cancel.cancelled:
+            return  # "cancelling…" stays until the summary
         bits = [f"{done} of {total} done"]
         if failed:
             bits.append(f"{failed} failed")
