@@ -353,3 +353,10 @@ def test_check_memory_names_the_largest_item(scene):
     with pytest.raises(LimitError, match=r"use --workers 3$"):
         batch.check_memory(p.items, 4, available=3 * 50 * 200 * 100)
     batch.check_memory(p.items, 3, available=3 * 50 * 200 * 100)  # fits: no error
+
+
+def test_importing_weft_does_not_import_dask():
+    code = ("import sys, app.cli, core.batch, app.batch_cli; app.cli.build_parser(); "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
