@@ -16,7 +16,10 @@ over all frames, outputs written as PNG with their recipe (``force``: every repe
 median of ``--repeats`` (default 3), the configurations alternating run by run. The start-up of
 each pool (spawning, imports, kernels; the Dask cluster's own start included) and the 1-minute
 load average during the runs (the machine is shared: above ~0.5 the figures are not clean) are
-printed too. Goals (issue 16):
+printed too, with two figures that do not depend on how busy the machine is: the median time of
+one item on its worker (read, run, encode, write: if two workers make it longer than one, they
+compete for cores or memory bandwidth) and how busy the workers were (the items' times over wall
+time x workers: below 100 % is time the pool left a worker idle). Goals (issue 16):
 2 workers >= 1.7x the items per second of 1, and Dask within 15 % of the local pool of 2.
 """
 
@@ -71,18 +74,19 @@ def make_recipes(folder: Path, first_frame: Path) -> dict[str, Path]:
     return out
 
 
-def time_batch(plan_factory, pool, repeats: int) -> list[float]:
+def time_batch(plan_factory, pool, slots: int) -> tuple[float, float, float]:
+    """One batch: (wall seconds, busy fraction, seconds per item on its worker). Busy = the items'
+    whole times on their workers / (wall x workers): how well the pool keeps its workers fed."""
     from core import batch
 
-    times = []
-    for _ in range(repeats):
-        plan = plan_factory()
-        t0 = time.perf_counter()
-        summary = batch.run(plan, pool=pool)
-        times.append(time.perf_counter() - t0)
-        if summary.written != len(plan.items):
-            raise SystemExit(f"batch failed: {summary.line()}")
-    return times
+    plan = plan_factory()
+    elapsed = []
+    t0 = time.perf_counter()
+    summary = batch.run(plan, pool=pool, on_outcome=lambda o: elapsed.append(o.elapsed))
+    wall = time.perf_counter() - t0
+    if summary.written != len(plan.items):
+        raise SystemExit(f"batch failed: {summary.line()}")
+    return wall, sum(elapsed) / (wall * slots), statistics.median(elapsed)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -125,13 +129,18 @@ def main(argv: list[str] | None = None) -> int:
                 return batch.plan(str(recipes[name]), [("target", str(tmp / "frames"))],
                                   str(tmp / "out" / name / "{stem}.png"), force=True)
             times = {label: [] for label, _ in configs}
+            busy = {label: [] for label, _ in configs}
+            per_item = {label: [] for label, _ in configs}
             loads = []
             try:
                 for r in range(args.repeats):  # configurations alternate, so a busier minute hits them all
                     for label, _ in configs:
                         print(f"{name}: {label}, run {r + 1}/{args.repeats} ...", file=sys.stderr, flush=True)
                         loads.append(os.getloadavg()[0])
-                        times[label] += time_batch(factory, pools[label], 1)
+                        wall, b, e = time_batch(factory, pools[label], pools[label].slots)
+                        times[label].append(wall)
+                        busy[label].append(b)
+                        per_item[label].append(e)
             finally:
                 for pool in pools.values():
                     pool.close()
@@ -139,19 +148,22 @@ def main(argv: list[str] | None = None) -> int:
                 med = statistics.median(times[label])
                 rows.append({"recipe": name, "pool": label, "items": args.frames, "median_s": round(med, 3),
                              "runs_s": [round(t, 3) for t in times[label]], "items_per_s": round(args.frames / med, 2),
-                             "startup_s": round(startup[label], 2), "load_avg": round(statistics.median(loads), 2)})
+                             "startup_s": round(startup[label], 2), "load_avg": round(statistics.median(loads), 2),
+                             "busy": round(statistics.median(busy[label]), 3),
+                             "item_s": round(statistics.median(per_item[label]), 3)})
         if cluster is not None:
             cluster.close()
 
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
           f"{args.frames} frames of 640x480, median of {args.repeats}")
-    print("| recipe | pool | items/s | median s | runs s | vs 1 worker | pool start s | load avg |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| recipe | pool | items/s | median s | runs s | vs 1 worker | s per item on its worker | workers busy "
+          "| pool start s | load avg |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in rows:
         one = next(x for x in rows if x["recipe"] == r["recipe"] and x["pool"] == "local, 1 worker")
         print(f"| {r['recipe']} | {r['pool']} | {r['items_per_s']} | {r['median_s']} | "
               f"{' / '.join(str(t) for t in r['runs_s'])} | {r['items_per_s'] / one['items_per_s']:.2f}x | "
-              f"{r['startup_s']} | {r['load_avg']} |")
+              f"{r['item_s']} | {r['busy'] * 100:.0f} % | {r['startup_s']} | {r['load_avg']} |")
     for name in {r["recipe"] for r in rows}:
         by = {r["pool"]: r["items_per_s"] for r in rows if r["recipe"] == name}
         two, one, dask = by.get("local, 2 workers"), by.get("local, 1 worker"), by.get("Dask, 2 workers")

@@ -107,6 +107,9 @@ class Outcome:
     figures: Mapping[str, Any] = field(default_factory=dict)
     worker: str = ""
     data: bytes | None = None
+    #: The item's whole time on its worker: reading, running, encoding, writing (``seconds`` is the
+    #: method's compute alone, as ``weft run --report`` gives it).
+    elapsed: float = 0.0
 
     def report(self) -> dict:
         """The item's ``--report`` line (without the encoded bytes)."""
@@ -115,6 +118,7 @@ class Outcome:
             line["error"] = self.error
         if self.status == "written":
             line["seconds"] = round(self.seconds, 6)
+            line["elapsed"] = round(self.elapsed, 6)
             line["worker"] = self.worker
             line.update(self.figures)
         return line
@@ -192,10 +196,11 @@ class BatchProgress:
 
     @property
     def seconds_left(self) -> float | None:
-        """Time left at the rate items have completed so far; None before one is done."""
-        if self._timed < 1:
+        """Time left at the rate items have completed since the first one (so the workers' start-up
+        does not count); None before two are done."""
+        if self._timed < 2:
             return None
-        rate = self._timed / max(1e-9, time.monotonic() - self.started)
+        rate = (self._timed - 1) / max(1e-9, time.monotonic() - self._first)
         return (self.total - self.done) / rate
 
 
@@ -518,6 +523,7 @@ def run_item(item: Item) -> Outcome:
     from .run import render
 
     worker = f"{os.uname().nodename}:{os.getpid()}" if hasattr(os, "uname") else str(os.getpid())
+    t0 = time.perf_counter()
     tmpdir = None
     try:
         set_threads(item.threads)
@@ -547,7 +553,7 @@ def run_item(item: Item) -> Outcome:
             atomic_write_bytes(Path(item.output), data)
             data = None
         return Outcome(item.index, item.label, item.output, "written", seconds=seconds,
-                       figures=dict(result.figures), worker=worker, data=data)
+                       figures=dict(result.figures), worker=worker, data=data, elapsed=time.perf_counter() - t0)
     except Cancelled:
         return Outcome(item.index, item.label, item.output, "failed", error="cancelled", worker=worker)
     except WeftError as e:
