@@ -18,6 +18,7 @@ from typing import Callable
 
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
+    QApplication,
     QCheckBox,
     QComboBox,
     QDialog,
@@ -141,6 +142,9 @@ class BatchDialog(QDialog):
         layout.addWidget(self.buttons)
         self.progressed.connect(self._on_progress)
         self.batch_finished.connect(self._on_finished)
+        app = QApplication.instance()
+        if app is not None:  # quitting stops the batch too (finished outputs stay; a re-run resumes)
+            app.aboutToQuit.connect(self.cancel)
         self.resize(640, self.sizeHint().height())
 
     def _describe(self) -> None:
@@ -201,22 +205,30 @@ class BatchDialog(QDialog):
                                         name="weft-batch", daemon=True)
         self._thread.start()
 
+    def _emit(self, signal, *args) -> None:
+        """Emit from the batch thread; if the dialog is gone (the window closed), stop the batch."""
+        try:
+            signal.emit(*args)
+        except RuntimeError:  # the C++ object was deleted
+            if self._cancel is not None:
+                self._cancel.cancel()
+
     def _work(self, over, pattern, options, workers, cancel) -> None:
         """The batch thread: plan (refusals end it at once), then run; only signals reach the GUI."""
         try:
             plan = batch.plan("the studio's recipe", over, pattern, recipe=self.recipe, **options)
-            self.progressed.emit(len(plan.skipped), len(plan.items), 0, -1.0)
+            self._emit(self.progressed, len(plan.skipped), len(plan.items), 0, -1.0)
             summary = batch.run(plan, workers=workers, cancel=cancel,
-                                progress=lambda s: self.progressed.emit(
-                                    s.done, s.total, s.failed,
+                                progress=lambda s: self._emit(
+                                    self.progressed, s.done, s.total, s.failed,
                                     -1.0 if s.seconds_left is None else float(s.seconds_left)))
         except WeftError as e:
-            self.batch_finished.emit(" ".join(str(e).split()), -1, False)
+            self._emit(self.batch_finished, " ".join(str(e).split()), -1, False)
             return
         except Exception as e:  # noqa: BLE001 - a bug must not kill the thread silently
-            self.batch_finished.emit(f"internal error: {type(e).__name__}: {e}", -1, False)
+            self._emit(self.batch_finished, f"internal error: {type(e).__name__}: {e}", -1, False)
             return
-        self.batch_finished.emit(summary.line(), len(summary.failed), summary.cancelled)
+        self._emit(self.batch_finished, summary.line(), len(summary.failed), summary.cancelled)
 
     def cancel(self) -> None:
         """Stop the running batch: finished items stay, queued ones never start."""
