@@ -607,6 +607,13 @@ class LocalPool:
     def _start(self) -> None:
         self.executor = cf.ProcessPoolExecutor(self.workers, mp_context=self.ctx, initializer=_init_local_worker,
                                                initargs=(self.method, self.cancel_event))
+        if self.workers > 1:
+            # One worker loads the kernels before the others start: on a first run (no numba cache
+            # yet) it compiles them once and the others load its cache, instead of every worker
+            # compiling the same kernels at once (24 fast transfers on 2 workers with a fresh
+            # NUMBA_CACHE_DIR, whole command: 7.2 -> 5.2 s; warm cache 4.45 -> 4.44 s, medians of 3 at load
+            # ~4). The executor starts a process per submit.
+            self.executor.submit(_pid_after, 0.0).result()
 
     @property
     def slots(self) -> int:
