@@ -89,7 +89,7 @@ def test_an_exported_png_is_a_recipe_and_seed_per_item_varies_the_seed(scene, ca
     tmp, frames = scene
     assert run(["run", tmp / "look.json", "-o", tmp / "look.png"], capsys)[0] == 0
     code, _, err = run(["batch", tmp / "look.png", "--over", "target", str(tmp / "frames" / "frame_*.png"),
-                        "-o", tmp / "out" / "{index}.png", "--seed-per-item", "--seed", "100"], capsys)
+                        "-o", tmp / "out" / "{index}.png", "--seed-per-item", "--seed", "100", "--workers", "1"], capsys)
     assert code == 0, err
     seeds = [json.loads(read_recipe(tmp / "out" / f"{i}.png"))["seed"] for i in range(5)]
     assert seeds == [100, 101, 102, 103, 104]
@@ -103,7 +103,7 @@ def test_a_corrupt_frame_fails_alone_with_its_reason(scene, capsys):
     frames[2].write_bytes(data[: len(data) // 2])  # truncated mid-stream
     (tmp / "frames" / "frame_9.png").write_bytes(b"")  # and an empty one
     code, out, err = run(["batch", tmp / "look.json", "--over", "target", tmp / "frames",
-                          "-o", tmp / "out" / "{stem}.png", "--report"], capsys)
+                          "-o", tmp / "out" / "{stem}.png", "--report", "--workers", "1"], capsys)
     assert code == 1
     last = err.strip().splitlines()[-1]
     assert last.startswith("4 written, 2 failed: frame_3.png: truncated or corrupt PNG data"), last
@@ -118,7 +118,7 @@ def test_a_corrupt_frame_fails_alone_with_its_reason(scene, capsys):
 def test_rerun_skips_what_is_done_and_force_redoes_it(scene, capsys):
     tmp, frames = scene
     argv = ["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o", tmp / "out" / "{stem}.png",
-            "--report"]
+            "--report", "--workers", "1"]
     assert run(argv, capsys)[0] == 0
     before = {p.name: p.read_bytes() for p in (tmp / "out").iterdir()}
     (tmp / "out" / "frame_2.png").unlink()  # an interrupted batch: two outputs never written
@@ -141,7 +141,8 @@ def test_a_recipe_without_seed_keeps_the_seed_of_its_first_run_when_resumed(scen
     data = json.loads((tmp / "look.json").read_text())
     data["seed"] = None
     (tmp / "look.json").write_text(json.dumps(data))
-    argv = ["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o", tmp / "out" / "{stem}.png"]
+    argv = ["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o", tmp / "out" / "{stem}.png",
+            "--workers", "1"]
     assert run(argv, capsys)[0] == 0
     seed = json.loads(read_recipe(tmp / "out" / "frame_1.png"))["seed"]
     (tmp / "out" / "frame_1.png").unlink()
@@ -212,7 +213,7 @@ def test_memory_for_all_workers_is_checked_up_front(scene, capsys, monkeypatch):
 def test_shipped_inputs_and_outputs_give_the_same_files(scene, capsys):
     tmp, frames = scene
     base = ["batch", tmp / "look.json", "--over", "target", tmp / "frames"]
-    assert run([*base, "-o", tmp / "a/{stem}.png"], capsys)[0] == 0
+    assert run([*base, "-o", tmp / "a/{stem}.png", "--workers", "1"], capsys)[0] == 0
     code, _, err = run([*base, "-o", tmp / "b/{stem}.png", "--ship-inputs", "--ship-outputs", "--workers", "1"],
                        capsys)
     assert code == 0, err
