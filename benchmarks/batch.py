@@ -18,8 +18,10 @@ each pool (spawning, imports, kernels; the Dask cluster's own start included) an
 load average during the runs (the machine is shared: above ~0.5 the figures are not clean) are
 printed too, with two figures that do not depend on how busy the machine is: the median time of
 one item on its worker (read, run, encode, write: if two workers make it longer than one, they
-compete for cores or memory bandwidth) and how busy the workers were (the items' times over wall
-time x workers: below 100 % is time the pool left a worker idle). Goals (issue 16):
+compete for cores or memory bandwidth), the CPU time its process used for it (all threads: if that
+grows with two workers, they slow each other down; if only the wall time grows, other programs took
+the cores), and how busy the workers were (the items' times over wall time x workers: below 100 %
+is time the pool left a worker idle). Goals (issue 16):
 2 workers >= 1.7x the items per second of 1, and Dask within 15 % of the local pool of 2.
 """
 
@@ -74,19 +76,21 @@ def make_recipes(folder: Path, first_frame: Path) -> dict[str, Path]:
     return out
 
 
-def time_batch(plan_factory, pool, slots: int) -> tuple[float, float, float]:
-    """One batch: (wall seconds, busy fraction, seconds per item on its worker). Busy = the items'
-    whole times on their workers / (wall x workers): how well the pool keeps its workers fed."""
+def time_batch(plan_factory, pool, slots: int) -> tuple[float, float, float, float]:
+    """One batch: (wall seconds, busy fraction, seconds per item on its worker, CPU seconds per item).
+    Busy = the items' whole times on their workers / (wall x workers): how well the pool keeps its
+    workers fed."""
     from core import batch
 
     plan = plan_factory()
-    elapsed = []
+    done = []
     t0 = time.perf_counter()
-    summary = batch.run(plan, pool=pool, on_outcome=lambda o: elapsed.append(o.elapsed))
+    summary = batch.run(plan, pool=pool, on_outcome=done.append)
     wall = time.perf_counter() - t0
     if summary.written != len(plan.items):
         raise SystemExit(f"batch failed: {summary.line()}")
-    return wall, sum(elapsed) / (wall * slots), statistics.median(elapsed)
+    return (wall, sum(o.elapsed for o in done) / (wall * slots), statistics.median(o.elapsed for o in done),
+            statistics.median(o.cpu for o in done))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -131,13 +135,15 @@ def main(argv: list[str] | None = None) -> int:
             times = {label: [] for label, _ in configs}
             busy = {label: [] for label, _ in configs}
             per_item = {label: [] for label, _ in configs}
+            cpu = {label: [] for label, _ in configs}
             loads = []
             try:
                 for r in range(args.repeats):  # configurations alternate, so a busier minute hits them all
                     for label, _ in configs:
                         print(f"{name}: {label}, run {r + 1}/{args.repeats} ...", file=sys.stderr, flush=True)
                         loads.append(os.getloadavg()[0])
-                        wall, b, e = time_batch(factory, pools[label], pools[label].slots)
+                        wall, b, e, c = time_batch(factory, pools[label], pools[label].slots)
+                        cpu[label].append(c)
                         times[label].append(wall)
                         busy[label].append(b)
                         per_item[label].append(e)
@@ -150,20 +156,21 @@ def main(argv: list[str] | None = None) -> int:
                              "runs_s": [round(t, 3) for t in times[label]], "items_per_s": round(args.frames / med, 2),
                              "startup_s": round(startup[label], 2), "load_avg": round(statistics.median(loads), 2),
                              "busy": round(statistics.median(busy[label]), 3),
-                             "item_s": round(statistics.median(per_item[label]), 3)})
+                             "item_s": round(statistics.median(per_item[label]), 3),
+                             "item_cpu_s": round(statistics.median(cpu[label]), 3)})
         if cluster is not None:
             cluster.close()
 
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
           f"{args.frames} frames of 640x480, median of {args.repeats}")
-    print("| recipe | pool | items/s | median s | runs s | vs 1 worker | s per item on its worker | workers busy "
-          "| pool start s | load avg |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| recipe | pool | items/s | median s | runs s | vs 1 worker | s per item on its worker | CPU s per item "
+          "| workers busy | pool start s | load avg |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in rows:
         one = next(x for x in rows if x["recipe"] == r["recipe"] and x["pool"] == "local, 1 worker")
         print(f"| {r['recipe']} | {r['pool']} | {r['items_per_s']} | {r['median_s']} | "
               f"{' / '.join(str(t) for t in r['runs_s'])} | {r['items_per_s'] / one['items_per_s']:.2f}x | "
-              f"{r['item_s']} | {r['busy'] * 100:.0f} % | {r['startup_s']} | {r['load_avg']} |")
+              f"{r['item_s']} | {r['item_cpu_s']} | {r['busy'] * 100:.0f} % | {r['startup_s']} | {r['load_avg']} |")
     for name in {r["recipe"] for r in rows}:
         by = {r["pool"]: r["items_per_s"] for r in rows if r["recipe"] == name}
         two, one, dask = by.get("local, 2 workers"), by.get("local, 1 worker"), by.get("Dask, 2 workers")

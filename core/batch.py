@@ -108,8 +108,10 @@ class Outcome:
     worker: str = ""
     data: bytes | None = None
     #: The item's whole time on its worker: reading, running, encoding, writing (``seconds`` is the
-    #: method's compute alone, as ``weft run --report`` gives it).
+    #: method's compute alone, as ``weft run --report`` gives it), and the CPU time its process used
+    #: meanwhile (all its threads).
     elapsed: float = 0.0
+    cpu: float = 0.0
 
     def report(self) -> dict:
         """The item's ``--report`` line (without the encoded bytes)."""
@@ -119,6 +121,7 @@ class Outcome:
         if self.status == "written":
             line["seconds"] = round(self.seconds, 6)
             line["elapsed"] = round(self.elapsed, 6)
+            line["cpu"] = round(self.cpu, 6)
             line["worker"] = self.worker
             line.update(self.figures)
         return line
@@ -523,7 +526,7 @@ def run_item(item: Item) -> Outcome:
     from .run import render
 
     worker = f"{os.uname().nodename}:{os.getpid()}" if hasattr(os, "uname") else str(os.getpid())
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     tmpdir = None
     try:
         set_threads(item.threads)
@@ -553,7 +556,8 @@ def run_item(item: Item) -> Outcome:
             atomic_write_bytes(Path(item.output), data)
             data = None
         return Outcome(item.index, item.label, item.output, "written", seconds=seconds,
-                       figures=dict(result.figures), worker=worker, data=data, elapsed=time.perf_counter() - t0)
+                       figures=dict(result.figures), worker=worker, data=data, elapsed=time.perf_counter() - t0,
+                       cpu=time.process_time() - c0)
     except Cancelled:
         return Outcome(item.index, item.label, item.output, "failed", error="cancelled", worker=worker)
     except WeftError as e:
@@ -826,12 +830,13 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                     outcome = Outcome(item.index, item.label, item.output, "failed", error=_one_line(e))
                 _finish(outcome, item, summary, state, on_outcome, progress)
             if died:
-                for item in inflight.values():  # the whole local pool went down with it
-                    died.append(item)
-                inflight.clear()
+                if isinstance(pool, LocalPool):  # the whole local pool went down with it
+                    died.extend(inflight.values())
+                    inflight.clear()
                 for item in sorted(died, key=lambda it: it.index, reverse=True):
                     attempts[item.index] += 1
-                    if attempts[item.index] >= MAX_ATTEMPTS or isinstance(pool, DaskPool):
+                    # Dask has already tried it on MAX_ATTEMPTS workers (its allowed-failures).
+                    if attempts[item.index] >= MAX_ATTEMPTS or not isinstance(pool, LocalPool):
                         outcome = Outcome(item.index, item.label, item.output, "failed",
                                           error="the worker running it died each time it was tried "
                                                 "(killed, or out of memory)")
