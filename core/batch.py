@@ -577,13 +577,24 @@ def _pid_after(seconds: float) -> int:
     return os.getpid()
 
 
-def _init_local_worker(method_name: str, cancel_event) -> None:
+def _exit_with_parent(parent: int) -> None:
+    """A local worker's watch: if the client process is gone (killed), the worker ends too instead
+    of waiting for items forever (an item it was writing is lost whole: writes are atomic)."""
+    while True:
+        time.sleep(0.5)
+        if os.getppid() != parent:
+            os._exit(1)
+
+
+def _init_local_worker(method_name: str, cancel_event, parent: int | None = None) -> None:
     """Local pool worker start: Ctrl-C is the client's to handle; kernels are loaded once."""
     import signal
 
     global _cancel_event
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _cancel_event = cancel_event
+    if parent is not None:
+        threading.Thread(target=_exit_with_parent, args=(parent,), name="weft-batch-parent", daemon=True).start()
     warm_up(method_name)
 
 
@@ -610,7 +621,7 @@ class LocalPool:
 
     def _start(self) -> None:
         self.executor = cf.ProcessPoolExecutor(self.workers, mp_context=self.ctx, initializer=_init_local_worker,
-                                               initargs=(self.method, self.cancel_event))
+                                               initargs=(self.method, self.cancel_event, os.getpid()))
         if self.workers > 1:
             # One worker loads the kernels before the others start: on a first run (no numba cache
             # yet) it compiles them once and the others load its cache, instead of every worker

@@ -6,6 +6,7 @@ a re-run resumes; nothing is ever overwritten that is an input, nor left half-wr
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -287,14 +288,26 @@ def test_a_killed_batch_leaves_whole_outputs_and_resumes(slow_scene):
     tmp, frames = slow_scene
     argv = ["batch", str(tmp / "look.json"), "--over", "target", str(tmp / "frames"), "-o",
             str(tmp / "out" / "{stem}.png"), "--workers", "1"]
-    proc = subprocess.Popen([*WEFT, *argv], cwd=tmp, start_new_session=True, stderr=subprocess.PIPE)
-    try:  # kill the whole process group (client and worker) as soon as two outputs exist
-        _wait_for(lambda: len(list((tmp / "out").glob("*.png"))) >= 2 if (tmp / "out").exists() else False)
-    finally:
-        os.killpg(proc.pid, signal.SIGKILL)
+    proc = subprocess.Popen([*WEFT, *argv, "--report"], cwd=tmp, start_new_session=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.DEVNULL, text=True)
+    def gone(pid):
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                return f.read().rsplit(")", 1)[1].split()[0] == "Z"  # a zombie has ended
+        except FileNotFoundError:
+            return True
+
+    try:  # kill the client (not its worker) as soon as two outputs exist
+        worker = int(json.loads(proc.stdout.readline())["worker"].rsplit(":", 1)[1])
+        _wait_for(lambda: len(list((tmp / "out").glob("*.png"))) >= 2)
+        proc.kill()
         proc.wait()
-        proc.stderr.close()
-    assert proc.returncode == -signal.SIGKILL
+        assert proc.returncode == -signal.SIGKILL
+        _wait_for(lambda: gone(worker))  # the orphaned worker ends by itself, within a second
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)  # nothing of the group may outlive a failed test
+        proc.stdout.close()
     written = sorted((tmp / "out").glob("*.png"))
     assert 2 <= len(written) < 8, "the kill must land mid-batch"
     # Every PNG there is whole and complete (atomic writes: a temp file never has the output's name).
