@@ -19,12 +19,11 @@ import json
 import os
 import secrets
 import sys
-import time
 from pathlib import Path
 from typing import Sequence
 
 from core import __version__
-from core.errors import Cancelled, ImageError, WeftError
+from core.errors import Cancelled, WeftError
 from core.params import specs
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
