@@ -19,6 +19,8 @@ import json
 import os
 import secrets
 import sys
+import threading
+import time
 from pathlib import Path
 from typing import Sequence
 
@@ -39,28 +41,100 @@ class _Parser(argparse.ArgumentParser):
 
 
 class _TerminalProgress:
-    """A one-line progress bar on stderr, drawn only when stderr is a terminal."""
+    """A one-line progress bar on stderr, drawn only when stderr is a terminal. It owns that line:
+    a :class:`_PreparingLine` ticking on it is ended (kept, with a newline) as the bar first draws."""
 
     wants_preview = False  # it draws the fraction only: algorithms need not build partial images
 
     def __init__(self, enabled: bool):
         self.enabled = enabled and sys.stderr.isatty()
         self.drawn = False
+        self.lock = threading.Lock()  # the preparing line ticks from its own thread
+        self.line_open = False  # a preparing line without its newline yet
 
     def __call__(self, p) -> None:
         if not self.enabled:
             return
         width = 30
         filled = int(round(p.fraction * width))
-        sys.stderr.write(f"\r{p.stage:<14} [{'#' * filled}{' ' * (width - filled)}] {p.fraction * 100:3.0f}%")
-        sys.stderr.flush()
-        self.drawn = True
+        with self.lock:
+            self._end_line()
+            sys.stderr.write(f"\r{p.stage:<14} [{'#' * filled}{' ' * (width - filled)}] {p.fraction * 100:3.0f}%")
+            sys.stderr.flush()
+            self.drawn = True
+
+    def _end_line(self) -> None:
+        if self.line_open:
+            sys.stderr.write("\n")
+            self.line_open = False
 
     def close(self) -> None:
-        if self.drawn:
-            sys.stderr.write("\n")
+        with self.lock:
+            self._end_line()
+            if self.drawn:
+                sys.stderr.write("\n")
+                self.drawn = False
             sys.stderr.flush()
-            self.drawn = False
+
+
+class _PreparingLine:
+    """Says on stderr that kernels are being compiled — the first run's long silent stretch (a cold
+    quilting transfer compiled for 39 s before its first progress report) — and keeps the line alive
+    with the seconds spent, every ``TICK`` s, until the progress bar takes over or the run ends.
+
+    Called from numba's compile events (``registry.watch_compiles``), i.e. only when a kernel really
+    compiles: a run that loads every kernel from numba's cache says nothing. Like the progress bar it
+    writes to a terminal only: stderr that is a file or a pipe belongs to scripts, for which weft
+    promises silence on success and exactly one line on failure (a ticking ``\r`` line would be
+    noise in a log); installers, render nodes and CI run ``weft warm-up`` first, which prints on
+    stdout what it compiled. ``wait(seconds) -> stopped`` is injectable for tests.
+    """
+
+    TICK = 1.0
+
+    def __init__(self, method: str, bar: _TerminalProgress, wait=None):
+        self.method = method
+        self.bar = bar
+        self.said = False
+        self._stop = threading.Event()
+        self._wait = wait if wait is not None else self._stop.wait
+        self.thread: threading.Thread | None = None
+
+    def text(self) -> str:
+        from core import registry
+
+        if registry.kernel_cache_notice() is not None:
+            return f"weft: compiling the {self.method} method's kernels (no cache: every run)"
+        return f"weft: {registry.preparing_text(self.method)} (compiling kernels)"  # < 80 columns
+
+    def __call__(self) -> None:
+        with self.bar.lock:
+            if self.said or not self.bar.enabled:
+                return
+            self.said = True
+            text = self.text()
+            if self.bar.drawn:  # a bar already drawn keeps its line; this one goes below it
+                sys.stderr.write("\n")
+                self.bar.drawn = False
+            sys.stderr.write(text)
+            sys.stderr.flush()
+            self.bar.line_open = True
+        self.thread = threading.Thread(target=self._tick, args=(text, time.monotonic()), daemon=True,
+                                       name="weft-preparing")
+        self.thread.start()
+
+    def _tick(self, text: str, since: float) -> None:
+        while not self._wait(self.TICK):
+            with self.bar.lock:
+                if not self.bar.line_open:
+                    return  # the bar took over, or the run ended
+                sys.stderr.write(f"\r{text} {time.monotonic() - since:.0f} s")
+                sys.stderr.flush()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self.thread is not None and self.thread is not threading.current_thread():
+            self.thread.join()
 
 
 def _add_common(p: argparse.ArgumentParser) -> None:
@@ -108,6 +182,13 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                                help="; ".join(bits).replace("%", "%%"))
         _add_common(p)
         p.set_defaults(method=method.name)
+    w = sub.add_parser("warm-up", help="prepare every method's compiled kernels now (installers, render nodes, CI)",
+                       description="Compile (or load) every method's numba kernels ahead of time, one process "
+                       "per method in parallel, into numba's cache, so that no later run pays the compile. "
+                       "Prints one line per method on stdout.")
+    w.add_argument("--jobs", metavar="N", help="processes at once (default: the number of CPUs)")
+    w.add_argument("-q", "--quiet", action="store_true", help="print nothing (errors still print)")
+    w.set_defaults(method=None)
     r = sub.add_parser("run", help="reproduce a recipe (.json, or a PNG exported by weft)",
                        description="Reproduce a recipe: the same method, parameters, inputs and seed.")
     r.add_argument("recipe", metavar="RECIPE", help="recipe JSON file, or a PNG exported by weft")
@@ -172,10 +253,16 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         seed = secrets.randbits(31)
 
     bar = _TerminalProgress(not args.quiet)
+    preparing = _PreparingLine(method.name, bar)
     try:
-        result, seconds = render(method, params, input_paths, seed, region, progress=bar)
+        with registry.watch_compiles(on_start=preparing):  # a kernel compiling: say so on the terminal
+            result, seconds = render(method, params, input_paths, seed, region, progress=bar)
     finally:
+        preparing.stop()
         bar.close()
+    notice = registry.kernel_cache_notice()
+    if notice is not None and not args.quiet:
+        print(f"weft: {notice}", file=sys.stderr)
     recipe = output_recipe(method, params, input_paths, seed, region, out)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if args.report:
@@ -183,6 +270,46 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         line = {"method": method.name, "seconds": round(seconds, 6), "size": [w, h], "seed": seed}
         line.update(result.figures)
         print(json.dumps(line), flush=True)
+    return 0
+
+
+def _warm_up_all(args: argparse.Namespace) -> int:
+    """``weft warm-up``: every method's ``warm_up`` in its own fresh process, ``--jobs`` at once."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    from core import registry
+
+    names = [m.name for m in registry.methods().values() if m.warm_up is not None]
+    jobs = _parse_int(args.jobs, "jobs", 1, 1024) or os.cpu_count() or 1
+    say = (lambda text: None) if args.quiet else (lambda text: print(text, flush=True))
+    t0 = time.perf_counter()
+    failed = []
+    notices = set()
+    # "spawn", one task per child: each method in a fresh interpreter (no inherited numba state or
+    # threads), as a real run is, so its figures say what a first run of that method costs.
+    with ProcessPoolExecutor(max_workers=min(jobs, len(names)), mp_context=multiprocessing.get_context("spawn"),
+                             max_tasks_per_child=1) as pool:
+        futures = {pool.submit(registry.warm_up_report, name): name for name in names}
+        for future in as_completed(futures):
+            name = futures[future]
+            try:
+                r = future.result()
+            except Exception as e:  # a broken kernel is a bug: say which method, keep warming the others
+                failed.append(name)
+                print(f"weft: warm-up of {name} failed: {type(e).__name__}: {e}", file=sys.stderr)
+                continue
+            if r["notice"]:
+                notices.add(r["notice"])
+            what = (f"compiled {r['compiled']} function{'s' if r['compiled'] != 1 else ''}" if r["compiled"]
+                    else "loaded from the cache")
+            say(f"{name:8} {what} in {r['seconds']:.1f} s")
+    for notice in sorted(notices):
+        print(f"weft: {notice}", file=sys.stderr)
+    if failed:
+        return 1
+    say(f"weft: {len(names)} methods ready in {time.perf_counter() - t0:.1f} s "
+        f"({min(jobs, len(names))} processes at once)")
     return 0
 
 
@@ -194,6 +321,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         from app.batch_cli import run_batch
 
         return run_batch(args)
+    if args.command == "warm-up":
+        return _warm_up_all(args)
     if args.command == "run":
         from core.run import check_recipe, load_recipe
 

@@ -45,12 +45,22 @@ ProgressCallback = Callable[["Progress"], None]
 
 class Progress(NamedTuple):
     """One progress report: ``stage`` (e.g. ``"transfer 2/3"``), ``done`` and ``total`` units of
-    work (blocks, rows, iterations) and an optional ``preview``, the partly built image."""
+    work (blocks, rows, iterations) and an optional ``preview``, the partly built image.
+
+    ``preparing`` marks a stage whose length is unknown and that is not the work itself — a
+    method's kernels compiling on a first run (:meth:`preparing_stage`): show its words, not a
+    percentage."""
 
     stage: str
     done: int
     total: int
     preview: np.ndarray | None = None
+    preparing: bool = False
+
+    @classmethod
+    def preparing_stage(cls, text: str) -> "Progress":
+        """A report that the job is preparing (``text`` says what), before any work is done."""
+        return cls(text, 0, 0, None, True)
 
     @property
     def fraction(self) -> float:

@@ -9,6 +9,8 @@ method here. Adding a method = writing its module + one line in ``_MODULES``.
 from __future__ import annotations
 
 import importlib
+import threading
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
@@ -109,8 +111,156 @@ def get(name: str) -> Method:
     return _loaded[name]
 
 
-def warm_up_all() -> None:
-    """Run every method's ``warm_up`` (for a background thread at GUI start)."""
-    for method in methods().values():
-        if method.warm_up is not None:
-            method.warm_up()
+# --- warm-up: loading (or compiling) the methods' kernels ahead of their first run -------------------
+#
+# ``warm_up(name)`` runs a method's ``warm_up`` at most once per process (concurrent callers wait for
+# the one running it); ``is_warm(name)`` then tells a front end that the method's kernels are loaded,
+# so a render can be timed without them. Whether a real compile is happening (a first run: numba's
+# cache is cold) is known from numba's compile events, which ``core._kernels`` forwards here:
+# ``watch_compiles()`` counts them and their time, ``compiling()`` tells whether one is under way.
+
+#: What a front end shows while a method's kernels compile (``{name}`` is the method's name).
+PREPARING = "preparing the {name} method — first run only"
+
+_warm: set[str] = set()
+_warm_locks: dict[str, threading.Lock] = {}
+_warm_lock = threading.Lock()
+_watchers: list["CompileWatch"] = []
+_watch_lock = threading.Lock()
+_compiles_running = 0
+_cache_notes: list[str] = []
+
+
+def preparing_text(name: str) -> str:
+    """The words a front end shows while ``name``'s kernels compile."""
+    return PREPARING.format(name=get(name).name)
+
+
+def is_warm(name: str) -> bool:
+    """Whether ``name``'s kernels are loaded in this process (its ``warm_up`` has run, or it has none)."""
+    return name in _warm or get(name).warm_up is None
+
+
+def warm_up(name: str) -> bool:
+    """Run ``name``'s ``warm_up`` unless it already ran in this process; returns True if it ran here.
+
+    Thread-safe: a second caller waits for the first one to finish rather than warming up twice."""
+    method = get(name)
+    if method.warm_up is None or name in _warm:
+        return False
+    with _warm_lock:
+        lock = _warm_locks.setdefault(name, threading.Lock())
+    with lock:
+        if name in _warm:
+            return False
+        method.warm_up()
+        _warm.add(name)
+    return True
+
+
+def warm_up_all(first: str | None = None, cancel=None) -> list[str]:
+    """Warm up every method not yet warm (``first`` before the others, then registration order), for
+    a background thread in the studio; ``cancel`` (a ``CancelToken``) is checked between methods.
+    Returns the names warmed up here."""
+    order = ([first] if first in _MODULES else []) + [n for n in _MODULES if n != first]
+    done = []
+    for name in order:
+        if cancel is not None:
+            cancel.raise_if_cancelled()
+        if warm_up(name):
+            done.append(name)
+    return done
+
+
+def warm_up_report(name: str) -> dict[str, Any]:
+    """Warm ``name`` up in this (fresh) process and say what happened: ``{"method", "seconds",
+    "compiled", "notice"}`` with ``compiled`` the number of kernels compiled (0: all loaded from the
+    cache). For ``weft warm-up``, which runs one process per method."""
+    import time
+
+    t0 = time.perf_counter()
+    with watch_compiles() as watch:
+        warm_up(name)
+    return {"method": name, "seconds": time.perf_counter() - t0, "compiled": watch.count,
+            "notice": kernel_cache_notice()}
+
+
+class CompileWatch:
+    """numba compilations seen while a :func:`watch_compiles` block runs: ``count`` (every function
+    compiled, the kernels a kernel calls included) and ``seconds`` (wall time of the outermost
+    compiles, which contain the nested ones)."""
+
+    def __init__(self, thread: int | None, on_start: Callable[[], None] | None) -> None:
+        self.thread = thread
+        self.on_start = on_start
+        self.count = 0
+        self.seconds = 0.0
+        self._started: dict[int, float] = {}
+
+    def _start(self, thread: int, now: float, outermost: bool) -> None:
+        self.count += 1
+        if outermost:
+            self._started[thread] = now
+            if self.on_start is not None:
+                self.on_start()
+
+    def _end(self, thread: int, now: float, outermost: bool) -> None:
+        started = self._started.pop(thread, None) if outermost else None
+        if started is not None:
+            self.seconds += now - started
+
+
+@contextmanager
+def watch_compiles(*, this_thread: bool = False, on_start: Callable[[], None] | None = None):
+    """Count numba compilations (and their time) while the block runs, in any thread or, with
+    ``this_thread``, only the calling thread's; ``on_start()`` is called (on the compiling thread) as
+    each one starts. A cache load is no compilation: a warm run sees none."""
+    watch = CompileWatch(threading.get_ident() if this_thread else None, on_start)
+    with _watch_lock:
+        _watchers.append(watch)
+    try:
+        yield watch
+    finally:
+        with _watch_lock:
+            _watchers.remove(watch)
+
+
+def compiling() -> bool:
+    """Whether a numba compilation is under way in some thread of this process."""
+    return _compiles_running > 0
+
+
+def _notify(started: bool, outermost: bool) -> None:
+    import time
+
+    global _compiles_running
+    now = time.perf_counter()
+    me = threading.get_ident()
+    with _watch_lock:
+        if outermost:
+            _compiles_running += 1 if started else -1
+        watchers = [w for w in _watchers if w.thread is None or w.thread == me]
+    for w in watchers:
+        (w._start if started else w._end)(me, now, outermost)
+
+
+def compile_started(outermost: bool = True) -> None:
+    """Called by ``core._kernels`` when a thread starts compiling a function (a cache miss);
+    ``outermost``: not a function compiled inside another one's compile."""
+    _notify(True, outermost)
+
+
+def compile_ended(outermost: bool = True) -> None:
+    """Called by ``core._kernels`` when that compilation ends."""
+    _notify(False, outermost)
+
+
+def note_kernel_cache(message: str) -> None:
+    """Called by ``core._kernels`` when numba's cache cannot be used (kept once)."""
+    if message not in _cache_notes:
+        _cache_notes.append(message)
+
+
+def kernel_cache_notice() -> str | None:
+    """A one-line notice if the kernels run without numba's on-disk cache (no writable folder)."""
+    return _cache_notes[0] if _cache_notes else None

@@ -123,7 +123,8 @@ def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
     The first input is cropped to ``region`` when given; an input smaller than its ``min_side`` is
     refused naming its file; a ``WeftError`` about one input gets its file name in front.
     ``warm_up`` loads the method's kernels first (when the method asks for that on the command line),
-    so ``seconds`` is the compute alone. ``shown_paths`` are the names to use in messages when the
+    so ``seconds`` is the compute alone; a kernel compiled during the run (this thread's numba
+    compiles) is left out of it too. ``shown_paths`` are the names to use in messages when the
     files read are copies (a batch's shipped inputs).
     """
     from .image import crop_square, load_image
@@ -139,15 +140,21 @@ def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
             cropped = " (the --region crop)" if region is not None and spec is method.inputs[0] else ""
             raise ImageError(f"{shown[spec.name]}: the {spec.name} is {w}x{h}{cropped}; weft {method.name} "
                              f"needs at least {spec.min_side}x{spec.min_side} pixels", path=shown[spec.name])
-    if warm_up and method.warm_up is not None and method.warm_up_in_cli:
-        method.warm_up()  # load compiled kernels now, so "seconds" is the compute alone
-    t0 = time.perf_counter()
-    try:
-        result = method.run(images, params, rng=seed, progress=progress, cancel=cancel)
-    except WeftError as e:
-        if e.input in shown:  # about one image (a block that does not fit it): say which file
-            named = type(e)(f"{shown[e.input]}: {e}")
-            named.__dict__.update(e.__dict__)
-            raise named from None
-        raise
-    return result, time.perf_counter() - t0
+    from . import registry
+
+    with registry.watch_compiles(this_thread=True) as compiles:
+        if warm_up and method.warm_up_in_cli:
+            registry.warm_up(method.name)  # load compiled kernels now, so "seconds" is the compute alone
+        before = compiles.seconds
+        t0 = time.perf_counter()
+        try:
+            result = method.run(images, params, rng=seed, progress=progress, cancel=cancel)
+        except WeftError as e:
+            if e.input in shown:  # about one image (a block that does not fit it): say which file
+                named = type(e)(f"{shown[e.input]}: {e}")
+                named.__dict__.update(e.__dict__)
+                raise named from None
+            raise
+        # kernels compiled on the way (a first run of a method that loads them lazily) are not compute
+        seconds = time.perf_counter() - t0 - (compiles.seconds - before)
+    return result, max(0.0, seconds)

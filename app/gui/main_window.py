@@ -143,14 +143,16 @@ class MainWindow(FilesMixin, QMainWindow):
         self.renderer.shown.connect(self._on_shown)
         self.renderer.partial.connect(lambda img: self.result_view.set_image(img))
         self.renderer.progress.connect(self._on_progress)
+        self.renderer.preparing.connect(self._on_preparing)
         self.renderer.busy.connect(self._on_busy)
         self.renderer.failed.connect(self._on_failed)
         self.renderer.cancelled.connect(self._on_cancelled)
         self._rebuild_method()
         self.restoreGeometry(self.settings.value("geometry", b""))
         self.restoreState(self.settings.value("state", b""))
-        # Load the methods' compiled kernels off the GUI thread, so the first result is not slow.
-        self.renderer.runner.submit("warm-up", _warm_up_job)
+        # The method on screen loads (or compiles) its kernels in its own first render; the other
+        # methods' are loaded off the GUI thread once that first result is shown.
+        self.renderer.warm_up_soon()
         if load_defaults:
             self.load_examples()
         self.offer_recovery()  # before the autosave is connected: opening the examples must not remove it
@@ -526,14 +528,28 @@ class MainWindow(FilesMixin, QMainWindow):
         self.statusBar().showMessage(describe(shown))
 
     def _on_progress(self, fraction: float, stage: str) -> None:
+        self.result_view.set_notice(None)
+        self.progress_bar.setRange(0, 1000)
         self.progress_bar.setValue(int(fraction * 1000))
         self.progress_bar.setFormat(f"{stage} %p%")
+
+    def _on_preparing(self, words: str) -> None:
+        """A first run: the method's kernels compile before any work can be counted — say so in
+        words on the result and keep the bar moving without a percentage."""
+        self.result_view.set_notice(words)
+        self.progress_bar.setRange(0, 0)  # busy indicator
+        self.progress_bar.setFormat(words)
+        self.progress_bar.setToolTip(words)
 
     def _on_busy(self, busy: bool) -> None:
         self.progress_bar.setVisible(busy)
         self.cancel_button.setVisible(busy)
         if busy:
-            self.progress_bar.setValue(0)
+            if self.progress_bar.maximum() > 0:  # not while preparing
+                self.progress_bar.setValue(0)
+        else:
+            self.result_view.set_notice(None)
+            self.progress_bar.setRange(0, 1000)
 
     def _on_failed(self, message: str) -> None:
         self.show_message(message)
@@ -608,10 +624,6 @@ class MainWindow(FilesMixin, QMainWindow):
         self.settings.setValue("state", self.saveState())
         self.shutdown()
         super().closeEvent(event)
-
-
-def _warm_up_job(*, progress=None, cancel=None) -> None:
-    registry.warm_up_all()
 
 
 def _load_job(name: str, path: str, *, progress=None, cancel=None):

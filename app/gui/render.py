@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
+from core import registry
 from core.errors import WeftError
 from core.image import resize
 from core.jobs import JobResult, JobRunner, Progress
@@ -30,6 +31,7 @@ PREVIEW_SIDE = 400
 FULL_PREVIEW_PIXELS: dict[str, int] = {}  # method -> pixel count up to which previews are full size
 PROGRESS_DELAY_MS = 300
 PARTIAL_INTERVAL = 0.25
+WARM_UP_DELAY_MS = 3000  # no render at start: warm the kernels up after this long anyway
 
 
 class _Partial:
@@ -46,13 +48,39 @@ class _Partial:
 
 @dataclass
 class Shown:
-    """What the result view shows: the image, which job made it and how long it took."""
+    """What the result view shows: the image, which job made it and how long it took (``seconds``:
+    the render alone; ``prepared``: the method's kernels compiling first, on a first run)."""
 
     image: np.ndarray
     job_id: int
     seconds: float
     figures: dict
     final: bool
+    prepared: float = 0.0
+
+
+def _render(method, inputs, params, seed, report, cancel, *, final: bool):
+    """Run ``method`` for a render job: its kernels first if this process has not loaded them yet
+    (``report`` then hears the method's "preparing" words as soon as a compile starts, or at once
+    if another thread is compiling, i.e. holds numba's lock), then the render, timed without any
+    compile. Returns ``(result, render seconds, final, compile seconds)``."""
+    said = []
+
+    def preparing() -> None:
+        if report is not None and not said:
+            said.append(True)
+            report(Progress.preparing_stage(registry.preparing_text(method.name)))
+
+    with registry.watch_compiles(this_thread=True, on_start=preparing) as compiles:
+        if not registry.is_warm(method.name):
+            if registry.compiling():
+                preparing()
+            registry.warm_up(method.name)
+        before = compiles.seconds
+        t0 = time.perf_counter()
+        result = method.run(inputs, params, rng=seed, progress=report, cancel=cancel)
+        seconds = time.perf_counter() - t0 - (compiles.seconds - before)
+    return result, max(0.0, seconds), final, compiles.seconds
 
 
 class Renderer(QObject):
@@ -60,12 +88,15 @@ class Renderer(QObject):
 
     Signals: ``shown(Shown)`` a new result to display; ``partial(image)`` a partial image of a
     running job; ``progress(fraction, stage)``; ``busy(bool)`` a job over the progress delay is
-    running (show the bar); ``failed(message)``; ``cancelled()``.
+    running (show the bar); ``failed(message)``; ``cancelled()``; ``preparing(words)`` the running
+    final render is waiting for its method's kernels to compile (a first run), in words for the
+    result view (then ``progress`` takes over again).
     """
 
     shown = Signal(object)
     partial = Signal(object)
     progress = Signal(float, str)
+    preparing = Signal(str)
     busy = Signal(bool)
     failed = Signal(str)
     cancelled = Signal()
@@ -93,6 +124,10 @@ class Renderer(QObject):
         self._busy_timer = QTimer(self, singleShot=True, interval=PROGRESS_DELAY_MS)
         self._busy_timer.timeout.connect(self._maybe_busy)
         self.enabled = True
+        self._warm_up_timer = QTimer(self, singleShot=True)
+        self._warm_up_timer.timeout.connect(self._warm_up_due)
+        self._warm_up_started = False
+        self._warm_up_wanted = False
 
     # --- requests ------------------------------------------------------------------------------
     def preview(self) -> None:
@@ -122,6 +157,8 @@ class Renderer(QObject):
         self.cancelled.emit()
 
     def shutdown(self) -> None:
+        self._warm_up_timer.stop()
+        self._warm_up_wanted = False  # a result still queued must not start it on a closed runner
         self._preview_timer.stop()
         self._final_timer.stop()
         self._busy_timer.stop()
@@ -152,9 +189,7 @@ class Renderer(QObject):
             # Previews report nothing; a final render's partial images are built at most every
             # PARTIAL_INTERVAL seconds (a fast render never pays for one).
             report = None if preview or progress is None else _Partial(progress)
-            t0 = time.perf_counter()
-            result = method.run(inputs, params, rng=seed, progress=report, cancel=cancel)
-            return result, time.perf_counter() - t0, not preview
+            return _render(method, inputs, params, seed, report, cancel, final=not preview)
 
         if slot == "final":
             self.runner.cancel("preview")
@@ -196,18 +231,22 @@ class Renderer(QObject):
             self._final_running = False
             self._busy_timer.stop()
             self.busy.emit(False)
+            self._start_warm_up()  # the first result (or error) is in: the other methods' turn
         if result.error is not None:
             if self.last is None or result.job_id > self.last.job_id:
                 self.failed.emit(f"render failed: {result.error}")
             return
         if self.last is not None and result.job_id < self.last.job_id:
             return  # older than what is shown: stale
-        res, seconds, final = result.value
-        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final)
+        res, seconds, final, prepared = result.value
+        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared)
         self.shown.emit(self.last)
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
         if slot != "final" or job_id != self.latest_final:
+            return
+        if p.preparing:
+            self.preparing.emit(p.stage)
             return
         self.progress.emit(p.fraction, p.stage)
         if p.preview is not None:
@@ -216,6 +255,33 @@ class Renderer(QObject):
     def _maybe_busy(self) -> None:
         if self._final_running:
             self.busy.emit(True)
+
+    # --- kernels warm-up -----------------------------------------------------------------------
+    def warm_up_soon(self, delay_ms: int = WARM_UP_DELAY_MS) -> None:
+        """Load (or compile) the other methods' kernels in the background — after the first full
+        result is shown, or after ``delay_ms`` if no render is running then — so that they never
+        make the visible render wait: numba compiles under one process-wide lock, and a warm-up
+        that went first held the first result back behind every other method's compile."""
+        self._warm_up_wanted = True
+        self._warm_up_timer.start(delay_ms)
+
+    def _warm_up_due(self) -> None:
+        if self._final_running:
+            self._warm_up_timer.start()  # that render's result starts it (or the next timeout)
+        else:
+            self._start_warm_up()
+
+    def _start_warm_up(self) -> None:
+        if self._warm_up_started or not self._warm_up_wanted:
+            return  # already started, or never asked for (warm_up_soon not called)
+        self._warm_up_started = True
+        self._warm_up_timer.stop()
+        current = self.doc.method
+
+        def warm_up_others(*, progress=None, cancel=None):
+            return registry.warm_up_all(first=current, cancel=cancel)
+
+        self.runner.submit("warm-up", warm_up_others)
 
 
 def reduced(inputs: dict[str, np.ndarray], params: Params, side: int, full_pixels: int = 0
@@ -248,4 +314,5 @@ def describe(shown: Shown) -> str:
     kind = "result" if shown.final else "preview"
     figs = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in shown.figures.items()
                      if not isinstance(v, (list, dict)))
-    return f"{kind} {w}x{h} in {shown.seconds * 1000:.0f} ms" + (f" — {figs}" if figs else "")
+    prepared = f" (after preparing its kernels for {shown.prepared:.1f} s, first run only)" if shown.prepared >= 0.05 else ""
+    return f"{kind} {w}x{h} in {shown.seconds * 1000:.0f} ms{prepared}" + (f" — {figs}" if figs else "")

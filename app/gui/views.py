@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QPainter, QPen, QPixmap
-from PySide6.QtWidgets import QGraphicsLineItem, QGraphicsPixmapItem, QGraphicsRectItem, QGraphicsScene, QGraphicsView
+from PySide6.QtWidgets import (QGraphicsLineItem, QGraphicsPixmapItem, QGraphicsRectItem, QGraphicsScene, QGraphicsView,
+                               QLabel)
 
 from .convert import to_qimage
 
@@ -229,6 +230,34 @@ class ResultView(ImageView):
         self.comparing = False
         self._dragging_split = False
         self._update_compare()
+        self.notice = QLabel(self.viewport())
+        self.notice.setObjectName("result-notice")
+        self.notice.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.notice.setWordWrap(True)
+        self.notice.setStyleSheet("QLabel { background: rgba(20, 20, 20, 200); color: white; padding: 12px 18px;"
+                                  " border-radius: 6px; font-size: 15px; }")
+        self.notice.hide()
+
+    def set_notice(self, text: str | None) -> None:
+        """Words shown over the middle of the result (e.g. what a long first run is doing); None hides them."""
+        if not text:
+            self.notice.hide()
+            return
+        self.notice.setText(text)
+        self._place_notice()
+        self.notice.show()
+
+    def _place_notice(self) -> None:
+        vp = self.viewport().rect()
+        width = min(max(vp.width() - 40, 120), 520)
+        self.notice.setFixedWidth(width)
+        self.notice.adjustSize()
+        self.notice.move(vp.center().x() - width // 2, vp.center().y() - self.notice.height() // 2)
+
+    def resizeEvent(self, event):  # noqa: N802
+        super().resizeEvent(event)
+        if self.notice.isVisible():
+            self._place_notice()
 
     def set_compare(self, image: np.ndarray | None) -> None:
         """The "before" image (e.g. the target), shown left of the divider when comparing."""

@@ -1,1 +1,168 @@
-"""numba kernels (njit, cache=True, nogil=True), one module per method."""
+"""numba kernels (njit, cache=True, nogil=True), one module per method.
+
+Importing this package (which every kernel module does first) prepares numba's on-disk cache and
+reports compilations; it is the only place that knows about numba's caching machinery:
+
+* **A cache folder that always works.** numba looks for a writable cache folder in turn: the
+  folder ``NUMBA_CACHE_DIR`` names, the package's own ``__pycache__``, then the user's cache folder
+  (``~/.cache/numba``); when none is writable — a shared read-only install used with
+  ``HOME=/nonexistent``, as on some render nodes — decorating a kernel raised ``RuntimeError: cannot
+  cache function ...: no locator available`` and every numba method died. We add a last folder to
+  that list: ``weft-numba-<uid>`` in the system's temporary folder, private to the user (created
+  0700; one owned by someone else, or open to others, is refused: numba's cache files are pickles,
+  loading a planted one would run its code). The user-wide and the temporary folder are seeded
+  from the package's own ``__pycache__`` (what ``weft warm-up`` wrote there at install time), so a
+  read-only install that was warmed up stays warm for every user. If even that fails, the kernels are compiled without a
+  cache (every run pays the compile) and :func:`core.registry.kernel_cache_notice` says so in one
+  line for the front ends to show.
+* **Compile events.** numba announces every real compilation (a cache miss, never a cache load) as
+  a ``numba:compile`` event; we forward their start and end to :mod:`core.registry`, which lets a
+  front end say "preparing ... — first run only" exactly while a compile happens, and leave the
+  compile out of a render's time.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import stat
+import tempfile
+import threading
+
+from numba.core import caching as _caching
+from numba.core import dispatcher as _dispatcher
+from numba.core import event as _event
+
+from .. import registry as _registry
+
+_FALLBACK_PREFIX = "weft-numba-"
+
+
+def fallback_cache_root() -> str:
+    """The per-user cache folder used when numba finds no writable one of its own."""
+    uid = os.getuid() if hasattr(os, "getuid") else os.getlogin()
+    return os.path.join(tempfile.gettempdir(), f"{_FALLBACK_PREFIX}{uid}")
+
+
+def _private_folder(path: str) -> bool:
+    """Create ``path`` (0700) if needed; True if it is a folder that only this user controls."""
+    try:
+        os.makedirs(path, mode=0o700, exist_ok=True)
+        st = os.lstat(path)
+    except OSError:
+        return False
+    if not stat.S_ISDIR(st.st_mode):
+        return False
+    if hasattr(os, "getuid") and (st.st_uid != os.getuid() or st.st_mode & 0o022):
+        return False  # someone else's, or writable by others: its pickles cannot be trusted
+    return True
+
+
+def _seed_from_tree(py_file: str, cache_path: str) -> None:
+    """Copy the cache files of ``py_file``'s kernels from the package's own ``__pycache__`` (written
+    there by ``weft warm-up`` run by whoever installed weft, when that folder was writable for them)
+    into ``cache_path``, unless already there: a read-only install then still starts warm. numba
+    checks each index against the source's hash, so a stale copy is simply ignored."""
+    tree = os.path.join(os.path.dirname(py_file), "__pycache__")
+    prefix = os.path.splitext(os.path.basename(py_file))[0] + "."
+    try:
+        names = [n for n in os.listdir(tree) if n.startswith(prefix) and n.endswith((".nbi", ".nbc"))]
+    except OSError:
+        return
+    for name in names:
+        target = os.path.join(cache_path, name)
+        if os.path.exists(target):
+            continue
+        try:
+            shutil.copyfile(os.path.join(tree, name), target + ".seed")
+            os.replace(target + ".seed", target)
+        except OSError:
+            return
+
+
+class UserWideCacheLocator(_caching.UserWideCacheLocator):
+    """numba's user-wide cache folder (``~/.cache/numba``), seeded from the package's own cache."""
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        self = super().from_function(py_func, py_file)
+        if self is not None:
+            _seed_from_tree(py_file, self.get_cache_path())
+        return self
+
+
+class TempCacheLocator(_caching.UserProvidedCacheLocator):
+    """numba's last cache folder: :func:`fallback_cache_root`, one sub-folder per source folder (as
+    ``NUMBA_CACHE_DIR`` would be laid out)."""
+
+    def __init__(self, py_func, py_file):
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = os.path.join(fallback_cache_root(), self.get_suitable_cache_subpath(py_file))
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if not os.path.exists(py_file) or not _private_folder(fallback_cache_root()):
+            return None
+        self = cls(py_func, py_file)
+        try:
+            self.ensure_cache_path()
+        except OSError:
+            return None
+        _seed_from_tree(py_file, self.get_cache_path())
+        return self
+
+
+def _install_fallback_locator() -> None:
+    classes = _caching.CacheImpl._locator_classes
+    if _caching.UserWideCacheLocator in classes:
+        classes[classes.index(_caching.UserWideCacheLocator)] = UserWideCacheLocator
+    if TempCacheLocator not in classes:
+        classes.append(TempCacheLocator)  # after numba's own: used only when they all fail
+
+
+_NO_CACHE_NOTICE = ("numba can write its cache nowhere (NUMBA_CACHE_DIR, the package folder, the home "
+                    "folder and {tmp} are not writable): kernels are compiled on every run")
+_original_enable_caching = _dispatcher.Dispatcher.enable_caching
+
+
+def _enable_caching_or_not(self):
+    """``Dispatcher.enable_caching`` that leaves a kernel uncached (numba's ``NullCache``) instead of
+    raising when no cache folder is usable at all."""
+    try:
+        _original_enable_caching(self)
+    except RuntimeError as e:
+        if "no locator available" not in str(e):
+            raise
+        self._cache = _caching.NullCache()
+        _registry.note_kernel_cache(_NO_CACHE_NOTICE.format(tmp=fallback_cache_root()))
+
+
+def _install_no_cache_fallback() -> None:
+    if _dispatcher.Dispatcher.enable_caching is not _enable_caching_or_not:
+        _dispatcher.Dispatcher.enable_caching = _enable_caching_or_not
+
+
+class _CompileListener(_event.Listener):
+    """Forwards numba's ``numba:compile`` events to the registry, saying which are a thread's outermost
+    (a kernel compiles the kernels it calls inside its own compile)."""
+
+    def __init__(self):
+        self._depth = threading.local()
+
+    def on_start(self, event):
+        depth = getattr(self._depth, "n", 0)
+        self._depth.n = depth + 1
+        _registry.compile_started(outermost=depth == 0)
+
+    def on_end(self, event):
+        depth = getattr(self._depth, "n", 1) - 1
+        self._depth.n = depth
+        _registry.compile_ended(outermost=depth == 0)
+
+
+_install_fallback_locator()
+_install_no_cache_fallback()
+if not getattr(_registry, "_compile_listener_installed", False):
+    _event.register("numba:compile", _CompileListener())
+    _registry._compile_listener_installed = True

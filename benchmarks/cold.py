@@ -1,0 +1,208 @@
+"""First run against second: ``python -m benchmarks.cold [--runs 3] [--only NAME...] [--json PATH]``.
+
+What a newcomer meets. Every command of the table runs as its own ``weft`` process, with stderr on a
+pseudo-terminal (as in a shell, so the progress bar and the "preparing" line are drawn), ``runs``
+times *cold* — each in a fresh, empty ``NUMBA_CACHE_DIR``, so every kernel compiles — and ``runs``
+times *warm* — in the folder the last cold run filled. Per command it reports the median wall time
+of each, their ratio, and the longest stretch the terminal stayed silent (from the start to the
+first byte on stderr, between two writes, or from the last write to the exit), cold.
+
+The studio row is the time from starting the process to the first full result shown (offscreen
+Qt, the bundled examples, the real main window); ``warm-up`` is ``weft warm-up`` itself (every
+method's kernels, in parallel processes). Prints a Markdown table (the README's) and writes the
+rows as JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pty
+import select
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+RES = ROOT / "resources"
+
+
+def _weft() -> list[str]:
+    return [sys.executable, "-c", "import sys; from app.cli import main; sys.exit(main())"]
+
+
+def commands(tmp: Path) -> dict[str, list[str]]:
+    """The timed commands (the issue's table, plus blend and rectify in their kernel modes)."""
+    out = str(tmp / "out.png")
+    return {
+        "studio": [sys.executable, "-m", "benchmarks.cold", "--probe-studio"],
+        "quilt --target, 3 passes": [*_weft(), "quilt", str(RES / "gravel.png"), "--target", str(RES / "camera.png"),
+                                     "--iterations", "3", "-o", out],
+        "nfpt 1024x768": [*_weft(), "nfpt", str(RES / "perspective.png"), "--lines",
+                          str(RES / "perspective-lines.json"), "--size", "1024x768", "-o", out],
+        "affine": [*_weft(), "affine", str(RES / "brick.png"), "-o", out],
+        "fast --target": [*_weft(), "fast", str(RES / "gravel.png"), "--target", str(RES / "camera.png"), "-o", out],
+        "blend --mode poisson": [*_weft(), "blend", str(tmp / "fg.png"), str(tmp / "bg.png"), "--mask",
+                                 str(tmp / "mask.png"), "--mode", "poisson", "-o", out],
+        "rectify --warp lines": [*_weft(), "rectify", str(RES / "perspective.png"), "--lines",
+                                 str(RES / "perspective-lines.json"), "--warp", "lines", "-o", out],
+        "warm-up (all methods)": [*_weft(), "warm-up"],
+    }
+
+
+def _blend_inputs(tmp: Path) -> None:
+    import numpy as np
+
+    from core.image import load_image, save_image
+
+    fg = load_image(RES / "brick.png").image[:256, :256]
+    bg = load_image(RES / "gravel.png").image[:256, :256]
+    if bg.shape != fg.shape:
+        bg = np.resize(bg, fg.shape)
+    y, x = np.mgrid[:256, :256]
+    save_image(tmp / "fg.png", fg)
+    save_image(tmp / "bg.png", bg)
+    save_image(tmp / "mask.png", (((x - 128) ** 2 + (y - 128) ** 2) < 80 ** 2).astype(np.float32))
+
+
+def timed_run(cmd: list[str], cache: str, timeout: float = 600.0) -> dict:
+    """Run ``cmd`` with stderr on a pseudo-terminal; wall seconds (or, for the studio probe, seconds
+    to its first result), the longest silence on that terminal, and what it printed there."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache, QT_QPA_PLATFORM="offscreen", COLUMNS="100")
+    master, slave = pty.openpty()
+    t0 = time.time()
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=slave, close_fds=True)
+    os.close(slave)
+    writes, text = [t0], b""
+    out_chunks = []
+    open_fds = {master, proc.stdout.fileno()}
+    while open_fds:
+        ready, _, _ = select.select(list(open_fds), [], [], 0.05)
+        for fd in ready:
+            try:
+                chunk = os.read(fd, 65536)
+            except OSError:  # the child closed the terminal (EIO)
+                chunk = b""
+            if not chunk:
+                open_fds.discard(fd)
+            elif fd == master:
+                writes.append(time.time())
+                text += chunk
+            else:
+                out_chunks.append(chunk)
+        if time.time() - t0 > timeout:
+            proc.kill()
+            raise TimeoutError(f"{' '.join(cmd)} took over {timeout} s")
+    proc.wait()
+    end = time.time()
+    os.close(master)
+    stdout = b"".join(out_chunks).decode(errors="replace")
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd[-6:])} exited {proc.returncode}: {text.decode(errors='replace')[-400:]}")
+    seconds = end - t0
+    if "--probe-studio" in cmd:  # the probe prints when its first result was shown
+        probe = json.loads(stdout.strip().splitlines()[-1])
+        seconds = probe["shown_at"] - t0
+        end = probe["shown_at"]
+        writes = [t0, end]  # the studio says what it does in its window, not on a terminal
+    gaps = [b - a for a, b in zip(writes, writes[1:] + [end])]
+    return {"seconds": seconds, "silent": max(gaps), "stderr": text.decode(errors="replace")}
+
+
+def measure(names: list[str] | None = None, runs: int = 3) -> list[dict]:
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="weft-cold-") as tmp_s:
+        tmp = Path(tmp_s)
+        _blend_inputs(tmp)
+        for name, cmd in commands(tmp).items():
+            if names and name not in names:
+                continue
+            print(f"running {name} ...", file=sys.stderr, flush=True)
+            cold, silent = [], []
+            cache = ""
+            for i in range(runs):
+                cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
+                r = timed_run(cmd, cache)
+                cold.append(r["seconds"])
+                silent.append(r["silent"])
+            warm = [timed_run(cmd, cache)["seconds"] for _ in range(runs)]
+            rows.append({"command": name, "runs": runs, "cold_s": round(statistics.median(cold), 2),
+                         "warm_s": round(statistics.median(warm), 2),
+                         "ratio": round(statistics.median(cold) / statistics.median(warm), 2),
+                         "cold_silent_s": round(max(silent), 2),
+                         "cold_range": [round(min(cold), 2), round(max(cold), 2)],
+                         "warm_range": [round(min(warm), 2), round(max(warm), 2)]})
+            shutil.rmtree(cache, ignore_errors=True)
+    return rows
+
+
+def markdown_table(rows: list[dict]) -> str:
+    lines = ["| command | cold s | warm s | cold / warm | longest silence (cold) |", "| --- | --- | --- | --- | --- |"]
+    for r in rows:
+        silent = "—" if r["command"] == "studio" else f"{r['cold_silent_s']:.1f} s"
+        lines.append(f"| {r['command']} | {r['cold_s']:.1f} ({r['cold_range'][0]:.1f}–{r['cold_range'][1]:.1f}) | "
+                     f"{r['warm_s']:.1f} ({r['warm_range'][0]:.1f}–{r['warm_range'][1]:.1f}) | {r['ratio']:.1f}x | {silent} |")
+    return "\n".join(lines)
+
+
+def probe_studio() -> int:
+    """Open the studio as ``weft`` does (examples loaded, offscreen) and print, as one JSON line, the
+    wall-clock time its first full result was shown, with the render and kernel-preparation times."""
+    from PySide6.QtCore import QSettings, QTimer
+    from PySide6.QtWidgets import QApplication
+
+    from app.gui.main_window import MainWindow
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["WEFT_RECOVERY_DIR"] = tmp  # never touch the user's recovery file
+        settings = QSettings(os.path.join(tmp, "weft.ini"), QSettings.Format.IniFormat)
+        window = MainWindow(settings=settings)
+        window.show()
+        seen = {}
+
+        def shown(s) -> None:
+            if s.final and not seen:
+                seen.update(shown_at=time.time(), render_s=s.seconds, prepared_s=s.prepared)
+                QTimer.singleShot(0, app.quit)
+
+        window.renderer.shown.connect(shown)
+        window.renderer.failed.connect(lambda m: (seen.update(error=m), app.quit()))
+        QTimer.singleShot(300_000, app.quit)
+        app.exec()
+        window.doc.undo_stack.setClean()
+        window.close()
+    if "shown_at" not in seen:
+        print(f"no result: {seen.get('error', 'timed out')}", file=sys.stderr)
+        return 1
+    print(json.dumps(seen), flush=True)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.cold", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--runs", type=int, default=3, help="cold runs and warm runs per command (default 3)")
+    ap.add_argument("--only", nargs="*", metavar="NAME", help="only these commands (names as in the table)")
+    ap.add_argument("--json", type=Path, default=None, help="also write the rows here")
+    ap.add_argument("--probe-studio", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.probe_studio:
+        return probe_studio()
+    rows = measure(args.only, args.runs)
+    print(f"{os.cpu_count()} cores, cold = a fresh NUMBA_CACHE_DIR per run, median of {args.runs}")
+    print(markdown_table(rows))
+    if args.json is not None:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
