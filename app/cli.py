@@ -186,6 +186,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                        description="Compile (or load) every method's numba kernels ahead of time, one process "
                        "per method in parallel, into numba's cache, so that no later run pays the compile. "
                        "Prints one line per method on stdout.")
+    w.add_argument("methods", nargs="*", metavar="METHOD", help="only these methods (default: all)")
     w.add_argument("--jobs", metavar="N", help="processes at once (default: the number of CPUs)")
     w.add_argument("-q", "--quiet", action="store_true", help="print nothing (errors still print)")
     w.set_defaults(method=None)
@@ -280,7 +281,10 @@ def _warm_up_all(args: argparse.Namespace) -> int:
 
     from core import registry
 
-    names = [m.name for m in registry.methods().values() if m.warm_up is not None]
+    chosen = [registry.get(name) for name in args.methods] if args.methods else registry.methods().values()
+    names = [m.name for m in chosen if m.warm_up is not None]
+    if not names:
+        return 0
     jobs = _parse_int(args.jobs, "jobs", 1, 1024) or os.cpu_count() or 1
     say = (lambda text: None) if args.quiet else (lambda text: print(text, flush=True))
     t0 = time.perf_counter()
@@ -308,7 +312,7 @@ def _warm_up_all(args: argparse.Namespace) -> int:
         print(f"weft: {notice}", file=sys.stderr)
     if failed:
         return 1
-    say(f"weft: {len(names)} methods ready in {time.perf_counter() - t0:.1f} s "
+    say(f"weft: {len(names)} method{'s' if len(names) != 1 else ''} ready in {time.perf_counter() - t0:.1f} s "
         f"({min(jobs, len(names))} processes at once)")
     return 0
 

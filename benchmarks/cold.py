@@ -32,26 +32,25 @@ ROOT = Path(__file__).resolve().parent.parent
 RES = ROOT / "resources"
 
 
-def _weft() -> list[str]:
-    return [sys.executable, "-c", "import sys; from app.cli import main; sys.exit(main())"]
-
-
-def commands(tmp: Path) -> dict[str, list[str]]:
-    """The timed commands (the issue's table, plus blend and rectify in their kernel modes)."""
+def commands(tmp: Path, python: str = sys.executable) -> dict[str, list[str]]:
+    """The timed commands (the issue's table, plus blend and rectify in their kernel modes), run by
+    ``python`` (another checkout's interpreter measures that checkout: a baseline)."""
     out = str(tmp / "out.png")
+    weft = [python, "-c", "import sys; from app.cli import main; sys.exit(main())"]
+
     return {
-        "studio": [sys.executable, "-m", "benchmarks.cold", "--probe-studio"],
-        "quilt --target, 3 passes": [*_weft(), "quilt", str(RES / "gravel.png"), "--target", str(RES / "camera.png"),
+        "studio": [python, str(Path(__file__).resolve()), "--probe-studio"],
+        "quilt --target, 3 passes": [*weft, "quilt", str(RES / "gravel.png"), "--target", str(RES / "camera.png"),
                                      "--iterations", "3", "-o", out],
-        "nfpt 1024x768": [*_weft(), "nfpt", str(RES / "perspective.png"), "--lines",
+        "nfpt 1024x768": [*weft, "nfpt", str(RES / "perspective.png"), "--lines",
                           str(RES / "perspective-lines.json"), "--size", "1024x768", "-o", out],
-        "affine": [*_weft(), "affine", str(RES / "brick.png"), "-o", out],
-        "fast --target": [*_weft(), "fast", str(RES / "gravel.png"), "--target", str(RES / "camera.png"), "-o", out],
-        "blend --mode poisson": [*_weft(), "blend", str(tmp / "fg.png"), str(tmp / "bg.png"), "--mask",
+        "affine": [*weft, "affine", str(RES / "brick.png"), "-o", out],
+        "fast --target": [*weft, "fast", str(RES / "gravel.png"), "--target", str(RES / "camera.png"), "-o", out],
+        "blend --mode poisson": [*weft, "blend", str(tmp / "fg.png"), str(tmp / "bg.png"), "--mask",
                                  str(tmp / "mask.png"), "--mode", "poisson", "-o", out],
-        "rectify --warp lines": [*_weft(), "rectify", str(RES / "perspective.png"), "--lines",
+        "rectify --warp lines": [*weft, "rectify", str(RES / "perspective.png"), "--lines",
                                  str(RES / "perspective-lines.json"), "--warp", "lines", "-o", out],
-        "warm-up (all methods)": [*_weft(), "warm-up"],
+        "warm-up (all methods)": [*weft, "warm-up"],
     }
 
 
@@ -70,13 +69,13 @@ def _blend_inputs(tmp: Path) -> None:
     save_image(tmp / "mask.png", (((x - 128) ** 2 + (y - 128) ** 2) < 80 ** 2).astype(np.float32))
 
 
-def timed_run(cmd: list[str], cache: str, timeout: float = 600.0) -> dict:
+def timed_run(cmd: list[str], cache: str, timeout: float = 600.0, cwd: Path = ROOT) -> dict:
     """Run ``cmd`` with stderr on a pseudo-terminal; wall seconds (or, for the studio probe, seconds
     to its first result), the longest silence on that terminal, and what it printed there."""
     env = dict(os.environ, NUMBA_CACHE_DIR=cache, QT_QPA_PLATFORM="offscreen", COLUMNS="100")
     master, slave = pty.openpty()
     t0 = time.time()
-    proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                             stderr=slave, close_fds=True)
     os.close(slave)
     writes, text = [t0], b""
@@ -112,30 +111,36 @@ def timed_run(cmd: list[str], cache: str, timeout: float = 600.0) -> dict:
         end = probe["shown_at"]
         writes = [t0, end]  # the studio says what it does in its window, not on a terminal
     gaps = [b - a for a, b in zip(writes, writes[1:] + [end])]
-    return {"seconds": seconds, "silent": max(gaps), "stderr": text.decode(errors="replace")}
+    return {"seconds": seconds, "silent": max(gaps), "first_words": gaps[0], "stderr": text.decode(errors="replace")}
 
 
-def measure(names: list[str] | None = None, runs: int = 3) -> list[dict]:
+def measure(names: list[str] | None = None, runs: int = 3, python: str = sys.executable, root: Path = ROOT
+            ) -> list[dict]:
     rows = []
     with tempfile.TemporaryDirectory(prefix="weft-cold-") as tmp_s:
         tmp = Path(tmp_s)
         _blend_inputs(tmp)
-        for name, cmd in commands(tmp).items():
+        for name, cmd in commands(tmp, python).items():
             if names and name not in names:
                 continue
             print(f"running {name} ...", file=sys.stderr, flush=True)
-            cold, silent = [], []
+            cold, silent, first = [], [], []
             cache = ""
-            for i in range(runs):
-                cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
-                r = timed_run(cmd, cache)
-                cold.append(r["seconds"])
-                silent.append(r["silent"])
-            warm = [timed_run(cmd, cache)["seconds"] for _ in range(runs)]
+            try:
+                for i in range(runs):
+                    cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
+                    r = timed_run(cmd, cache, cwd=root)
+                    cold.append(r["seconds"])
+                    silent.append(r["silent"])
+                    first.append(r["first_words"])
+                warm = [timed_run(cmd, cache, cwd=root)["seconds"] for _ in range(runs)]
+            except RuntimeError as e:  # e.g. a command the measured checkout does not have
+                print(f"  {name}: {e}", file=sys.stderr)
+                continue
             rows.append({"command": name, "runs": runs, "cold_s": round(statistics.median(cold), 2),
                          "warm_s": round(statistics.median(warm), 2),
                          "ratio": round(statistics.median(cold) / statistics.median(warm), 2),
-                         "cold_silent_s": round(max(silent), 2),
+                         "cold_silent_s": round(max(silent), 2), "cold_first_words_s": round(max(first), 2),
                          "cold_range": [round(min(cold), 2), round(max(cold), 2)],
                          "warm_range": [round(min(warm), 2), round(max(warm), 2)]})
             shutil.rmtree(cache, ignore_errors=True)
@@ -143,11 +148,15 @@ def measure(names: list[str] | None = None, runs: int = 3) -> list[dict]:
 
 
 def markdown_table(rows: list[dict]) -> str:
-    lines = ["| command | cold s | warm s | cold / warm | longest silence (cold) |", "| --- | --- | --- | --- | --- |"]
+    lines = ["| command | cold s | warm s | cold / warm | first words on the terminal (cold) | longest silence (cold) |",
+             "| --- | --- | --- | --- | --- | --- |"]
     for r in rows:
-        silent = "—" if r["command"] == "studio" else f"{r['cold_silent_s']:.1f} s"
+        studio = r["command"] == "studio"
+        first = "—" if studio else f"{r['cold_first_words_s']:.1f} s"
+        silent = "—" if studio else f"{r['cold_silent_s']:.1f} s"
         lines.append(f"| {r['command']} | {r['cold_s']:.1f} ({r['cold_range'][0]:.1f}–{r['cold_range'][1]:.1f}) | "
-                     f"{r['warm_s']:.1f} ({r['warm_range'][0]:.1f}–{r['warm_range'][1]:.1f}) | {r['ratio']:.1f}x | {silent} |")
+                     f"{r['warm_s']:.1f} ({r['warm_range'][0]:.1f}–{r['warm_range'][1]:.1f}) | {r['ratio']:.1f}x | "
+                     f"{first} | {silent} |")
     return "\n".join(lines)
 
 
@@ -169,7 +178,7 @@ def probe_studio() -> int:
 
         def shown(s) -> None:
             if s.final and not seen:
-                seen.update(shown_at=time.time(), render_s=s.seconds, prepared_s=s.prepared)
+                seen.update(shown_at=time.time(), render_s=s.seconds, prepared_s=getattr(s, "prepared", None))
                 QTimer.singleShot(0, app.quit)
 
         window.renderer.shown.connect(shown)
@@ -191,11 +200,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--runs", type=int, default=3, help="cold runs and warm runs per command (default 3)")
     ap.add_argument("--only", nargs="*", metavar="NAME", help="only these commands (names as in the table)")
     ap.add_argument("--json", type=Path, default=None, help="also write the rows here")
+    ap.add_argument("--python", default=sys.executable,
+                    help="the interpreter whose weft is measured (e.g. another checkout's .venv/bin/python)")
+    ap.add_argument("--root", type=Path, default=ROOT, help="that checkout's folder (the commands run there)")
     ap.add_argument("--probe-studio", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.probe_studio:
         return probe_studio()
-    rows = measure(args.only, args.runs)
+    rows = measure(args.only, args.runs, args.python, args.root)
     print(f"{os.cpu_count()} cores, cold = a fresh NUMBA_CACHE_DIR per run, median of {args.runs}")
     print(markdown_table(rows))
     if args.json is not None:

@@ -2,6 +2,8 @@
 
 import json
 
+import pytest
+
 from benchmarks.__main__ import main as bench_main
 from benchmarks.cases import CASES, Case, Input
 from benchmarks.harness import markdown_table, prepare_inputs, run_case
@@ -46,3 +48,22 @@ def test_command_line_writes_json(tmp_path, capsys, monkeypatch):
     assert rows[0]["case"] == CASES[0].name
     assert CASES[0].name in capsys.readouterr().out
     assert bench_main(["no-such-case"]) == 2
+
+
+def test_cold_runs_a_command_with_stderr_on_a_terminal_and_tables_the_rows(tmp_path):
+    import sys
+
+    from benchmarks import cold
+
+    code = "import sys; sys.stderr.write(f'tty {sys.stderr.isatty()}'); sys.stderr.flush(); print('out')"
+    r = cold.timed_run([sys.executable, "-c", code], str(tmp_path / "cache"))
+    assert r["stderr"] == "tty True"  # the bar and the preparing line are drawn, as in a shell
+    assert 0 < r["first_words"] <= r["seconds"] and r["silent"] <= r["seconds"]
+    with pytest.raises(RuntimeError, match="exited 3"):
+        cold.timed_run([sys.executable, "-c", "raise SystemExit(3)"], str(tmp_path / "cache"))
+    row = {"command": "fast --target", "runs": 3, "cold_s": 2.5, "warm_s": 0.8, "ratio": 3.12, "cold_silent_s": 1.3,
+           "cold_first_words_s": 0.6, "cold_range": [2.4, 2.7], "warm_range": [0.8, 0.9]}
+    table = cold.markdown_table([row])
+    assert table.splitlines()[2] == "| fast --target | 2.5 (2.4–2.7) | 0.8 (0.8–0.9) | 3.1x | 0.6 s | 1.3 s |"
+    assert set(cold.commands(tmp_path)) >= {"studio", "quilt --target, 3 passes", "nfpt 1024x768", "affine",
+                                              "fast --target", "warm-up (all methods)"}

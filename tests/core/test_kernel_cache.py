@@ -1,0 +1,126 @@
+"""No cache crash: a numba method still runs when its cache cannot go where numba looks for one.
+
+numba tries ``NUMBA_CACHE_DIR``, the package's ``__pycache__`` and the user's ``~/.cache/numba``;
+when none could be written, decorating a kernel raised ``RuntimeError: cannot cache function ...:
+no locator available`` (``weft: internal error``, exit 1). Each case runs ``weft blend --mode poisson``
+(a numba kernel) in a fresh process, on a copy of the package. The tests run as root in CI, where
+file permissions do not stop writes, so unwritability is made of paths that cannot be folders: the
+copy's ``core/_kernels/__pycache__`` is a regular file, ``HOME`` and ``NUMBA_CACHE_DIR`` point under
+a regular file.
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.image import save_image
+
+ROOT = Path(__file__).resolve().parents[2]
+NO_CACHE = "numba can write its cache nowhere"
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("cache")
+    for pkg in ("core", "app"):
+        shutil.copytree(ROOT / pkg, tmp / "pkg" / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    (tmp / "file").write_text("not a folder")
+    rng = np.random.default_rng(0)
+    img = rng.random((24, 24, 3)).astype(np.float32)
+    save_image(tmp / "fg.png", img)
+    save_image(tmp / "bg.png", img[::-1])
+    mask = np.zeros((24, 24), np.float32)
+    mask[6:18, 6:18] = 1
+    save_image(tmp / "mask.png", mask)
+    return tmp
+
+
+def run_blend(setup, *, package_writable=True, home_writable=True, numba_dir_writable=None, tmpdir=None,
+              no_temp=False):
+    """``weft blend --mode poisson`` on the package copy; returns (exit code, stderr, env)."""
+    pkg = setup / "pkg"
+    cache = pkg / "core" / "_kernels" / "__pycache__"
+    if cache.is_dir():
+        shutil.rmtree(cache)
+    elif cache.exists():
+        cache.unlink()
+    if not package_writable:
+        cache.write_text("a file where numba wants its folder")
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME", "PYTHONPATH")}
+    home = setup / "home"
+    env["HOME"] = str(home) if home_writable else str(setup / "file" / "home")
+    if numba_dir_writable is not None:
+        env["NUMBA_CACHE_DIR"] = str(setup / "numba") if numba_dir_writable else str(setup / "file" / "numba")
+    env["TMPDIR"] = str(tmpdir if tmpdir is not None else setup / "tmp")
+    Path(env["TMPDIR"]).mkdir(exist_ok=True)
+    env["PYTHONPATH"] = str(pkg)
+    patch = ("import core._kernels as k; k.fallback_cache_root = lambda: " + repr(str(setup / "file" / "t")) + "; "
+             if no_temp else "")
+    code = (f"import sys; {patch}from app.cli import main; sys.exit(main(['blend', {str(setup / 'fg.png')!r}, "
+            f"{str(setup / 'bg.png')!r}, '--mask', {str(setup / 'mask.png')!r}, '--mode', 'poisson', "
+            f"'-o', {str(setup / 'out.png')!r}]))")
+    r = subprocess.run([sys.executable, "-c", code], cwd=setup, env=env, capture_output=True, text=True, timeout=300)
+    assert (setup / "out.png").exists() or r.returncode != 0
+    return r.returncode, r.stderr, env
+
+
+def test_unwritable_numba_cache_dir_runs(setup):
+    code, err, _ = run_blend(setup, numba_dir_writable=False)
+    assert code == 0, err
+    assert err == ""
+    assert list((setup / "pkg" / "core" / "_kernels" / "__pycache__").glob("quilting.poisson_cg-*.nbi"))  # numba's next folder
+
+
+def test_unwritable_package_folder_runs(setup):
+    code, err, _ = run_blend(setup, package_writable=False)
+    assert code == 0, err
+    assert err == ""
+
+
+def test_unwritable_home_runs(setup):
+    code, err, _ = run_blend(setup, home_writable=False)
+    assert code == 0, err
+    assert err == ""
+
+
+def test_nothing_writable_falls_back_to_a_private_temp_folder_that_stays_warm(setup):
+    tmpdir = setup / "tmp-all"
+    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
+                             tmpdir=tmpdir)
+    assert code == 0, err  # was: weft: internal error: RuntimeError: cannot cache function ...: no locator
+    assert err == ""
+    folder = tmpdir / f"weft-numba-{os.getuid()}"
+    assert folder.is_dir() and (folder.stat().st_mode & 0o777) == 0o700
+    index = list(folder.glob("*/quilting.poisson_cg-*.nbi"))
+    assert index
+    stamp = index[0].stat().st_mtime_ns
+    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
+                             tmpdir=tmpdir)
+    assert code == 0 and err == ""
+    assert index[0].stat().st_mtime_ns == stamp  # loaded from there, not compiled and saved again
+
+
+def test_a_temp_folder_open_to_others_is_not_used(setup):
+    tmpdir = setup / "tmp-shared"
+    folder = tmpdir / f"weft-numba-{os.getuid()}"
+    folder.mkdir(parents=True)
+    folder.chmod(0o777)  # someone could plant cache files (pickles) there
+    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
+                             tmpdir=tmpdir)
+    assert code == 0, err
+    assert err.startswith("weft: " + NO_CACHE)
+    assert not list(folder.iterdir())
+
+
+def test_no_writable_folder_at_all_runs_uncached_with_a_one_line_notice(setup):
+    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
+                             no_temp=True)
+    assert code == 0, err
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("weft: " + NO_CACHE)
+    assert lines[0].endswith("kernels are compiled on every run")

@@ -1,0 +1,100 @@
+"""The studio on a first run: the method on screen prepares its kernels in its own render, says so in
+words on the result (not a bare 0 %), leaves the compile out of the render time, and only then are
+the other methods warmed up in the background.
+
+The "compile" is the fast method's warm-up raising numba's compile events
+(``registry.compile_started/compile_ended``) and held open on a ``threading.Event`` until the test
+has seen the words: no timing."""
+
+import dataclasses
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from app.gui.document import InputImage
+from app.gui.main_window import MainWindow
+from core import registry
+
+
+@pytest.fixture
+def cold_fast(monkeypatch):
+    """'fast' whose kernels are not loaded yet; its warm-up compiles until ``release`` is set."""
+    release = threading.Event()
+    started = threading.Event()
+    real = registry.get("fast")
+
+    def warm_up():
+        registry.compile_started()
+        started.set()
+        try:
+            release.wait(60)
+        finally:
+            registry.compile_ended()
+
+    monkeypatch.setitem(registry._loaded, "fast", dataclasses.replace(real, warm_up=warm_up))
+    monkeypatch.setattr(registry, "_warm", set())
+    background = []
+    monkeypatch.setattr(registry, "warm_up_all", lambda first=None, cancel=None: background.append(first) or [])
+    return release, started, background
+
+
+def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest(qtbot, settings, cold_fast):
+    release, started, background = cold_fast
+    window = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(window)
+    window.show()
+    rng = np.random.default_rng(1)
+    window.doc._put_input("texture", InputImage(None, rng.random((32, 32, 3)).astype(np.float32)))
+    window.doc._put_input("target", InputImage(None, rng.random((40, 48, 3)).astype(np.float32)))
+    assert window.doc.method == "fast"
+    window.renderer.final(now=True)
+
+    words = "preparing the fast method — first run only"
+    qtbot.waitUntil(lambda: window.result_view.notice.isVisible(), timeout=20000)
+    held_from = time.perf_counter()
+    assert window.result_view.notice.text() == words
+    qtbot.waitUntil(lambda: window.progress_bar.isVisible(), timeout=20000)
+    assert window.progress_bar.maximum() == 0  # a busy bar, no percentage
+    assert window.progress_bar.format() == words
+    assert window.renderer.runner.latest("warm-up") is None  # nothing competes with the visible method
+    assert window.renderer.last is None
+
+    with qtbot.waitSignal(window.renderer.shown, timeout=30000) as shown:
+        held = time.perf_counter() - held_from  # the compile lasted at least this long
+        release.set()
+    result = shown.args[0]
+    assert result.final and result.image.shape == (40, 48, 3)
+    assert result.prepared >= held  # the compile, measured apart ...
+    message = window.statusBar().currentMessage()
+    assert message.startswith(f"result 48x40 in {result.seconds * 1000:.0f} ms (after preparing its kernels for ")
+    assert message.split(" — ")[0].endswith(" s, first run only)")  # ... and not counted as render time
+    qtbot.waitUntil(lambda: not window.result_view.notice.isVisible(), timeout=5000)
+    assert registry.is_warm("fast")
+    qtbot.waitUntil(lambda: background == ["fast"], timeout=10000)  # the others, once the result is in
+
+    # a second render: kernels loaded, no words, nothing prepared
+    with qtbot.waitSignal(window.renderer.shown, timeout=30000) as again:
+        window.renderer.final(now=True)
+    assert again.args[0].prepared == 0.0
+    assert "preparing" not in window.statusBar().currentMessage()
+    window.doc.undo_stack.setClean()
+    window.shutdown()
+
+
+def test_a_warm_method_renders_without_preparing(qtbot, settings, cold_fast, monkeypatch):
+    release, started, background = cold_fast
+    registry._warm.add("fast")  # its kernels already loaded in this process
+    window = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(window)
+    seen = []
+    window.renderer.preparing.connect(seen.append)
+    rng = np.random.default_rng(2)
+    window.doc._put_input("texture", InputImage(None, rng.random((32, 32)).astype(np.float32)))
+    window.doc._put_input("target", InputImage(None, rng.random((24, 24)).astype(np.float32)))
+    with qtbot.waitSignal(window.renderer.shown, timeout=30000) as shown:
+        window.renderer.final(now=True)
+    assert shown.args[0].prepared == 0.0 and seen == [] and not started.is_set()
+    window.doc.undo_stack.setClean()
+    window.shutdown()
