@@ -15,6 +15,9 @@ reports compilations; it is the only place that knows about numba's caching mach
   read-only install that was warmed up stays warm for every user. If even that fails, the kernels are compiled without a
   cache (every run pays the compile) and :func:`core.registry.kernel_cache_notice` says so in one
   line for the front ends to show.
+* **Safe concurrent saves.** numba's cache saves a new signature by rewriting the function's index
+  and a numbered data file, without a lock; weft takes a file lock around each save (POSIX), so
+  processes compiling at once (``weft warm-up``'s workers) cannot cross their files.
 * **Compile events.** numba announces every real compilation (a cache miss, never a cache load) as
   a ``numba:compile`` event; we forward their start and end to :mod:`core.registry`, which lets a
   front end say "preparing ... — first run only" exactly while a compile happens, and leave the
@@ -143,6 +146,30 @@ def _install_no_cache_fallback() -> None:
         _dispatcher.Dispatcher.enable_caching = _enable_caching_or_not
 
 
+_original_save = _caching.IndexDataCacheFile.save
+
+
+def _save_locked(self, key, data):
+    """``IndexDataCacheFile.save`` under an exclusive lock on the function's index: numba reads the
+    index, picks the first free data-file number and writes both, so two processes saving two
+    signatures of one function at once (``weft warm-up``'s workers, or a render farm's first jobs)
+    could leave the index naming the other one's data file — compiled code for the wrong types."""
+    try:
+        import fcntl
+
+        lock = open(os.path.join(self._cache_path, self._index_name + ".lock"), "a")
+    except (ImportError, OSError):  # no POSIX locks here, or no writing: numba's own behaviour
+        return _original_save(self, key, data)
+    with lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        return _original_save(self, key, data)
+
+
+def _install_save_lock() -> None:
+    if _caching.IndexDataCacheFile.save is not _save_locked:
+        _caching.IndexDataCacheFile.save = _save_locked
+
+
 class _CompileListener(_event.Listener):
     """Forwards numba's ``numba:compile`` events to the registry, saying which are a thread's outermost
     (a kernel compiles the kernels it calls inside its own compile)."""
@@ -163,6 +190,7 @@ class _CompileListener(_event.Listener):
 
 _install_fallback_locator()
 _install_no_cache_fallback()
+_install_save_lock()
 if not getattr(_registry, "_compile_listener_installed", False):
     _event.register("numba:compile", _CompileListener())
     _registry._compile_listener_installed = True

@@ -124,3 +124,30 @@ def test_no_writable_folder_at_all_runs_uncached_with_a_one_line_notice(setup):
     lines = err.splitlines()
     assert len(lines) == 1 and lines[0].startswith("weft: " + NO_CACHE)
     assert lines[0].endswith("kernels are compiled on every run")
+
+
+def _hammer(folder):
+    """8 threads save 10 signatures each of one function's cache at once; the keys that read back
+    wrong or not at all."""
+    import threading
+
+    from numba.core.caching import IndexDataCacheFile
+
+    def work(i):
+        f = IndexDataCacheFile(str(folder), "kernel-1.py311", "stamp")
+        for j in range(10):
+            f.save((i, j), f"code for {i} {j}")
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(60)
+    check = IndexDataCacheFile(str(folder), "kernel-1.py311", "stamp")
+    return [(i, j) for i in range(8) for j in range(10) if check.load((i, j)) != f"code for {i} {j}"]
+
+
+def test_concurrent_cache_saves_never_cross_signatures(tmp_path):
+    import core._kernels  # noqa: F401  (the lock around numba's saves)
+
+    assert _hammer(tmp_path) == []
