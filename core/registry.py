@@ -119,8 +119,10 @@ def get(name: str) -> Method:
 # cache is cold) is known from numba's compile events, which ``core._kernels`` forwards here:
 # ``watch_compiles()`` counts them and their time, ``compiling()`` tells whether one is under way.
 
-#: What a front end shows while a method's kernels compile (``{name}`` is the method's name).
+#: What a front end shows while a method's kernels compile (``{name}`` is the method's name) ...
 PREPARING = "preparing the {name} method — first run only"
+#: ... and while they load, before it is known whether they compile (numba's import alone takes ~0.5 s).
+LOADING = "loading the {name} method"
 
 _warm: set[str] = set()
 _warm_locks: dict[str, threading.Lock] = {}
@@ -134,6 +136,11 @@ _cache_notes: list[str] = []
 def preparing_text(name: str) -> str:
     """The words a front end shows while ``name``'s kernels compile."""
     return PREPARING.format(name=get(name).name)
+
+
+def loading_text(name: str) -> str:
+    """The words a front end shows while ``name``'s kernels load (cache or compile: not known yet)."""
+    return LOADING.format(name=get(name).name)
 
 
 def is_warm(name: str) -> bool:

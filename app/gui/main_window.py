@@ -528,8 +528,7 @@ class MainWindow(FilesMixin, QMainWindow):
         self.statusBar().showMessage(describe(shown))
 
     def _on_progress(self, fraction: float, stage: str) -> None:
-        self.result_view.set_notice(None)
-        self.progress_bar.setRange(0, 1000)
+        self._end_preparing()
         self.progress_bar.setValue(int(fraction * 1000))
         self.progress_bar.setFormat(f"{stage} %p%")
 
@@ -537,9 +536,15 @@ class MainWindow(FilesMixin, QMainWindow):
         """A first run: the method's kernels compile before any work can be counted — say so in
         words on the result and keep the bar moving without a percentage."""
         self.result_view.set_notice(words)
-        self.progress_bar.setRange(0, 0)  # busy indicator
-        self.progress_bar.setFormat(words)
+        self.progress_bar.setRange(0, 0)  # a busy indicator: no percentage ...
+        self.progress_bar.setTextVisible(False)  # ... (some styles draw a stale one in it)
         self.progress_bar.setToolTip(words)
+
+    def _end_preparing(self) -> None:
+        self.result_view.set_notice(None)
+        self.progress_bar.setRange(0, 1000)
+        self.progress_bar.setTextVisible(True)
+        self.progress_bar.setToolTip("")
 
     def _on_busy(self, busy: bool) -> None:
         self.progress_bar.setVisible(busy)
@@ -548,8 +553,7 @@ class MainWindow(FilesMixin, QMainWindow):
             if self.progress_bar.maximum() > 0:  # not while preparing
                 self.progress_bar.setValue(0)
         else:
-            self.result_view.set_notice(None)
-            self.progress_bar.setRange(0, 1000)
+            self._end_preparing()
 
     def _on_failed(self, message: str) -> None:
         self.show_message(message)

@@ -49,7 +49,8 @@ class _Partial:
 @dataclass
 class Shown:
     """What the result view shows: the image, which job made it and how long it took (``seconds``:
-    the render alone; ``prepared``: the method's kernels compiling first, on a first run)."""
+    the render alone; ``prepared``: loading the method's kernels first, the first time in this
+    process; ``compiled``: they had to be compiled, a first run)."""
 
     image: np.ndarray
     job_id: int
@@ -57,30 +58,38 @@ class Shown:
     figures: dict
     final: bool
     prepared: float = 0.0
+    compiled: bool = False
 
 
 def _render(method, inputs, params, seed, report, cancel, *, final: bool):
     """Run ``method`` for a render job: its kernels first if this process has not loaded them yet
-    (``report`` then hears the method's "preparing" words as soon as a compile starts, or at once
-    if another thread is compiling, i.e. holds numba's lock), then the render, timed without any
-    compile. Returns ``(result, render seconds, final, compile seconds)``."""
+    (``report`` then hears "loading the ... method", and the method's "preparing ... — first run
+    only" words as soon as a compile starts, or at once if another thread is compiling, i.e. holds
+    numba's lock), then the render, timed without any of that. Returns ``(result, render seconds,
+    final, seconds spent on kernels, whether they compiled)``."""
     said = []
 
     def preparing() -> None:
-        if report is not None and not said:
-            said.append(True)
+        said.append(True)
+        if report is not None and len(said) == 1:
             report(Progress.preparing_stage(registry.preparing_text(method.name)))
 
+    prepared = 0.0
     with registry.watch_compiles(this_thread=True, on_start=preparing) as compiles:
         if not registry.is_warm(method.name):
+            t0 = time.perf_counter()
+            if report is not None:  # numba's import and the cache take a moment even when warm
+                report(Progress.preparing_stage(registry.loading_text(method.name)))
             if registry.compiling():
                 preparing()
             registry.warm_up(method.name)
+            prepared = time.perf_counter() - t0
         before = compiles.seconds
         t0 = time.perf_counter()
         result = method.run(inputs, params, rng=seed, progress=report, cancel=cancel)
-        seconds = time.perf_counter() - t0 - (compiles.seconds - before)
-    return result, max(0.0, seconds), final, compiles.seconds
+        during = compiles.seconds - before  # a kernel the warm-up did not cover
+        seconds = time.perf_counter() - t0 - during
+    return result, max(0.0, seconds), final, prepared + during, bool(said)
 
 
 class Renderer(QObject):
@@ -238,8 +247,8 @@ class Renderer(QObject):
             return
         if self.last is not None and result.job_id < self.last.job_id:
             return  # older than what is shown: stale
-        res, seconds, final, prepared = result.value
-        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared)
+        res, seconds, final, prepared, compiled = result.value
+        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared, compiled)
         self.shown.emit(self.last)
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
@@ -314,5 +323,9 @@ def describe(shown: Shown) -> str:
     kind = "result" if shown.final else "preview"
     figs = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in shown.figures.items()
                      if not isinstance(v, (list, dict)))
-    prepared = f" (after preparing its kernels for {shown.prepared:.1f} s, first run only)" if shown.prepared >= 0.05 else ""
+    prepared = ""
+    if shown.compiled:
+        prepared = f" (after preparing its kernels for {shown.prepared:.1f} s, first run only)"
+    elif shown.prepared >= 0.05:
+        prepared = f" (after loading its kernels for {shown.prepared:.1f} s)"
     return f"{kind} {w}x{h} in {shown.seconds * 1000:.0f} ms{prepared}" + (f" — {figs}" if figs else "")

@@ -249,7 +249,8 @@ class ResultView(ImageView):
 
     def _place_notice(self) -> None:
         vp = self.viewport().rect()
-        width = min(max(vp.width() - 40, 120), 520)
+        text = self.notice.fontMetrics().horizontalAdvance(self.notice.text()) + 48  # + padding
+        width = max(min(vp.width() - 40, text), 120)
         self.notice.setFixedWidth(width)
         self.notice.adjustSize()
         self.notice.move(vp.center().x() - width // 2, vp.center().y() - self.notice.height() // 2)
