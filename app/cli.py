@@ -80,7 +80,7 @@ class _TerminalProgress:
 class _PreparingLine:
     """Says on stderr that kernels are being compiled — the first run's long silent stretch (a cold
     quilting transfer compiled for 39 s before its first progress report) — and keeps the line alive
-    with the seconds spent, every ``TICK`` s, until the progress bar takes over or the run ends.
+    with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes over or the run ends.
 
     Called from numba's compile events (``registry.watch_compiles``), i.e. only when a kernel really
     compiles: a run that loads every kernel from numba's cache says nothing. Like the progress bar it
@@ -90,7 +90,7 @@ class _PreparingLine:
     stdout what it compiled. ``wait(seconds) -> stopped`` is injectable for tests.
     """
 
-    TICK = 1.0
+    TICK = 0.5
 
     def __init__(self, method: str, bar: _TerminalProgress, wait=None):
         self.method = method
