@@ -290,6 +290,8 @@ def _warm_up_all(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     failed = []
     notices = set()
+    say(f"weft: warming up {len(names)} method{'s' if len(names) != 1 else ''}, "
+        f"{min(jobs, len(names))} process{'es' if min(jobs, len(names)) != 1 else ''} at once")
     # "spawn", one task per child: each method in a fresh interpreter (no inherited numba state or
     # threads), as a real run is, so its figures say what a first run of that method costs.
     with ProcessPoolExecutor(max_workers=min(jobs, len(names)), mp_context=multiprocessing.get_context("spawn"),
@@ -312,8 +314,7 @@ def _warm_up_all(args: argparse.Namespace) -> int:
         print(f"weft: {notice}", file=sys.stderr)
     if failed:
         return 1
-    say(f"weft: {len(names)} method{'s' if len(names) != 1 else ''} ready in {time.perf_counter() - t0:.1f} s "
-        f"({min(jobs, len(names))} processes at once)")
+    say(f"weft: {len(names)} method{'s' if len(names) != 1 else ''} ready in {time.perf_counter() - t0:.1f} s")
     return 0
 
 

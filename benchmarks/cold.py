@@ -93,7 +93,8 @@ def timed_run(cmd: list[str], cache: str, timeout: float = 600.0, cwd: Path = RO
             elif fd == master:
                 writes.append(time.time())
                 text += chunk
-            else:
+            else:  # stdout: in a shell it is the same terminal
+                writes.append(time.time())
                 out_chunks.append(chunk)
         if time.time() - t0 > timeout:
             proc.kill()

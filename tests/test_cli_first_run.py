@@ -151,6 +151,7 @@ def test_warm_up_command_prepares_every_method_in_processes(monkeypatch, capsys)
     out = capsys.readouterr().out.splitlines()
     with_warm_up = [m.name for m in registry.methods().values() if m.warm_up is not None]
     assert calls[0] == ("pool", 2, "spawn", 1) and sorted(calls[1:]) == sorted(with_warm_up)
+    assert out[0] == f"weft: warming up {len(with_warm_up)} methods, 2 processes at once"
     assert "quilt    compiled 3 functions in 0.5 s" in out
     assert "fast     loaded from the cache in 0.5 s" in out
     assert out[-1].startswith(f"weft: {len(with_warm_up)} methods ready in ")
@@ -166,12 +167,13 @@ def test_warm_up_command_for_real_in_processes(tmp_path):
     import sys
 
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    cmd = [sys.executable, "-c", "import sys; from app.cli import main; sys.exit(main(['warm-up', 'blend', 'rectify']))"]
+    cmd = [sys.executable, "-c", "import sys; from app.cli import main; sys.exit(main(['warm-up', 'blend', 'rectify', '--jobs', '2']))"]
     first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
     assert first.returncode == 0, first.stderr
     lines = first.stdout.splitlines()
-    assert sorted(line.split()[0] for line in lines[:-1]) == ["blend", "rectify"]
-    assert all(" compiled " in line for line in lines[:-1]) and lines[-1].startswith("weft: 2 methods ready in ")
+    assert lines[0] == "weft: warming up 2 methods, 2 processes at once"
+    assert sorted(line.split()[0] for line in lines[1:-1]) == ["blend", "rectify"]
+    assert all(" compiled " in line for line in lines[1:-1]) and lines[-1].startswith("weft: 2 methods ready in ")
     second = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
     assert second.returncode == 0, second.stderr
     assert second.stdout.count("loaded from the cache") == 2
