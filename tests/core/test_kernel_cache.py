@@ -73,7 +73,7 @@ def test_unwritable_numba_cache_dir_runs(setup):
     code, err, _ = run_blend(setup, numba_dir_writable=False)
     assert code == 0, err
     assert err == ""
-    assert list((setup / "pkg" / "core" / "_kernels" / "__pycache__").glob("quilting.poisson_cg-*.nbi"))  # numba's next folder
+    assert list((setup / "pkg" / "core" / "_kernels" / "__pycache__").glob("poisson.poisson_cg-*.nbi"))  # numba's next folder
 
 
 def test_unwritable_package_folder_runs(setup):
@@ -96,7 +96,7 @@ def test_nothing_writable_falls_back_to_a_private_temp_folder_that_stays_warm(se
     assert err == ""
     folder = tmpdir / f"weft-numba-{os.getuid()}"
     assert folder.is_dir() and (folder.stat().st_mode & 0o777) == 0o700
-    index = list(folder.glob("*/quilting.poisson_cg-*.nbi"))
+    index = list(folder.glob("*/poisson.poisson_cg-*.nbi"))
     assert index
     stamp = index[0].stat().st_mtime_ns
     code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
