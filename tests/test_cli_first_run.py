@@ -129,8 +129,8 @@ def test_warm_up_command_prepares_every_method_in_processes(monkeypatch, capsys)
     calls = []
 
     class Pool:  # the real pool spawns interpreters that compile for seconds; its use is what matters
-        def __init__(self, max_workers, mp_context, max_tasks_per_child):
-            calls.append(("pool", max_workers, mp_context.get_start_method(), max_tasks_per_child))
+        def __init__(self, max_workers, mp_context):
+            calls.append(("pool", max_workers, mp_context.get_start_method()))
 
         def __enter__(self):
             return self
@@ -150,7 +150,7 @@ def test_warm_up_command_prepares_every_method_in_processes(monkeypatch, capsys)
     assert main(["warm-up", "--jobs", "2"]) == 0
     out = capsys.readouterr().out.splitlines()
     with_warm_up = [m.name for m in registry.methods().values() if m.warm_up is not None]
-    assert calls[0] == ("pool", 2, "spawn", 1) and sorted(calls[1:]) == sorted(with_warm_up)
+    assert calls[0] == ("pool", 2, "spawn") and sorted(calls[1:]) == sorted(with_warm_up)
     assert out[0] == f"weft: warming up {len(with_warm_up)} methods, 2 processes at once"
     assert "quilt    compiled 3 functions in 0.5 s" in out
     assert "fast     loaded from the cache in 0.5 s" in out
