@@ -183,8 +183,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         _add_common(p)
         p.set_defaults(method=method.name)
     w = sub.add_parser("warm-up", help="prepare every method's compiled kernels now (installers, render nodes, CI)",
-                       description="Compile (or load) every method's numba kernels ahead of time, one process "
-                       "per method in parallel, into numba's cache, so that no later run pays the compile. "
+                       description="Compile (or load) every method's numba kernels ahead of time, in parallel "
+                       "processes (one per CPU), into numba's cache, so that no later run pays the compile. "
                        "Prints one line per method on stdout.")
     w.add_argument("methods", nargs="*", metavar="METHOD", help="only these methods (default: all)")
     w.add_argument("--jobs", metavar="N", help="processes at once (default: the number of CPUs)")
@@ -275,7 +275,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
 
 
 def _warm_up_all(args: argparse.Namespace) -> int:
-    """``weft warm-up``: every method's ``warm_up`` in its own fresh process, ``--jobs`` at once."""
+    """``weft warm-up``: every method's ``warm_up`` in a pool of ``--jobs`` fresh processes."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 

@@ -180,9 +180,9 @@ def warm_up_all(first: str | None = None, cancel=None) -> list[str]:
 
 
 def warm_up_report(name: str) -> dict[str, Any]:
-    """Warm ``name`` up in this (fresh) process and say what happened: ``{"method", "seconds",
+    """Warm ``name`` up in this process and say what happened: ``{"method", "seconds",
     "compiled", "notice"}`` with ``compiled`` the number of kernels compiled (0: all loaded from the
-    cache). For ``weft warm-up``, which runs one process per method."""
+    cache). For ``weft warm-up``'s worker processes."""
     import time
 
     t0 = time.perf_counter()
