@@ -26,7 +26,7 @@ from typing import Sequence
 
 from core import __version__
 from core.errors import Cancelled, WeftError
-from core.params import specs
+from core.params import Params, specs
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -178,7 +178,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             if spec.default is not None:
                 d = spec.default
                 bits.append("default " + (f"{d[0]}x{d[1]}" if isinstance(d, tuple) else str(d)))
-            group.add_argument(spec.option, dest="param_" + spec.name, metavar=spec.kind.upper(),
+            metavar = spec.type.METAVAR if spec.kind == "geometry" else spec.kind.upper()
+            group.add_argument(spec.option, dest="param_" + spec.name, metavar=metavar,
                                help="; ".join(bits).replace("%", "%%"))
         _add_common(p)
         p.set_defaults(method=method.name)
@@ -245,7 +246,8 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     from core.run import output_recipe, render
 
     method = registry.get(method_name)
-    params = method.params.from_dict(params_dict)
+    # typed parameters (a method's own command line) or their JSON form (a recipe's, read at its edge)
+    params = params_dict if isinstance(params_dict, Params) else method.params.from_dict(params_dict)
     bit_depth = _parse_bit_depth(args)
     out = _check_output(args.output, list(input_paths.values()))
     if bit_depth == 16 and out.suffix.lower() in (".jpg", ".jpeg"):
@@ -321,7 +323,7 @@ def _warm_up_all(args: argparse.Namespace) -> int:
 
 def _dispatch(args: argparse.Namespace) -> int:
     from core import registry
-    from core.image import parse_square
+    from core.geometry import Square
 
     if args.command == "batch":
         from app.batch_cli import run_batch
@@ -341,7 +343,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
         else:
             seed = recipe.seed
-        region = parse_square(args.region) if args.region is not None else recipe.region
+        region = Square.parse(args.region) if args.region is not None else recipe.region
         return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region)
 
     method = registry.get(args.method)
@@ -358,8 +360,8 @@ def _dispatch(args: argparse.Namespace) -> int:
         if value is not None:
             inputs[inp.name] = value
     seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
-    region = parse_square(args.region) if args.region is not None else None
-    return _execute(method.name, params.to_dict(), inputs, seed, args, region)
+    region = Square.parse(args.region) if args.region is not None else None
+    return _execute(method.name, params, inputs, seed, args, region)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -36,7 +36,7 @@ class _PaintWatch(QObject):
 
 
 def measure(values: int = 30, hz: float = 60.0) -> dict:
-    from app.gui.document import InputImage
+    from app.gui.document import DocumentState, InputImage
     from app.gui.main_window import MainWindow
     from core.examples import example
     from core.image import load_image, resize
@@ -49,21 +49,18 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
         window.resize(1400, 900)
         window.show()
         doc = window.doc
-        doc._put_input("texture", InputImage(None, load_image(example("gravel")).image[:192, :192]))
-        doc._put_input("target", InputImage(None, resize(load_image(example("astronaut")).image, (640, 500))))
+        doc.restore(DocumentState(inputs={
+            "texture": InputImage(None, load_image(example("gravel")).image[:192, :192]),
+            "target": InputImage(None, resize(load_image(example("astronaut")).image, (640, 500)))}, method="fast"))
         window.renderer.final(now=True)
         _wait(app, lambda: window.renderer.last is not None and window.renderer.last.final, 30)
 
         value_of_job: dict[int, float] = {}
-        submit = window.renderer._submit
-
-        def recording_submit(slot, preview):
-            job_id = submit(slot, preview)
-            if job_id is not None and slot == "preview":  # the render after release is not a preview
+        def recording_submit(job_id, slot):
+            if slot == "preview":  # the render after release is not a preview
                 value_of_job[job_id] = doc.current_params.p
-            return job_id
 
-        window.renderer._submit = recording_submit
+        window.renderer.submitted.connect(recording_submit)
         changed_at: dict[float, float] = {}
         latencies: list[float] = []
         pending: list[int] = []

@@ -41,6 +41,7 @@ from .image import luminance, resize, validate_image
 from .jobs import CancelToken, Progress, ProgressReporter
 from .params import Params, as_rng, out_of_range, param
 from .registry import InputSpec, Method, Result
+from .studio import SQUARE, Geometry, Studio
 
 MODES = ("auto", "transfer", "synthesis", "superres", "novel")
 # Metric codes of the kernel (core._kernels.fast), which is imported on first use: importing numba
@@ -351,6 +352,12 @@ def warm_up() -> None:
     transfer(tiny, size=(8, 8), n=3, rng=0)
 
 
+def _auto(params: FastParams, open_inputs: frozenset) -> dict:
+    """What "auto" resolves to with these inputs (the studio shows it beside the box)."""
+    resolved = params.resolved("target" in open_inputs)
+    return {name: getattr(resolved, name) for name in ("p", "p_l")}
+
+
 METHOD = Method(
     name="fast",
     summary="fast texture transfer (Ashikhmin): live artistic styles, synthesis, super-resolution",
@@ -364,4 +371,11 @@ METHOD = Method(
     run=_run,
     warm_up=warm_up,
     memory=memory_estimate,
+    studio=Studio(
+        title="Fast texture transfer (Ashikhmin)",
+        canvas="texture",
+        geometry=(Geometry(SQUARE, on=("texture",),
+                           help="texture — drag a square: the source region (the method copies only from it)"),),
+        preview_inputs=("target",), preview_params=("size",), auto=_auto, compare=("target", "texture"),
+        examples={"texture": "wood-grain", "target": "astronaut"}, rank=0),
 )

@@ -39,9 +39,11 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .errors import InvalidParameter, WeftError
+from .geometry import MAX_SIDE, Square
+from .jsonio import MAX_FILE_BYTES, parse_json, read_json_file  # noqa: F401 (re-exported)
 
-KINDS = ("int", "float", "bool", "choice", "size", "str")
-MAX_SIDE = 16384
+KINDS = ("int", "float", "bool", "choice", "size", "str", "geometry")
+INT, FLOAT, BOOL, CHOICE, SIZE, STR, GEOMETRY = KINDS  # for front ends that branch on the kind
 RECIPE_VERSION = 1
 
 
@@ -52,7 +54,10 @@ class Spec:
     Attributes
     ----------
     name : parameter name (the dataclass field); the CLI option is ``--name`` with ``_`` -> ``-``.
-    kind : one of ``int, float, bool, choice, size, str``; ``size`` is a ``(width, height)`` pair.
+    kind : one of ``int, float, bool, choice, size, str, geometry``; ``size`` is a ``(width, height)``
+        pair; ``geometry`` a typed value of class ``type`` (:mod:`core.geometry`: a square, feature
+        lines, a view), parsed at the edges by the type's ``parse`` (command line), ``from_json``
+        (recipes, sessions) and ``coerce`` (Python callers), written by its ``to_json``.
     default : the default value (from the paper where it gives one).
     lo, hi : inclusive bounds for ``int``, ``float`` and each side of ``size``.
     choices : the allowed values of a ``choice``.
@@ -60,7 +65,7 @@ class Spec:
     symbol : the paper's symbol (shown in tooltips), e.g. ``"p_l"`` or ``"α"``.
     help : one sentence for tooltips and ``--help``.
     step : slider step for ``float`` parameters.
-    log : a ``float`` slider should move on a logarithmic scale.
+    type : the class of a ``geometry`` parameter.
     """
 
     name: str
@@ -73,7 +78,7 @@ class Spec:
     symbol: str = ""
     help: str = ""
     step: float | None = None
-    log: bool = False
+    type: Any = None
 
     @property
     def option(self) -> str:
@@ -132,6 +137,8 @@ class Spec:
                 raise InvalidParameter(
                     f"parameter '{name}' = {value[0]}x{value[1]} has a side outside {lo}..{hi}", name=name, value=value
                 )
+        elif self.kind == "geometry":
+            value = self.type.coerce(value, name)
         elif self.kind == "str":
             if not isinstance(value, str):
                 raise InvalidParameter(f"parameter '{name}' = {value!r} must be text", name=name, value=value)
@@ -162,6 +169,8 @@ class Spec:
             value = low in ("1", "true", "yes", "on")
         elif self.kind == "size":
             value = parse_size(text, self.name)
+        elif self.kind == "geometry":
+            value = self.type.parse(text, self.name)
         else:
             value = text
         return self.validate(value)
@@ -216,7 +225,7 @@ def param(
     symbol: str = "",
     help: str = "",
     step: float | None = None,
-    log: bool = False,
+    type: Any = None,
 ) -> Any:
     """Declare a parameter field of a :class:`Params` dataclass.
 
@@ -240,9 +249,11 @@ def param(
             raise TypeError(f"cannot infer the kind of a parameter with default {default!r}")
     if kind not in KINDS:
         raise TypeError(f"unknown parameter kind {kind!r}")
+    if (kind == "geometry") != (type is not None):
+        raise TypeError("a geometry parameter needs its type (and only a geometry parameter has one)")
     meta = dict(
         kind=kind, lo=lo, hi=hi, choices=tuple(choices or ()), optional=optional,
-        symbol=symbol, help=help, step=step, log=log,
+        symbol=symbol, help=help, step=step, type=type,
     )
     return field(default=default, metadata={"weft": meta})
 
@@ -271,20 +282,31 @@ class Params:
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
+        """The JSON form (recipes, sessions): geometry written by its ``to_json``, sizes as lists."""
         out = {}
         for spec in specs(type(self)):
             v = getattr(self, spec.name)
+            if spec.kind == "geometry" and v is not None:
+                v = v.to_json()
             out[spec.name] = list(v) if isinstance(v, tuple) else v
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "Params":
+    def from_dict(cls, data: Mapping[str, Any], *, base: str | os.PathLike | None = None) -> "Params":
+        """Parameters from their JSON form; a geometry value is read by its type's ``from_json``
+        (a file it names is found relative to ``base``, the recipe's folder)."""
         if not isinstance(data, Mapping):
             raise InvalidParameter(f"{cls.__name__}: parameters must be a JSON object, not {type(data).__name__}")
-        unknown = set(data) - {s.name for s in specs(cls)}
+        by_name = {s.name: s for s in specs(cls)}
+        unknown = set(data) - set(by_name)
         if unknown:
             raise InvalidParameter(_unknown_message(cls, unknown))
-        return cls(**dict(data))
+        values = dict(data)
+        for name, value in values.items():
+            spec = by_name[name]
+            if spec.kind == "geometry" and value is not None and not isinstance(value, spec.type):
+                values[name] = spec.type.from_json(value, name, base)
+        return cls(**values)
 
 
 def _unknown_message(cls: type, unknown: set) -> str:
@@ -318,63 +340,6 @@ def as_rng(rng: None | int | np.random.Generator) -> np.random.Generator:
     raise InvalidParameter(f"parameter 'rng' = {rng!r} must be None, an integer seed or a numpy Generator", name="rng")
 
 
-MAX_FILE_BYTES = 10 * 1024 * 1024
-"""The largest recipe or session weft reads (real ones are a few kB): a larger file is refused unread."""
-
-
-def parse_json(text: str) -> Any:
-    """Parse ``text`` as strict JSON, the only format of weft's recipes and sessions.
-
-    Stricter than :func:`json.loads`: ``NaN`` and ``Infinity`` (not JSON) are refused, and every
-    failure (bad syntax, nesting too deep for the parser, a number with thousands of digits) is a
-    :class:`~core.errors.WeftError` saying so in one line. Nothing is evaluated.
-    """
-    def no_constant(name: str):
-        raise WeftError(f"not valid JSON: {name} is not a JSON number")
-
-    if len(text) > MAX_FILE_BYTES:
-        raise WeftError(f"longer than the {MAX_FILE_BYTES // 2**20} MB limit")
-    try:
-        return json.loads(text, parse_constant=no_constant)
-    except json.JSONDecodeError as e:
-        raise WeftError(f"not valid JSON: {e.msg} at line {e.lineno} column {e.colno}") from None
-    except RecursionError:
-        raise WeftError("not valid JSON: nested too deeply") from None
-    except WeftError:
-        raise
-    except ValueError as e:  # e.g. an integer longer than Python converts
-        raise WeftError(f"not valid JSON: {' '.join(str(e).split(';')[0].split())}") from None
-
-
-def read_json_file(path: str | os.PathLike, what: str) -> Any:
-    """Read a weft JSON file (``what``: "recipe", "weft session"); one-line ``WeftError`` naming the
-    file if it is missing, a folder, larger than :data:`MAX_FILE_BYTES`, not UTF-8 text or not JSON."""
-    name = os.fsdecode(path)
-    limit = f"the limit is {MAX_FILE_BYTES // 2**20} MB"
-    try:
-        with open(name, "rb") as f:
-            size = os.fstat(f.fileno()).st_size
-            raw = f.read(MAX_FILE_BYTES + 1) if size <= MAX_FILE_BYTES else b""
-    except FileNotFoundError:
-        raise WeftError(f"{name}: no such {what} file") from None
-    except IsADirectoryError:
-        raise WeftError(f"{name}: is a directory, not a {what} file") from None
-    except (OSError, ValueError) as e:  # ValueError: a NUL in the name
-        raise WeftError(f"{name}: cannot read {what} ({getattr(e, 'strerror', None) or e})") from None
-    if size > MAX_FILE_BYTES:
-        raise WeftError(f"{name}: {size / 2**20:.1f} MB is too large for a {what} file ({limit}); not read")
-    if len(raw) > MAX_FILE_BYTES:  # grew since, or a device without a size
-        raise WeftError(f"{name}: too large for a {what} file ({limit}); not read")
-    try:
-        text = raw.decode("utf-8-sig")  # a byte-order mark (Windows editors) is not an error
-    except UnicodeDecodeError as e:
-        raise WeftError(f"{name}: not a {what} file (not UTF-8 JSON text: byte {e.start} is 0x{raw[e.start]:02x})") from None
-    try:
-        return parse_json(text)
-    except WeftError as e:
-        raise WeftError(f"{name}: not a {what} file ({e})") from None
-
-
 @dataclass(frozen=True)
 class Recipe:
     """Everything needed to reproduce a result: method, parameters, input paths and seed.
@@ -395,13 +360,18 @@ class Recipe:
     params: Mapping[str, Any] = field(default_factory=dict)
     inputs: Mapping[str, str] = field(default_factory=dict)
     seed: int | None = None
-    region: tuple[int, int, int] | None = None
+    region: Square | None = None
 
-    def to_json(self) -> str:
+    def to_json(self, relative_to: str | os.PathLike | None = None) -> str:
+        """The recipe's JSON text; with ``relative_to`` (the folder of the file that will carry it),
+        input paths are written relative to it."""
+        inputs = dict(self.inputs)
+        if relative_to is not None:
+            inputs = {k: relative_path(v, relative_to) if os.path.isabs(v) else v for k, v in inputs.items()}
         data = {"weft": RECIPE_VERSION, "method": self.method, "params": dict(self.params),
-                "inputs": dict(self.inputs), "seed": self.seed}
+                "inputs": inputs, "seed": self.seed}
         if self.region is not None:
-            data["region"] = list(self.region)
+            data["region"] = Square(*self.region).to_json()
         return json.dumps(data, sort_keys=False)
 
     @classmethod
@@ -437,10 +407,10 @@ class Recipe:
             raise WeftError(f"recipe \"seed\" = {seed!r} must be a non-negative integer below 2**63, or null")
         region = data.get("region")
         if region is not None:
-            if (not isinstance(region, list) or len(region) != 3
-                    or any(isinstance(v, bool) or not isinstance(v, int) or v < 0 for v in region)):
-                raise WeftError(f"recipe \"region\" = {region!r} must be [x, y, side] in pixels")
-            region = tuple(region)
+            try:
+                region = Square.from_json(region, "region")
+            except InvalidParameter:
+                raise WeftError(f"recipe \"region\" = {region!r} must be [x, y, side] in pixels") from None
         if base is not None:
             inputs = {k: str(Path(base) / v) if not os.path.isabs(v) else v for k, v in inputs.items()}
         return cls(method=method, params=params, inputs=inputs, seed=seed, region=region)
@@ -456,6 +426,17 @@ class Recipe:
             raise WeftError(f"{path}: {e}") from None
 
     def save(self, path: str | os.PathLike) -> None:
+        """Write the recipe to ``path`` (atomically), input paths relative to its folder."""
         from .image import atomic_write_bytes
 
-        atomic_write_bytes(Path(path), (self.to_json() + "\n").encode("utf-8"))
+        path = Path(path)
+        atomic_write_bytes(path, (self.to_json(relative_to=path.resolve().parent) + "\n").encode("utf-8"))
+
+
+def relative_path(path: str, folder: str | os.PathLike) -> str:
+    """``path`` relative to ``folder`` (recipes and sessions store paths relative to their own file);
+    absolute when there is no relative form (another drive on Windows)."""
+    try:
+        return os.path.relpath(Path(path).resolve(), Path(folder).resolve())
+    except ValueError:
+        return str(Path(path).resolve())

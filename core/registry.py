@@ -3,7 +3,9 @@
 A method module (``core/quilting.py``, ...) builds one :class:`Method` and the registry lists the
 modules to import; the CLI turns each into a subcommand (inputs become positionals or options,
 parameters become options generated from the ``Params`` specs) and ``weft run`` finds a recipe's
-method here. Adding a method = writing its module + one line in ``_MODULES``.
+method here. Adding a method = writing its module + one line in ``_MODULES`` (or, at run time,
+:func:`register`). A method the studio offers says so, and what it needs, in ``Method.studio``
+(:class:`core.studio.Studio`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy as np
 
 from .errors import WeftError
 from .params import Params
+from .studio import Studio
 
 # Method name -> the module that defines it as a module-level ``METHOD``; imported on first use, one
 # at a time where possible (``weft quilt`` need not import the affine model's FFT machinery).
@@ -71,6 +74,7 @@ class Method:
     tiny inputs, so that the first real run is not charged with it; the GUI calls it once in a
     background thread at start, the CLI before timing unless ``warm_up_in_cli`` is false (a method
     that can avoid its kernels on small inputs, such as quilting's numpy engine, would only pay).
+    ``studio``, when given, puts the method in the studio (:class:`core.studio.Studio`).
     """
 
     name: str
@@ -84,9 +88,32 @@ class Method:
     #: shapes (input name -> array shape), the figure the run checks against the memory available;
     #: a batch multiplies it by its workers to refuse up front (:mod:`core.batch`). None: no estimate.
     memory: Callable[[Mapping[str, tuple[int, ...]], Params], float] | None = None
+    studio: Studio | None = None
 
 
 _loaded: dict[str, Method] = {}
+
+
+def register(method: Method) -> None:
+    """Add a method at run time (a plug-in, a test): the CLI, ``weft run`` and, with a ``studio``
+    description, the studio offer it like the built-in ones. A second method of one name is an error."""
+    if method.name in _MODULES:
+        raise WeftError(f"a method called {method.name!r} is registered already")
+    _MODULES[method.name] = ""
+    _loaded[method.name] = method
+
+
+def unregister(name: str) -> None:
+    """Remove a method added by :func:`register`."""
+    if _MODULES.get(name) == "":
+        del _MODULES[name]
+        _loaded.pop(name, None)
+
+
+def studio_methods() -> dict[str, Method]:
+    """The methods the studio offers, in its order (``Studio.rank``, then registration)."""
+    offered = [m for m in methods().values() if m.studio is not None]
+    return {m.name: m for m in sorted(offered, key=lambda m: m.studio.rank)}
 
 
 def names() -> tuple[str, ...]:

@@ -4,7 +4,8 @@
 functions, so a batch output is byte for byte what ``weft run`` gives for that item's recipe:
 
 * :func:`load_recipe` reads a recipe (``.json``, or a PNG exported by weft) and
-  :func:`check_recipe` validates it against its method (inputs it takes, parameters, files);
+  :func:`check_recipe` validates it against its method (inputs it takes, parameters; geometry that
+  names a file, as older recipes' ``"lines": "L.json"``, is read there, relative to the recipe);
 * :func:`output_recipe` is the recipe an output at a given path carries (paths relative to its folder);
 * :func:`render` loads the inputs, checks their sizes, runs the method and names the file behind an
   error about one input; the caller encodes or saves the result with the recipe
@@ -19,42 +20,8 @@ from pathlib import Path
 from typing import Mapping
 
 from .errors import ImageError, WeftError
-from .params import Params, Recipe, specs
-
-
-def names_file(value) -> bool:
-    """Whether a text parameter names an existing file (JSON given inline, e.g. ``{...}``, does not)."""
-    if not isinstance(value, str) or not value or value.lstrip().startswith(("{", "[")):
-        return False
-    try:
-        return Path(value).is_file()
-    except (OSError, ValueError):  # too long for a file name, or a NUL in it
-        return False
-
-
-def relative_to(path: str, folder: Path) -> str:
-    """``path`` relative to ``folder`` (recipes store paths relative to the file that carries them)."""
-    try:
-        return os.path.relpath(Path(path).resolve(), folder)
-    except ValueError:  # another drive on Windows
-        return str(Path(path).resolve())
-
-
-def resolve_file_params(method, params: dict, base: Path) -> dict:
-    """Text parameters of a recipe that name files (nfpt's lines, view), made absolute against the
-    recipe's folder ``base``, never the current directory; a ``.json`` one that is not there is an error
-    naming the parameter and the file."""
-    out = dict(params)
-    for spec in specs(method.params):
-        value = out.get(spec.name)
-        if spec.kind != "str" or not isinstance(value, str) or not value or value.lstrip().startswith(("{", "[")):
-            continue  # not text, or JSON given inline
-        path = value if os.path.isabs(value) else str(base / value)
-        if names_file(path):
-            out[spec.name] = path
-        elif Path(value).suffix.lower() == ".json" and not os.path.exists(path):
-            raise WeftError(f"parameter '{spec.name}' names {value}, but {path} does not exist")
-    return out
+from .geometry import Square
+from .params import Params, Recipe, relative_path
 
 
 def load_recipe(path: str) -> Recipe:
@@ -77,8 +44,9 @@ def load_recipe(path: str) -> Recipe:
 
 
 def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) -> dict:
-    """Validate ``recipe`` against its method before any image is read; returns its parameters with
-    file parameters made absolute against ``base`` (the recipe file's folder).
+    """Validate ``recipe`` against its method before any image is read; returns its parameters in
+    their JSON form with every geometry inline (one that names a file is read relative to ``base``,
+    the recipe file's folder, never the current one).
 
     ``supplied`` names inputs given from elsewhere (a batch's ``--over``): they need not be in the
     recipe, nor exist. Messages do not name the recipe file; the caller puts it in front.
@@ -94,25 +62,22 @@ def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) 
     missing = [i.name for i in method.inputs if i.required and i.name not in recipe.inputs and i.name not in supplied]
     if missing:
         raise WeftError(f"recipe names no {', '.join(missing)} image for {method.name}")
-    method.params.from_dict(recipe.params)
+    params = method.params.from_dict(recipe.params, base=base)
     for name, path in recipe.inputs.items():
         if name not in supplied and not os.path.exists(path):
             raise WeftError(f"the {name} image {path} does not exist")
-    return resolve_file_params(method, dict(recipe.params), base)
+    return params.to_dict()
 
 
 def output_recipe(method, params: Params, input_paths: Mapping[str, str], seed: int,
                   region: tuple[int, int, int] | None, out: str | os.PathLike) -> Recipe:
-    """The recipe a run's output at ``out`` carries: input paths and file parameters relative to the
-    output's folder (``weft run OUT.png`` then finds them wherever the folder moves)."""
+    """The recipe a run's output at ``out`` carries: input paths relative to the output's folder
+    (``weft run OUT.png`` then finds them wherever the folder moves); geometry (feature lines, a view)
+    inline, so it needs no other file."""
     out_dir = Path(out).resolve().parent
-    rel_inputs = {name: relative_to(path, out_dir) for name, path in input_paths.items()}
-    recipe_params = params.to_dict()
-    for spec in specs(method.params):  # text parameters naming files (nfpt's --lines, --view)
-        value = recipe_params.get(spec.name)
-        if spec.kind == "str" and names_file(value):
-            recipe_params[spec.name] = relative_to(value, out_dir)
-    return Recipe(method=method.name, params=recipe_params, inputs=rel_inputs, seed=seed, region=region)
+    rel_inputs = {name: relative_path(path, out_dir) for name, path in input_paths.items()}
+    return Recipe(method=method.name, params=params.to_dict(), inputs=rel_inputs, seed=seed,
+                  region=None if region is None else Square(*region))
 
 
 def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
@@ -127,13 +92,13 @@ def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
     compiles) is left out of it too. ``shown_paths`` are the names to use in messages when the
     files read are copies (a batch's shipped inputs).
     """
-    from .image import crop_square, load_image
+    from .image import load_image
 
     shown = dict(shown_paths or input_paths)
     images = {name: load_image(path).image for name, path in input_paths.items()}
     if region is not None:
         first = method.inputs[0].name
-        images[first] = crop_square(images[first], region, what=first)
+        images[first] = Square(*region).crop(images[first], what=first)
     for spec in method.inputs:
         if spec.name in images and min(images[spec.name].shape[:2]) < spec.min_side:
             h, w = images[spec.name].shape[:2]

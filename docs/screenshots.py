@@ -18,7 +18,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QSettings  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
-from app.gui.document import InputImage  # noqa: E402
+from app.gui.document import DocumentState, InputImage  # noqa: E402
 from app.gui.main_window import MainWindow  # noqa: E402
 from core import registry  # noqa: E402
 from core.examples import RESOURCES, example  # noqa: E402
@@ -65,9 +65,7 @@ def shoot(app, name: str, setup) -> Path:
 
 def fast(window) -> None:
     doc = window.doc
-    doc._put_method("fast")
-    doc._put_input("texture", _input("hatching"))
-    doc._put_input("target", _input("chelsea"))
+    doc.restore(DocumentState(inputs={"texture": _input("hatching"), "target": _input("chelsea")}, method="fast"))
     doc.set_param("metric", "artistic")
     doc.set_param("p", 0.2)
     doc.set_param("colour", "source")
@@ -75,9 +73,8 @@ def fast(window) -> None:
 
 def quilt(window) -> None:
     doc = window.doc
-    doc._put_method("quilt")
-    doc._put_input("texture", _input("brick"))
-    doc.set_prototype((0, 0, 128))
+    doc.restore(DocumentState(inputs={"texture": _input("brick")}, method="quilt"))
+    doc.set_square((0, 0, 128))
     doc.set_param("mode", "mincut")
     doc.set_param("size", (384, 384))
     window.compare_button.setChecked(False)
@@ -87,8 +84,7 @@ def nfpt(window) -> None:
     import json
 
     doc = window.doc
-    doc._put_input("photo", _input("perspective"))
-    doc._put_method("nfpt")
+    doc.restore(DocumentState(inputs={"photo": _input("perspective")}, method="nfpt"))
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     doc.set_lines(data["image_lines"], data["frontal_lines"], frontal_size=data["frontal_size"])
     doc.set_param("size", (640, 480))
@@ -97,9 +93,8 @@ def nfpt(window) -> None:
 
 def affine(window) -> None:
     doc = window.doc
-    doc._put_method("affine")
-    doc._put_input("texture", _input("cat-fur"))
-    doc.set_prototype((20, 20, 64))
+    doc.restore(DocumentState(inputs={"texture": _input("cat-fur")}, method="affine"))
+    doc.set_square((20, 20, 64))
     doc.set_param("block", 16)
 
 

@@ -2,6 +2,7 @@
 
 import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -43,8 +44,9 @@ def test_nfpt_synthesizes_reprojects_and_reproduces_its_recipe(tmp_path, capsys)
     report = json.loads(stdout)
     assert report["size"] == [160, 128] and report["patches"] == 35 and report["repaired_pixels"] >= 0
     recipe = json.loads(read_recipe(out))
-    # the lines file is recorded relative to the output's folder, like the inputs
-    assert recipe["params"]["lines"] == os.path.relpath(LINES, tmp_path) and recipe["seed"] == 3
+    # the lines are read once, at the edge, and the recipe holds them (their JSON object): no other file
+    assert recipe["params"]["lines"]["frontal_size"] == json.loads(Path(LINES).read_text())["frontal_size"]
+    assert recipe["seed"] == 3
     again = tmp_path / "again.png"
     assert run(["run", out, "-o", again], capsys)[0] == 0
     assert np.array_equal(load_image(out).image, load_image(again).image)
@@ -91,6 +93,7 @@ def test_nfpt_without_lines_synthesizes_the_photo_as_it_is(tmp_path, capsys):
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, fragment):
     (tmp_path / "bad.json").write_text("{nope")
+    (tmp_path / "v.json").write_text('{"quad": [[0, 0], [99, 0], [99, 79], [0, 79]]}')  # a good view
     out = tmp_path / "out.png"
     argv = [str(a).replace("{tmp}", str(tmp_path)).replace("{out}", str(out)) for a in argv]
     code, _, err = run(argv, capsys)
@@ -114,7 +117,8 @@ def test_recipe_finds_the_lines_file_from_any_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["nfpt", "perspective.png", "--lines", "perspective-lines.json", "--size", "96x96",
                  "-o", "out.png", "--seed", "2"]) == 0
-    assert json.loads(read_recipe(tmp_path / "out.png"))["params"]["lines"] == "perspective-lines.json"
+    lines = json.loads((tmp_path / "perspective-lines.json").read_text())
+    assert json.loads(read_recipe(tmp_path / "out.png"))["params"]["lines"]["image_lines"] == lines["image_lines"]
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     monkeypatch.chdir(elsewhere)
@@ -133,4 +137,4 @@ def test_lines_given_as_json_text_on_the_command_line(tmp_path):
     text = (RESOURCES / "perspective-lines.json").read_text()
     out = tmp_path / "r.png"
     assert main(["rectify", str(RESOURCES / "perspective.png"), "--lines", text, "-o", str(out)]) == 0
-    assert json.loads(json.loads(read_recipe(out))["params"]["lines"])["frontal_size"] == [512, 384]
+    assert json.loads(read_recipe(out))["params"]["lines"]["frontal_size"] == [512, 384]

@@ -1,17 +1,17 @@
 """The document: everything the user has set up, and the undo commands that change it.
 
-Views listen to ``Document.changed(name)`` and never own state. Every edit goes through
-``Document.push(command)`` onto one ``QUndoStack``; consecutive changes of one parameter merge into
-one undo step (a slider drag is one step). Names emitted: ``"input:<name>"``, ``"method"``,
-``"params"``, ``"prototype"``, ``"lines"``, ``"seed"``.
+Contract: views listen to ``Document.changed(name)`` and never own state; they read the document's
+public attributes and change it only through its setters (``set_param``, ``set_params``,
+``set_input``, ``set_method``, ``set_seed``, ``set_geometry``/``set_square``/``set_lines``) or
+:meth:`Document.restore`. Every setter pushes one ``QUndoCommand`` onto one ``QUndoStack`` (consecutive
+changes of one parameter merge: a slider drag is one step). Names emitted: ``"input:<name>"``,
+``"method"``, ``"params"``, ``"geometry"``, ``"seed"``, ``"restored"`` (everything changed).
 """
 
 from __future__ import annotations
 
 import json
-import math
-import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -21,10 +21,11 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 
 from core import registry
 from core.errors import WeftError
-from core.image import crop_square
-from core.params import MAX_SIDE, Params, Recipe, read_json_file, specs
+from core.geometry import LINES, SQUARE, LineDraft, Square
+from core.params import Params, Recipe, relative_path
+from core.session import SESSION_VERSION, read_session  # noqa: F401 (read_session: the studio reads sessions)
+from core.studio import Studio
 
-SESSION_VERSION = 1
 _MERGE_PARAM = 1001
 
 
@@ -36,8 +37,28 @@ class InputImage:
     image: np.ndarray
 
 
+@dataclass(frozen=True)
+class DocumentState:
+    """A whole document at once, for :meth:`Document.restore` (sessions, crash recovery, the bundled
+    examples, screenshots, benchmarks). ``geometry`` maps method -> geometry key -> typed value
+    (:class:`~core.geometry.Square`, :class:`~core.geometry.LineDraft`); what is not given is empty
+    or default."""
+
+    inputs: dict[str, InputImage] = field(default_factory=dict)
+    method: str | None = None
+    params: dict[str, Params] = field(default_factory=dict)
+    geometry: dict[str, dict[str, Any]] = field(default_factory=dict)
+    seed: int = 1
+
+
 class Document(QObject):
-    """Inputs, method, parameters of every method, prototype rectangle, feature lines, seed."""
+    """Inputs, method, parameters and geometry of every method, seed (see the module docstring).
+
+    Geometry belongs to its method: ``geometry[method][key]`` holds the typed value of each geometry
+    the method's studio description lists (the key is the parameter it fills, or ``"region"``), so a
+    square drawn for one method never reaches another. ``params`` hold the rest; :meth:`run_params`
+    puts the geometry in (typed: no text in between).
+    """
 
     changed = Signal(str)
 
@@ -45,21 +66,22 @@ class Document(QObject):
         super().__init__(parent)
         self.undo_stack = QUndoStack(self)
         self.inputs: dict[str, InputImage] = {}
-        self.methods = registry.methods()
-        self.method = "fast" if "fast" in self.methods else next(iter(self.methods))
+        self.methods = registry.studio_methods()
+        self.method = next(iter(self.methods))
         self.params: dict[str, Params] = {name: m.params() for name, m in self.methods.items()}
-        self.prototype: tuple[int, int, int] | None = None
-        self.image_lines: list[list[float]] = []
-        self.frontal_lines: list[list[float]] = []
-        self.frontal_size: tuple[int, int] = (512, 512)
+        self.geometry: dict[str, dict[str, Any]] = {name: {} for name in self.methods}
         self.seed = 1
-        # The prototype square while it is being dragged (not an edit yet: no undo step until release).
-        self.live_prototype: tuple[int, int, int] | None = None
+        # The geometry being dragged (key, value): not an edit yet, no undo step until release.
+        self.live: tuple[str, Any] | None = None
 
     # --- reading -------------------------------------------------------------------------------
     @property
     def current(self) -> registry.Method:
         return self.methods[self.method]
+
+    @property
+    def studio(self) -> Studio:
+        return self.current.studio
 
     @property
     def current_params(self) -> Params:
@@ -72,53 +94,79 @@ class Document(QObject):
     def missing_inputs(self) -> list[str]:
         return [i.name for i in self.current.inputs if i.required and i.name not in self.inputs]
 
-    def source_region(self) -> tuple[int, int, int] | None:
-        """The prototype rectangle, when the current method uses it as its source region (methods
-        with a ``prototype`` parameter of their own, such as ``affine``, use it as that instead)."""
-        if self.prototype is None or any(s.name == "prototype" for s in specs(self.current.params)):
-            return None
-        return self.prototype
+    def geometry_of(self, kind: str, method: str | None = None) -> Geometry | None:
+        """The (first) geometry of ``kind`` the method (default the current one) has."""
+        method = method or self.method
+        return next((g for g in self.methods[method].studio.geometry if g.kind == kind), None)
+
+    def value(self, key: str, method: str | None = None) -> Any:
+        """The typed value of one geometry of a method (default the current one), or None."""
+        return self.geometry[method or self.method].get(key)
+
+    @property
+    def square(self) -> Square | None:
+        """The current method's square (its source region or a square parameter), or None."""
+        g = self.geometry_of(SQUARE)
+        return None if g is None else self.value(g.key)
+
+    @property
+    def lines(self) -> LineDraft:
+        """The current method's feature lines being drawn (empty if it has none)."""
+        g = self.geometry_of(LINES)
+        value = None if g is None else self.value(g.key)
+        return value if value is not None else LineDraft()
+
+    @property
+    def image_lines(self) -> list[list[float]]:
+        return [list(x) for x in self.lines.image_lines]
+
+    @property
+    def frontal_lines(self) -> list[list[float]]:
+        return [list(x) for x in self.lines.frontal_lines]
+
+    @property
+    def frontal_size(self) -> tuple[int, int]:
+        return self.lines.frontal_size
+
+    def region(self, method: str | None = None) -> Square | None:
+        """The source region of a method (a square that fills no parameter), or None."""
+        method = method or self.method
+        g = next((g for g in self.methods[method].studio.geometry if g.param is None), None)
+        return None if g is None else self.value(g.key, method)
 
     def method_inputs(self) -> dict[str, np.ndarray]:
-        """The current method's loaded inputs; the texture cropped to the source region if there is one."""
+        """The current method's loaded inputs; the canvas cropped to the source region if there is one."""
         out = {i.name: self.inputs[i.name].image for i in self.current.inputs if i.name in self.inputs}
-        region = self.source_region()
-        first = self.current.inputs[0].name
-        if region is not None and first in out:
-            out[first] = crop_square(out[first], region, what=first)
+        region = self.region()
+        g = next((g for g in self.studio.geometry if g.param is None), None)
+        if region is not None and g is not None and g.on[0] in out:
+            out[g.on[0]] = region.crop(out[g.on[0]], what=g.on[0].replace("_", " "))
         return out
 
-    def lines_json(self) -> str | None:
-        """The feature lines as DESIGN.md's JSON text (complete pairs only), or None if there are none."""
-        n = min(len(self.image_lines), len(self.frontal_lines))
-        if n == 0:
-            return None
-        return json.dumps({"image_lines": self.image_lines[:n], "frontal_lines": self.frontal_lines[:n],
-                           "frontal_size": list(self.frontal_size)})
-
-    def run_params(self) -> Params:
-        """The current method's parameters as a run uses them: a method with a ``lines`` parameter
-        (nfpt) gets the document's feature lines as JSON text, one with a ``prototype`` parameter
-        (affine) the prototype square as ``"X,Y,S"`` (the one being dragged, if any), so recipes need
-        no extra file and the mouse is the one way to set them."""
+    def run_params(self, *, live: bool = True) -> Params:
+        """The current method's parameters as a run uses them: its geometry put into the parameters it
+        fills (typed; with ``live``, the one being dragged instead of the stored one)."""
         params = self.current_params
-        names = {s.name for s in specs(self.current.params)}
-        if "lines" in names:
-            params = params.replace(lines=self.lines_json())
-        if "prototype" in names:
-            rect = self.live_prototype or self.prototype
-            params = params.replace(prototype=",".join(str(int(v)) for v in rect) if rect else None)
-        return params
+        changes = {}
+        for g in self.studio.geometry:
+            if g.param is None:
+                continue
+            value = self.value(g.key)
+            if live and self.live is not None and self.live[0] == g.key:
+                value = self.live[1]
+            if isinstance(value, LineDraft):
+                value = value.complete()
+            changes[g.param] = value
+        return params.replace(**changes) if changes else params
 
-    def recipe(self, relative_to: str | Path | None = None) -> Recipe:
-        """The recipe that reproduces the current result (``weft run`` gives the same pixels)."""
+    def recipe(self, params: Params | None = None) -> Recipe:
+        """The recipe of a render of the document now with ``params`` (default :meth:`run_params`);
+        input paths absolute (``Recipe.to_json(relative_to=...)`` writes them relative to its file)."""
         names = {i.name for i in self.current.inputs}
-        inputs = {}
-        for name, item in self.inputs.items():
-            if name in names and item.path:
-                inputs[name] = _relative(item.path, relative_to)
-        return Recipe(method=self.method, params=self.run_params().to_dict(), inputs=inputs, seed=self.seed,
-                      region=self.source_region())
+        inputs = {name: item.path for name, item in self.inputs.items() if name in names and item.path}
+        params = self.run_params(live=False) if params is None else params
+        return Recipe(method=self.method, params=params.to_dict(), inputs=inputs,
+                      seed=self.seed, region=self.region())
 
     # --- edits (undoable) ----------------------------------------------------------------------
     def push(self, command: QUndoCommand) -> None:
@@ -130,6 +178,11 @@ class Document(QObject):
         if new != self.current_params:
             self.push(SetParams(self, self.method, new, f"{name} = {value}", merge_key=name))
 
+    def set_params(self, params: Params, text: str) -> None:
+        """Undoable change of several parameters of the current method at once (one step)."""
+        if params != self.current_params:
+            self.push(SetParams(self, self.method, params, text))
+
     def set_input(self, name: str, path: str | None, image: np.ndarray) -> None:
         self.push(SetInput(self, name, InputImage(path, image)))
 
@@ -137,17 +190,51 @@ class Document(QObject):
         if method != self.method:
             self.push(SetMethod(self, method))
 
-    def set_prototype(self, rect: tuple[int, int, int] | None) -> None:
-        if rect != self.prototype:
-            self.push(SetPrototype(self, rect))
+    def set_seed(self, seed: int) -> None:
+        """Undoable change of the seed (it marks the document unsaved like any edit)."""
+        seed = int(seed)
+        if seed != self.seed:
+            self.push(SetSeed(self, seed))
+
+    def set_geometry(self, key: str, value: Any, text: str) -> None:
+        """Undoable change of one geometry of the current method."""
+        if value != self.value(key):
+            self.push(SetGeometry(self, self.method, key, value, text))
+
+    def set_square(self, rect) -> None:
+        """Set (or with None clear) the current method's square; nothing if it has none."""
+        g = self.geometry_of(SQUARE)
+        if g is not None:
+            self.set_geometry(g.key, None if rect is None else Square(*rect), "Square" if rect else "Clear square")
 
     def set_lines(self, image_lines, frontal_lines, text: str = "Edit lines", frontal_size=None) -> None:
-        new = ([list(map(float, ln)) for ln in image_lines], [list(map(float, ln)) for ln in frontal_lines])
+        """Set the current method's feature lines (pairs may be unfinished); nothing if it has none."""
+        g = self.geometry_of(LINES)
+        if g is None:
+            return
         size = tuple(frontal_size) if frontal_size is not None else self.frontal_size
-        if new != (self.image_lines, self.frontal_lines) or size != self.frontal_size:
-            self.push(SetLines(self, *new, text, frontal_size=size))
+        draft = LineDraft(tuple(map(tuple, image_lines)), tuple(map(tuple, frontal_lines)), size)
+        if draft != self.lines:
+            self.set_geometry(g.key, draft, text)
 
-    # --- raw mutators (used by the commands) ---------------------------------------------------
+    # --- the whole document at once ------------------------------------------------------------
+    def restore(self, state: DocumentState) -> None:
+        """Replace the whole document by ``state``: one clean state with no undo history (inputs
+        the state lacks are closed). Listeners get ``changed("restored")`` once."""
+        self.inputs = dict(state.inputs)
+        if state.method is not None:
+            if state.method not in self.methods:
+                raise WeftError(f"the studio does not offer method {state.method!r}")
+            self.method = state.method
+        self.params = {name: m.params() for name, m in self.methods.items()}
+        self.params.update({k: v for k, v in state.params.items() if k in self.methods})
+        self.geometry = {name: dict(state.geometry.get(name, {})) for name in self.methods}
+        self.seed = int(state.seed)
+        self.live = None
+        self.undo_stack.clear()
+        self.changed.emit("restored")
+
+    # --- raw mutators (used by the undo commands of this module only) --------------------------
     def _put_params(self, method: str, params: Params) -> None:
         self.params[method] = params
         self.changed.emit("params")
@@ -161,29 +248,33 @@ class Document(QObject):
 
     def _put_method(self, method: str) -> None:
         self.method = method
+        self.live = None
         self.changed.emit("method")
 
-    def _put_prototype(self, rect) -> None:
-        self.prototype = rect
-        self.changed.emit("prototype")
+    def _put_geometry(self, method: str, key: str, value) -> None:
+        if value is None:
+            self.geometry[method].pop(key, None)
+        else:
+            self.geometry[method][key] = value
+        self.live = None
+        self.changed.emit("geometry")
 
-    def _put_lines(self, image_lines, frontal_lines, frontal_size=None) -> None:
-        self.image_lines = [list(x) for x in image_lines]
-        self.frontal_lines = [list(x) for x in frontal_lines]
-        if frontal_size is not None:
-            self.frontal_size = (int(frontal_size[0]), int(frontal_size[1]))
-        self.changed.emit("lines")
+    def _put_seed(self, seed: int) -> None:
+        self.seed = seed
+        self.changed.emit("seed")
 
     # --- sessions ------------------------------------------------------------------------------
     def session_dict(self, relative_to: str | Path | None = None) -> dict:
+        def path(p):
+            return p if relative_to is None else relative_path(p, relative_to)
+
         return {
             "weft_session": SESSION_VERSION,
             "method": self.method,
             "params": {name: p.to_dict() for name, p in self.params.items()},
-            "inputs": {name: _relative(item.path, relative_to) for name, item in self.inputs.items() if item.path},
-            "prototype": list(self.prototype) if self.prototype else None,
-            "lines": {"image_lines": self.image_lines, "frontal_lines": self.frontal_lines,
-                      "frontal_size": list(self.frontal_size)},
+            "inputs": {name: path(item.path) for name, item in self.inputs.items() if item.path},
+            "geometry": {name: {key: value.to_json() for key, value in values.items()}
+                         for name, values in self.geometry.items() if values},
             "seed": self.seed,
         }
 
@@ -193,97 +284,6 @@ class Document(QObject):
         path = Path(path)
         text = json.dumps(self.session_dict(relative_to=path.resolve().parent), indent=1)
         atomic_write_bytes(path, (text + "\n").encode("utf-8"))
-
-
-MAX_SEED = 2**31 - 1  # the studio's seed box
-FRONTAL_SIDES = (2, MAX_SIDE)  # what a feature-lines file may give (core.rectify)
-
-
-def read_session(path: str | Path) -> dict:
-    """Parse and validate a session file (JSON only, at most ``core.params.MAX_FILE_BYTES``); input
-    paths come back absolute, relative ones resolved against the session's folder. ``WeftError`` with
-    one line naming the file if anything is wrong, so a bad file never half-replaces a document."""
-    path = Path(path)
-    data = read_json_file(path, "weft session")
-    try:
-        return _session_from_data(data, path.resolve().parent)
-    except WeftError as e:
-        raise WeftError(f"{path}: {e}") from None
-
-
-def _session_from_data(data: Any, base: Path) -> dict:
-    if not isinstance(data, dict) or data.get("weft_session") != SESSION_VERSION:
-        raise WeftError(f"not a weft session file (version {SESSION_VERSION})")
-    methods = registry.methods()
-    if data.get("method") not in methods:
-        raise WeftError(f"unknown method {data.get('method')!r}")
-    raw_params = _get(data, "params", dict, "an object of method name -> parameters", {})
-    params = {}
-    for name, values in raw_params.items():
-        if name in methods:  # a method this version lacks is skipped, not fatal
-            try:
-                params[name] = methods[name].params.from_dict(values)
-            except WeftError as e:
-                raise WeftError(f"{name}: {e}") from None
-    known_inputs = {i.name for m in methods.values() for i in m.inputs}
-    inputs = {}
-    for name, value in _get(data, "inputs", dict, "an object of input name -> image file", {}).items():
-        if name not in known_inputs:
-            raise WeftError(f"unknown input {name!r} (known: {', '.join(sorted(known_inputs))})")
-        if not isinstance(value, str) or not value or "\0" in value:
-            raise WeftError(f"input {name!r} = {value!r} is not a file path")
-        inputs[name] = value if os.path.isabs(value) else str(base / value)
-    proto = data.get("prototype")
-    if proto is not None and (not isinstance(proto, list) or len(proto) != 3 or not _ints(proto, 0)
-                              or proto[2] < 1):
-        raise WeftError(f"prototype = {proto!r} must be [x, y, side] in pixels, or null")
-    lines = _get(data, "lines", dict, "an object {image_lines, frontal_lines, frontal_size}", {})
-    image_lines = _lines(lines, "image_lines")
-    frontal_lines = _lines(lines, "frontal_lines")
-    lo, hi = FRONTAL_SIDES
-    frontal_size = lines.get("frontal_size", [512, 512])
-    if not isinstance(frontal_size, list) or len(frontal_size) != 2 or not _ints(frontal_size, lo, hi):
-        raise WeftError(f"frontal_size = {frontal_size!r} must be [width, height], each {lo}..{hi}")
-    seed = data.get("seed", 1)
-    if not _ints([seed], 0, MAX_SEED):
-        raise WeftError(f"seed = {seed!r} must be an integer in 0..{MAX_SEED}")
-    return {"method": data["method"], "params": params, "inputs": inputs,
-            "prototype": tuple(proto) if proto else None,
-            "image_lines": image_lines, "frontal_lines": frontal_lines,
-            "frontal_size": tuple(frontal_size), "seed": seed}
-
-
-def _get(data: dict, key: str, kind: type, what: str, default):
-    value = data.get(key)
-    if value is None:
-        return default
-    if not isinstance(value, kind):
-        raise WeftError(f"{key} must be {what}")
-    return value
-
-
-def _ints(values, lo: int, hi: int | None = None) -> bool:
-    return all(isinstance(v, int) and not isinstance(v, bool) and lo <= v and (hi is None or v <= hi)
-               for v in values)
-
-
-def _lines(lines: dict, key: str) -> list[list[float]]:
-    value = lines.get(key, [])
-    if (not isinstance(value, list)
-            or not all(isinstance(ln, list) and len(ln) == 4
-                       and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in ln)
-                       for ln in value)):
-        raise WeftError(f"{key} must be a list of [x1, y1, x2, y2] in pixels")
-    return [[float(v) for v in ln] for ln in value]
-
-
-def _relative(path: str | None, base: str | Path | None) -> str | None:
-    if path is None or base is None:
-        return path
-    try:
-        return os.path.relpath(Path(path).resolve(), Path(base).resolve())
-    except ValueError:
-        return str(Path(path).resolve())
 
 
 # --- undo commands -------------------------------------------------------------------------------
@@ -341,27 +341,28 @@ class SetMethod(QUndoCommand):
         self.doc._put_method(self.old)
 
 
-class SetPrototype(QUndoCommand):
-    def __init__(self, doc: Document, rect):
-        super().__init__("Prototype" if rect else "Clear prototype")
-        self.doc, self.new, self.old = doc, rect, doc.prototype
+class SetSeed(QUndoCommand):
+    def __init__(self, doc: Document, seed: int):
+        super().__init__(f"Seed {seed}")
+        self.doc, self.new, self.old = doc, seed, doc.seed
 
     def redo(self):
-        self.doc._put_prototype(self.new)
+        self.doc._put_seed(self.new)
 
     def undo(self):
-        self.doc._put_prototype(self.old)
+        self.doc._put_seed(self.old)
 
 
-class SetLines(QUndoCommand):
-    def __init__(self, doc: Document, image_lines, frontal_lines, text: str, frontal_size=None):
+class SetGeometry(QUndoCommand):
+    """Replace one geometry value of one method."""
+
+    def __init__(self, doc: Document, method: str, key: str, value, text: str):
         super().__init__(text)
-        self.doc = doc
-        self.new = (image_lines, frontal_lines, frontal_size or doc.frontal_size)
-        self.old = ([list(x) for x in doc.image_lines], [list(x) for x in doc.frontal_lines], doc.frontal_size)
+        self.doc, self.method, self.key, self.new = doc, method, key, value
+        self.old = doc.geometry[method].get(key)
 
     def redo(self):
-        self.doc._put_lines(*self.new)
+        self.doc._put_geometry(self.method, self.key, self.new)
 
     def undo(self):
-        self.doc._put_lines(*self.old)
+        self.doc._put_geometry(self.method, self.key, self.old)

@@ -1,7 +1,10 @@
 """The studio's files: export, recipes, sessions, and never losing work (ask, autosave, recover).
 
-A mixin of ``MainWindow`` (it uses the window's document, renderer, settings, status bar and
-``show_message``): every question goes through :meth:`FilesMixin._confirm`, so tests can answer it.
+Contract: :class:`FileActions` is given the window (a parent for dialogs, with ``show_message(text)``,
+``statusBar()``, ``settings`` and ``_confirm(question) -> bool``, the one place the studio asks), the
+document and the renderer. It exports the *shown result* with that result's own recipe (never the
+panel's state), and changes the document only through :meth:`Document.restore`. It imports nothing
+of the window.
 """
 
 from __future__ import annotations
@@ -12,17 +15,28 @@ import threading
 from pathlib import Path
 from typing import Callable, TypeVar
 
-from PySide6.QtCore import QEventLoop, QMetaObject, Qt
-from PySide6.QtWidgets import QFileDialog, QMessageBox
+from PySide6.QtCore import QEventLoop, QMetaObject, QObject, QStandardPaths, Qt, QTimer
+from PySide6.QtWidgets import QFileDialog
 
+from core import registry
 from core.errors import WeftError
-from core.image import atomic_write_bytes, crop_square, load_image, save_image
+from core.studio import SQUARE
+from core.image import atomic_write_bytes, load_image, save_image
 
-from .document import InputImage, read_session
+from .document import DocumentState, InputImage, read_session
 
 T = TypeVar("T")
 
 SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
+AUTOSAVE_MS = 2000  # unsaved edits reach the recovery file at most this long after they are made
+RECOVERY_FILE = "recovery.weft.json"
+
+
+def recovery_path() -> Path:
+    """The crash-recovery session file: in ``WEFT_RECOVERY_DIR`` if set, else the app data folder."""
+    folder = os.environ.get("WEFT_RECOVERY_DIR") or QStandardPaths.writableLocation(
+        QStandardPaths.StandardLocation.AppDataLocation) or str(Path.home() / ".weft")
+    return Path(folder) / RECOVERY_FILE
 
 
 def off_gui_thread(fn: Callable[[], T]) -> T:
@@ -52,20 +66,40 @@ def off_gui_thread(fn: Callable[[], T]) -> T:
     return box["value"]
 
 
-class FilesMixin:
-    """Export, recipes, sessions, autosave and recovery of :class:`~app.gui.main_window.MainWindow`."""
+class FileActions(QObject):
+    """Export, recipes, sessions, autosave and recovery (see the module docstring)."""
+
+    def __init__(self, window, doc, renderer):
+        super().__init__(window)
+        self.window, self.doc, self.renderer = window, doc, renderer
+        self.settings = window.settings
+        # Crash recovery: while the document has unsaved edits, it is autosaved (atomically) at most
+        # every AUTOSAVE_MS; a clean document has no recovery file.
+        self.recovery_file = recovery_path()
+        self._autosave_timer = QTimer(window, singleShot=True, interval=AUTOSAVE_MS)
+        self._autosave_timer.timeout.connect(self.autosave)
+        self._owns_recovery = False  # only a file this window wrote (or restored) is removed by it
+
+    def show_message(self, text: str) -> None:
+        self.window.show_message(text)
+
+    def statusBar(self):  # noqa: N802 (the window's)
+        return self.window.statusBar()
+
+    def _confirm(self, question: str) -> bool:
+        return self.window._confirm(question)
 
     # --- export, sessions ------------------------------------------------------------------------
     def save_result_dialog(self) -> None:
         if self.renderer.last is None or not self.renderer.last.final:
             self.show_message("nothing to export yet: wait for the full-size result")
             return
-        path, _ = QFileDialog.getSaveFileName(self, "Export result", str(self.settings.value("last_dir", "")), SAVE_FILTER)
+        path, _ = QFileDialog.getSaveFileName(self.window, "Export result", str(self.settings.value("last_dir", "")), SAVE_FILTER)
         if path:
             self.export_result(path)
 
     def export_result(self, path: str) -> bool:
-        """Save the shown full-size result: PNG carries the recipe, TIFF is 16-bit, JPEG 8-bit."""
+        """Save the shown full-size result: PNG carries the result's recipe, TIFF is 16-bit, JPEG 8-bit."""
         shown = self.renderer.last
         if shown is None or not shown.final:
             self.show_message("nothing to export yet: wait for the full-size result")
@@ -80,7 +114,7 @@ class FilesMixin:
         if p.exists() and not self._confirm(f"{p.name} exists. Replace it?"):
             self.show_message(f"{p.name}: not exported (the existing file is kept)")
             return False
-        recipe = self.doc.recipe(relative_to=p.resolve().parent).to_json()
+        recipe = shown.recipe.to_json(relative_to=p.resolve().parent)
         depth = 16 if p.suffix.lower() in (".tif", ".tiff") else 8
         self.statusBar().showMessage(f"exporting {p.name}…")
         try:  # encoding a large PNG takes a second: off the GUI thread
@@ -92,15 +126,25 @@ class FilesMixin:
         return True
 
     def export_recipe_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Export recipe", "", "Recipe (*.json)")
+        path, _ = QFileDialog.getSaveFileName(self.window, "Export recipe", "", "Recipe (*.json)")
         if path:
-            try:
-                self.doc.recipe(relative_to=Path(path).resolve().parent).save(path)
-            except WeftError as e:
-                self.show_message(str(e))
+            self.export_recipe(path)
+
+    def export_recipe(self, path: str) -> bool:
+        """Save the recipe of the shown full-size result (``weft run`` reproduces its pixels)."""
+        shown = self.renderer.last
+        if shown is None or not shown.final:
+            self.show_message("no recipe to export yet: wait for the full-size result")
+            return False
+        try:
+            shown.recipe.save(path)
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
+        return True
 
     def save_session_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save session", "", "weft session (*.weft.json *.json)")
+        path, _ = QFileDialog.getSaveFileName(self.window, "Save session", "", "weft session (*.weft.json *.json)")
         if path:
             self.save_session(path)
 
@@ -115,7 +159,7 @@ class FilesMixin:
         return True
 
     def open_session_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Open session", "", "weft session (*.json)")
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open session", "", "weft session (*.json)")
         if path:
             self.open_session(path)
 
@@ -140,12 +184,11 @@ class FilesMixin:
 
         Raises ``WeftError`` naming the session file and, for an image, which input it is.
         """
-        from .main_window import STUDIO_METHODS
-
         data = read_session(path)
-        if data["method"] not in STUDIO_METHODS:
+        offered = registry.studio_methods()
+        if data["method"] not in offered:
             raise WeftError(f"{path}: the studio does not offer method {data['method']!r} "
-                            f"(it offers {', '.join(STUDIO_METHODS)}; use 'weft {data['method']}')")
+                            f"(it offers {', '.join(offered)}; use 'weft {data['method']}')")
         def decode() -> dict[str, InputImage]:
             images = {}
             for name, p in data["inputs"].items():
@@ -157,47 +200,23 @@ class FilesMixin:
 
         self.statusBar().showMessage(f"opening {Path(path).name}…")
         images = off_gui_thread(decode)
-        proto = data["prototype"]
-        on = "prototype_image" if data["method"] == "affine" and "prototype_image" in images else "texture"
-        if proto is not None and on in images:
-            try:
-                crop_square(images[on].image, proto, what=on.replace("_", " "))
-            except WeftError as e:
-                raise WeftError(f"{path}: prototype: {e}") from None
+        for method, values in data["geometry"].items():  # a square must lie inside its image
+            for g in offered[method].studio.geometry:
+                square, on = values.get(g.key), g.input_for(images)
+                if g.kind == SQUARE and square is not None and on in images:
+                    try:
+                        square.crop(images[on].image, what=on.replace("_", " "), name=g.key)
+                    except WeftError as e:
+                        raise WeftError(f"{path}: {method} {g.key}: {e}") from None
         return data, images
 
     def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
         """Put a read session into the document (one clean state, no undo history) and render it."""
-        doc = self.doc
-        self.renderer.enabled = False
-        try:
-            for name in [n for n in doc.inputs if n not in images]:
-                doc._put_input(name, None)  # an input the session does not have is closed, and its view cleared
-            for name, item in images.items():
-                doc._put_input(name, item)
-            for name, params in data["params"].items():
-                doc.params[name] = params
-            doc._put_method(data["method"])
-            doc._put_prototype(data["prototype"])
-            doc.frontal_size = data["frontal_size"]
-            doc._put_lines(data["image_lines"], data["frontal_lines"])
-            doc.seed = data["seed"]
-            doc.changed.emit("seed")
-            doc.undo_stack.clear()
-            self._show_params()
-        finally:
-            self.renderer.enabled = True
+        self.doc.restore(DocumentState(inputs=images, method=data["method"], params=data["params"],
+                                       geometry=data["geometry"], seed=data["seed"]))
         self.renderer.final(now=True)
 
     # --- asking, autosave, recovery --------------------------------------------------------------
-    def _confirm(self, question: str) -> bool:
-        """Ask a yes/no question in a modal box; True for yes. The one place the window asks
-        (tests replace it)."""
-        answer = QMessageBox.question(self, "weft", question,
-                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
-                                      QMessageBox.StandardButton.No)
-        return answer == QMessageBox.StandardButton.Yes
-
     def _schedule_autosave(self, *_args) -> None:
         if self.doc.undo_stack.isClean():
             self._autosave_timer.stop()

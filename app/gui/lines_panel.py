@@ -1,10 +1,10 @@
-"""Feature lines of the nfpt method: the photo's line tool and the frontal frame with live rectification.
+"""The feature-lines tool's panel: the photo's line tool and the frontal frame with live rectification.
 
 Line i drawn on the photo goes with line i drawn in the frontal frame (numbered and coloured alike).
 While an end point is dragged, the photo is rectified on a worker (latest wins) and shown in the
 frontal frame, so the user sees the effect of every move; *Quad…* makes four pairs from four clicked
 corners; the frontal size sets the frame the lines live in. Lines load from and save to DESIGN.md's
-JSON; the document holds them (undoable) and the nfpt render takes them from there.
+JSON; the document holds them (undoable, per method) and the render takes them from there.
 """
 
 from __future__ import annotations
@@ -28,11 +28,12 @@ class FeatureLinesPanel(QWidget):
     message = Signal(str)
     _rectified = Signal(object)
 
-    def __init__(self, doc, photo_view: ImageView, parent=None):
+    def __init__(self, doc, photo_view: ImageView, input_name: str, parent=None):
         super().__init__(parent)
         self.doc = doc
         self.photo_view = photo_view
-        self.active = False  # rectify only while the nfpt method is shown
+        self.input_name = input_name  # the input the lines are drawn on
+        self.active = False  # rectify only while a method with feature lines is shown
         self.photo_lines = LineTool(photo_view, doc, "image", on_drag=self._lines_dragged)
         photo_view.tool = self.photo_lines
         self.frontal_view = ImageView(self, title="frontal")
@@ -108,7 +109,7 @@ class FeatureLinesPanel(QWidget):
         """Rectify the photo with the current (or the dragged) lines on the worker (latest wins)."""
         if not self.active:
             return
-        photo = self.doc.image("photo")
+        photo = self.doc.image(self.input_name)
         image_lines = self.doc.image_lines if image_lines is None else image_lines
         frontal_lines = self.doc.frontal_lines if frontal_lines is None else frontal_lines
         n = min(len(image_lines), len(frontal_lines))
@@ -128,7 +129,7 @@ class FeatureLinesPanel(QWidget):
         def job(*, progress=None, cancel=None):
             return rectifier.rectify(lines[0], lines[1], size).image
 
-        self.runner.submit("rectify", job)
+        self.runner.submit("frontal", job)
 
     def _on_rectified(self, result: JobResult) -> None:
         if result.error is not None:
@@ -164,12 +165,12 @@ class FeatureLinesPanel(QWidget):
     def save_lines(self, path: str) -> bool:
         from core.image import atomic_write_bytes
 
-        text = self.doc.lines_json()
-        if text is None:
+        lines = self.doc.lines.complete()
+        if lines is None:
             self.message.emit("no complete line pairs to save")
             return False
         try:
-            atomic_write_bytes(Path(path), (text + "\n").encode("utf-8"))
+            atomic_write_bytes(Path(path), (lines.to_text() + "\n").encode("utf-8"))
         except WeftError as e:
             self.message.emit(str(e))
             return False

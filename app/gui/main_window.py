@@ -1,40 +1,37 @@
-"""The weft studio's main window.
+"""The weft studio's main window: it assembles a few parts, each with a written contract.
 
-Left: the method's inputs (the texture on top with the prototype tool; the other inputs in tabs
-below). Right: the result, with a before/after split. Dock: method, parameters (generated from the
-specs), seed, variations. Every edit is an undo command on the document; renders run on the worker
-pool (``app.gui.render``); the GUI thread only decodes nothing larger than a frame's work.
+* :class:`~app.gui.document.Document`: the state (inputs, method, parameters and geometry per
+  method, seed); every edit an undo command.
+* :class:`~app.gui.canvas.InputsPane` (left): the method's inputs, the canvas on top, with the
+  tool of each geometry.
+* :class:`~app.gui.method_panel.MethodPanel` (dock): method list, parameters, seed, buttons.
+* :class:`~app.gui.render.Renderer`: preview and final jobs on the worker pool; a result carries
+  its recipe.
+* :class:`~app.gui.files.FileActions`: export, recipes, sessions, autosave and recovery.
+
+The window wires them (document changes -> parts; results -> result view, status bar) and holds the
+menus. Everything method-specific comes from the methods' studio descriptions (``core.studio``).
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 from PIL import Image as PILImage
-from PySide6.QtCore import QMimeData, QSettings, QSize, QStandardPaths, Qt, QTimer, QUrl, Signal
-from PySide6.QtGui import QAction, QIcon, QKeySequence, QPixmap
+from PySide6.QtCore import QMimeData, QSettings, QSize, Qt, QUrl, Signal
+from PySide6.QtGui import QAction, QIcon, QKeySequence
 from PySide6.QtWidgets import (
-    QComboBox,
     QDockWidget,
     QFileDialog,
-    QHBoxLayout,
     QLabel,
     QListWidget,
     QListWidgetItem,
     QMainWindow,
+    QMessageBox,
     QProgressBar,
     QPushButton,
-    QScrollArea,
-    QSizePolicy,
-    QSpinBox,
     QSplitter,
-    QStackedWidget,
-    QTabWidget,
-    QToolButton,
-    QVBoxLayout,
-    QWidget,
 )
 
 from core import registry
@@ -43,29 +40,15 @@ from core.examples import example, examples
 from core.image import load_image
 from core.jobs import JobRunner
 
-from .convert import to_qimage
-from .document import Document, InputImage
-from .files import FilesMixin
-from .params_panel import ParamsPanel
+from .canvas import InputsPane, titled
+from .document import Document, DocumentState, InputImage
+from .files import FileActions, recovery_path  # noqa: F401 (recovery_path: the window's recovery file)
+from .method_panel import MethodPanel
 from .render import Renderer, describe
-from .lines_panel import FeatureLinesPanel
-from .tools import PatchTool
 from .views import ImageView, ResultView, is_image_path
 
 OPEN_FILTER = "Images (*.png *.jpg *.jpeg *.tif *.tiff *.bmp *.webp);;All files (*)"
-DEFAULT_INPUTS = {"texture": "wood-grain", "target": "astronaut", "photo": "perspective"}
 MAX_RECENT = 8
-# The methods the studio offers (those registered): "blend" and "rectify" are command-line steps.
-STUDIO_METHODS = ("fast", "quilt", "affine", "nfpt")
-AUTOSAVE_MS = 2000  # unsaved edits reach the recovery file at most this long after they are made
-RECOVERY_FILE = "recovery.weft.json"
-
-
-def recovery_path() -> Path:
-    """The crash-recovery session file: in ``WEFT_RECOVERY_DIR`` if set, else the app data folder."""
-    folder = os.environ.get("WEFT_RECOVERY_DIR") or QStandardPaths.writableLocation(
-        QStandardPaths.StandardLocation.AppDataLocation) or str(Path.home() / ".weft")
-    return Path(folder) / RECOVERY_FILE
 
 
 class _ExampleList(QListWidget):
@@ -77,7 +60,7 @@ class _ExampleList(QListWidget):
         return data
 
 
-class MainWindow(FilesMixin, QMainWindow):
+class MainWindow(QMainWindow):
     """The studio window (see the module docstring)."""
 
     message = Signal(str)
@@ -97,49 +80,41 @@ class MainWindow(FilesMixin, QMainWindow):
         # Opened files are decoded off the GUI thread; the result comes back through a queued signal.
         self.loader = JobRunner(max_workers=1, on_result=self._opened.emit)
         self._opened.connect(self._on_opened)
-        self._dragging = False
 
-        # views
-        self.views: dict[str, ImageView] = {}
         self.result_view = ResultView(self)
-        self.texture_view = self._input_view("texture")
-        self.patch_tool = PatchTool(self.texture_view, self.doc, on_drag=self._prototype_dragged)
-        self.texture_view.tool = self.patch_tool
-        self.prototype_patch_tool = PatchTool(self._input_view("prototype_image"), self.doc,
-                                              on_drag=self._prototype_dragged)
-        # nfpt: the photo with its feature lines, and the frontal frame (live rectification) with its own
-        self.photo_view = self._input_view("photo")
-        self.lines_panel = FeatureLinesPanel(self.doc, self.photo_view, self)
-        self.lines_panel.message.connect(self.show_message)
-        self.first_input = QStackedWidget()
-        self.first_input.addWidget(self._titled(self.texture_view, "texture — drag a square: prototype / source region"))
-        self.first_input.addWidget(self._titled(self.photo_view, "photo — drag to draw feature lines; drag an end to "
-                                                                  "move it; click a line + Delete to remove it"))
-        self.input_tabs = QTabWidget()
-        left = QSplitter(Qt.Orientation.Vertical)
-        left.addWidget(self.first_input)
-        left.addWidget(self.input_tabs)
+        self.inputs_pane = InputsPane(self.doc, self)
+        self.inputs_pane.message.connect(self.show_message)
+        self.inputs_pane.dragging.connect(self._geometry_dragged)
+        self.inputs_pane.hovered.connect(self._on_hover)
+        self.inputs_pane.open_requested.connect(self.open_input)
         self.splitter = QSplitter(Qt.Orientation.Horizontal)
-        self.splitter.addWidget(left)
-        self.splitter.addWidget(self._titled(self.result_view, "result"))
+        self.splitter.addWidget(self.inputs_pane)
+        self.splitter.addWidget(titled(self.result_view, "result"))
         self.splitter.setStretchFactor(0, 2)
         self.splitter.setStretchFactor(1, 3)
         self.splitter.setSizes([420, 630])
         self.setCentralWidget(self.splitter)
 
-        self._build_dock()
+        self.method_panel = MethodPanel(self.doc, self)
+        self.method_panel.message.connect(self.show_message)
+        self.method_panel.preview_requested.connect(self.renderer.preview)
+        self.method_panel.final_requested.connect(self.renderer.final)
+        self.method_panel.render_requested.connect(lambda: self.renderer.final(now=True))
+        self.method_panel.variations_requested.connect(self.open_variations)
+        self.method_panel.compare_button.toggled.connect(self.result_view.set_comparing)
+        dock = QDockWidget("Method", self)
+        dock.setObjectName("method")
+        dock.setWidget(self.method_panel)
+        dock.setMinimumWidth(390)
+        self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+        self.files = FileActions(self, self.doc, self.renderer)
         self._build_examples()
         self._build_status()
         self._build_menus()
 
         self.doc.changed.connect(self._on_doc_changed)
         self.doc.undo_stack.indexChanged.connect(self._update_title)
-        # Crash recovery: while the document has unsaved edits, it is autosaved (atomically) at most
-        # every AUTOSAVE_MS; a clean document has no recovery file.
-        self.recovery_file = recovery_path()
-        self._autosave_timer = QTimer(self, singleShot=True, interval=AUTOSAVE_MS)
-        self._autosave_timer.timeout.connect(self.autosave)
-        self._owns_recovery = False  # only a file this window wrote (or restored) is removed by it
+        self.doc.undo_stack.cleanChanged.connect(self._update_title)
         self.renderer.shown.connect(self._on_shown)
         self.renderer.partial.connect(lambda img: self.result_view.set_image(img))
         self.renderer.progress.connect(self._on_progress)
@@ -155,94 +130,81 @@ class MainWindow(FilesMixin, QMainWindow):
         self.renderer.warm_up_soon()
         if load_defaults:
             self.load_examples()
-        self.offer_recovery()  # before the autosave is connected: opening the examples must not remove it
+        self.files.offer_recovery()  # before the autosave is connected: opening the examples must not remove it
+        # connected to the window (not to its files part): gone with it before its children are
         self.doc.undo_stack.indexChanged.connect(self._schedule_autosave)
         self.doc.undo_stack.cleanChanged.connect(self._schedule_autosave)
         self.doc.changed.connect(self._schedule_autosave)
-        self._schedule_autosave()
+        self.files._schedule_autosave()
+
+    # --- the parts, as tests and scripts reach them ----------------------------------------------
+    @property
+    def views(self) -> dict[str, ImageView]:
+        return self.inputs_pane.views
+
+    @property
+    def canvas_view(self) -> ImageView:
+        """The view of the current method's canvas input."""
+        return self.inputs_pane.canvas_view
+
+    @property
+    def lines_panel(self):
+        return self.inputs_pane.lines_panel
+
+    @property
+    def input_tabs(self):
+        return self.inputs_pane.tabs
+
+    @property
+    def params_panel(self):
+        return self.method_panel.params_panel
+
+    @property
+    def seed_box(self):
+        return self.method_panel.seed_box
+
+    @property
+    def compare_button(self):
+        return self.method_panel.compare_button
+
+    @property
+    def recovery_file(self) -> Path:
+        return self.files.recovery_file
+
+    @property
+    def _autosave_timer(self):
+        return self.files._autosave_timer
+
+    def export_result(self, path: str) -> bool:
+        return self.files.export_result(path)
+
+    def export_recipe(self, path: str) -> bool:
+        return self.files.export_recipe(path)
+
+    def save_session(self, path: str) -> bool:
+        return self.files.save_session(path)
+
+    def open_session(self, path: str) -> bool:
+        return self.files.open_session(path)
+
+    def autosave(self) -> bool:
+        return self.files.autosave()
+
+    def new_seed(self) -> None:
+        self.method_panel.new_seed()
+
+    def _schedule_autosave(self, *_args) -> None:
+        self.files._schedule_autosave()
+
+    def _confirm(self, question: str) -> bool:
+        """Ask a yes/no question in a modal box; True for yes. The one place the studio asks
+        (tests replace it)."""
+        answer = QMessageBox.question(self, "weft", question,
+                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+                                      QMessageBox.StandardButton.No)
+        return answer == QMessageBox.StandardButton.Yes
 
     # --- construction --------------------------------------------------------------------------
-    def _titled(self, view: ImageView, title: str) -> QWidget:
-        box = QWidget()
-        lay = QVBoxLayout(box)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.setSpacing(0)
-        label = QLabel(f"  {title}")
-        label.setStyleSheet("background:#2b2b2b; color:#ddd; padding:2px;")
-        label.setToolTip(title)
-        # A long title must not widen its pane: it is cut instead.
-        label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
-        lay.addWidget(label)
-        lay.addWidget(view)
-        return box
-
-    def _input_view(self, name: str) -> ImageView:
-        view = self.views.get(name)
-        if view is None:
-            view = ImageView(self, title=name)
-            view.hovered.connect(lambda x, y, v=view: self._on_hover(v, x, y))
-            view.file_dropped.connect(lambda path, n=name: self.open_input(n, path))
-            self.views[name] = view
-        return view
-
-    def _build_dock(self) -> None:
-        panel = QWidget()
-        lay = QVBoxLayout(panel)
-        top = QHBoxLayout()
-        top.addWidget(QLabel("Method"))
-        self.method_box = QComboBox()
-        for name, m in registry.methods().items():
-            if name in STUDIO_METHODS:
-                self.method_box.addItem(name)
-                self.method_box.setItemData(self.method_box.count() - 1, m.summary, Qt.ItemDataRole.ToolTipRole)
-        self.method_box.currentTextChanged.connect(lambda name: self.doc.set_method(name) if name else None)
-        top.addWidget(self.method_box, 1)
-        lay.addLayout(top)
-        self.params_panel = ParamsPanel()
-        self.params_panel.edited.connect(self._on_param_edited)
-        scroll = QScrollArea()
-        scroll.setWidgetResizable(True)
-        scroll.setWidget(self.params_panel)
-        lay.addWidget(scroll, 1)
-        self.prototype_label = QLabel()
-        self.prototype_label.setFixedSize(96, 96)
-        self.prototype_label.setToolTip("the prototype patch (drag a square on the texture)")
-        self.prototype_label.setStyleSheet("border:1px solid #888;")
-        seed_row = QHBoxLayout()
-        seed_row.addWidget(QLabel("seed"))
-        self.seed_box = QSpinBox()
-        self.seed_box.setRange(0, 2**31 - 1)
-        self.seed_box.setValue(self.doc.seed)
-        self.seed_box.setKeyboardTracking(False)
-        self.seed_box.valueChanged.connect(self._on_seed)
-        seed_row.addWidget(self.seed_box, 1)
-        new_seed = QToolButton()
-        new_seed.setText("New")
-        new_seed.setToolTip("a new random seed")
-        new_seed.clicked.connect(self.new_seed)
-        seed_row.addWidget(new_seed)
-        seed_row.addWidget(self.prototype_label)
-        lay.addLayout(seed_row)
-        buttons = QHBoxLayout()
-        self.render_button = QPushButton("Render")
-        self.render_button.setToolTip("render the full-size result (F5)")
-        self.render_button.clicked.connect(lambda: self.renderer.final(now=True))
-        self.compare_button = QPushButton("Compare")
-        self.compare_button.setCheckable(True)
-        self.compare_button.setToolTip("before/after split on the result: drag to move the divider (C)")
-        self.compare_button.toggled.connect(self.result_view.set_comparing)
-        self.variations_button = QPushButton("Variations…")
-        self.variations_button.setToolTip("render a grid over two parameters and adopt a cell")
-        self.variations_button.clicked.connect(self.open_variations)
-        for b in (self.render_button, self.compare_button, self.variations_button):
-            buttons.addWidget(b)
-        lay.addLayout(buttons)
-        dock = QDockWidget("Method", self)
-        dock.setObjectName("method")
-        dock.setWidget(panel)
-        dock.setMinimumWidth(390)
-        self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
-
     def _build_examples(self) -> None:
         self.example_list = _ExampleList()
         self.example_list.setViewMode(QListWidget.ViewMode.IconMode)
@@ -254,10 +216,11 @@ class MainWindow(FilesMixin, QMainWindow):
         for path in examples():
             item = QListWidgetItem(QIcon(str(path)), path.stem)
             item.setData(Qt.ItemDataRole.UserRole, str(path))
-            item.setToolTip(f"{path.name}: double-click to open as texture, drag onto a view to open it there")
+            item.setToolTip(f"{path.name}: double-click to open it as the method's first input, "
+                            f"drag onto a view to open it there")
             self.example_list.addItem(item)
         self.example_list.itemDoubleClicked.connect(
-            lambda item: self.open_input("texture", item.data(Qt.ItemDataRole.UserRole)))
+            lambda item: self.open_input(self.doc.studio.canvas, item.data(Qt.ItemDataRole.UserRole)))
         dock = QDockWidget("Examples", self)
         dock.setObjectName("examples")
         dock.setWidget(self.example_list)
@@ -276,8 +239,7 @@ class MainWindow(FilesMixin, QMainWindow):
             self.statusBar().addPermanentWidget(w)
         self.progress_bar.hide()
         self.cancel_button.hide()
-        for view in (self.texture_view, self.result_view):
-            view.zoomed.connect(lambda s: self.zoom_label.setText(f"{s * 100:.0f}%"))
+        self.result_view.zoomed.connect(lambda s: self.zoom_label.setText(f"{s * 100:.0f}%"))
         self.result_view.hovered.connect(lambda x, y: self._on_hover(self.result_view, x, y))
 
     def _action(self, menu, text, slot, shortcut=None, tip=None) -> QAction:
@@ -292,20 +254,22 @@ class MainWindow(FilesMixin, QMainWindow):
 
     def _build_menus(self) -> None:
         m = self.menuBar().addMenu("&File")
-        self._action(m, "Open &Texture…", lambda: self.open_input_dialog("texture"), QKeySequence.StandardKey.Open)
-        self._action(m, "Open T&arget…", lambda: self.open_input_dialog("target"), "Ctrl+Shift+O")
-        self.open_other_menu = m.addMenu("Open Other Input")
+        # Ctrl+O opens the current method's first input, Ctrl+Shift+O its second (the texture and the
+        # target of a transfer); "Open Input" lists them all.
+        self.open_first_action = self._action(m, "&Open…", lambda: self._open_nth(0), QKeySequence.StandardKey.Open)
+        self.open_second_action = self._action(m, "Open &Second Input…", lambda: self._open_nth(1), "Ctrl+Shift+O")
+        self.open_other_menu = m.addMenu("Open Input")
         self.recent_menu = m.addMenu("Open &Recent")
         m.addSeparator()
-        self._action(m, "Open &Session…", self.open_session_dialog, "Ctrl+Shift+L")
-        self._action(m, "&Save Session…", self.save_session_dialog, QKeySequence.StandardKey.Save)
+        self._action(m, "Open &Session…", self.files.open_session_dialog, "Ctrl+Shift+L")
+        self._action(m, "&Save Session…", self.files.save_session_dialog, QKeySequence.StandardKey.Save)
         m.addSeparator()
-        self.save_result_action = self._action(m, "&Export Result…", self.save_result_dialog, "Ctrl+E")
-        self._action(m, "Export &Recipe…", self.export_recipe_dialog, "Ctrl+Shift+E")
+        self.save_result_action = self._action(m, "&Export Result…", self.files.save_result_dialog, "Ctrl+E")
+        self._action(m, "Export &Recipe…", self.files.export_recipe_dialog, "Ctrl+Shift+E")
         self._action(m, "Apply to &Folder…", self.open_batch_dialog, "Ctrl+Shift+B")
         m.addSeparator()
-        self._action(m, "Load Feature &Lines…", lambda: self.lines_panel.load_lines_dialog())
-        self._action(m, "Save Feature Li&nes…", lambda: self.lines_panel.save_lines_dialog())
+        self.load_lines_action = self._action(m, "Load Feature &Lines…", lambda: self.lines_panel.load_lines_dialog())
+        self.save_lines_action = self._action(m, "Save Feature Li&nes…", lambda: self.lines_panel.save_lines_dialog())
         m.addSeparator()
         self._action(m, "&Quit", self.close, QKeySequence.StandardKey.Quit)
         e = self.menuBar().addMenu("&Edit")
@@ -317,14 +281,14 @@ class MainWindow(FilesMixin, QMainWindow):
         e.addAction(redo)
         self.undo_action, self.redo_action = undo, redo
         e.addSeparator()
-        self._action(e, "New &Seed", self.new_seed, "Ctrl+R")
-        self._action(e, "Clear &Prototype", lambda: self.doc.set_prototype(None))
+        self._action(e, "New &Seed", self.method_panel.new_seed, "Ctrl+R")
+        self.clear_square_action = self._action(e, "Clear S&quare", lambda: self.doc.set_square(None))
         v = self.menuBar().addMenu("&View")
         self._action(v, "Zoom &In", lambda: self._focused_view().zoom_by(1.25), QKeySequence.StandardKey.ZoomIn)
         self._action(v, "Zoom &Out", lambda: self._focused_view().zoom_by(0.8), QKeySequence.StandardKey.ZoomOut)
         self._action(v, "&Fit to Window", lambda: self._focused_view().fit(), "Ctrl+0")
         self._action(v, "&Actual Size", lambda: self._focused_view().actual_size(), "Ctrl+1")
-        self._action(v, "&Compare Before/After", self.compare_button.toggle, "C")
+        self._action(v, "&Compare Before/After", self.method_panel.compare_button.toggle, "C")
         self._action(v, "&Render", lambda: self.renderer.final(now=True), "F5")
         v.addSeparator()
         v.addAction(self.examples_dock.toggleViewAction())
@@ -332,20 +296,28 @@ class MainWindow(FilesMixin, QMainWindow):
 
     # --- inputs ----------------------------------------------------------------------------------
     def load_examples(self) -> None:
-        """Open the bundled default texture and target (the window opens with a result)."""
-        for name, stem in DEFAULT_INPUTS.items():
-            try:
-                path = example(stem)
-            except WeftError:
-                continue
-            loaded = load_image(path)  # small bundled files: a few milliseconds
-            self.doc._put_input(name, InputImage(str(path), loaded.image))
-        self.doc.undo_stack.clear()
+        """Open the bundled examples the methods name for their inputs (the window opens with a result)."""
+        inputs = {}
+        for method in self.doc.methods.values():
+            for name, stem in method.studio.examples.items():
+                if name in inputs:
+                    continue
+                try:
+                    path = example(stem)
+                except WeftError:
+                    continue
+                inputs[name] = InputImage(str(path), load_image(path).image)  # small files: milliseconds
+        self.doc.restore(DocumentState(inputs=inputs, method=self.doc.method, seed=self.doc.seed))
         self.renderer.final(now=True)
+
+    def _open_nth(self, i: int) -> None:
+        inputs = self.doc.current.inputs
+        if i < len(inputs):
+            self.open_input_dialog(inputs[i].name)
 
     def open_input_dialog(self, name: str) -> None:
         start = str(self.settings.value("last_dir", ""))
-        path, _ = QFileDialog.getOpenFileName(self, f"Open {name}", start, OPEN_FILTER)
+        path, _ = QFileDialog.getOpenFileName(self, f"Open {name.replace('_', ' ')}", start, OPEN_FILTER)
         if path:
             self.open_input(name, path)
 
@@ -381,150 +353,67 @@ class MainWindow(FilesMixin, QMainWindow):
             recent = [recent]
         for path in recent:
             sub = self.recent_menu.addMenu(Path(path).name)
-            for inp in ("texture", "target"):
-                act = sub.addAction(f"as {inp}")
+            for inp in [i.name for i in self.doc.current.inputs]:
+                act = sub.addAction(f"as {inp.replace('_', ' ')}")
                 act.triggered.connect(lambda _=False, p=path, n=inp: self.open_input(n, p))
         self.recent_menu.setEnabled(bool(recent))
 
     # --- document changes ----------------------------------------------------------------------
     def _on_doc_changed(self, what: str) -> None:
         if what.startswith("input:"):
-            name = what.split(":", 1)[1]
-            view = self._input_view(name)
-            view.set_image(self.doc.image(name), fit=True)
-            if name == "texture":
-                self.patch_tool.refresh()
-                self._update_prototype_thumb()
-            if name in ("texture", "prototype_image"):
-                self._sync_patch_tools()
-            if name == "photo":
-                self.lines_panel.photo_changed()
-            self._update_compare()
+            self.inputs_pane.input_changed(what.split(":", 1)[1])
+            self.method_panel.show_square()
+            self.method_panel.show_params()
             self.renderer.final()
-        elif what == "method":
+        elif what in ("method", "restored"):
             self._rebuild_method()
+            self.method_panel.show_seed()
             self.renderer.final()
         elif what == "params":
-            self._show_params()
-            if not self._dragging:
+            self.method_panel.show_params()
+            self.inputs_pane.sync_tools()
+            if not self.method_panel.dragging:
                 self.renderer.final()
-        elif what == "lines":
-            self.lines_panel.lines_changed()
-            if self.doc.method == "nfpt":
-                self.renderer.final()
-        elif what == "prototype":
-            self.doc.live_prototype = None
-            self._sync_patch_tools()
-            self._update_prototype_thumb()
+        elif what == "geometry":
+            self.inputs_pane.geometry_changed()
+            self.method_panel.show_square()
             self.renderer.final()
         elif what == "seed":
-            self.seed_box.blockSignals(True)
-            self.seed_box.setValue(self.doc.seed)
-            self.seed_box.blockSignals(False)
+            self.method_panel.show_seed()
             self.renderer.final()
 
     def _rebuild_method(self) -> None:
-        method = self.doc.current
-        self.method_box.blockSignals(True)
-        self.method_box.setCurrentText(self.doc.method)
-        self.method_box.blockSignals(False)
-        self.params_panel.build(method.params, hidden=("lines", "prototype"))
-        self._show_params()
-        self.first_input.setCurrentIndex(1 if method.inputs[0].name == "photo" else 0)
-        self.input_tabs.clear()
-        self.lines_panel.set_active(method.inputs[0].name == "photo")
-        if method.inputs[0].name == "photo":
-            self.input_tabs.addTab(self.lines_panel, "frontal frame (live rectification)")
-        for inp in method.inputs[1:]:
-            view = self._input_view(inp.name)
-            label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")
-            self.input_tabs.addTab(self._titled(view, inp.help), label)
-            view.set_image(self.doc.image(inp.name))
-        self.input_tabs.setVisible(self.input_tabs.count() > 0)
-        self._sync_patch_tools()
+        self.inputs_pane.rebuild()
+        self.method_panel.show_method()
+        has_lines = self.lines_panel is not None and self.lines_panel.active
+        self.load_lines_action.setEnabled(has_lines)
+        self.save_lines_action.setEnabled(has_lines)
+        self.clear_square_action.setEnabled(self.inputs_pane.square_on() is not None)
+        inputs = self.doc.current.inputs
+        self.open_first_action.setText(f"&Open {inputs[0].name.replace('_', ' ')}…")
+        self.open_second_action.setVisible(len(inputs) > 1)
+        if len(inputs) > 1:
+            self.open_second_action.setText(f"Open {inputs[1].name.replace('_', ' ')}…")
         self.open_other_menu.clear()
-        for inp in method.inputs:
+        for inp in inputs:
             act = self.open_other_menu.addAction(f"{inp.name.replace('_', ' ')}…")
             act.triggered.connect(lambda _=False, n=inp.name: self.open_input_dialog(n))
-        self._update_compare()
+        self._refresh_recent()
+        self._update_title()
 
-    def _show_params(self) -> None:
-        params = self.doc.current_params
-        auto = {}
-        resolver = getattr(params, "resolved", None)
-        if resolver is not None:
-            try:
-                resolved = resolver("target" in self.doc.inputs)
-                auto = {name: getattr(resolved, name) for name in self.params_panel.rows}
-            except WeftError:
-                auto = {}
-        self.params_panel.show_params(params, auto)
-
-    def _on_param_edited(self, name: str, value, dragging: bool) -> None:
-        try:
-            self._dragging = dragging
-            self.doc.set_param(name, value)
-        except WeftError as e:
-            self.show_message(str(e))
-            self._show_params()  # back to the valid value
-            return
-        finally:
-            self._dragging = False
-        if dragging:
+    def _geometry_dragged(self, key: str, value) -> None:
+        self.method_panel.show_square(value)
+        g = next((g for g in self.doc.studio.geometry if g.key == key), None)
+        if g is not None and g.live is not None and g.live(self.doc.current_params):
+            # the method asks for a live result while the square moves (affine's prototype swap)
+            self.doc.live = (key, value)
             self.renderer.preview()
-        else:
-            self.renderer.final()
-
-    def _on_seed(self, value: int) -> None:
-        self.doc.seed = int(value)
-        self.doc.changed.emit("seed")
-
-    def new_seed(self) -> None:
-        self.seed_box.setValue(int(np.random.default_rng().integers(0, 2**31 - 1)))
-
-    def _prototype_dragged(self, rect) -> None:
-        self._update_prototype_thumb(rect)
-        params = self.doc.current_params
-        if getattr(params, "reuse_transforms", False):
-            # affine with reused transforms: re-render live while the square moves (§4 prototype swap)
-            self.doc.live_prototype = rect
-            self.renderer.preview()
-
-    def _prototype_source(self) -> str:
-        """Which input the prototype square lies on: affine's prototype image when one is open."""
-        if self.doc.method == "affine" and "prototype_image" in self.doc.inputs:
-            return "prototype_image"
-        return "texture"
-
-    def _sync_patch_tools(self) -> None:
-        """The prototype square is drawn (and edited) on the image it belongs to."""
-        source = self._prototype_source()
-        for name, tool in (("texture", self.patch_tool), ("prototype_image", self.prototype_patch_tool)):
-            tool.view.tool = tool if name == source else None
-            tool.rect_item.setVisible(False)
-            for h in tool.handles:
-                h.setVisible(False)
-            if name == source:
-                tool.refresh()
-
-    def _update_prototype_thumb(self, rect=None) -> None:
-        rect = rect or self.doc.prototype
-        tex = self.doc.image(self._prototype_source())
-        if rect is None or tex is None:
-            self.prototype_label.clear()
-            return
-        x, y, s = rect
-        patch = tex[y:y + s, x:x + s]
-        if patch.size:
-            pix = QPixmap.fromImage(to_qimage(patch)).scaled(96, 96, Qt.AspectRatioMode.KeepAspectRatio)
-            self.prototype_label.setPixmap(pix)
-
-    def _update_compare(self) -> None:
-        self.result_view.set_compare(self.doc.image("target") if "target" in self.doc.inputs else self.doc.image("texture"))
 
     # --- results ---------------------------------------------------------------------------------
     def _on_shown(self, shown) -> None:
         self.result_view.set_image(shown.image)
+        if shown.before is not None:
+            self.result_view.set_compare(shown.before)  # the input of this result, not of the panel
         self.statusBar().showMessage(describe(shown))
 
     def _on_progress(self, fraction: float, stage: str) -> None:
@@ -599,13 +488,13 @@ class MainWindow(FilesMixin, QMainWindow):
 
     def _update_title(self, *_args) -> None:
         dirty = "" if self.doc.undo_stack.isClean() else " *"
-        self.setWindowTitle(f"weft — {self.doc.method}{dirty}")
+        self.setWindowTitle(f"weft — {self.doc.studio.title}{dirty}")
 
     # --- shutdown --------------------------------------------------------------------------------
     def shutdown(self) -> None:
         self.renderer.shutdown()
         self.loader.shutdown(wait=True, cancel=True)
-        self.lines_panel.shutdown()
+        self.inputs_pane.shutdown()
         dialog = getattr(self, "_variations", None)
         if dialog is not None:
             dialog.shutdown()
@@ -621,9 +510,9 @@ class MainWindow(FilesMixin, QMainWindow):
         if not self.doc.undo_stack.isClean() and not self._confirm("Discard your unsaved edits and quit?"):
             event.ignore()
             return
-        self._autosave_timer.stop()
-        if self._owns_recovery:
-            self.discard_recovery()
+        self.files._autosave_timer.stop()
+        if self.files._owns_recovery:
+            self.files.discard_recovery()
         self.settings.setValue("geometry", self.saveGeometry())
         self.settings.setValue("state", self.saveState())
         self.shutdown()

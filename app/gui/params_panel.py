@@ -25,7 +25,7 @@ from PySide6.QtWidgets import (
 )
 from superqt import QLabeledDoubleSlider, QLabeledSlider
 
-from core.params import Params, Spec, specs
+from core.params import BOOL, CHOICE, FLOAT, INT, SIZE, Params, Spec, specs
 
 
 class _Row(QWidget):
@@ -45,25 +45,25 @@ class _Row(QWidget):
             self.auto.toggled.connect(self._auto_toggled)
             lay.addWidget(self.auto)
         k = spec.kind
-        if k in ("int", "float"):
-            cls = QLabeledSlider if k == "int" else QLabeledDoubleSlider
+        if k in (INT, FLOAT):
+            cls = QLabeledSlider if k == INT else QLabeledDoubleSlider
             self.editor = cls(Qt.Orientation.Horizontal)
             lo = spec.lo if spec.lo is not None else 0
             hi = spec.hi if spec.hi is not None else 100
             self.editor.setRange(lo, hi)
-            if k == "float":
+            if k == FLOAT:
                 self.editor.setDecimals(3)
                 self.editor.setSingleStep(spec.step or (hi - lo) / 100)
             self.editor.valueChanged.connect(self._value_changed)
             self.editor.sliderReleased.connect(lambda: self.changed.emit(self.value(), False))
-        elif k == "choice":
+        elif k == CHOICE:
             self.editor = QComboBox()
             self.editor.addItems([str(c) for c in spec.choices])
             self.editor.currentTextChanged.connect(lambda _: self.changed.emit(self.value(), False))
-        elif k == "bool":
+        elif k == BOOL:
             self.editor = QCheckBox()
             self.editor.toggled.connect(lambda _: self.changed.emit(self.value(), False))
-        elif k == "size":
+        elif k == SIZE:
             self.editor = QWidget()
             sl = QHBoxLayout(self.editor)
             sl.setContentsMargins(0, 0, 0, 0)
@@ -88,7 +88,7 @@ class _Row(QWidget):
         if spec.symbol:
             tip.insert(0, f"paper symbol: {spec.symbol}")
         if spec.range_text():
-            tip.append(("one of " if k == "choice" else "range ") + spec.range_text())
+            tip.append(("one of " if k == CHOICE else "range ") + spec.range_text())
         self.setToolTip("\n".join(tip))
 
     def _auto_toggled(self, on: bool) -> None:
@@ -108,22 +108,22 @@ class _Row(QWidget):
         if self.auto is not None and self.auto.isChecked():
             return None
         k = self.spec.kind
-        if k == "int":
+        if k == INT:
             return int(self.editor.value())
-        if k == "float":
+        if k == FLOAT:
             return round(float(self.editor.value()), 6)
-        if k == "choice":
+        if k == CHOICE:
             return self.spec.choices[self.editor.currentIndex()]
-        if k == "bool":
+        if k == BOOL:
             return self.editor.isChecked()
-        if k == "size":
+        if k == SIZE:
             return (self.w_box.value(), self.h_box.value())
         return self.editor.text()
 
     def set_value(self, value: Any, shown_when_auto: Any = None) -> None:
         """Show ``value`` without emitting ``changed``."""
         widgets = [self, self.editor] + ([self.auto] if self.auto else []) + (
-            [self.w_box, self.h_box] if self.spec.kind == "size" else [])
+            [self.w_box, self.h_box] if self.spec.kind == SIZE else [])
         for w in widgets:
             w.blockSignals(True)
         try:
@@ -137,13 +137,13 @@ class _Row(QWidget):
             if value is None:
                 return
             k = self.spec.kind
-            if k in ("int", "float"):
+            if k in (INT, FLOAT):
                 self.editor.setValue(value)
-            elif k == "choice":
+            elif k == CHOICE:
                 self.editor.setCurrentIndex(list(self.spec.choices).index(value))
-            elif k == "bool":
+            elif k == BOOL:
                 self.editor.setChecked(bool(value))
-            elif k == "size":
+            elif k == SIZE:
                 self.w_box.setValue(int(value[0]))
                 self.h_box.setValue(int(value[1]))
             else:

@@ -5,11 +5,14 @@
   started as soon as the running one is done (cancelling a running preview at every slider step
   would starve the display while the slider moves). Release, and any other edit, asks for
   ``final()`` (slot ``"final"``, full size), which cancels any preview.
-  Previews scale the target (or the output size) so its longer side is ``PREVIEW_SIDE``; measured with
+  Previews are reduced as the method's studio description says (its ``preview_inputs``, else its
+  ``preview_params`` sizes, scaled so the longer side is ``PREVIEW_SIDE``); measured with
   ``python -m benchmarks.gui_latency``, full-size previews of a 640x500 fast transfer (~40 ms each)
   gave a median latency of ~100 ms, 400 px previews meet the 50 ms goal.
 * Jobs carry ids; a result older than the one shown is dropped, so what is shown is always the last
-  completed job. Workers never touch widgets: results and progress arrive through queued signals.
+  completed job. A result carries the recipe of its pixels (method, parameters, inputs, seed, region)
+  and its "before" image, captured when the job was made: export and Compare use those, never the
+  panel's state at the time of the export. Workers never touch widgets: results and progress arrive through queued signals.
 * A job running longer than ``PROGRESS_DELAY_MS`` shows its progress (with partial previews where the
   method gives them) and can be cancelled; after a cancel or an error the last good result stays.
 """
@@ -22,13 +25,11 @@ import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
 from core import registry
-from core.errors import WeftError
-from core.image import resize
 from core.jobs import JobResult, JobRunner, Progress
-from core.params import Params
+from core.params import Params, Recipe
+from core.studio import reduce_for_preview
 
 PREVIEW_SIDE = 400
-FULL_PREVIEW_PIXELS: dict[str, int] = {}  # method -> pixel count up to which previews are full size
 PROGRESS_DELAY_MS = 300
 PARTIAL_INTERVAL = 0.25
 WARM_UP_DELAY_MS = 3000  # no render at start: warm the kernels up after this long anyway
@@ -50,7 +51,8 @@ class _Partial:
 class Shown:
     """What the result view shows: the image, which job made it and how long it took (``seconds``:
     the render alone; ``prepared``: loading the method's kernels first, the first time in this
-    process; ``compiled``: they had to be compiled, a first run)."""
+    process; ``compiled``: they had to be compiled, a first run), the recipe that reproduces it
+    (``weft run``) and the input Compare shows beside it."""
 
     image: np.ndarray
     job_id: int
@@ -59,6 +61,8 @@ class Shown:
     final: bool
     prepared: float = 0.0
     compiled: bool = False
+    recipe: Recipe | None = None
+    before: np.ndarray | None = None
 
 
 def _render(method, inputs, params, seed, report, cancel, *, final: bool):
@@ -99,8 +103,11 @@ class Renderer(QObject):
     running job; ``progress(fraction, stage)``; ``busy(bool)`` a job over the progress delay is
     running (show the bar); ``failed(message)``; ``cancelled()``; ``preparing(words)`` the running
     final render is waiting for its method's kernels to compile (a first run), in words for the
-    result view (then ``progress`` takes over again).
+    result view (then ``progress`` takes over again); ``submitted(job_id, slot)`` a job was handed
+    to the workers (for measurements).
     """
+
+    submitted = Signal(int, str)
 
     shown = Signal(object)
     partial = Signal(object)
@@ -182,7 +189,7 @@ class Renderer(QObject):
         inputs = doc.method_inputs()
         params = doc.run_params()
         if preview:
-            inputs, params = reduced(inputs, params, PREVIEW_SIDE, FULL_PREVIEW_PIXELS.get(doc.method, 0))
+            inputs, params = reduce_for_preview(doc.studio, inputs, params, PREVIEW_SIDE)
         return inputs, params
 
     def _submit(self, slot: str, preview: bool) -> int | None:
@@ -192,13 +199,16 @@ class Renderer(QObject):
         if built is None:
             return None
         inputs, params = built
-        method, seed = self.doc.current, self.doc.seed
+        doc = self.doc
+        method, seed = doc.current, doc.seed
+        recipe = None if preview else doc.recipe(params)
+        before = doc.image(doc.studio.compare_input(doc.inputs))
 
         def job(*, progress=None, cancel=None):
             # Previews report nothing; a final render's partial images are built at most every
             # PARTIAL_INTERVAL seconds (a fast render never pays for one).
             report = None if preview or progress is None else _Partial(progress)
-            return _render(method, inputs, params, seed, report, cancel, final=not preview)
+            return (*_render(method, inputs, params, seed, report, cancel, final=not preview), recipe, before)
 
         if slot == "final":
             self.runner.cancel("preview")
@@ -211,6 +221,7 @@ class Renderer(QObject):
             self.latest_final = handle.id
             self._final_running = True
             self._busy_timer.start()
+        self.submitted.emit(handle.id, slot)
         return handle.id
 
     def _submit_preview(self) -> None:
@@ -247,8 +258,9 @@ class Renderer(QObject):
             return
         if self.last is not None and result.job_id < self.last.job_id:
             return  # older than what is shown: stale
-        res, seconds, final, prepared, compiled = result.value
-        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared, compiled)
+        res, seconds, final, prepared, compiled, recipe, before = result.value
+        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared, compiled,
+                          recipe, before)
         self.shown.emit(self.last)
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
@@ -291,30 +303,6 @@ class Renderer(QObject):
             return registry.warm_up_all(first=current, cancel=cancel)
 
         self.runner.submit("warm-up", warm_up_others)
-
-
-def reduced(inputs: dict[str, np.ndarray], params: Params, side: int, full_pixels: int = 0
-            ) -> tuple[dict[str, np.ndarray], Params]:
-    """Inputs and parameters of a reduced render: the target (or the output ``size``) scaled so its
-    longer side is ``side``, unless it has at most ``full_pixels`` pixels (then unchanged)."""
-    target = inputs.get("target")
-    limit = full_pixels
-    if target is not None:
-        h, w = target.shape[:2]
-        if h * w <= limit or max(h, w) <= side:
-            return inputs, params
-        k = side / max(h, w)
-        small = dict(inputs)
-        small["target"] = resize(target, (max(8, round(w * k)), max(8, round(h * k))), interpolation="area")
-        return small, params
-    size = getattr(params, "size", None)
-    if size is not None and max(size) > side and size[0] * size[1] > limit:
-        k = side / max(size)
-        try:
-            return inputs, params.replace(size=(max(8, round(size[0] * k)), max(8, round(size[1] * k))))
-        except WeftError:  # a size the method refuses at preview scale: render at full size
-            return inputs, params
-    return inputs, params
 
 
 def describe(shown: Shown) -> str:

@@ -3,8 +3,9 @@
 A tool gets the left-button press/move/release in scene (= image pixel) coordinates, draws its
 overlay in the view's scene, and pushes one undo command on release. Esc cancels what is in progress.
 
-* ``PatchTool``: a square rubber band (the prototype patch); the side snaps to even pixels; drag
-  inside to move it, drag a corner handle to resize it.
+* ``PatchTool``: a square rubber band (a square geometry of the current method: a source region or
+  a square parameter); the side snaps to even pixels; drag inside to move it, drag a corner handle to
+  resize it.
 * ``LineTool``: feature lines on the photo or on the frontal frame; click-drag draws a line, dragging an
   end point edits it, a click on a line selects it and Delete removes the pair. Lines are numbered
   and coloured alike in both views (line i of the photo goes with line i of the frontal frame).
@@ -20,6 +21,8 @@ from typing import Callable
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QFont, QPen
 from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsLineItem, QGraphicsRectItem, QGraphicsSimpleTextItem
+
+from core.geometry import Square
 
 HANDLE_PX = 8  # grab distance of handles and end points, in screen pixels
 PALETTE = [QColor(c) for c in ("#ff5252", "#40c4ff", "#ffd740", "#69f0ae", "#e040fb", "#ff9100", "#b2ff59", "#f8bbd0")]
@@ -49,12 +52,16 @@ class Tool:
 
     def refresh(self) -> None: ...
 
+    def hide(self) -> None:
+        """Remove the overlay (the tool is detached from its view)."""
+
 
 class PatchTool(Tool):
-    """Square prototype rectangle ``(x, y, side)`` with an even side, inside the image."""
+    """A square ``(x, y, side)`` with an even side, inside the image: the geometry ``key`` of the
+    document's current method."""
 
-    def __init__(self, view, doc, on_drag: Callable[[tuple[int, int, int]], None] | None = None):
-        self.view, self.doc, self.on_drag = view, doc, on_drag
+    def __init__(self, view, doc, key: str, on_drag: Callable[[Square], None] | None = None):
+        self.view, self.doc, self.geometry_key, self.on_drag = view, doc, key, on_drag
         self.rect_item = QGraphicsRectItem()
         self.rect_item.setPen(_cosmetic(QColor("#ffd740"), 2, Qt.PenStyle.DashLine))
         self.rect_item.setZValue(10)
@@ -70,8 +77,16 @@ class PatchTool(Tool):
         self.mode = None
         self.anchor = None
         self.offset = None
-        self.live: tuple[int, int, int] | None = None
+        self.live: Square | None = None
         self.refresh()
+
+    @property
+    def square(self) -> Square | None:
+        return self.doc.value(self.geometry_key)
+
+    def hide(self) -> None:
+        self.mode = None
+        self._show(None)
 
     def _corners(self, rect):
         x, y, s = rect
@@ -91,18 +106,18 @@ class PatchTool(Tool):
             h.setRect(QRectF(cx - r, cy - r, 2 * r, 2 * r))
 
     def refresh(self) -> None:
-        self._show(self.doc.prototype)
+        self._show(self.square)
 
-    def _clamp(self, x: float, y: float, s: int) -> tuple[int, int, int]:
+    def _clamp(self, x: float, y: float, s: int) -> Square:
         w, h = self.view.image_size()
         s = int(max(2, min(s, min(w, h) - min(w, h) % 2)))
         s -= s % 2
         x = int(round(min(max(x, 0), w - s)))
         y = int(round(min(max(y, 0), h - s)))
-        return x, y, s
+        return Square(x, y, s)
 
     def press(self, view, pos, event):
-        rect = self.doc.prototype
+        rect = self.square
         grab = view.screen_to_image_distance(HANDLE_PX)
         self.mode = "new"
         self.anchor = (pos.x(), pos.y())
@@ -120,9 +135,9 @@ class PatchTool(Tool):
                     self.offset = (pos.x() - x, pos.y() - y)
         self.live = rect if self.mode == "move" else None
 
-    def _rect_from(self, pos) -> tuple[int, int, int]:
+    def _rect_from(self, pos) -> Square:
         if self.mode == "move":
-            s = self.doc.prototype[2]
+            s = self.square[2]
             return self._clamp(pos.x() - self.offset[0], pos.y() - self.offset[1], s)
         ax, ay = self.anchor
         dx, dy = pos.x() - ax, pos.y() - ay
@@ -156,7 +171,7 @@ class PatchTool(Tool):
         self.mode = None
         self.live = None
         if rect is not None:
-            self.doc.set_prototype(rect)
+            self.doc.set_geometry(self.geometry_key, rect, "Square")
         self.refresh()
 
     def key(self, view, event) -> bool:
@@ -164,8 +179,8 @@ class PatchTool(Tool):
             self.mode = None
             self.live = None
             self.refresh()
-            if self.on_drag is not None and self.doc.prototype is not None:
-                self.on_drag(self.doc.prototype)
+            if self.on_drag is not None and self.square is not None:
+                self.on_drag(self.square)
             return True
         return False
 
@@ -177,12 +192,15 @@ class LineTool(Tool):
         self.view, self.doc, self.which, self.on_drag = view, doc, which, on_drag
         self.items: list = []
         self.drag = None  # ("new", start) or ("end", index, 0|1)
-        self.temp: list[float] | None = None
         self.selected: int | None = None
         self.refresh()
 
     def lines(self) -> list[list[float]]:
         return self.doc.image_lines if self.which == "image" else self.doc.frontal_lines
+
+    def hide(self) -> None:
+        self.drag = None
+        self.refresh([])
 
     def _lists_with(self, mine: list[list[float]]) -> tuple[list, list]:
         if self.which == "image":
@@ -261,7 +279,6 @@ class LineTool(Tool):
                 self.refresh()
                 return
             self.drag = ("new", self._clamp(pos))
-        self.temp = None
 
     def _edited(self, pos) -> list[list[float]]:
         lines = [list(x) for x in self.lines()]
@@ -278,7 +295,6 @@ class LineTool(Tool):
         if self.drag is None or not (event.buttons() & Qt.MouseButton.LeftButton):
             return
         lines = self._edited(pos)
-        self.temp = lines
         self.refresh(lines)
         if self.on_drag is not None:
             self.on_drag(*self._lists_with(lines))
@@ -289,7 +305,6 @@ class LineTool(Tool):
         lines = self._edited(pos)
         kind = self.drag[0]
         self.drag = None
-        self.temp = None
         if kind == "new":
             x1, y1, x2, y2 = lines[-1]
             if ((x2 - x1) ** 2 + (y2 - y1) ** 2) ** 0.5 < self.view.screen_to_image_distance(4):
@@ -315,7 +330,6 @@ class LineTool(Tool):
     def key(self, view, event) -> bool:
         if event.key() == Qt.Key.Key_Escape and self.drag is not None:
             self.drag = None
-            self.temp = None
             self.refresh()
             return True
         if event.key() in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):

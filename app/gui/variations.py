@@ -24,22 +24,22 @@ from PySide6.QtWidgets import (
 
 from core.errors import WeftError
 from core.jobs import JobResult, JobRunner
-from core.params import specs
+from core.params import FLOAT, INT, specs
+from core.studio import reduce_for_preview
 
 from .convert import to_qimage
-from .render import reduced
 
 THUMB_SIDE = 192
 
 
 def numeric_specs(params_cls) -> list:
-    return [s for s in specs(params_cls) if s.kind in ("int", "float") and s.lo is not None and s.hi is not None]
+    return [s for s in specs(params_cls) if s.kind in (INT, FLOAT) and s.lo is not None and s.hi is not None]
 
 
 def grid_values(spec, lo: float, hi: float, n: int) -> list:
     """``n`` values from ``lo`` to ``hi`` (integers for int parameters, duplicates removed)."""
     values = np.linspace(lo, hi, n)
-    if spec.kind == "int":
+    if spec.kind == INT:
         return [int(round(v)) for v in values]
     return [round(float(v), 4) for v in values]
 
@@ -52,7 +52,7 @@ class VariationsDialog(QDialog):
 
     def __init__(self, doc, parent=None):
         super().__init__(parent)
-        self.setWindowTitle(f"Variations — {doc.method}")
+        self.setWindowTitle(f"Variations — {doc.studio.title}")
         self.doc = doc
         self.method = doc.method
         self.runner = JobRunner(max_workers=2, on_result=self._delivered.emit)
@@ -109,7 +109,7 @@ class VariationsDialog(QDialog):
         spec = self._spec(row)
         for box in (self.lo[row], self.hi[row]):
             box.setRange(spec.lo, spec.hi)
-            box.setSingleStep(1 if spec.kind == "int" else (spec.step or (spec.hi - spec.lo) / 20))
+            box.setSingleStep(1 if spec.kind == INT else (spec.step or (spec.hi - spec.lo) / 20))
         current = getattr(self.doc.params[self.method], spec.name)
         if current is None:
             current = spec.default if spec.default is not None else spec.lo
@@ -189,9 +189,7 @@ class VariationsDialog(QDialog):
         except WeftError as e:
             self.status.setText(str(e))
             return
-        from .document import SetParams
-
-        doc.push(SetParams(doc, self.method, new, f"Adopt {na}={va}, {nb}={vb}"))
+        doc.set_params(new, f"Adopt {na}={va}, {nb}={vb}")
         self.status.setText(f"adopted {na}={va}, {nb}={vb}")
 
     def shutdown(self) -> None:
@@ -206,4 +204,4 @@ def _thumb_inputs(doc):
     """Thumbnail-size inputs and the current parameters, or None if inputs are missing."""
     if doc.missing_inputs():
         return None
-    return reduced(doc.method_inputs(), doc.run_params(), THUMB_SIDE)
+    return reduce_for_preview(doc.studio, doc.method_inputs(), doc.run_params(), THUMB_SIDE)

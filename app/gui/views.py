@@ -112,9 +112,6 @@ class ImageView(QGraphicsView):
         event.accept()
 
     # --- coordinates ---------------------------------------------------------------------------
-    def scene_pos(self, view_pos) -> QPointF:
-        return self.mapToScene(view_pos)
-
     def image_pos(self, view_pos) -> tuple[int, int]:
         p = self.mapToScene(view_pos)
         x, y = int(np.floor(p.x())), int(np.floor(p.y()))

@@ -40,7 +40,7 @@ from .boundary import BoundaryReport, match_boundaries, total_boundary_error
 from .spectral import Centroids, centroid_pairs, centroids, cos2_window, segment_sums
 from .fields import field_model, field_transforms
 from .method import METHOD, synthesize, warm_up
-from .params import AffineParams, check_rect, default_rect, parse_rect
+from .params import AffineParams, check_rect, default_rect
 from .analysis import analyse, levenberg_marquardt
 from .model import (AffineModel, Decomposition, Grid, Prototype, decompose, lowpass, make_prototype,
                     prototype_from_patch)
@@ -51,6 +51,6 @@ __all__ = [
     "METHOD", "AffineModel", "AffineParams", "BoundaryReport", "Centroids", "Decomposition", "Grid", "Prototype",
     "analyse", "candidate_transforms", "centroid_pairs", "centroids", "check_rect", "compose", "correlate_shifts",
     "cos2_window", "decompose", "default_rect", "field_model", "field_transforms", "levenberg_marquardt", "lowpass",
-    "make_prototype", "match_boundaries", "parse_rect", "prototype_from_patch", "regularise_pairs", "render", "sampling_matrices",
+    "make_prototype", "match_boundaries", "prototype_from_patch", "regularise_pairs", "render", "sampling_matrices",
     "segment_sums", "synthesize", "total_boundary_error", "warm_up",
 ]

@@ -15,6 +15,7 @@ from ..jobs import CancelToken, Progress
 from ..limits import check_output_size
 from ..metrics import snr_db
 from ..registry import InputSpec, Method, Result
+from ..studio import SQUARE, Geometry, Studio
 from .boundary import BoundaryReport, match_boundaries
 from .fields import field_model
 from .params import MIN_SIDE, AffineParams, check_rect, default_rect
@@ -93,20 +94,14 @@ def synthesize(
     float32 (H, W) or (H, W, 3) in [0, 1]
     """
     params = AffineParams(
-        prototype=_rect_text(prototype), block=block, segments=segments, lowpass=lowpass, colour=colour,
+        prototype=prototype, block=block, segments=segments, lowpass=lowpass, colour=colour,
         propagate=propagate, refine=refine, reuse_transforms=reuse_transforms,
-        analysis_prototype=_rect_text(analysis_prototype), boundary=boundary, iterations=iterations,
+        analysis_prototype=analysis_prototype, boundary=boundary, iterations=iterations,
         per_radius=per_radius, shaker_start=shaker_start, field=field, field_strength=field_strength, size=size)
     inputs = {"texture": texture}
     if prototype_image is not None:
         inputs["prototype_image"] = prototype_image
     return _run(inputs, params, rng=rng, progress=progress, cancel=cancel).image
-
-
-def _rect_text(rect) -> str | None:
-    if rect is None or isinstance(rect, str):
-        return rect
-    return ",".join(str(int(v)) for v in rect)
 
 
 def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=None, progress=None, cancel=None
@@ -126,22 +121,22 @@ def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=Non
             check_output_size(w, h)
         if B > min(h, w):
             raise ImageError(f"the output is {w}x{h}; it must be at least the block, {B} pixels, on each side")
-        rect = params.rect() or default_rect(source.shape, B, source_name)
+        rect = params.prototype or default_rect(source.shape, B, source_name)
         proto = make_prototype(source, check_rect(rect, source.shape, source_name), block=B, colour=params.colour,
                                what=source_name)
         model = field_model((h, w), proto, params.field, strength=params.field_strength, block=B)
         render_proto = proto
     elif params.reuse_transforms:
-        arect = params.analysis_rect() or default_rect(texture.shape, B, "texture")
+        arect = params.analysis_prototype or default_rect(texture.shape, B, "texture")
         check_rect(arect, texture.shape, "texture", "analysis_prototype")
         model = _cached_analysis(texture, arect, params, progress, cancel)
-        rect = params.rect() or default_rect(source.shape, B, source_name)
+        rect = params.prototype or default_rect(source.shape, B, source_name)
         dec = model.decomposition if other is None else None
         render_proto = make_prototype(source, check_rect(rect, source.shape, source_name), block=B,
                                       colour=params.colour, decomposition=dec, what=source_name)
         info["analysis_prototype"] = list(arect)
     else:
-        rect = params.rect()
+        rect = params.prototype
         if rect is not None:
             check_rect(rect, source.shape, source_name)
         model = analyse(texture, prototype=rect, prototype_image=other, block=B, segments=params.segments,
@@ -226,4 +221,12 @@ METHOD = Method(
     ),
     run=_run,
     warm_up=warm_up,
+    studio=Studio(
+        title="Affine prototype model (Smith & Bhalerao)",
+        canvas="texture",
+        geometry=(Geometry(SQUARE, on=("prototype_image", "texture"), param="prototype",
+                           help="drag a square: the prototype patch (on the prototype image when one is open); "
+                                "with reuse transforms the result follows it live",
+                           live=lambda params: params.reuse_transforms),),
+        preview_params=("size",), compare=("texture",), examples={"texture": "wood-grain"}, rank=2),
 )

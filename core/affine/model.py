@@ -17,7 +17,8 @@ import numpy as np
 
 from ..errors import ImageError, InvalidParameter
 from ..image import PcaBasis, from_pca, luminance, rgb_to_yiq, to_pca, validate_image, yiq_to_rgb
-from .params import COLOURS, Rect, check_rect, default_rect, parse_rect
+from ..geometry import Square
+from .params import COLOURS, MIN_SIDE, Rect, check_rect, default_rect
 
 # ----------------------------------------------------------------------------------------------
 # grey / chroma decomposition and the lowpass (§3.3, §3.4)
@@ -171,7 +172,7 @@ def make_prototype(image: np.ndarray, rect: Rect | str | None = None, *, block: 
         The square does not fit in the image.
     """
     image = validate_image(image, what)
-    rect = default_rect(image.shape, block, what) if rect is None else parse_rect(rect)
+    rect = default_rect(image.shape, block, what) if rect is None else Square.coerce(rect, "prototype").check_side("prototype", minimum=MIN_SIDE, even=True)
     check_rect(rect, image.shape, what)
     dec = decomposition or decompose(image, block, colour, need_chroma=False)
     x, y, s = rect

@@ -1,10 +1,11 @@
-"""Parameters of the affine prototype model and the prototype rectangle ``X,Y,S``."""
+"""Parameters of the affine prototype model; the prototype square (:class:`core.geometry.Square`)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from ..errors import GeometryError, InvalidParameter
+from ..geometry import Square
 from ..params import Params, param
 
 LOWPASS = ("add", "absorb")
@@ -14,47 +15,7 @@ FIELDS = ("none", "swirl", "zoom", "rotate")
 SHAKER_STARTS = ("partial", "analysis")
 MIN_SIDE = 8
 
-Rect = tuple[int, int, int]
-
-
-def parse_rect(text: str | tuple | list, name: str = "prototype") -> Rect:
-    """Parse a prototype rectangle ``"X,Y,S"`` (top-left corner and side of a square, pixels).
-
-    Accepts a string or a sequence of three integers. The side must be even and at least 8 (the
-    prototype has a centre between pixels, like the target patches); the corner must not be
-    negative. Whether the square fits in an image is checked by :func:`check_rect`.
-
-    Raises
-    ------
-    InvalidParameter
-        Naming the parameter and the value.
-    """
-    if isinstance(text, str):
-        parts = [p.strip() for p in text.replace(" ", ",").split(",") if p.strip()]
-        try:
-            values = tuple(int(p) for p in parts)
-        except ValueError:
-            values = ()
-        shown = text
-    else:
-        try:
-            values = tuple(int(v) for v in text)
-            if any(v != w for v, w in zip(values, text)):  # 8.5 is not a pixel count: no silent rounding
-                values = ()
-        except (TypeError, ValueError, OverflowError):
-            values = ()
-        shown = ",".join(str(v) for v in text) if isinstance(text, (tuple, list)) else repr(text)
-    if len(values) != 3:
-        raise InvalidParameter(f"parameter '{name}' = {shown!r} must be X,Y,S (top-left corner and side "
-                               f"of a square in pixels, e.g. 96,96,64)", name=name, value=text)
-    x, y, s = values
-    if x < 0 or y < 0:
-        raise InvalidParameter(f"parameter '{name}' = {x},{y},{s}: the corner {x},{y} must not be negative",
-                               name=name, value=text)
-    if s < MIN_SIDE or s % 2:
-        raise InvalidParameter(f"parameter '{name}' = {x},{y},{s}: the side {s} must be even and at least {MIN_SIDE}",
-                               name=name, value=text)
-    return x, y, s
+Rect = Square
 
 
 def check_rect(rect: Rect, shape: tuple[int, ...], what: str = "texture", name: str = "prototype") -> Rect:
@@ -63,7 +24,7 @@ def check_rect(rect: Rect, shape: tuple[int, ...], what: str = "texture", name: 
     Parameters
     ----------
     rect : (x, y, s)
-        From :func:`parse_rect`.
+        A :class:`~core.geometry.Square` (or any ``(x, y, side)``).
     shape : tuple
         The image's shape (H, W[, C]).
     what, name : str
@@ -109,7 +70,7 @@ def default_rect(shape: tuple[int, ...], block: int, what: str = "image") -> Rec
 class AffineParams(Params):
     """Parameters of the affine prototype model (Smith & Bhalerao)."""
 
-    prototype: str = param(None, kind="str", optional=True,
+    prototype: Square = param(None, kind="geometry", type=Square, optional=True,
                            help="prototype square X,Y,S (top-left corner and side, pixels) in the "
                                 "prototype image or the texture; default a 2B square in the middle")
     block: int = param(32, lo=8, hi=256, symbol="B", help="target patch side (even); patches overlap by B/2")
@@ -130,7 +91,7 @@ class AffineParams(Params):
     reuse_transforms: bool = param(False,
                                    help="compute the transforms with --analysis-prototype of the texture and "
                                         "re-render them with --prototype (a prototype swap, §4)")
-    analysis_prototype: str = param(None, kind="str", optional=True,
+    analysis_prototype: Square = param(None, kind="geometry", type=Square, optional=True,
                                     help="with --reuse-transforms: the texture square X,Y,S the transforms are "
                                          "computed for; default the default prototype")
     boundary: str = param("auto", choices=BOUNDARIES,
@@ -156,9 +117,9 @@ class AffineParams(Params):
             raise InvalidParameter(f"parameter 'segments' = {self.segments} must be even (the spectrum's "
                                    f"half-plane symmetry, eqs. 14-16)", name="segments", value=self.segments)
         if self.prototype is not None:
-            parse_rect(self.prototype, "prototype")
+            self.prototype.check_side("prototype", minimum=MIN_SIDE, even=True)
         if self.analysis_prototype is not None:
-            parse_rect(self.analysis_prototype, "analysis_prototype")
+            self.analysis_prototype.check_side("analysis_prototype", minimum=MIN_SIDE, even=True)
             if not self.reuse_transforms:
                 raise InvalidParameter("parameter 'analysis_prototype' only applies with reuse_transforms "
                                        "(--reuse-transforms true)", name="analysis_prototype",
@@ -176,11 +137,3 @@ class AffineParams(Params):
         if self.boundary == "auto":
             return "shaker" if self.field != "none" else "none"
         return self.boundary
-
-    def rect(self) -> Rect | None:
-        return None if self.prototype is None else parse_rect(self.prototype, "prototype")
-
-    def analysis_rect(self) -> Rect | None:
-        return None if self.analysis_prototype is None else parse_rect(self.analysis_prototype, "analysis_prototype")
-
-

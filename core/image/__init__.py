@@ -11,11 +11,9 @@ from .files import (
     ImageInfo,
     Loaded,
     atomic_write_bytes,
-    crop_square,
     encode_image,
     get_max_pixels,
     load_image,
-    parse_square,
     read_recipe,
     resize,
     save_image,
@@ -24,8 +22,7 @@ from .files import (
 )
 
 __all__ = [
-    "DEFAULT_MAX_PIXELS", "ImageInfo", "Loaded", "PcaBasis", "atomic_write_bytes", "crop_square", "encode_image",
-    "from_pca",
-    "get_max_pixels", "load_image", "luminance", "parse_square", "pca_basis", "pca_grey", "read_recipe", "resize",
+    "DEFAULT_MAX_PIXELS", "ImageInfo", "Loaded", "PcaBasis", "atomic_write_bytes", "encode_image", "from_pca",
+    "get_max_pixels", "load_image", "luminance", "pca_basis", "pca_grey", "read_recipe", "resize",
     "rgb_to_yiq", "save_image", "set_max_pixels", "to_pca", "validate_image", "yiq_to_rgb",
 ]

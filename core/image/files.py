@@ -63,31 +63,6 @@ def validate_image(image: np.ndarray, what: str = "image") -> np.ndarray:
     return image
 
 
-def parse_square(text: str, name: str = "region") -> tuple[int, int, int]:
-    """Parse ``"X,Y,S"`` (top-left corner and side of a square, pixels) as DESIGN.md writes prototypes."""
-    parts = str(text).replace(" ", "").split(",")
-    try:
-        x, y, s = (int(v) for v in parts)
-    except ValueError:
-        raise InvalidParameter(f"parameter '{name}' = {text!r} must be X,Y,SIDE in pixels, e.g. 32,16,64",
-                               name=name, value=text) from None
-    if x < 0 or y < 0 or s < 2:
-        raise InvalidParameter(f"parameter '{name}' = {text!r}: X and Y must be >= 0 and SIDE >= 2",
-                               name=name, value=text)
-    return x, y, s
-
-
-def crop_square(image: np.ndarray, square: tuple[int, int, int], what: str = "texture",
-                name: str = "region") -> np.ndarray:
-    """The ``(x, y, side)`` square of ``image``; ``InvalidParameter`` if it leaves the image."""
-    x, y, s = square
-    h, w = image.shape[:2]
-    if x < 0 or y < 0 or s < 1 or x + s > w or y + s > h:
-        raise InvalidParameter(f"parameter '{name}' = {x},{y},{s} leaves the {what} ({w}x{h})",
-                               name=name, value=square)
-    return np.ascontiguousarray(image[y:y + s, x:x + s])
-
-
 _INTERPOLATIONS = {"cubic": cv2.INTER_CUBIC, "linear": cv2.INTER_LINEAR, "area": cv2.INTER_AREA,
                    "nearest": cv2.INTER_NEAREST_EXACT}
 

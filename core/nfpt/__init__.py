@@ -23,8 +23,9 @@ from ..errors import GeometryError, InvalidParameter
 from ..image import validate_image
 from ..jobs import CancelToken, Progress
 from ..params import out_of_range, param
-from ..rectify import WarpParams
+from ..rectify import FeatureLines, View, WarpParams
 from ..registry import InputSpec, Method, Result
+from ..studio import LINES, Geometry, Studio
 from .synthesis import SMOOTH_SIGMA, Synthesis, distance_weights, synthesize_patches
 
 __all__ = ["NfptParams", "NfptResult", "Synthesis", "distance_weights", "nfpt", "synthesize", "METHOD"]
@@ -59,8 +60,8 @@ class NfptParams(WarpParams):
                                   "than this (RMS over channels, intensity 0..1)")
     n: int = param(5, lo=3, hi=15, help="neighbourhood side for re-synthesizing a pixel (odd)")
     smooth: bool = param(False, help="step 7: Gaussian-filter the re-synthesized pixels")
-    view: str = param(None, kind="str", optional=True,
-                      help="put the result into this view: a JSON file (or text), {\"quad\": [[x, y] x 4], \"size\": "
+    view: View = param(None, kind="geometry", type=View, optional=True,
+                       help="put the result into this view: a JSON file (or the JSON text, starting with {), {\"quad\": [[x, y] x 4], \"size\": "
                            "[w, h]} or view image_lines + texture frontal_lines; texture pixel coordinates")
     into_photo: bool = param(False, help="replace the textured plane in the photo with the larger synthesized one")
 
@@ -274,10 +275,10 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
     photo = validate_image(photo, "photo")
     ph, pw = photo.shape[:2]
     figures: dict[str, Any] = {}
-    if isinstance(lines, str) or hasattr(lines, "__fspath__"):
-        lines = rf.load_feature_lines(lines)
-    if isinstance(view, str) or hasattr(view, "__fspath__"):
-        view = rf.load_view(view)
+    if lines is not None:
+        lines = FeatureLines.coerce(lines)
+    if view is not None:
+        view = View.coerce(view)
     if params.into_photo and lines is None:
         raise GeometryError("--into-photo needs the feature lines (--lines) that rectified the photo")
     if cancel is not None:
@@ -324,9 +325,7 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
 def _run(inputs: Mapping[str, np.ndarray], params: NfptParams, *, rng=None, progress=None, cancel=None) -> Result:
     from .. import rectify as rf
 
-    lines = rf.load_feature_lines(params.lines) if params.lines is not None else None
-    view = rf.load_view(params.view) if params.view is not None else None
-    res = _nfpt(inputs["photo"], lines, view, params, rng=rng, progress=progress, cancel=cancel)
+    res = _nfpt(inputs["photo"], params.lines, params.view, params, rng=rng, progress=progress, cancel=cancel)
     figures = dict(res.figures)
     if res.homography is not None:
         figures["homography"] = rf.homography_figure(res.homography)
@@ -353,4 +352,12 @@ METHOD = Method(
     inputs=(InputSpec("photo", "the photo of the texture (or a frontal texture, without --lines)", min_side=8),),
     run=_run,
     warm_up=warm_up,
+    studio=Studio(
+        title="Non-frontal textures (Yan, Lee & Lin)",
+        canvas="photo",
+        geometry=(Geometry(LINES, on=("photo",), param="lines",
+                           help="photo — drag to draw feature lines; drag an end to move it; click a line + "
+                                "Delete to remove it"),),
+        preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
+        auto=lambda params, open_inputs: {"sigma_d": params.overlap / 2.0}, rank=3),
 )

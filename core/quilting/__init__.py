@@ -40,6 +40,7 @@ from ..image import luminance, validate_image
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import Params, as_rng, out_of_range, param
 from ..registry import InputSpec, Method, Result
+from ..studio import SQUARE, Geometry, Studio
 from .engine import RULES, _grid, _K, _Pass, _pad_to, _quilt_pass  # noqa: F401 (_K: tests compare it to the kernel)
 
 __all__ = ["QuiltParams", "synthesize", "transfer", "transfer_schedule", "METHOD"]
@@ -630,4 +631,11 @@ METHOD = Method(
     warm_up=warm_up,
     warm_up_in_cli=False,
     memory=memory_estimate,
+    studio=Studio(
+        title="Image quilting (Efros & Freeman)",
+        canvas="texture",
+        geometry=(Geometry(SQUARE, on=("texture",),
+                           help="texture — drag a square: the source region (blocks come only from it)"),),
+        preview_inputs=("target", "target_map"), preview_params=("size",), compare=("target", "texture"),
+        examples={"texture": "wood-grain", "target": "astronaut"}, rank=1),
 )

@@ -55,14 +55,15 @@ INTERPOLATIONS = ("cubic", "linear", "lanczos")
 class WarpParams(Params):
     """The rectification parameters, shared by ``weft rectify`` and ``weft nfpt`` (which add theirs)."""
 
-    lines: str = param(None, kind="str", optional=True,
-                       help="feature lines: a JSON file {image_lines, frontal_lines, frontal_size} "
-                            "(DESIGN.md), or that JSON text itself (nfpt without lines: the photo is frontal)")
+    lines: FeatureLines = param(None, kind="geometry", type=FeatureLines, optional=True,
+                                help="feature lines: a JSON file {image_lines, frontal_lines, frontal_size} "
+                                     "(DESIGN.md), or that JSON text itself, starting with { (nfpt without "
+                                     "lines: the photo is frontal)")
     warp: str = param("homography", choices=WARPS,
                       help="homography: exact for a plane (least squares + robust refinement); morph: the paper's "
                            "view morph (fundamental matrix, needs points off one plane); lines: Beier-Neely field "
                            "morph, for gently curved surfaces")
-    a: float = param(1.0, lo=0.001, hi=1000.0, symbol="a", step=0.1, log=True,
+    a: float = param(1.0, lo=0.001, hi=1000.0, symbol="a", step=0.1,
                      help="Beier-Neely: distance offset in pixels of the weight (length^p / (a + dist))^b "
                           "(morph, lines)")
     b: float = param(2.0, lo=0.0, hi=4.0, symbol="b", step=0.1,
@@ -250,7 +251,7 @@ def _run(inputs: Mapping[str, np.ndarray], params: RectifyParams, *, rng=None, p
     if params.lines is None:
         raise InvalidParameter("weft rectify needs --lines L.json (feature lines on the photo and in the frontal frame)",
                                name="lines")
-    lines = load_feature_lines(params.lines)
+    lines = params.lines
     report = ProgressReporter(progress, "rectify", 1)
     if cancel is not None:
         cancel.raise_if_cancelled()

@@ -27,7 +27,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..errors import GeometryError
-from ..params import MAX_SIDE
+from ..geometry import FeatureLines, _short, as_lines as _as_lines, as_size as _as_size, read_json_or_file as read_json
 
 __all__ = [
     "FeatureLines", "Correspondences", "load_feature_lines", "parse_feature_lines", "check_lines",
@@ -40,153 +40,16 @@ MIN_ANGLE_DEG = 2.0  # two lines closer to parallel than this (in either image) 
 FAR_MARGIN = 0.5  # an intersection further than this many frame sizes outside the frame is dropped
 
 
-@dataclass(frozen=True)
-class FeatureLines:
-    """Validated feature lines: ``image_lines`` and ``frontal_lines`` are float64 (N, 4) arrays.
-
-    ``frontal_size`` is ``(width, height)`` of the frontal frame. Build with
-    :func:`parse_feature_lines` (from a dict), :func:`load_feature_lines` (from a file or JSON text)
-    or directly (the constructor validates the arrays).
-    """
-
-    image_lines: np.ndarray
-    frontal_lines: np.ndarray
-    frontal_size: tuple[int, int]
-
-    def __post_init__(self) -> None:
-        img = _as_lines(self.image_lines, "image_lines")
-        fro = _as_lines(self.frontal_lines, "frontal_lines")
-        if len(img) != len(fro):
-            raise GeometryError(f"{len(img)} image_lines but {len(fro)} frontal_lines: line i of the photo "
-                                f"must match line i of the frontal frame")
-        size = _as_size(self.frontal_size, "frontal_size")
-        object.__setattr__(self, "image_lines", img)
-        object.__setattr__(self, "frontal_lines", fro)
-        object.__setattr__(self, "frontal_size", size)
-
-    def __len__(self) -> int:
-        return len(self.image_lines)
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"image_lines": self.image_lines.tolist(), "frontal_lines": self.frontal_lines.tolist(),
-                "frontal_size": list(self.frontal_size)}
-
-
-def _num(v: Any) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool)
-
-
-def _as_lines(value: Any, key: str) -> np.ndarray:
-    """``value`` as a float64 (N, 4) array, or a GeometryError naming the first bad entry."""
-    if isinstance(value, np.ndarray):
-        arr = value
-        if arr.ndim != 2 or arr.shape[1] != 4 or not np.issubdtype(arr.dtype, np.number):
-            raise GeometryError(f"{key} must be an (N, 4) array of [x1, y1, x2, y2], not shape {arr.shape}")
-        arr = arr.astype(np.float64)
-        bad = np.nonzero(~np.isfinite(arr).all(axis=1))[0]
-        if len(bad):
-            raise GeometryError(f"{key}[{bad[0]}] = {arr[bad[0]].tolist()} has a NaN or infinite coordinate")
-        return np.ascontiguousarray(arr)
-    if not isinstance(value, (list, tuple)):
-        raise GeometryError(f"{key} must be a list of [x1, y1, x2, y2], not {type(value).__name__}")
-    for i, line in enumerate(value):
-        if (not isinstance(line, (list, tuple, np.ndarray)) or len(line) != 4 or not all(_num(v) for v in line)):
-            raise GeometryError(f"{key}[{i}] = {_short(line)} must be [x1, y1, x2, y2] (four numbers)")
-        if not all(math.isfinite(float(v)) for v in line):
-            raise GeometryError(f"{key}[{i}] = {_short(line)} has a NaN or infinite coordinate")
-    return np.array(value, dtype=np.float64).reshape(-1, 4)
-
-
-def _as_size(value: Any, key: str) -> tuple[int, int]:
-    """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not)."""
-    if (not isinstance(value, (list, tuple)) or len(value) != 2
-            or not all(_num(v) and math.isfinite(float(v)) and float(v) == int(v) for v in value)):
-        raise GeometryError(f"{key} = {_short(value)} must be [width, height] in whole pixels")
-    w, h = int(value[0]), int(value[1])
-    if not (2 <= w <= MAX_SIDE and 2 <= h <= MAX_SIDE):
-        raise GeometryError(f"{key} = [{w}, {h}] has a side outside 2..{MAX_SIDE}")
-    return w, h
-
-
-def _short(value: Any) -> str:
-    text = json.dumps(value) if not isinstance(value, np.ndarray) else str(value.tolist())
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def parse_feature_lines(data: Mapping[str, Any], *, source: str = "") -> FeatureLines:
-    """Build :class:`FeatureLines` from the parsed JSON object of DESIGN.md.
-
-    Parameters
-    ----------
-    data : mapping
-        ``{"image_lines": [[x1, y1, x2, y2], ...], "frontal_lines": [...], "frontal_size": [w, h]}``.
-    source : str, optional
-        Where the data came from (a file name), put in front of error messages.
-
-    Raises
-    ------
-    GeometryError
-        A missing key, a line that is not four finite numbers, different line counts, a bad size.
-    """
-    prefix = f"{source}: " if source else ""
-    try:
-        if not isinstance(data, Mapping):
-            raise GeometryError(f"feature lines must be a JSON object, not {type(data).__name__}")
-        for key in ("image_lines", "frontal_lines", "frontal_size"):
-            if key not in data:
-                what = "[width, height]" if key == "frontal_size" else "a list of [x1, y1, x2, y2]"
-                raise GeometryError(f"no \"{key}\" ({what})")
-        return FeatureLines(_as_lines(data["image_lines"], "image_lines"),
-                            _as_lines(data["frontal_lines"], "frontal_lines"),
-                            _as_size(data["frontal_size"], "frontal_size"))
-    except GeometryError as e:
-        raise GeometryError(prefix + str(e)) from None
-
-
-def read_json(text_or_path: str | Path, what: str) -> tuple[Any, str]:
-    """Parse a JSON file, or JSON text given inline (it starts with ``{``); returns (data, source)."""
-    text = str(text_or_path)
-    if text.lstrip().startswith("{"):
-        source = f"{what} (inline JSON)"
-        raw = text
-    else:
-        source = text
-        path = Path(text)
-        try:
-            raw = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise GeometryError(f"{text}: no such {what} file") from None
-        except IsADirectoryError:
-            raise GeometryError(f"{text}: is a directory, not a {what} file") from None
-        except (OSError, UnicodeDecodeError) as e:
-            raise GeometryError(f"{text}: cannot read {what} ({getattr(e, 'strerror', None) or e})") from None
-    try:
-        return json.loads(raw), source
-    except json.JSONDecodeError as e:
-        raise GeometryError(f"{source}: not valid JSON ({e.msg} at line {e.lineno} column {e.colno})") from None
+    """:meth:`FeatureLines.from_mapping`: from the parsed JSON object of DESIGN.md (``source``, a file
+    name, goes in front of error messages)."""
+    return FeatureLines.from_mapping(data, source=source)
 
 
 def load_feature_lines(path_or_json: str | Path) -> FeatureLines:
-    """Read feature lines from a JSON file, or from JSON text given directly.
-
-    Parameters
-    ----------
-    path_or_json : str or Path
-        A file name, or the JSON object itself as text (anything starting with ``{``), which is how
-        the studio and recipes may pass lines without a file.
-
-    Returns
-    -------
-    FeatureLines
-
-    Raises
-    ------
-    GeometryError
-        A missing or unreadable file, invalid JSON, or any problem :func:`parse_feature_lines` finds;
-        the message starts with the file name.
-    """
-    data, source = read_json(path_or_json, "feature-lines")
-    return parse_feature_lines(data, source=source)
+    """:meth:`FeatureLines.parse`: a JSON file's name, or the JSON object itself as text (anything
+    starting with ``{``); GeometryError naming the file."""
+    return FeatureLines.parse(path_or_json)
 
 
 def check_lines(lines: np.ndarray, size: tuple[int, int], *, key: str, frame: str,

@@ -18,6 +18,8 @@ view that the texture does not cover are black (0).
 
 from __future__ import annotations
 
+import json
+
 import math
 import numbers
 from dataclasses import dataclass
@@ -37,7 +39,7 @@ __all__ = ["View", "load_view", "parse_view", "quad_homography", "view_plan", "i
 SUPERSAMPLE = 3  # samples per side per output pixel when a texture is put into a (receding) view
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class View:
     """A view: its ``size`` (or None: the photo's) and either a ``quad`` (4, 2) or line pairs.
 
@@ -51,6 +53,47 @@ class View:
 
     def with_size(self, default: tuple[int, int]) -> tuple[int, int]:
         return self.size if self.size is not None else tuple(default)
+
+    # A typed geometry parameter (core.geometry): parsed at the edges, written once.
+    METAVAR = "VIEW"
+
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        if self.quad is not None:
+            out["quad"] = np.asarray(self.quad).tolist()
+        else:
+            out["image_lines"] = np.asarray(self.view_lines).tolist()
+            out["frontal_lines"] = np.asarray(self.texture_lines).tolist()
+        if self.size is not None:
+            out["size"] = list(self.size)
+        return out
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, View) and self.to_json() == other.to_json()
+
+    def __hash__(self) -> int:
+        return hash(json.dumps(self.to_json()))
+
+    @classmethod
+    def parse(cls, text: str | Path, name: str = "view") -> "View":
+        """Command-line text: the JSON object itself (starts with ``{``) or a JSON file's name."""
+        return load_view(text)
+
+    @classmethod
+    def coerce(cls, value: Any, name: str = "view") -> "View":
+        if isinstance(value, View):
+            return value
+        if isinstance(value, dict):
+            return parse_view(value)
+        if isinstance(value, (str, Path)):
+            return load_view(value)
+        raise GeometryError(f"parameter '{name}' = {_short(repr(value))} must be a view (a quad or line pairs)")
+
+    @classmethod
+    def from_json(cls, data: Any, name: str = "view", base=None) -> "View":
+        from ..geometry import _from_json_or_path
+
+        return _from_json_or_path(cls, data, name, base, "view")
 
 
 def parse_view(data: Any, *, source: str = "") -> View:

@@ -33,7 +33,6 @@ from core.affine import (
     field_model,
     make_prototype,
     match_boundaries,
-    parse_rect,
     prototype_from_patch,
     render,
     sampling_matrices,
@@ -43,6 +42,7 @@ from core.affine import (
 )
 from core.affine.transforms import MAX_SCALE, MIN_SCALE, singular_values
 from core.errors import WeftError
+from core.geometry import Square
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
@@ -128,19 +128,19 @@ def rect_problem(rect, shape) -> bool:
                       st.tuples(st.floats(-2, 20), st.floats(-2, 20), st.floats(-2, 20)), st.none(), st.just(8)),
        h=st.integers(1, 24), w=st.integers(1, 24), name=st.sampled_from(["prototype", "analysis_prototype"]))
 def test_parse_and_check_rect(rect, h, w, name):
-    """``parse_rect`` + ``check_rect``: a square inside the image, or an error naming the parameter."""
+    """``Square.parse`` + ``check_rect``: a square inside the image, or an error naming the parameter."""
     values = None
     if isinstance(rect, (tuple, list)) and len(rect) == 3 and all(float(v) == int(v) for v in rect):
         values = tuple(int(v) for v in rect)
     elif isinstance(rect, str):
         try:
-            values = tuple(int(p) for p in rect.replace(" ", ",").split(",") if p.strip())
+            values = tuple(int(p) for p in rect.replace(" ", "").split(","))  # Square.parse: spaces ignored
         except ValueError:
             values = None
         if values is not None and len(values) != 3:
             values = None
     try:
-        parsed = parse_rect(rect, name)
+        parsed = Square.parse(rect, name).check_side(name, minimum=8, even=True)
         check_rect(parsed, (h, w), "texture", name)
     except WeftError as e:
         one_line_naming(e, [f"'{name}'"])
@@ -154,7 +154,7 @@ def test_parse_and_check_rect(rect, h, w, name):
        s=st.sampled_from([8, 10, 16]))
 @settings(max_examples=60, deadline=None)
 def test_check_rect_refuses_a_corner_outside(x, y, s):
-    """``check_rect`` alone (its callers may skip ``parse_rect``): a negative corner is outside too."""
+    """``check_rect`` alone (its callers may skip ``Square.parse``): a negative corner is outside too."""
     shape = (24, 24)
     if rect_problem((x, y, s), shape):
         with pytest.raises(WeftError) as info:

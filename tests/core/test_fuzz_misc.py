@@ -4,7 +4,7 @@ Hypothesis over ``core.blending`` (Laplacian pyramid and Poisson blend: random, 
 all-white masks, sizes 1..16, grey/colour mixes, mismatched sizes), ``core.seams`` (minimum cuts on
 random and constant error surfaces, checked against a brute-force dynamic program), ``core.metrics``
 (identical, constant, tiny images: finite values in the documented ranges, the documented values for
-the degenerate cases), ``core.image`` colour helpers and ``crop_square``/``parse_square``. Valid
+the degenerate cases), ``core.image`` colour helpers and ``Square.parse``/``Square.crop``. Valid
 inputs give finite results of the documented shape and range; invalid ones a one-line
 ``WeftError`` naming the parameter or the image. Numpy ``RuntimeWarning``s are errors throughout.
 """
@@ -21,11 +21,10 @@ from hypothesis import strategies as st
 from core import metrics
 from core.blending import max_levels, poisson_blend, pyramid_blend
 from core.errors import ImageError, InvalidParameter, WeftError
+from core.geometry import Square
 from core.image import (
-    crop_square,
     from_pca,
     luminance,
-    parse_square,
     pca_basis,
     pca_grey,
     rgb_to_yiq,
@@ -425,7 +424,7 @@ _coord = st.integers(-5, 24)
 def test_parse_and_crop_square(text, h, w, name):
     img = image("noise", h, w, True, 0)
     try:
-        square = parse_square(text, name)
+        square = Square.parse(text, name)
     except WeftError as e:
         one_line_naming(e, [f"'{name}'"])
         parts = text.replace(" ", "").split(",")
@@ -438,7 +437,7 @@ def test_parse_and_crop_square(text, h, w, name):
     x, y, s = square
     assert all(isinstance(v, int) for v in square) and x >= 0 and y >= 0 and s >= 2
     try:
-        crop = crop_square(img, square, what="texture", name=name)
+        crop = square.crop(img, what="texture", name=name)
     except WeftError as e:
         one_line_naming(e, [f"'{name}'"])
         assert "texture" in str(e) and f"{w}x{h}" in str(e)
@@ -451,11 +450,11 @@ def test_parse_and_crop_square(text, h, w, name):
 @given(x=st.integers(-8, 8), y=st.integers(-8, 8), s=st.integers(-3, 12))
 @settings(max_examples=100, deadline=None)
 def test_crop_square_alone_refuses_every_square_outside(x, y, s):
-    """``crop_square`` without ``parse_square`` in front (the GUI and recipes call it directly)."""
+    """``Square.crop`` without ``Square.parse`` in front (the GUI and recipes call it directly)."""
     img = image("noise", 10, 10, False, 0)
     if x < 0 or y < 0 or s < 1 or x + s > 10 or y + s > 10:
         with pytest.raises(WeftError) as info:
-            crop_square(img, (x, y, s))
+            Square(x, y, s).crop(img)
         one_line_naming(info.value, ["'region'"])
     else:
-        assert crop_square(img, (x, y, s)).shape == (s, s)
+        assert Square(x, y, s).crop(img).shape == (s, s)

@@ -48,6 +48,11 @@ def _valid(spec) -> st.SearchStrategy:
     if spec.kind == "size":
         side = st.integers(int(spec.lo or 1) - 1, min(int(spec.hi or 64), 96))
         return st.tuples(side, side) | st.builds(lambda w, h: f"{w}x{h}", side, side)
+    if spec.kind == "geometry":  # typed geometry: Python callers' forms (a Square also takes "X,Y,S")
+        lines = {"image_lines": [[1, 1, 9, 1], [1, 9, 9, 9]], "frontal_lines": [[0, 0, 8, 0], [0, 8, 8, 8]],
+                 "frontal_size": [8, 8]}
+        return st.sampled_from(["0,0,8", "1,2,16", "x", (1, 2, 16), (-1, 0, 8), [0, 0, 7], lines, {"quad": 1},
+                                "/nonexistent/lines.json", json.dumps(lines)]) | st.text(max_size=16)
     if spec.kind == "str":
         lines = json.dumps({"image_lines": [[1, 1, 9, 1], [1, 9, 9, 9]], "frontal_lines": [[0, 0, 8, 0], [0, 8, 8, 8]],
                             "frontal_size": [8, 8]})

@@ -158,7 +158,7 @@ def test_method_runs_with_params_and_reports_figures(photo):
     assert {"patches", "repaired_pixels", "repaired_fraction", "rectify_rms_lines_px", "homography"} <= set(result.figures)
     assert NfptParams().block == 48  # defaults construct (the studio builds them for every method)
     with pytest.raises(InvalidParameter, match="'view' and 'into_photo' exclude each other"):
-        NfptParams(view="v.json", into_photo=True)
+        NfptParams(view={"quad": [[0, 0], [9, 0], [9, 9], [0, 9]]}, into_photo=True)
 
 
 def test_fft_search_equals_the_direct_sum_of_eq_3(fur):

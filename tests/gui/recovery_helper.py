@@ -44,16 +44,20 @@ def main() -> int:
                 return  # the target is still being decoded
             window.seed_box.setValue(EDITS["seed"])
             doc.set_param("p", EDITS["p"])
-            doc.set_prototype(tuple(EDITS["prototype"]))
+            doc.set_square(tuple(EDITS["prototype"]))  # fast's source region
+            doc.set_method("nfpt")  # feature lines belong to the method that uses them
             doc.set_lines(EDITS["image_lines"], EDITS["frontal_lines"])
+            doc.set_method("fast")
             state["edited"] = True
             return
         try:
             saved = json.loads(window.recovery_file.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             return
-        if (saved["params"]["fast"]["p"] == EDITS["p"] and saved["prototype"] == EDITS["prototype"]
-                and saved["lines"]["image_lines"] == EDITS["image_lines"] and saved["seed"] == EDITS["seed"]
+        geometry = saved.get("geometry", {})
+        if (saved["params"]["fast"]["p"] == EDITS["p"] and geometry.get("fast", {}).get("region") == EDITS["prototype"]
+                and geometry.get("nfpt", {}).get("lines", {}).get("image_lines") == EDITS["image_lines"]
+                and saved["seed"] == EDITS["seed"] and saved["method"] == "fast"
                 and saved["inputs"].get("target") == target):
             print("AUTOSAVED", flush=True)
             timer.stop()

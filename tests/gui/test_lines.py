@@ -8,6 +8,7 @@ from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import QApplication
 
 from core.examples import RESOURCES
+from core.geometry import Square
 
 from .helpers import drag, mouse
 
@@ -25,7 +26,7 @@ def _key(widget, key):
 
 
 def test_draw_edit_delete_lines_with_undo(nfpt):
-    doc, photo, frontal = nfpt.doc, nfpt.photo_view, nfpt.lines_panel.frontal_view
+    doc, photo, frontal = nfpt.doc, nfpt.canvas_view, nfpt.lines_panel.frontal_view
     photo.actual_size()
     photo.zoom_by(2.0)
     photo.centerOn(100, 100)
@@ -51,7 +52,7 @@ def test_draw_edit_delete_lines_with_undo(nfpt):
 
 
 def test_escape_cancels_a_line_in_progress(nfpt):
-    photo = nfpt.photo_view
+    photo = nfpt.canvas_view
     before = list(nfpt.doc.image_lines)
     mouse(photo, "press", (50.0, 50.0))
     mouse(photo, "move", (120.0, 60.0))
@@ -65,8 +66,8 @@ def test_quad_preset_and_live_rectification(nfpt, qtbot):
     corners = [line[:2] for line in data["image_lines"][:4]]  # the plane's corners, clockwise
     nfpt.lines_panel.quad_button.setChecked(True)
     for x, y in corners:
-        mouse(nfpt.photo_view, "press", (x, y))
-        mouse(nfpt.photo_view, "release", (x, y))
+        mouse(nfpt.canvas_view, "press", (x, y))
+        mouse(nfpt.canvas_view, "release", (x, y))
     assert not nfpt.lines_panel.quad_button.isChecked()
     doc = nfpt.doc
     assert len(doc.image_lines) == 4 and len(doc.frontal_lines) == 4
@@ -74,9 +75,9 @@ def test_quad_preset_and_live_rectification(nfpt, qtbot):
     assert doc.frontal_lines[1] == pytest.approx([w - 1, 0, w - 1, h - 1])
     qtbot.waitUntil(lambda: nfpt.lines_panel.rectify_status.text() == "rectified", timeout=10000)
     assert nfpt.lines_panel.frontal_view.image.shape[:2] == (h, w)
-    # The render uses the lines: the recipe carries them as JSON text.
+    # The render uses the lines: the recipe carries them as their JSON object (held typed until then).
     recipe = doc.recipe()
-    assert json.loads(recipe.params["lines"])["image_lines"] == doc.image_lines
+    assert recipe.params["lines"]["image_lines"] == doc.image_lines
 
 
 def test_too_few_lines_say_why(nfpt, qtbot):
@@ -106,13 +107,13 @@ def test_affine_prototype_by_mouse_and_live_swap(window, qtbot):
     doc = window.doc
     doc.set_method("affine")
     doc.set_param("block", 16)
-    view = window.texture_view
+    view = window.canvas_view
     view.actual_size()
     view.zoom_by(2.0)
     view.centerOn(50, 50)
     drag(view, (20.2, 24.2), (52.2, 40.2))
-    assert doc.prototype == (20, 24, 32)
-    assert doc.run_params().prototype == "20,24,32"
+    assert doc.square == (20, 24, 32)
+    assert doc.run_params().prototype == Square(20, 24, 32)
     qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.figures.get("prototype") == [20, 24, 32],
                     timeout=30000)
     # With reuse_transforms, moving the square re-renders while the mouse moves (previews).
@@ -126,5 +127,5 @@ def test_affine_prototype_by_mouse_and_live_swap(window, qtbot):
         qtbot.wait(30)
     qtbot.waitUntil(lambda: any(not s.final for s in shown), timeout=30000)
     mouse(view, "release", (40.0, 30.0))
-    assert doc.prototype == (30, 24, 32)
+    assert doc.square == (30, 24, 32)
     qtbot.waitUntil(lambda: shown[-1].final and shown[-1].figures.get("prototype") == [30, 24, 32], timeout=30000)

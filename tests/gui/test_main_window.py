@@ -1,5 +1,6 @@
 """The studio as a user drives it: real mouse events, sliders, undo, cancel, errors, sessions, export."""
 
+import dataclasses
 import json
 import threading
 
@@ -30,40 +31,40 @@ def test_opens_on_the_examples_with_a_result(window):
 
 @pytest.mark.parametrize("zoom", [2.0, 0.5])
 def test_drawing_a_prototype_sets_the_rectangle_in_image_pixels(window, qtbot, zoom):
-    view = window.texture_view
+    view = window.canvas_view
     view.actual_size()
     view.zoom_by(zoom)
     view.centerOn(40, 40)
     drag(view, (10.2, 20.2), (50.2, 44.2))
-    assert window.doc.prototype == (10, 20, 40)  # side = larger extent, even
+    assert window.doc.square == (10, 20, 40)  # side = larger extent, even
     # Move it by dragging inside, then resize from the bottom-right handle.
     drag(view, (30, 40), (36, 42))
-    assert window.doc.prototype == (16, 22, 40)
+    assert window.doc.square == (16, 22, 40)
     drag(view, (56, 62), (46.5, 50))
-    assert window.doc.prototype == (16, 22, 30)
+    assert window.doc.square == (16, 22, 30)
     window.doc.undo_stack.undo()
-    assert window.doc.prototype == (16, 22, 40)
+    assert window.doc.square == (16, 22, 40)
     window.doc.undo_stack.redo()
-    assert window.doc.prototype == (16, 22, 30)
+    assert window.doc.square == (16, 22, 30)
 
 
 def test_escape_cancels_a_prototype_drag(window):
-    view = window.texture_view
-    window.doc.set_prototype((4, 4, 20))
+    view = window.canvas_view
+    window.doc.set_square((4, 4, 20))
     mouse(view, "press", (60, 60))
     mouse(view, "move", (90, 90))
-    assert window.patch_tool.live is not None
+    assert window.canvas_view.tool.live is not None
     from PySide6.QtGui import QKeyEvent
     from PySide6.QtCore import QEvent
 
     QApplication.sendEvent(view, QKeyEvent(QEvent.Type.KeyPress, Qt.Key.Key_Escape, Qt.KeyboardModifier.NoModifier))
     mouse(view, "release", (90, 90))
-    assert window.doc.prototype == (4, 4, 20)
+    assert window.doc.square == (4, 4, 20)
 
 
 def test_the_prototype_is_the_source_region_of_fast_and_is_in_the_recipe(window, qtbot, tmp_path):
     before = window.renderer.last.job_id
-    window.doc.set_prototype((10, 10, 40))
+    window.doc.set_square((10, 10, 40))
     qtbot.waitUntil(lambda: window.renderer.last.job_id > before and window.renderer.last.final, timeout=10000)
     out = tmp_path / "r.png"
     assert window.export_result(str(out))
@@ -117,7 +118,7 @@ def _slow_method(started: threading.Event) -> Method:
             cancel.raise_if_cancelled()
             threading.Event().wait(0.01)
 
-    return Method("fast", "slow stand-in", METHOD.params, METHOD.inputs, run)
+    return dataclasses.replace(METHOD, summary="slow stand-in", run=run)
 
 
 def test_cancel_keeps_the_previous_result(window, qtbot, monkeypatch):
@@ -141,7 +142,7 @@ def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, mo
     def boom(inputs, params, *, rng=None, progress=None, cancel=None):
         raise WeftError("texture.png: something is wrong with it")
 
-    monkeypatch.setitem(window.doc.methods, "fast", Method("fast", "broken", real.params, real.inputs, boom))
+    monkeypatch.setitem(window.doc.methods, "fast", dataclasses.replace(real, summary="broken", run=boom))
     messages = []
     window.message.connect(messages.append)
     window.renderer.final(now=True)
@@ -156,7 +157,7 @@ def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, mo
 def test_invalid_value_is_refused_with_a_message(window):
     messages = []
     window.message.connect(messages.append)
-    window._on_param_edited("n", 4, False)  # even: refused by FastParams
+    window.method_panel._param_edited("n", 4, False)  # even: refused by FastParams
     assert window.doc.current_params.n == 5
     assert "must be odd" in messages[-1]
     assert window.params_panel.row("n").value() == 5
@@ -212,17 +213,17 @@ def test_opening_a_corrupt_file_keeps_the_document(window, qtbot, tmp_path):
 def test_session_round_trip(window, qtbot, tmp_path):
     doc = window.doc
     doc.set_param("p", 0.3)
-    doc.set_prototype((2, 4, 16))
+    doc.set_square((2, 4, 16))
     window.seed_box.setValue(42)
     path = tmp_path / "s.weft.json"
     assert window.save_session(str(path))
     data = json.loads(path.read_text())
-    assert data["params"]["fast"]["p"] == 0.3 and data["seed"] == 42 and data["prototype"] == [2, 4, 16]
+    assert data["params"]["fast"]["p"] == 0.3 and data["seed"] == 42 and data["geometry"] == {"fast": {"region": [2, 4, 16]}}
     doc.set_param("p", 0.9)
-    doc.set_prototype(None)
+    doc.set_square(None)
     window.seed_box.setValue(1)
     assert window.open_session(str(path))
-    assert doc.current_params.p == 0.3 and doc.prototype == (2, 4, 16) and doc.seed == 42
+    assert doc.current_params.p == 0.3 and doc.square == (2, 4, 16) and doc.seed == 42
     assert window.seed_box.value() == 42 and window.params_panel.row("p").value() == 0.3
     bad = tmp_path / "bad.json"
     bad.write_text("{")

@@ -150,8 +150,10 @@ def test_kill_9_then_restart_offers_to_restore(qtbot, tmp_path, private_recovery
     assert doc.inputs["target"].path == str(target)
     assert doc.inputs["target"].image.shape == (48, 64, 3)
     assert doc.params["fast"].p == EDITS["p"]
-    assert doc.prototype == tuple(EDITS["prototype"])
-    assert doc.image_lines == EDITS["image_lines"] and doc.frontal_lines == EDITS["frontal_lines"]
+    assert doc.square == tuple(EDITS["prototype"])
+    lines = doc.value("lines", "nfpt")
+    assert [list(x) for x in lines.image_lines] == EDITS["image_lines"]
+    assert [list(x) for x in lines.frontal_lines] == EDITS["frontal_lines"]
     assert doc.seed == EDITS["seed"] and w.seed_box.value() == EDITS["seed"]
     assert not doc.undo_stack.isClean()  # still unsaved: the recovery file stays until saved or discarded
     assert recovery.exists()

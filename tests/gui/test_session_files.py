@@ -22,7 +22,7 @@ def _image(path, seed, side=24):
 def _state(doc):
     """What must not change when a session is refused (images by identity: not even re-read)."""
     return ({name: (item.path, id(item.image)) for name, item in doc.inputs.items()}, doc.method,
-            dict(doc.params), doc.prototype, doc.seed, [list(x) for x in doc.image_lines],
+            dict(doc.params), doc.square, doc.seed, [list(x) for x in doc.image_lines],
             [list(x) for x in doc.frontal_lines], doc.frontal_size,
             doc.undo_stack.count(), doc.undo_stack.index(), doc.undo_stack.isClean())
 
@@ -42,7 +42,7 @@ def edited(window):
     """The window with unsaved edits: a parameter and a prototype (two undo steps)."""
     doc = window.doc
     doc.set_param("p", 0.3)
-    doc.set_prototype((2, 4, 16))
+    doc.set_square((2, 4, 16))
     assert doc.undo_stack.count() == 2 and not doc.undo_stack.isClean()
     return window
 
@@ -93,7 +93,7 @@ def test_a_session_naming_a_missing_image_says_which_and_keeps_the_document(edit
     assert _state(doc) == before
     # the undo history still works, and a good session still opens: the studio goes on
     doc.undo_stack.undo()
-    assert doc.prototype is None and doc.current_params.p == 0.3
+    assert doc.square is None and doc.current_params.p == 0.3
     data["inputs"] = {"texture": "tex.png", "target": "tex.png"}
     session.write_text(json.dumps(data))
     assert window.open_session(str(session))

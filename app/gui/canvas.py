@@ -1,0 +1,163 @@
+"""The inputs pane: one view per input of the current method, each with the tool of its geometry.
+
+Contract
+--------
+* Built from the document and the current method's studio description (``core.studio``) only: the
+  canvas input in the large view on top, the other inputs (and a lines tool's frontal frame) in tabs
+  below. It knows no method, input or parameter by name.
+* It reads the document and changes it only through the tools (``Document.set_geometry`` /
+  ``set_lines`` on release). :meth:`rebuild` after a method change, :meth:`input_changed` after an
+  input changed, :meth:`geometry_changed` after a geometry changed.
+* Signals: ``message(text)`` a one-line problem; ``dragging(key, value)`` a square is being dragged
+  (the window renders a live preview when the geometry asks for one); ``open_requested(input, path)``
+  a file was dropped on an input's view.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import QLabel, QSizePolicy, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout, QWidget
+
+from core.studio import LINES, SQUARE
+
+from .lines_panel import FeatureLinesPanel
+from .tools import PatchTool, QuadTool, Tool
+from .views import ImageView
+
+
+def titled(view: QWidget, title: str) -> QWidget:
+    """``view`` under a one-line title bar (cut, never widening its pane)."""
+    box = QWidget()
+    lay = QVBoxLayout(box)
+    lay.setContentsMargins(0, 0, 0, 0)
+    lay.setSpacing(0)
+    label = QLabel(f"  {title}")
+    label.setStyleSheet("background:#2b2b2b; color:#ddd; padding:2px;")
+    label.setToolTip(title)
+    label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+    lay.addWidget(label)
+    lay.addWidget(view)
+    box.label = label
+    return box
+
+
+class InputsPane(QSplitter):
+    """See the module docstring."""
+
+    message = Signal(str)
+    dragging = Signal(str, object)
+    hovered = Signal(object, int, int)  # view, x, y
+    open_requested = Signal(str, str)
+
+    def __init__(self, doc, parent=None):
+        super().__init__(Qt.Orientation.Vertical, parent)
+        self.doc = doc
+        self.views: dict[str, ImageView] = {}
+        self._boxes: dict[str, QWidget] = {}
+        self._tools: dict[tuple, Tool] = {}
+        self.lines_panel: FeatureLinesPanel | None = None
+        self.canvas = QStackedWidget()
+        self.tabs = QTabWidget()
+        self.addWidget(self.canvas)
+        self.addWidget(self.tabs)
+
+    # --- parts ----------------------------------------------------------------------------------
+    def view(self, name: str) -> ImageView:
+        """The view of input ``name`` (made on first use)."""
+        view = self.views.get(name)
+        if view is None:
+            view = ImageView(self, title=name)
+            view.hovered.connect(lambda x, y, v=view: self.hovered.emit(v, x, y))
+            view.file_dropped.connect(lambda path, n=name: self.open_requested.emit(n, path))
+            self.views[name] = view
+            self._boxes[name] = titled(view, name)
+        return view
+
+    @property
+    def canvas_view(self) -> ImageView:
+        return self.view(self.doc.studio.canvas)
+
+    def tool(self, geometry, input_name: str) -> Tool:
+        """The tool that edits ``geometry`` on the view of ``input_name`` (made on first use)."""
+        key = (geometry.kind, geometry.key, input_name)
+        tool = self._tools.get(key)
+        if tool is None:
+            view = self.view(input_name)
+            if geometry.kind == SQUARE:
+                tool = PatchTool(view, self.doc, geometry.key,
+                                 on_drag=lambda square, k=geometry.key: self.dragging.emit(k, square))
+            elif geometry.kind == LINES:
+                if self.lines_panel is None:
+                    self.lines_panel = FeatureLinesPanel(self.doc, view, input_name, self)
+                    self.lines_panel.message.connect(self.message)
+                tool = self.lines_panel.photo_lines
+            else:
+                raise ValueError(f"the studio has no tool for {geometry.kind!r} geometry")
+            self._tools[key] = tool
+        return tool
+
+    # --- following the document -----------------------------------------------------------------
+    def rebuild(self) -> None:
+        """Lay the current method's inputs out (canvas on top, the others in tabs) with their tools."""
+        method, studio = self.doc.current, self.doc.studio
+        while self.canvas.count():
+            self.canvas.removeWidget(self.canvas.widget(0))
+        self.tabs.clear()
+        self.view(studio.canvas)
+        self.canvas.addWidget(self._boxes[studio.canvas])
+        if self.lines_panel is not None:
+            self.lines_panel.set_active(False)
+        for inp in method.inputs:
+            view = self.view(inp.name)
+            view.set_image(self.doc.image(inp.name))
+            help_ = " — ".join(g.help for g in studio.geometry if g.input_for(self.doc.inputs) == inp.name)
+            self._boxes[inp.name].label.setText(f"  {help_ or inp.help}")
+            if inp.name == studio.canvas:
+                continue
+            label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")
+            self.tabs.addTab(self._boxes[inp.name], label)
+        if any(g.kind == LINES for g in studio.geometry):
+            self.tool(next(g for g in studio.geometry if g.kind == LINES), studio.canvas)
+            self.tabs.insertTab(0, self.lines_panel, "frontal frame (live rectification)")
+            self.lines_panel.set_active(True)
+        self.tabs.setCurrentIndex(0)
+        self.tabs.setVisible(self.tabs.count() > 0)
+        self.sync_tools()
+
+    def sync_tools(self) -> None:
+        """Attach each geometry's tool to the view of the input it is drawn on now; others none."""
+        studio = self.doc.studio
+        wanted = {}
+        for g in studio.geometry:
+            name = g.input_for(self.doc.inputs)
+            wanted[name] = self.tool(g, name)
+        for tool in self._tools.values():
+            if tool not in wanted.values():
+                tool.hide()
+        for name, view in self.views.items():
+            tool = wanted.get(name)
+            if isinstance(view.tool, QuadTool) and tool is not None and tool.view is view:
+                continue  # the lines panel's four-click mode stays until it is done
+            view.tool = tool
+            if tool is not None:
+                tool.refresh()
+
+    def input_changed(self, name: str) -> None:
+        self.view(name).set_image(self.doc.image(name), fit=True)
+        self.sync_tools()
+        if self.lines_panel is not None and name == self.lines_panel.input_name:
+            self.lines_panel.photo_changed()
+
+    def geometry_changed(self) -> None:
+        self.sync_tools()
+        if self.lines_panel is not None and self.lines_panel.active:
+            self.lines_panel.lines_changed()
+
+    def square_on(self) -> tuple[str, object] | None:
+        """(input, geometry) of the current method's square, or None."""
+        g = self.doc.geometry_of(SQUARE)
+        return None if g is None else (g.input_for(self.doc.inputs), g)
+
+    def shutdown(self) -> None:
+        if self.lines_panel is not None:
+            self.lines_panel.shutdown()

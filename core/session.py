@@ -1,0 +1,152 @@
+"""The studio's session files: reading and validating them (Qt-free; the studio writes them).
+
+A session is the whole document as JSON::
+
+    {"weft_session": 1, "method": "fast", "params": {"fast": {...}, ...}, "inputs": {"texture": "a.png"},
+     "geometry": {"fast": {"region": [x, y, side]}, "nfpt": {"lines": {...}}}, "seed": 7}
+
+``geometry`` holds each method's own geometry (its studio description's keys). Files written before
+geometry was per method have one ``"prototype": [x, y, side]`` and one ``"lines": {...}`` instead;
+each is given to every method with a geometry of that kind.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+from . import registry
+from .errors import WeftError
+from .geometry import LINES, MAX_SIDE, SQUARE, LineDraft, Square
+from .jsonio import read_json_file
+from .studio import Geometry
+
+SESSION_VERSION = 1
+LEGACY_SQUARE, LEGACY_LINES = "prototype", "lines"  # the version-1 keys of the one shared geometry
+
+
+MAX_SEED = 2**31 - 1  # the studio's seed box
+FRONTAL_SIDES = (2, MAX_SIDE)  # what a feature-lines file may give (core.rectify)
+
+
+def read_session(path: str | Path) -> dict:
+    """Parse and validate a session file (JSON only, at most ``core.params.MAX_FILE_BYTES``); input
+    paths come back absolute, relative ones resolved against the session's folder. ``WeftError`` with
+    one line naming the file if anything is wrong, so a bad file never half-replaces a document."""
+    path = Path(path)
+    data = read_json_file(path, "weft session")
+    try:
+        return _session_from_data(data, path.resolve().parent)
+    except WeftError as e:
+        raise WeftError(f"{path}: {e}") from None
+
+
+def _session_from_data(data: Any, base: Path) -> dict:
+    if not isinstance(data, dict) or data.get("weft_session") != SESSION_VERSION:
+        raise WeftError(f"not a weft session file (version {SESSION_VERSION})")
+    methods = registry.methods()
+    if data.get("method") not in methods:
+        raise WeftError(f"unknown method {data.get('method')!r}")
+    raw_params = _get(data, "params", dict, "an object of method name -> parameters", {})
+    params = {}
+    for name, values in raw_params.items():
+        if name in methods:  # a method this version lacks is skipped, not fatal
+            try:
+                params[name] = methods[name].params.from_dict(values)
+            except WeftError as e:
+                raise WeftError(f"{name}: {e}") from None
+    known_inputs = {i.name for m in methods.values() for i in m.inputs}
+    inputs = {}
+    for name, value in _get(data, "inputs", dict, "an object of input name -> image file", {}).items():
+        if name not in known_inputs:
+            raise WeftError(f"unknown input {name!r} (known: {', '.join(sorted(known_inputs))})")
+        if not isinstance(value, str) or not value or "\0" in value:
+            raise WeftError(f"input {name!r} = {value!r} is not a file path")
+        inputs[name] = value if os.path.isabs(value) else str(base / value)
+    proto = data.get(LEGACY_SQUARE)
+    if proto is not None and (not isinstance(proto, list) or len(proto) != 3 or not _ints(proto, 0)
+                              or proto[2] < 1):
+        raise WeftError(f"{LEGACY_SQUARE} = {proto!r} must be [x, y, side] in pixels, or null")
+    lines = _get(data, LEGACY_LINES, dict, "an object {image_lines, frontal_lines, frontal_size}", {})
+    image_lines = _lines(lines, "image_lines")
+    frontal_lines = _lines(lines, "frontal_lines")
+    lo, hi = FRONTAL_SIDES
+    frontal_size = lines.get("frontal_size", [512, 512])
+    if not isinstance(frontal_size, list) or len(frontal_size) != 2 or not _ints(frontal_size, lo, hi):
+        raise WeftError(f"frontal_size = {frontal_size!r} must be [width, height], each {lo}..{hi}")
+    seed = data.get("seed", 1)
+    if not _ints([seed], 0, MAX_SEED):
+        raise WeftError(f"seed = {seed!r} must be an integer in 0..{MAX_SEED}")
+    # Geometry per method. Sessions written before it was per method have one "prototype" and one
+    # "lines" for all: each goes to every method with a geometry of that kind.
+    geometry: dict[str, dict[str, Any]] = {}
+    for name, method in methods.items():
+        if method.studio is None:
+            continue
+        for g in method.studio.geometry:
+            if g.kind == SQUARE and proto is not None:
+                geometry.setdefault(name, {})[g.key] = Square(*proto)
+            elif g.kind == LINES and (image_lines or frontal_lines):
+                geometry.setdefault(name, {})[g.key] = LineDraft(tuple(map(tuple, image_lines)),
+                                                                 tuple(map(tuple, frontal_lines)), tuple(frontal_size))
+    for name, values in _get(data, "geometry", dict, "an object of method name -> geometry", {}).items():
+        method = methods.get(name)
+        if method is None or method.studio is None:
+            continue  # a method this version lacks is skipped, as its parameters are
+        if not isinstance(values, dict):
+            raise WeftError(f"geometry of {name} must be an object of geometry name -> value")
+        known = {g.key: g for g in method.studio.geometry}
+        geometry[name] = {}
+        for key, value in values.items():
+            g = known.get(key)
+            if g is None:
+                raise WeftError(f"{name}: unknown geometry {key!r} (known: {', '.join(known) or 'none'})")
+            try:
+                geometry[name][key] = _geometry_from_json(g, value)
+            except WeftError as e:
+                raise WeftError(f"{name}: {e}") from None
+    return {"method": data["method"], "params": params, "inputs": inputs, "geometry": geometry, "seed": seed}
+
+
+def _geometry_from_json(g: Geometry, value: Any):
+    if value is None:
+        return None
+    if g.kind == SQUARE:
+        try:
+            return Square.from_json(value, g.key)
+        except WeftError:
+            raise WeftError(f"{g.key} = {value!r} must be [x, y, side] in pixels, or null") from None
+    if not isinstance(value, dict):
+        raise WeftError(f"{g.key} must be an object {{image_lines, frontal_lines, frontal_size}}")
+    lo, hi = FRONTAL_SIDES
+    size = value.get("frontal_size", [512, 512])
+    if not isinstance(size, list) or len(size) != 2 or not _ints(size, lo, hi):
+        raise WeftError(f"frontal_size = {size!r} must be [width, height], each {lo}..{hi}")
+    return LineDraft(tuple(map(tuple, _lines(value, "image_lines"))), tuple(map(tuple, _lines(value, "frontal_lines"))),
+                     tuple(size))
+
+
+def _get(data: dict, key: str, kind: type, what: str, default):
+    value = data.get(key)
+    if value is None:
+        return default
+    if not isinstance(value, kind):
+        raise WeftError(f"{key} must be {what}")
+    return value
+
+
+def _ints(values, lo: int, hi: int | None = None) -> bool:
+    return all(isinstance(v, int) and not isinstance(v, bool) and lo <= v and (hi is None or v <= hi)
+               for v in values)
+
+
+def _lines(lines: dict, key: str) -> list[list[float]]:
+    value = lines.get(key, [])
+    if (not isinstance(value, list)
+            or not all(isinstance(ln, list) and len(ln) == 4
+                       and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in ln)
+                       for ln in value)):
+        raise WeftError(f"{key} must be a list of [x1, y1, x2, y2] in pixels")
+    return [[float(v) for v in ln] for ln in value]

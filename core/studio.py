@@ -1,0 +1,150 @@
+"""What a method tells the studio about itself (Qt-free): the studio is generic over methods.
+
+A method that the studio offers sets ``Method.studio`` to a :class:`Studio`: its name for people,
+which input is the canvas (the first view), which geometry each input carries and which parameter
+(or the recipe's source region) it fills, how a preview is reduced, and which parameters are derived
+from the inputs ("auto") with the values they resolve to. ``app/gui`` reads only this; it holds no
+method, input or parameter name of any method, so adding a method never touches it.
+
+Example: a method whose one input carries a square that fills its ``square`` parameter::
+
+    Studio(title="Invert a square", canvas="image",
+           geometry=(Geometry(SQUARE, on=("image",), param="square", help="drag the square to invert"),))
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from .errors import WeftError
+from .geometry import KINDS, LINES, MASK, SQUARE, Square  # noqa: F401 (the kinds are re-exported)
+
+__all__ = ["Studio", "Geometry", "reduce_for_preview", "SQUARE", "LINES", "MASK", "REGION"]
+
+#: The key of a square that fills no parameter: the recipe's source ``region`` (the input is cropped to it).
+REGION = "region"
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """One geometry the user edits with the mouse on an input.
+
+    Attributes
+    ----------
+    kind : ``"square"``, ``"lines"`` or ``"mask"`` (:data:`core.geometry.KINDS`): which tool edits it.
+    on : the inputs it is drawn on, in order of preference: the first one that is open is used (the
+        affine prototype lies on the prototype image when one is open, else on the texture).
+    param : the ``Params`` field it fills (typed: a :class:`~core.geometry.Square`,
+        :class:`~core.geometry.FeatureLines`); ``None`` for a square means the recipe's source
+        ``region``: the first input of ``on`` is cropped to it before the method runs.
+    help : what the user does, shown as the view's title.
+    live : ``live(params) -> bool``: re-render a preview while the geometry is being dragged.
+    """
+
+    kind: str
+    on: tuple[str, ...]
+    param: str | None = None
+    help: str = ""
+    live: Callable[[Any], bool] | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"unknown geometry kind {self.kind!r} (known: {', '.join(KINDS)})")
+        if self.param is None and self.kind != SQUARE:
+            raise ValueError("only a square may stand for the source region (param None)")
+
+    @property
+    def key(self) -> str:
+        """Its name in the document and in sessions: the parameter, or :data:`REGION`."""
+        return self.param if self.param is not None else REGION
+
+    def input_for(self, open_inputs) -> str:
+        """The input it is drawn on, given the names of the open inputs."""
+        for name in self.on:
+            if name in open_inputs:
+                return name
+        return self.on[-1]
+
+
+@dataclass(frozen=True)
+class Studio:
+    """A method's studio description (see the module docstring).
+
+    Attributes
+    ----------
+    title : the name people read in the method list, e.g. ``"Fast transfer (Ashikhmin)"``.
+    canvas : the input shown in the first (large) view.
+    geometry : what the user draws, per input (:class:`Geometry`).
+    preview_inputs : inputs scaled down for a preview while a slider moves (the output follows them).
+    preview_params : size parameters ``(width, height)`` scaled down for a preview instead, when
+        none of ``preview_inputs`` is open.
+    auto : ``auto(params, open_inputs) -> {name: value}``: what the optional ("auto") parameters
+        resolve to for these inputs, shown greyed beside their "auto" box; may raise ``WeftError``.
+    compare : the "before" image of Compare: the first of these inputs that is open (default the canvas).
+    examples : a bundled example (``core.examples``) per input, opened when the studio starts.
+    rank : position in the method list (lowest first; the first is the studio's starting method).
+    """
+
+    title: str
+    canvas: str
+    geometry: tuple[Geometry, ...] = ()
+    preview_inputs: tuple[str, ...] = ()
+    preview_params: tuple[str, ...] = ()
+    auto: Callable[[Any, frozenset], Mapping[str, Any]] | None = None
+    compare: tuple[str, ...] = ()
+    examples: Mapping[str, str] = field(default_factory=dict)
+    rank: int = 100
+
+    def geometry_on(self, input_name: str, open_inputs) -> tuple[Geometry, ...]:
+        """The geometry drawn on ``input_name`` given the open inputs."""
+        return tuple(g for g in self.geometry if g.input_for(open_inputs) == input_name)
+
+    def resolved(self, params, open_inputs) -> dict[str, Any]:
+        """What "auto" parameters resolve to (empty if the method says nothing or refuses the inputs)."""
+        if self.auto is None:
+            return {}
+        try:
+            return dict(self.auto(params, frozenset(open_inputs)))
+        except WeftError:
+            return {}
+
+    def compare_input(self, open_inputs) -> str:
+        for name in self.compare:
+            if name in open_inputs:
+                return name
+        return self.canvas
+
+
+def reduce_for_preview(studio: Studio, inputs: Mapping[str, np.ndarray], params, side: int
+                       ) -> tuple[dict[str, np.ndarray], Any]:
+    """Inputs and parameters of a reduced render: the studio's ``preview_inputs`` that are open
+    scaled so the longer side of the largest is ``side``; else its ``preview_params`` sizes scaled
+    so; unchanged when already that small (or when the method refuses the smaller size)."""
+    from .image import resize
+
+    scaled = [n for n in studio.preview_inputs if n in inputs]
+    if scaled:
+        longest = max(max(inputs[n].shape[:2]) for n in scaled)
+        if longest <= side:
+            return dict(inputs), params
+        k = side / longest
+        small = dict(inputs)
+        for n in scaled:
+            h, w = inputs[n].shape[:2]
+            small[n] = resize(inputs[n], (max(8, round(w * k)), max(8, round(h * k))), interpolation="area")
+        return small, params
+    changes = {}
+    for name in studio.preview_params:
+        size = getattr(params, name, None)
+        if size is not None and max(size) > side:
+            k = side / max(size)
+            changes[name] = (max(8, round(size[0] * k)), max(8, round(size[1] * k)))
+    if changes:
+        try:
+            return dict(inputs), params.replace(**changes)
+        except WeftError:  # a size the method refuses at preview scale: render at full size
+            pass
+    return dict(inputs), params
