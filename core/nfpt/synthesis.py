@@ -60,6 +60,7 @@ from ..errors import ImageError
 from ..image import luminance, validate_image
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng, out_of_range
+from ..quilting.engine import _grid
 
 __all__ = ["Synthesis", "synthesize_patches", "distance_weights", "SMOOTH_SIGMA"]
 
@@ -81,14 +82,6 @@ class Synthesis:
         h, w = self.image.shape[:2]
         return {"patches": self.patches, "repaired_pixels": int(self.repaired),
                 "repaired_fraction": round(self.repaired / float(h * w), 5)}
-
-
-def _grid(n: int, block: int, overlap: int) -> tuple[list[int], int]:
-    """Patch starts along one axis and the canvas length (whole patches; cropped afterwards)."""
-    step = block - overlap
-    k = 1 if n <= block else -(-(n - overlap) // step)
-    starts = [j * step for j in range(k)]
-    return starts, starts[-1] + block
 
 
 def distance_weights(block: int, top: int, left: int, sigma_d: float) -> np.ndarray:
@@ -213,8 +206,8 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
                          f"(the rectified area is too small for the block; use a smaller --block)")
     rng = as_rng(rng)
     width, height = size
-    ys, hc = _grid(height, block, overlap)
-    xs, wc = _grid(width, block, overlap)
+    ys, _, _, hc = _grid(height, block, overlap, False)  # the one patch grid, shared with quilting
+    xs, _, _, wc = _grid(width, block, overlap, False)
     rows, cols = len(ys), len(xs)
 
     src_y = luminance(tex[..., 0] if nc == 1 else tex)

@@ -246,15 +246,16 @@ def test_numpy_and_numba_engines_give_the_same_pixels(brick, monkeypatch, kw):
     import dataclasses
 
     import core.quilting as q
+    import core.quilting.method as qm
     from core._kernels import quilting as k
 
     for name in ("P_Y0", "P_SX", "N_IPARAMS", "MODE_MINCUT", "SAMPLE_FRACTION", "TOP_FRACTION"):
         assert getattr(q._K, name) == getattr(k, name)
     colour = np.ascontiguousarray(np.stack([brick, brick[::-1], brick.T], axis=2))
-    original = q._quilt_pass
+    original = qm._quilt_pass
     outs = {}
     for engine in ("numba", "numpy"):
-        monkeypatch.setattr(q, "_quilt_pass", lambda tex, h, w, p, rng, _e=engine, **k2:
+        monkeypatch.setattr(qm, "_quilt_pass", lambda tex, h, w, p, rng, _e=engine, **k2:
                             original(tex, h, w, dataclasses.replace(p, engine=_e), rng, **k2))
         outs[engine] = q.synthesize(colour, size=(90, 70), block=16, overlap=5, rng=3, **kw)
     assert np.array_equal(outs["numba"], outs["numpy"])
