@@ -27,7 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from core.affine import (analyse, field_model, make_prototype, match_boundaries,  # noqa: E402
                          render, synthesize)
-from core.affine.procedural import cells, weave  # noqa: E402
+from benchmarks.fixtures.procedural import cells, weave  # noqa: E402
 from panels import grid, label  # noqa: E402 (docs/panels.py)
 from core.examples import example  # noqa: E402
 from core.image import load_image, save_image  # noqa: E402

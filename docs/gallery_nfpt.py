@@ -28,7 +28,7 @@ from core.image import load_image, resize, save_image
 from core.metrics import coherence
 from core.nfpt import nfpt, synthesize
 from core.rectify import load_feature_lines, rectify, rectify_feature_lines
-from core.rectify.synthetic import folded_case, perspective_case
+from benchmarks.fixtures.synthetic import folded_case, perspective_case
 
 OUT = Path(__file__).resolve().parent / "images"
 LINES = RESOURCES / "perspective-lines.json"

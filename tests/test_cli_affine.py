@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from app.cli import main
-from core.affine.procedural import cells
+from benchmarks.fixtures.procedural import cells
 from core.examples import example
 from core.image import load_image, read_recipe, save_image
 

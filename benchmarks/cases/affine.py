@@ -2,7 +2,7 @@
 
 The harness decodes bundled examples only, so the timed run of every case is a bundled picture
 (brick, enlarged to 512x512 where the target is about 512²). The procedural textures the paper's
-SNR figures are compared on (:mod:`core.affine.procedural`: ``cells`` -- reptile-like scales --
+SNR figures are compared on (:mod:`benchmarks.fixtures.procedural`: ``cells`` -- reptile-like scales --
 and ``weave``, 512x512, drifting orientation and scale) are generated and measured inside the
 ``figures`` of their cases, each with its own median time of 5 runs (``*_s``); the ``snr_db``
 column of those rows is the procedural texture's. Paper-only figures (``--propagate no
@@ -36,7 +36,7 @@ def _median_time(fn, repeats: int = 5):
 
 @lru_cache(maxsize=4)
 def _procedural(name: str, **kw) -> np.ndarray:
-    from core.affine import procedural
+    from benchmarks.fixtures import procedural
 
     return procedural.cells(512, **kw) if name == "cells" else procedural.weave(512, **kw)
 

@@ -1,7 +1,7 @@
 """Benchmark cases of rectification (``core.rectify``) and NFPT synthesis (``core.nfpt``).
 
 The figures of the rectification case come from the synthetic known-geometry case of
-:func:`core.rectify.synthetic.perspective_case` (gravel enlarged to 400x300, photographed at
+:func:`benchmarks.fixtures.synthetic.perspective_case` (gravel enlarged to 400x300, photographed at
 35°/-12°/3° into 640x480, noise 0.01, a 5 x 5 grid of lines with 0.3 px noise on every end point):
 PSNR of the fitted rectification against the ground truth on the interior, with the same for the
 exact homography and for one shifted by 0.5 px as the scale of the criterion.
@@ -44,7 +44,7 @@ def _interior(img: np.ndarray, frac: float = 0.05) -> np.ndarray:
 def synthetic_accuracy() -> dict[str, float]:
     """Accuracy (and the time of the fit + warp alone) on the synthetic known-geometry case."""
     from core.rectify import Rectifier, apply_homography
-    from core.rectify.synthetic import perspective_case
+    from benchmarks.fixtures.synthetic import perspective_case
 
     frontal = resize(load_image(example("gravel")).image, (400, 300), interpolation="cubic")
     case = perspective_case(frontal, seed=1)

@@ -27,8 +27,9 @@ call :func:`render` with each new prototype (``reuse transforms``).
 Example
 -------
 >>> from core.affine import analyse, render, make_prototype
->>> from core.affine.procedural import cells
->>> tex = cells(128)
+>>> from core.examples import example
+>>> from core.image import load_image
+>>> tex = load_image(example("brick")).image[:128, :128]
 >>> model = analyse(tex, prototype=(32, 32, 64), block=32)
 >>> out = render(model)                                   # the synthesis
 >>> moved = render(model, make_prototype(tex, (40, 30, 64), block=32))  # a prototype swap

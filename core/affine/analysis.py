@@ -156,7 +156,7 @@ def analyse(
                 ctx.refine(state, sl, refine, only=changed)
             step()
         step()
-    return state.model(ctx, lowpass, proto, dec, T_all=None)
+    return state.model(ctx, lowpass, proto, dec)
 
 
 @dataclass
@@ -181,7 +181,7 @@ class _State:
         self.err[rows] = err
         self.choice[rows] = choice
 
-    def model(self, ctx: "_Context", lowpass, proto, dec, T_all=None) -> AffineModel:
+    def model(self, ctx: "_Context", lowpass, proto, dec) -> AffineModel:
         return AffineModel(
             grid=ctx.grid,
             transforms=np.linalg.inv(self.mats),

@@ -6,7 +6,7 @@ import pytest
 from core.affine import (analyse, field_model, field_transforms, make_prototype, match_boundaries, render,
                          synthesize, total_boundary_error)
 from core.affine.boundary import _Canvas
-from core.affine.procedural import cells
+from benchmarks.fixtures.procedural import cells
 from core.affine.model import Grid
 from core.errors import InvalidParameter
 from core.examples import example

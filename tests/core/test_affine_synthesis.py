@@ -9,7 +9,7 @@ import pytest
 from core import metrics
 from core.affine import (METHOD, AffineParams, analyse, decompose, make_prototype, prototype_from_patch, render,
                          synthesize)
-from core.affine.procedural import cells, weave
+from benchmarks.fixtures.procedural import cells, weave
 from core.errors import Cancelled, GeometryError, ImageError, InvalidParameter
 from core.examples import example
 from core.image import load_image, resize

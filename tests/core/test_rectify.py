@@ -11,7 +11,7 @@ from core.image import load_image, resize
 from core.metrics import psnr_db
 from core.rectify import (FeatureLines, Rectifier, apply_homography, fit_homography, line_correspondences,
                           load_feature_lines, parse_feature_lines, rectify, rectify_feature_lines, scale_lines)
-from core.rectify.synthetic import folded_case, perspective_case
+from benchmarks.fixtures.synthetic import folded_case, perspective_case
 
 LINES_JSON = example("perspective").parent / "perspective-lines.json"
 
