@@ -375,7 +375,7 @@ METHOD = Method(
         title="Fast texture transfer (Ashikhmin)",
         canvas="texture",
         geometry=(Geometry(SQUARE, on=("texture",),
-                           help="texture — drag a square: the source region (the method copies only from it)"),),
+                           help="drag a square: the source region (the method copies only from it)"),),
         preview_inputs=("target",), preview_params=("size",), auto=_auto, compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=0),
 )

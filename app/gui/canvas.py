@@ -111,7 +111,7 @@ class InputsPane(QSplitter):
             view = self.view(inp.name)
             view.set_image(self.doc.image(inp.name))
             help_ = " — ".join(g.help for g in studio.geometry if g.input_for(self.doc.inputs) == inp.name)
-            self._boxes[inp.name].label.setText(f"  {help_ or inp.help}")
+            self._boxes[inp.name].label.setText(f"  {inp.name.replace('_', ' ')} — {help_ or inp.help}")
             if inp.name == studio.canvas:
                 continue
             label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")

@@ -147,7 +147,8 @@ class _Row(QWidget):
                 self.w_box.setValue(int(value[0]))
                 self.h_box.setValue(int(value[1]))
             else:
-                self.editor.setText(str(value))
+                # a typed geometry shows its command-line text (e.g. X,Y,S), which the spec parses back
+                self.editor.setText(value.to_text() if hasattr(value, "to_text") else str(value))
         finally:
             for w in widgets:
                 w.blockSignals(False)

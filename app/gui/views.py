@@ -55,15 +55,17 @@ class ImageView(QGraphicsView):
 
     # --- image ---------------------------------------------------------------------------------
     def set_image(self, image: np.ndarray | None, *, fit: bool = False) -> None:
-        """Show ``image`` (float32 [0, 1]); ``fit`` also fits it to the window."""
+        """Show ``image`` (float32 [0, 1]); ``fit`` also fits it to the window, as does an image of
+        another size while the view is fitting (the user has not zoomed)."""
         first = self.image is None
+        resized = not first and image is not None and self.image.shape[:2] != image.shape[:2]
         self.image = image
         if image is None:
             self._item.setPixmap(QPixmap())
             return
         self._item.setPixmap(QPixmap.fromImage(to_qimage(image)))
         self.scene().setSceneRect(self._item.boundingRect())
-        if fit or first:
+        if fit or first or (resized and self.auto_fit):
             self.fit()
         self.viewport().update()
 

@@ -342,7 +342,7 @@ METHOD = Method(
         title="Non-frontal textures (Yan, Lee & Lin)",
         canvas="photo",
         geometry=(Geometry(LINES, on=("photo",), param="lines",
-                           help="photo — drag to draw feature lines; drag an end to move it; click a line + "
+                           help="drag to draw feature lines; drag an end to move it; click a line + "
                                 "Delete to remove it"),),
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
         auto=lambda params, open_inputs: {"sigma_d": params.overlap / 2.0}, rank=3),

@@ -613,7 +613,7 @@ METHOD = Method(
         title="Image quilting (Efros & Freeman)",
         canvas="texture",
         geometry=(Geometry(SQUARE, on=("texture",),
-                           help="texture — drag a square: the source region (blocks come only from it)"),),
+                           help="drag a square: the source region (blocks come only from it)"),),
         preview_inputs=("target", "target_map"), preview_params=("size",), compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=1),
 )
