@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from .errors import WeftError
-from .geometry import KINDS, LINES, MASK, SQUARE, Square  # noqa: F401 (the kinds are re-exported)
+from .geometry import KINDS, LINES, MASK, SQUARE  # noqa: F401 (the kinds are re-exported)
 
 __all__ = ["Studio", "Geometry", "reduce_for_preview", "SQUARE", "LINES", "MASK", "REGION"]
 

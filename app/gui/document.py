@@ -24,7 +24,7 @@ from core.errors import WeftError
 from core.geometry import LINES, SQUARE, LineDraft, Square
 from core.params import Params, Recipe, relative_path
 from core.session import SESSION_VERSION, read_session  # noqa: F401 (read_session: the studio reads sessions)
-from core.studio import Studio
+from core.studio import Geometry, Studio
 
 _MERGE_PARAM = 1001
 

@@ -42,7 +42,7 @@ from core.jobs import JobRunner
 
 from .canvas import InputsPane, titled
 from .document import Document, DocumentState, InputImage
-from .files import FileActions, recovery_path  # noqa: F401 (recovery_path: the window's recovery file)
+from .files import FileActions
 from .method_panel import MethodPanel
 from .render import Renderer, describe
 from .views import ImageView, ResultView, is_image_path

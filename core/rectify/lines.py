@@ -17,9 +17,7 @@ one), the key, the line index and the value.
 
 from __future__ import annotations
 
-import json
 import math
-import numbers
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -27,7 +25,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..errors import GeometryError
-from ..geometry import FeatureLines, _short, as_lines as _as_lines, as_size as _as_size, read_json_or_file as read_json
+from ..geometry import FeatureLines
 
 __all__ = [
     "FeatureLines", "Correspondences", "load_feature_lines", "parse_feature_lines", "check_lines",

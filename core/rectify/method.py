@@ -12,10 +12,8 @@ from ..image import validate_image
 from ..jobs import ProgressReporter
 from ..params import Params, param
 from ..registry import InputSpec, Method, Result
-from .homography import HomographyFit, apply_homography, fit_homography
-from .lines import FeatureLines, line_correspondences, load_feature_lines, parse_feature_lines
-from .view import View, load_view
-from .warps import PLANAR_TOL_PX, WARPS, WarpPlan, homography_plan, plan_warp
+from .lines import FeatureLines, load_feature_lines
+from .warps import WARPS, WarpPlan, homography_plan, plan_warp
 
 
 INTERPOLATIONS = ("cubic", "linear", "lanczos")

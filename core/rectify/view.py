@@ -31,7 +31,8 @@ import numpy as np
 from ..errors import GeometryError
 from ..params import MAX_SIDE
 from .homography import apply_homography
-from .lines import _as_lines, _as_size, _short, check_lines, read_json
+from ..geometry import _short, as_lines as _as_lines, as_size as _as_size, read_json_or_file as read_json
+from .lines import check_lines
 from .warps import WarpPlan, homography_plan, plan_warp
 
 __all__ = ["View", "load_view", "parse_view", "quad_homography", "view_plan", "into_photo_plan", "SUPERSAMPLE"]

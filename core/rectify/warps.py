@@ -28,7 +28,8 @@ import numpy as np
 
 from ..errors import GeometryError, InvalidParameter
 from .homography import HomographyFit, apply_homography, fit_homography, homography_from_points
-from .lines import _short, check_lines, line_correspondences
+from ..geometry import _short
+from .lines import check_lines, line_correspondences
 
 __all__ = ["WARPS", "WarpPlan", "plan_warp", "homography_plan", "PLANAR_TOL_PX"]
 
