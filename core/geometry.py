@@ -31,11 +31,12 @@ from .jsonio import MAX_FILE_BYTES
 
 MAX_SIDE = 16384
 
-__all__ = ["Square", "FeatureLines", "LineDraft", "read_json_or_file", "SQUARE", "LINES", "MASK", "KINDS"]
+__all__ = ["Square", "FeatureLines", "LineDraft", "read_json_or_file", "SQUARE", "LINES", "KINDS"]
 
-#: The kinds of geometry the studio has a tool for (a method's studio description names one per input).
-SQUARE, LINES, MASK = "square", "lines", "mask"
-KINDS = (SQUARE, LINES, MASK)
+#: The kinds of geometry the studio has a tool for (a method's studio description names them per input).
+#: DESIGN.md's third kind, a mask painted with a brush, comes with the method that needs it (fill).
+SQUARE, LINES = "square", "lines"
+KINDS = (SQUARE, LINES)
 
 
 class Square(NamedTuple):

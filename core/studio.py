@@ -20,9 +20,9 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from .errors import WeftError
-from .geometry import KINDS, LINES, MASK, SQUARE  # noqa: F401 (the kinds are re-exported)
+from .geometry import KINDS, LINES, SQUARE  # noqa: F401 (the kinds are re-exported)
 
-__all__ = ["Studio", "Geometry", "reduce_for_preview", "SQUARE", "LINES", "MASK", "REGION"]
+__all__ = ["Studio", "Geometry", "reduce_for_preview", "SQUARE", "LINES", "REGION"]
 
 #: The key of a square that fills no parameter: the recipe's source ``region`` (the input is cropped to it).
 REGION = "region"
@@ -34,7 +34,7 @@ class Geometry:
 
     Attributes
     ----------
-    kind : ``"square"``, ``"lines"`` or ``"mask"`` (:data:`core.geometry.KINDS`): which tool edits it.
+    kind : ``"square"`` or ``"lines"`` (:data:`core.geometry.KINDS`): which tool edits it.
     on : the inputs it is drawn on, in order of preference: the first one that is open is used (the
         affine prototype lies on the prototype image when one is open, else on the texture).
     param : the ``Params`` field it fills (typed: a :class:`~core.geometry.Square`,
