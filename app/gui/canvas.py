@@ -66,7 +66,7 @@ class InputsPane(QSplitter):
         """The view of input ``name`` (made on first use)."""
         view = self.views.get(name)
         if view is None:
-            view = ImageView(self, title=name)
+            view = ImageView(self.canvas, title=name)  # (a QSplitter parent would adopt it as a pane)
             view.hovered.connect(lambda x, y, v=view: self.hovered.emit(v, x, y))
             view.file_dropped.connect(lambda path, n=name: self.open_requested.emit(n, path))
             self.views[name] = view
@@ -87,6 +87,7 @@ class InputsPane(QSplitter):
                 tool = PatchTool(view, self.doc, geometry.key,
                                  on_drag=lambda square, k=geometry.key: self.dragging.emit(k, square))
             elif geometry.kind == LINES:
+                # one lines panel (with the frontal frame), on the view of the first lines geometry met
                 if self.lines_panel is None:
                     self.lines_panel = FeatureLinesPanel(self.doc, view, input_name, self)
                     self.lines_panel.message.connect(self.message)
@@ -110,14 +111,13 @@ class InputsPane(QSplitter):
         for inp in method.inputs:
             view = self.view(inp.name)
             view.set_image(self.doc.image(inp.name))
-            help_ = " — ".join(g.help for g in studio.geometry if g.input_for(self.doc.inputs) == inp.name)
-            self._boxes[inp.name].label.setText(f"  {inp.name.replace('_', ' ')} — {help_ or inp.help}")
             if inp.name == studio.canvas:
                 continue
             label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")
             self.tabs.addTab(self._boxes[inp.name], label)
-        if any(g.kind == LINES for g in studio.geometry):
-            self.tool(next(g for g in studio.geometry if g.kind == LINES), studio.canvas)
+        lines = next((g for g in studio.geometry if g.kind == LINES), None)
+        if lines is not None:
+            self.tool(lines, lines.input_for(self.doc.inputs))
             self.tabs.insertTab(0, self.lines_panel, "frontal frame (live rectification)")
             self.lines_panel.set_active(True)
         self.tabs.setCurrentIndex(0)
@@ -125,8 +125,13 @@ class InputsPane(QSplitter):
         self.sync_tools()
 
     def sync_tools(self) -> None:
-        """Attach each geometry's tool to the view of the input it is drawn on now; others none."""
+        """Attach each geometry's tool to the view of the input it is drawn on now (others none), and
+        title each view with its input and what to draw on it."""
         studio = self.doc.studio
+        for inp in self.doc.current.inputs:
+            help_ = " — ".join(g.help for g in studio.geometry if g.input_for(self.doc.inputs) == inp.name)
+            self.view(inp.name)
+            self._boxes[inp.name].label.setText(f"  {inp.name.replace('_', ' ')} — {help_ or inp.help}")
         wanted = {}
         for g in studio.geometry:
             name = g.input_for(self.doc.inputs)

@@ -96,3 +96,24 @@ def test_a_seed_change_is_an_undo_step_and_unsaved(window, qtbot):
     assert doc.seed == old and window.seed_box.value() == old and doc.undo_stack.isClean()
     doc.undo_stack.redo()
     assert doc.seed == old + 41 and window.seed_box.value() == old + 41
+
+
+def test_the_affine_square_is_drawn_on_the_prototype_image_once_one_is_open(window, qtbot):
+    from .helpers import drag
+
+    doc = window.doc
+    doc.set_method("affine")
+    texture_view = window.views["texture"]
+    assert texture_view.tool is not None and texture_view.tool.square is None
+    other = np.random.default_rng(2).random((96, 96, 3)).astype(np.float32)
+    doc.set_input("prototype_image", None, other)
+    view = window.views["prototype_image"]
+    assert view.tool is not None and texture_view.tool is None  # the square moved to the prototype image
+    window.input_tabs.setCurrentIndex(0)
+    view.actual_size()
+    view.zoom_by(2.0)
+    view.centerOn(30, 30)
+    drag(view, (10.2, 10.2), (42.2, 42.2))
+    assert doc.square == (10, 10, 32)
+    qtbot.waitUntil(lambda: window.renderer.last.final
+                    and window.renderer.last.figures.get("prototype") == [10, 10, 32], timeout=30000)
