@@ -131,7 +131,13 @@ def test_public_functions_take_the_options_of_their_params():
         wanted = {s.name: s.default for s in specs(params_cls) if s.name not in not_taken}
         taken = {n: d for n, d in options.items() if n in wanted}
         assert taken == wanted, (fn.__qualname__, set(wanted) ^ set(taken))
-    # quilting splits its options over synthesis and transfer: together they are the Params' options
-    quilt = {n for fn in (quilting.synthesize, quilting.transfer)
-             for n, p in inspect.signature(fn).parameters.items() if p.kind is p.KEYWORD_ONLY}
-    assert {s.name for s in specs(quilting.QuiltParams)} <= quilt
+    # quilting splits its options over synthesis and transfer: each takes Params options with the
+    # Params' defaults, and together they take them all
+    quilt_specs = {s.name: s.default for s in specs(quilting.QuiltParams)}
+    taken = {}
+    for fn in (quilting.synthesize, quilting.transfer):
+        options = {n: p.default for n, p in inspect.signature(fn).parameters.items() if p.kind is p.KEYWORD_ONLY}
+        mine = {n: d for n, d in options.items() if n in quilt_specs}
+        assert mine == {n: quilt_specs[n] for n in mine}, fn.__qualname__
+        taken.update(mine)
+    assert set(taken) == set(quilt_specs)

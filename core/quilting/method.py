@@ -272,10 +272,10 @@ def synthesize(
     texture: np.ndarray,
     *,
     size: tuple[int, int] | None = None,
-    block: int = SYNTH_BLOCK,
+    block: int | None = None,
     overlap: int | None = None,
     mode: str = "mincut",
-    tol: int = SYNTH_TOL,
+    tol: int | None = None,
     rule: str = "tol",
     epsilon: float = 0.1,
     tile: bool = False,
@@ -293,8 +293,8 @@ def synthesize(
         The sample texture.
     size : (width, height), optional
         Output size in pixels (1..16384 per side). Default: twice the texture's size.
-    block : int, default 32
-        Block side B in pixels, 2..min(H, W) of the texture.
+    block : int, optional
+        Block side B in pixels, 2..min(H, W) of the texture; default (None) 32.
     overlap : int, optional
         Overlap between neighbouring blocks, 1..B-1; default ceil(B / 6) (E&F §2.1: "the size of
         the overlap was 1/6 of the size of the block"). Unused in ``random`` mode.
@@ -304,8 +304,8 @@ def synthesize(
         the pixels already in place (left and top strips) and the same strips at *every* position
         of the texture, and pasted over them (Fig. 2b). ``mincut``: as ``overlap``, then pasted only
         on its side of the minimum-error boundary cut through the overlap (Fig. 2c, :mod:`core.seams`).
-    tol : int, default 2
-        Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD positions (Ngo's ``tol``; 1 =
+    tol : int, optional
+        Default (None) 2. Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD positions (Ngo's ``tol``; 1 =
         always the best). 2 keeps seams nearly invisible yet uses the whole sample (brick 128² ->
         512², block 32/6, mincut: coherence 0.024, completeness 0.011; a pure best match repeats).
     rule : {"tol", "epsilon", "sampled"}, default "tol"
@@ -429,7 +429,7 @@ def transfer(
     correspondence: str = "blur",
     source_map: np.ndarray | None = None,
     target_map: np.ndarray | None = None,
-    tol: int = 1,
+    tol: int | None = None,
     rule: str = "tol",
     epsilon: float = 0.1,
     remap: bool = True,
@@ -479,8 +479,8 @@ def transfer(
         0.30 against 0.21 with remapping, fidelity 0.99 against 0.98). ``False`` is the papers'
         behaviour.
     tol, rule, epsilon
-        Position rule as in :func:`synthesize`; transfer takes the best (tol = 1, Ngo), the first
-        block being the best correspondence.
+        Position rule as in :func:`synthesize`; transfer takes the best (tol None means 1, Ngo), the
+        first block being the best correspondence.
     tile, poisson, band
         As in :func:`synthesize` (a tileable transfer wraps the texture seamlessly; the target is
         not periodic, so its picture may not continue across the wrap).
