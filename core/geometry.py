@@ -344,6 +344,18 @@ class LineDraft:
                 "frontal_lines": [list(x) for x in self.frontal_lines], "frontal_size": list(self.frontal_size)}
 
     @classmethod
+    def from_json(cls, data: Any, name: str = "lines") -> "LineDraft":
+        """From a session's ``{image_lines, frontal_lines, frontal_size}`` (pairs may be unfinished;
+        ``frontal_size`` defaults to 512x512); the line and size checks are :class:`FeatureLines`'."""
+        if not isinstance(data, Mapping):
+            raise GeometryError(f"{name} must be an object {{image_lines, frontal_lines, frontal_size}}")
+        drafts = []
+        for key in ("image_lines", "frontal_lines"):
+            value = data.get(key, [])
+            drafts.append(tuple(map(tuple, as_lines(value, key).tolist())) if len(value) else ())
+        return cls(drafts[0], drafts[1], as_size(data.get("frontal_size", [512, 512]), "frontal_size"))
+
+    @classmethod
     def of(cls, lines: FeatureLines) -> "LineDraft":
         return cls(tuple(map(tuple, lines.image_lines.tolist())), tuple(map(tuple, lines.frontal_lines.tolist())),
                    lines.frontal_size)

@@ -12,14 +12,13 @@ each is given to every method with a geometry of that kind.
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 from typing import Any
 
 from . import registry
 from .errors import WeftError
-from .geometry import LINES, MAX_SIDE, SQUARE, LineDraft, Square
+from .geometry import LINES, SQUARE, LineDraft, Square
 from .jsonio import read_json_file
 from .studio import Geometry
 
@@ -28,7 +27,6 @@ LEGACY_SQUARE, LEGACY_LINES = "prototype", "lines"  # the version-1 keys of the 
 
 
 MAX_SEED = 2**31 - 1  # the studio's seed box
-FRONTAL_SIDES = (2, MAX_SIDE)  # what a feature-lines file may give (core.rectify)
 
 
 def read_session(path: str | Path) -> dict:
@@ -66,16 +64,13 @@ def _session_from_data(data: Any, base: Path) -> dict:
             raise WeftError(f"input {name!r} = {value!r} is not a file path")
         inputs[name] = value if os.path.isabs(value) else str(base / value)
     proto = data.get(LEGACY_SQUARE)
-    if proto is not None and (not isinstance(proto, list) or len(proto) != 3 or not _ints(proto, 0)
-                              or proto[2] < 1):
-        raise WeftError(f"{LEGACY_SQUARE} = {proto!r} must be [x, y, side] in pixels, or null")
-    lines = _get(data, LEGACY_LINES, dict, "an object {image_lines, frontal_lines, frontal_size}", {})
-    image_lines = _lines(lines, "image_lines")
-    frontal_lines = _lines(lines, "frontal_lines")
-    lo, hi = FRONTAL_SIDES
-    frontal_size = lines.get("frontal_size", [512, 512])
-    if not isinstance(frontal_size, list) or len(frontal_size) != 2 or not _ints(frontal_size, lo, hi):
-        raise WeftError(f"frontal_size = {frontal_size!r} must be [width, height], each {lo}..{hi}")
+    if proto is not None:
+        try:
+            proto = Square.from_json(proto, LEGACY_SQUARE)
+        except WeftError:
+            raise WeftError(f"{LEGACY_SQUARE} = {proto!r} must be [x, y, side] in pixels, or null") from None
+    lines = LineDraft.from_json(_get(data, LEGACY_LINES, dict, "an object {image_lines, frontal_lines, frontal_size}",
+                                     {}), LEGACY_LINES)
     seed = data.get("seed", 1)
     if not _ints([seed], 0, MAX_SEED):
         raise WeftError(f"seed = {seed!r} must be an integer in 0..{MAX_SEED}")
@@ -87,10 +82,9 @@ def _session_from_data(data: Any, base: Path) -> dict:
             continue
         for g in method.studio.geometry:
             if g.kind == SQUARE and proto is not None:
-                geometry.setdefault(name, {})[g.key] = Square(*proto)
-            elif g.kind == LINES and (image_lines or frontal_lines):
-                geometry.setdefault(name, {})[g.key] = LineDraft(tuple(map(tuple, image_lines)),
-                                                                 tuple(map(tuple, frontal_lines)), tuple(frontal_size))
+                geometry.setdefault(name, {})[g.key] = proto
+            elif g.kind == LINES and (lines.image_lines or lines.frontal_lines):
+                geometry.setdefault(name, {})[g.key] = lines
     for name, values in _get(data, "geometry", dict, "an object of method name -> geometry", {}).items():
         method = methods.get(name)
         if method is None or method.studio is None:
@@ -118,14 +112,7 @@ def _geometry_from_json(g: Geometry, value: Any):
             return Square.from_json(value, g.key)
         except WeftError:
             raise WeftError(f"{g.key} = {value!r} must be [x, y, side] in pixels, or null") from None
-    if not isinstance(value, dict):
-        raise WeftError(f"{g.key} must be an object {{image_lines, frontal_lines, frontal_size}}")
-    lo, hi = FRONTAL_SIDES
-    size = value.get("frontal_size", [512, 512])
-    if not isinstance(size, list) or len(size) != 2 or not _ints(size, lo, hi):
-        raise WeftError(f"frontal_size = {size!r} must be [width, height], each {lo}..{hi}")
-    return LineDraft(tuple(map(tuple, _lines(value, "image_lines"))), tuple(map(tuple, _lines(value, "frontal_lines"))),
-                     tuple(size))
+    return LineDraft.from_json(value, g.key)
 
 
 def _get(data: dict, key: str, kind: type, what: str, default):
@@ -140,13 +127,3 @@ def _get(data: dict, key: str, kind: type, what: str, default):
 def _ints(values, lo: int, hi: int | None = None) -> bool:
     return all(isinstance(v, int) and not isinstance(v, bool) and lo <= v and (hi is None or v <= hi)
                for v in values)
-
-
-def _lines(lines: dict, key: str) -> list[list[float]]:
-    value = lines.get(key, [])
-    if (not isinstance(value, list)
-            or not all(isinstance(ln, list) and len(ln) == 4
-                       and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in ln)
-                       for ln in value)):
-        raise WeftError(f"{key} must be a list of [x1, y1, x2, y2] in pixels")
-    return [[float(v) for v in ln] for ln in value]

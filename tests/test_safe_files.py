@@ -432,7 +432,7 @@ def test_bad_session_files_are_refused_in_one_line(tmp_path, sentinel):
     ({"prototype": {"x": 1}}, "prototype = {'x': 1} must be [x, y, side]"),
     ({"lines": [1]}, "lines must be an object"),
     ({"lines": {"image_lines": "abc"}}, "image_lines must be a list of [x1, y1, x2, y2]"),
-    ({"lines": {"frontal_lines": [[1, 2, 3]]}}, "frontal_lines must be a list of [x1, y1, x2, y2]"),
+    ({"lines": {"frontal_lines": [[1, 2, 3]]}}, "frontal_lines[0] = [1, 2, 3] must be [x1, y1, x2, y2]"),
     ({"lines": {"frontal_size": [0]}}, "frontal_size = [0] must be [width, height]"),
     ({"seed": -1}, "seed = -1 must be an integer in 0..2147483647"),
     ({"seed": 2**40}, f"seed = {2**40} must be an integer in 0..2147483647"),

@@ -121,7 +121,7 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
         "inputs_list": (field(inputs=["tex.png"]), "inputs must be an object"),
         "prototype_outside": (field(prototype=[100, 100, 16]), "leaves the texture (24x24)"),
         "bad_lines": (field(lines={"image_lines": [[1]], "frontal_lines": [], "frontal_size": [64, 64]}),
-                      "image_lines must be a list"),
+                      "image_lines[0] = [1] must be [x1, y1, x2, y2]"),
         "huge_seed": (field(seed=2**40), "seed = 1099511627776 must be an integer"),
         "not_a_studio_method": (field(method="blend"), "the studio does not offer method 'blend'"),
     }
