@@ -412,7 +412,7 @@ class MainWindow(QMainWindow):
     # --- results ---------------------------------------------------------------------------------
     def _on_shown(self, shown) -> None:
         self.result_view.set_image(shown.image)
-        if shown.before is not None:
+        if shown.before is not None and shown.before is not self.result_view.compare_image:
             self.result_view.set_compare(shown.before)  # the input of this result, not of the panel
         self.statusBar().showMessage(describe(shown))
 
