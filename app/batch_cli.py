@@ -93,7 +93,7 @@ class _BatchBar:
 
 
 def run_batch(args: argparse.Namespace) -> int:
-    from app.cli import _parse_bit_depth, _parse_int
+    from app.options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
     from core import batch
     from core.errors import WeftError
 

@@ -28,6 +28,8 @@ from core import __version__
 from core.errors import Cancelled, WeftError
 from core.params import Params, specs
 
+from .options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
+
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
 
@@ -216,27 +218,6 @@ def _check_output(output: str, inputs: Sequence[str]) -> Path:
         if os.path.realpath(src) == real_out:
             raise WeftError(f"{output}: refusing to overwrite the input file {src}")
     return out
-
-
-def _parse_int(text: str | None, name: str, lo: int, hi: int) -> int | None:
-    if text is None:
-        return None
-    from core.params import out_of_range
-
-    try:
-        value = int(text)
-    except ValueError:
-        raise WeftError(f"parameter '{name}' = {text!r} must be an integer") from None
-    if not lo <= value <= hi:
-        raise out_of_range(name, value, lo, hi)
-    return value
-
-
-def _parse_bit_depth(args: argparse.Namespace) -> int:
-    bit_depth = _parse_int(args.bit_depth, "bit-depth", 8, 16)
-    if bit_depth not in (8, 16):
-        raise WeftError(f"parameter 'bit-depth' = {bit_depth} must be 8 or 16")
-    return bit_depth
 
 
 def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,

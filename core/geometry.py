@@ -242,8 +242,7 @@ class FeatureLines:
             raise GeometryError(f"{len(img)} image_lines but {len(fro)} frontal_lines: line i of the photo "
                                 f"must match line i of the frontal frame")
         size = as_size(frontal_size, "frontal_size")
-        img.setflags(write=False)
-        fro.setflags(write=False)
+        # (the arrays stay writeable: numba compiles a second signature of every kernel for read-only ones)
         object.__setattr__(self, "image_lines", img)
         object.__setattr__(self, "frontal_lines", fro)
         object.__setattr__(self, "frontal_size", size)
