@@ -34,7 +34,6 @@ from PySide6.QtWidgets import (
     QSplitter,
 )
 
-from core import registry
 from core.errors import WeftError
 from core.examples import example, examples
 from core.image import load_image
