@@ -36,7 +36,12 @@ def prepare_inputs(case: Case) -> dict[str, np.ndarray]:
     """Decode, crop, resize and (optionally) grey each input of ``case``."""
     out = {}
     for name, spec in case.inputs.items():
-        img = load_image(example(spec.example)).image
+        if spec.example.startswith("skimage:"):  # the peers' inputs, rebuilt from scikit-image's data
+            from skimage import data
+
+            img = np.asarray(getattr(data, spec.example.split(":", 1)[1])(), dtype=np.float32) / 255.0
+        else:
+            img = load_image(example(spec.example)).image
         if spec.crop is not None:
             x, y, w, h = spec.crop
             img = img[y:y + h, x:x + w]
@@ -195,6 +200,11 @@ _COLUMNS = [
     ("coherence", "coherence", "{:.4f}"),
     ("completeness", "completeness", "{:.4f}"),
     ("fidelity", "fidelity", "{:.3f}"),
+    ("coherence_median", "coherence median", "{:.4f}"),
+    ("coherence_max", "coherence max", "{:.4f}"),
+    ("completeness_median", "completeness median", "{:.4f}"),
+    ("completeness_max", "completeness max", "{:.4f}"),
+    ("verbatim_max", "largest verbatim (max)", "{:.3f}"),
     ("snr_db", "SNR dB", "{:.2f}"),
     ("psnr_db", "PSNR dB", "{:.2f}"),
     ("psnr_cubic_db", "cubic PSNR dB", "{:.2f}"),

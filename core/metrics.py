@@ -7,6 +7,9 @@
 * :func:`fidelity` -- does the output follow the target's large-scale luminance (texture transfer)?
   (Pearson correlation of blurred luminances, 1 is perfect).
 * :func:`snr_db` -- signal-to-noise ratio of a reconstruction against its original, in decibels.
+* :func:`verbatim_fraction` -- the largest region of an output copied verbatim from its sample
+  (connected pixels sharing one source offset, from the method's record of where each pixel came
+  from), as a fraction of the sample's area (low is good: a large region is a visible strip).
 
 Coherence and completeness are the two halves of the bidirectional similarity of Simakov et al.
 (CVPR 2008), measured on 7x7 luminance patches with exact nearest neighbours. The search is a
@@ -27,7 +30,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from .errors import ImageError, InvalidParameter
 from .image import luminance, validate_image
 
-__all__ = ["coherence", "completeness", "fidelity", "psnr_db", "snr_db"]
+__all__ = ["coherence", "completeness", "fidelity", "psnr_db", "snr_db", "verbatim_fraction", "verbatim_region"]
 
 MIN_SIDE = 7
 # Upper bound on the float32 distance block held at once by the nearest-neighbour search
@@ -322,3 +325,68 @@ def psnr_db(orig, synth) -> float:
         raise ImageError(f"original image has shape {orig.shape} but synthesized image has {synth.shape}")
     mse = float(np.mean((orig.astype(np.float64) - synth.astype(np.float64)) ** 2))
     return math.inf if mse == 0.0 else -10.0 * math.log10(mse)
+
+
+def verbatim_region(sources) -> int:
+    """Pixels of the largest region of an output copied verbatim from its sample.
+
+    ``sources`` (H, W, 2) integers give, for every output pixel (y, x), the sample pixel
+    (sy, sx) it was copied from, or a negative value where the pixel is not a copy (not made yet,
+    blended). A verbatim region is a 4-connected set of copied pixels sharing one offset
+    ``(sy - y, sx - x)``: a piece of the sample pasted as it is, whatever the blocks it was pasted
+    in. Returns its pixel count (0 when nothing is a copy).
+
+    Raises
+    ------
+    ImageError
+        If ``sources`` is not an (H, W, 2) integer array.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    src = np.asarray(sources)
+    if src.ndim != 3 or src.shape[2] != 2 or not np.issubdtype(src.dtype, np.integer):
+        raise ImageError(f"source map has shape {src.shape} and type {src.dtype}; it must be (H, W, 2) integers")
+    h, w = src.shape[:2]
+    if h == 0 or w == 0:
+        return 0
+    valid = (src[..., 0] >= 0) & (src[..., 1] >= 0)
+    if not valid.any():
+        return 0
+    yy, xx = np.mgrid[0:h, 0:w]
+    dy = src[..., 0].astype(np.int64) - yy
+    dx = src[..., 1].astype(np.int64) - xx
+    index = np.arange(h * w).reshape(h, w)
+    rows, cols = [], []
+    # an edge between 4-neighbours that are both copies with the same offset
+    for a, b in (((slice(None), slice(None, -1)), (slice(None), slice(1, None))),
+                 ((slice(None, -1), slice(None)), (slice(1, None), slice(None)))):
+        same = valid[a] & valid[b] & (dy[a] == dy[b]) & (dx[a] == dx[b])
+        rows.append(index[a][same])
+        cols.append(index[b][same])
+    r = np.concatenate(rows)
+    c = np.concatenate(cols)
+    graph = coo_matrix((np.ones(r.size, dtype=np.int8), (r, c)), shape=(h * w, h * w))
+    _, labels = connected_components(graph, directed=False)
+    counts = np.bincount(labels[valid.ravel()])
+    return int(counts.max())
+
+
+def verbatim_fraction(sources, sample_shape) -> float:
+    """The largest verbatim region of an output (:func:`verbatim_region`) as a fraction of the
+    sample's area ``sample_shape[0] * sample_shape[1]`` (lower is better).
+
+    Quilting copies blocks, so every output has verbatim regions of about a block; a fraction near
+    the block's share of the sample is the floor. When a method keeps choosing the continuation of
+    its neighbour's source position, one region grows across blocks into a strip of the sample
+    (1.0: as large as the whole sample).
+
+    Raises
+    ------
+    ImageError
+        If ``sources`` is not an (H, W, 2) integer array or ``sample_shape`` has no area.
+    """
+    sh, sw = int(sample_shape[0]), int(sample_shape[1])
+    if sh <= 0 or sw <= 0:
+        raise ImageError(f"sample shape {tuple(sample_shape)} has no area")
+    return verbatim_region(sources) / float(sh * sw)

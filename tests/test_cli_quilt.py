@@ -44,6 +44,7 @@ def test_mincut_synthesis_tileable_poisson(files, tmp_path, capsys):
     assert code == 0, err
     report = json.loads(out)
     assert report["size"] == [100, 90] and report["blocks"] == 7 * 6
+    assert 0 < report["verbatim_fraction"] < 1
     assert load_image(out_path).image.shape == (90, 100)
     recipe = json.loads(read_recipe(out_path))
     assert recipe["params"]["tile"] is True and recipe["params"]["mode"] == "mincut"

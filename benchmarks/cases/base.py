@@ -1,7 +1,8 @@
 """What a benchmark case is. The cases themselves live in one module per method beside this one.
 
 An input is ``Input(example, crop=(x, y, w, h) | None, resize=(w, h) | None, grey=False)`` over a
-bundled example of ``resources/``. ``metrics`` names the figures of ``core.metrics`` to compute on
+bundled example of ``resources/``, or over ``skimage.data``'s image NAME with ``example="skimage:NAME"``
+(the peers' inputs, rebuilt exactly). ``metrics`` names the figures of ``core.metrics`` to compute on
 the output: ``coherence`` / ``completeness`` against the ``texture`` input, ``fidelity`` against the
 ``target`` input, ``snr_db`` against the ``texture`` input. ``gmic`` is a G'MIC command line run on
 the texture input in the same run (whole process against whole ``weft`` process) when ``gmic`` is

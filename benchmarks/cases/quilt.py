@@ -1,9 +1,40 @@
-"""Benchmark cases of image quilting (``core.quilting``)."""
+"""Benchmark cases of image quilting (``core.quilting``).
+
+The ``quilt-t1-*`` and ``quilt-t2-*`` cases use the peers' own inputs (issue 17), rebuilt from
+scikit-image's data: ``brick_128`` = ``brick()[0:256, 256:512]`` box-downscaled 2x, ``gravel_128``
+= ``gravel()[0:256, 0:256]`` box-downscaled 2x, ``camera_256`` = ``camera()`` box-downscaled 2x.
+T1 is a 512x512 synthesis from brick_128 with the defaults, measured over seeds 0-9; T2 renders
+camera_256 in gravel_128 (one point of weft's quality front each, see ``docs/quality_front.py``).
+"""
+
+import statistics
 
 from .base import Case, Input
 
 BRICK = Input("brick", crop=(0, 0, 128, 128))
 GRAVEL = Input("gravel", crop=(0, 0, 128, 128))
+PEER_BRICK = Input("skimage:brick", crop=(256, 0, 256, 256), resize=(128, 128))
+PEER_GRAVEL = Input("skimage:gravel", crop=(0, 0, 256, 256), resize=(128, 128))
+PEER_CAMERA = Input("skimage:camera", resize=(256, 256))
+T1_SEEDS = range(10)
+
+
+def t1_over_seeds(inputs, out, seeds=T1_SEEDS, size=(512, 512)) -> dict[str, float]:
+    """T1's figures over ``seeds``: the median and worst coherence and completeness, and the
+    largest verbatim region (``core.metrics.verbatim_fraction``) of any seed."""
+    from core.metrics import coherence, completeness
+    from core.quilting import METHOD, QuiltParams
+
+    tex = inputs["texture"]
+    coh, comp, verb = [], [], []
+    for s in seeds:
+        res = METHOD.run({"texture": tex}, QuiltParams(size=size), rng=s)
+        coh.append(coherence(res.image, tex))
+        comp.append(completeness(res.image, tex))
+        verb.append(res.figures["verbatim_fraction"])
+    return {"coherence_median": statistics.median(coh), "coherence_max": max(coh),
+            "completeness_median": statistics.median(comp), "completeness_max": max(comp),
+            "verbatim_max": max(verb)}
 
 CASES: list[Case] = [
     Case(
@@ -51,5 +82,25 @@ CASES: list[Case] = [
         params={"block": 9, "overlap": 3, "alpha": 0.1, "iterations": 3},
         metrics=("fidelity", "coherence"),
         note="camera 256x256 in gravel 128x128, block 9 / overlap 3, alpha 0.1, 3 iterations",
+    ),
+    Case(
+        name="quilt-t1-brick",
+        method="quilt",
+        inputs={"texture": PEER_BRICK},
+        params={"size": (512, 512)},
+        metrics=("coherence", "completeness"),
+        figures=t1_over_seeds,
+        quick={"size": (256, 256)},
+        note="T1: 512x512 from brick_128 with the defaults; figures of seed 1, and median/max over seeds 0-9 "
+             "(peers: Texturize 0.027/0.015, G'MIC 0.037/0.021, numpy quilting 0.027/0.046)",
+    ),
+    Case(
+        name="quilt-t2-front-a",
+        method="quilt",
+        inputs={"texture": PEER_GRAVEL, "target": PEER_CAMERA},
+        params={"block": 9, "overlap": 3, "alpha": 0.1, "iterations": 3},
+        metrics=("fidelity", "coherence"),
+        quick={"iterations": 1},
+        note="T2: camera_256 in gravel_128, block 9 / overlap 3, alpha 0.1, 3 iterations",
     ),
 ]

@@ -26,6 +26,12 @@ RULES = ("tol", "epsilon", "sampled")
 # than the numpy step (~0.3 ms a block) there. Both engines give the same pixels.
 NUMPY_ENGINE_MAX_BLOCKS = 1024
 STATIC_AHEAD = True  # transfer: static terms one row ahead on a second thread
+#: Synthesis never takes a source position within this many pixels of the continuation of a
+#: neighbouring block's piece of the sample, across the seam (see ``_forbid_continuations``); -1: off.
+AVOID_RADIUS = 8
+#: The cross-correlation written at a forbidden position: its SSD becomes ~2e30, so every rule ranks
+#: it behind every allowed position (and still picks among them when nothing else is left).
+_FORBIDDEN_CROSS = np.float32(-1e30)
 
 
 @dataclass(frozen=True)
@@ -43,6 +49,7 @@ class _Pass:
     w_prev: float = 0.0
     w_corr: float = 0.0
     engine: str = "auto"  # "auto", "numba" or "numpy" (tests compare the two)
+    avoid: int | None = None  # radius of _forbid_continuations, -1 off; None: AVOID_RADIUS for synthesis, off for transfer
 
 
 def _grid(n: int, block: int, overlap: int, tile: bool) -> tuple[list[int], list[int], list[int], int]:
@@ -64,6 +71,76 @@ def _grid(n: int, block: int, overlap: int, tile: bool) -> tuple[list[int], list
     starts = [j * step for j in range(k)]
     before = [0] + [overlap] * (k - 1)
     return starts, before, [0] * k, max(block, starts[-1] + block)
+
+
+def _forbid_continuations(cross: np.ndarray, ph: int, pw: int, y0: int, x0: int,
+                          neighbours: list[tuple[int, int, int, int]], radius: int) -> None:
+    """Forbid the source positions that would continue a neighbouring block's piece of the sample.
+
+    A block whose neighbour (at canvas (ny, nx)) came from source (nsy, nsx) matches that
+    neighbour's overlap exactly at ``(nsy + y0 - ny, nsx + x0 - nx)``: the sample continued as it
+    is (SSD 0 over that overlap, so the tol 2 rule takes it one time in two, and runs of it are
+    verbatim copies of the sample several blocks long). Nearby positions are the same strip to the
+    eye, and so is the same band of the sample shifted along the seam: on brick_128 a chain of
+    blocks down the first column kept coming from the sample's few columns of long bricks without
+    mortar joints (each one matching the joint-free overlap above it best), an 80-pixel strip.
+    So, with ``_FORBIDDEN_CROSS`` written into ``cross`` (every rule then ranks those last):
+
+    * the neighbour above (or below, wrapped): every position within ``radius`` columns of the
+      continuation's column, at any row -- the block does not come from the same band of columns;
+    * the neighbour on the left (or right, wrapped): every position within ``radius`` rows of the
+      continuation's row, at any column;
+    * a diagonal neighbour (the overlaps' corners): the positions within ``radius`` pixels
+      (Chebyshev) of the continuation.
+
+    A verbatim region is thus at most about one block (plus what the cut leaves of it), and no
+    strip of the sample runs across several blocks. ``radius`` 0 forbids the exact continuation
+    (and its row or column) only.
+    """
+    for nsy, nsx, ny, nx in neighbours:
+        cy, cx = nsy + y0 - ny, nsx + x0 - nx
+        ya, yb = max(cy - radius, 0), min(cy + radius + 1, ph)
+        xa, xb = max(cx - radius, 0), min(cx + radius + 1, pw)
+        if nx == x0:  # above or below: the same source columns, at any row
+            ya, yb = 0, ph
+        elif ny == y0:  # left or right: the same source rows, at any column
+            xa, xb = 0, pw
+        if ya < yb and xa < xb:
+            cross[ya:yb, xa:xb] = _FORBIDDEN_CROSS
+
+
+def _neighbours(chosen: np.ndarray, i: int, j: int, ys: list[int], xs: list[int], hc: int, wc: int,
+                tile: bool) -> list[tuple[int, int, int, int]]:
+    """(source y, source x, canvas y, canvas x) of the blocks already placed that overlap block (i, j)."""
+    rows, cols = chosen.shape[:2]
+    cand = [(i, j - 1, 0, 0), (i - 1, j, 0, 0), (i - 1, j - 1, 0, 0), (i - 1, j + 1, 0, 0)]
+    if tile:  # the last column and row overlap the first ones, placed one canvas width/height further
+        if j == cols - 1:
+            cand += [(i, 0, 0, wc), (i - 1, 0, 0, wc)]
+        if i == rows - 1:
+            cand += [(0, j, hc, 0), (0, j - 1, hc, 0), (0, j + 1, hc, 0)]
+    out = []
+    for ni, nj, oy, ox in cand:
+        if 0 <= ni < rows and 0 <= nj < cols and chosen[ni, nj, 0] >= 0 and (ni, nj) != (i, j):
+            out.append((int(chosen[ni, nj, 0]), int(chosen[ni, nj, 1]), ys[ni] + oy, xs[nj] + ox))
+    return out
+
+
+def _record(sources: np.ndarray, y0: int, x0: int, sy: int, sx: int, b: int, mask: np.ndarray | None) -> None:
+    """Write the source coordinates of the pixels a block pasted (all, or where ``mask``) into ``sources``."""
+    hc, wc = sources.shape[:2]
+    ar = np.arange(b)
+    iy, ix = np.ix_((y0 + ar) % hc, (x0 + ar) % wc)
+    sub = sources[iy, ix]
+    new_y = np.broadcast_to((sy + ar)[:, None], (b, b))
+    new_x = np.broadcast_to((sx + ar)[None, :], (b, b))
+    if mask is None:
+        sub[..., 0], sub[..., 1] = new_y, new_x
+    else:
+        m = mask.astype(bool)
+        sub[..., 0][m] = new_y[m]
+        sub[..., 1][m] = new_x[m]
+    sources[iy, ix] = sub
 
 
 # --------------------------------------------------------------------------------------------
@@ -135,8 +212,13 @@ class _Source:
 def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.random.Generator, *,
                 prev: np.ndarray | None = None, corr: tuple[np.ndarray, np.ndarray] | None = None,
                 report: ProgressReporter | None = None, cancel: CancelToken | None = None,
-                channels_out: int = 3) -> tuple[np.ndarray, int]:
-    """One pass of quilting; returns the (out_h, out_w, C) image and the number of blocks."""
+                channels_out: int = 3, record: dict | None = None) -> tuple[np.ndarray, int]:
+    """One pass of quilting; returns the (out_h, out_w, C) image and the number of blocks.
+
+    With ``record`` (a dict), ``record["sources"]`` is set to the (out_h, out_w, 2) int32 source
+    coordinates each output pixel was copied from (-1 where none), for
+    ``core.metrics.verbatim_fraction``; a Poisson band's pixels count as copied.
+    """
     import cv2
 
     b = p.block
@@ -151,6 +233,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
         img = canvas[:out_h, :out_w]
         return (img[..., 0] if channels_out == 1 else img).copy()
 
+    sources = np.full((hc, wc, 2), -1, dtype=np.int32) if record is not None else None
+
     if p.mode == "random":
         # One draw of all positions up front: the picture depends on the seed only.
         sy = rng.integers(0, th - b + 1, size=(rows, cols))
@@ -164,8 +248,13 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                 x0 = xs[j]
                 bw = min(b, wc - x0)
                 canvas[y0:y0 + bh, x0:x0 + bw] = tex[sy[i, j]:sy[i, j] + bh, sx[i, j]:sx[i, j] + bw]
+                if sources is not None:
+                    sources[y0:y0 + bh, x0:x0 + bw, 0] = (sy[i, j] + np.arange(bh))[:, None]
+                    sources[y0:y0 + bh, x0:x0 + bw, 1] = (sx[i, j] + np.arange(bw))[None, :]
             if report is not None:
                 report.update(i + 1, preview=preview)
+        if record is not None:
+            record["sources"] = sources[:out_h, :out_w].copy()
         return canvas[:out_h, :out_w], rows * cols
 
     import sys
@@ -209,6 +298,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     us = rng.random((rows, cols))
     seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
     first = (int(rng.integers(0, src.ph)), int(rng.integers(0, src.pw)))
+    avoid = p.avoid if p.avoid is not None else (AVOID_RADIUS if prev is None and corr is None else -1)
+    chosen = np.full((rows, cols, 2), -1, dtype=np.int64)  # each block's source position
     ip = np.zeros(_K.N_IPARAMS, dtype=np.int64)
     ip[_K.P_B] = b
     ip[_K.P_WRAP] = int(p.tile)
@@ -282,6 +373,9 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                                 cv2.mulSpectrums(spectra[c], fwd, 0, c=part, conjB=True)
                                 spec = np.add(spec, part, out=acc)
                     cross = cv2.idft(spec, dst=cross_buf, flags=flags)
+                    if avoid >= 0:
+                        _forbid_continuations(cross, src.ph, src.pw, y0, x0,
+                                              _neighbours(chosen, i, j, ys, xs, hc, wc, wrap), avoid)
                     sq = src.sq((top, left, right, bottom), p)
                     ip[_K.P_SY], ip[_K.P_SX] = divmod(int(choose(cross, sq, float(const), cost_buf, us[i, j],
                                                                  seeds[i, j])), src.pw)
@@ -291,6 +385,10 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                     error(canvas, filled, tex, ip, err)
                     cut(err, top, left, right, bottom, mask)
                 place(canvas, filled, tex, ip, mask, win, label, old)
+                chosen[i, j] = ip[_K.P_SY], ip[_K.P_SX]
+                if sources is not None:
+                    _record(sources, y0, x0, int(ip[_K.P_SY]), int(ip[_K.P_SX]), b,
+                            mask if mincut and overlaps else None)
                 if blend is not None and p.poisson:
                     blend(canvas, old, label, win, p.band)
             if report is not None:
@@ -298,6 +396,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     finally:
         if static_rows is not None:
             static_rows.shutdown(wait=True, cancel_futures=True)
+    if record is not None:
+        record["sources"] = sources[:out_h, :out_w].copy()
     return canvas[:out_h, :out_w], rows * cols
 
 
@@ -440,7 +540,8 @@ def _place_block_numpy(canvas, filled, tex, ip, *work):
     (same pixels).
 
     ``work`` are the kernel's work buffers; numpy makes its own arrays (this engine only runs small
-    jobs, where reuse does not matter).
+    jobs, where reuse does not matter), except that the cut is written into ``work[0]`` (the mask),
+    as the numba engine's ``cut_mask`` leaves it there for the record of source positions.
     """
     hc, wc, nc = canvas.shape
     b = int(ip[_K.P_B])
@@ -460,6 +561,8 @@ def _place_block_numpy(canvas, filled, tex, ip, *work):
         strips[b - bottom:] = True
         err[~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
         mask = _cut_mask_numpy(err, top, left, right, bottom)
+        if work:
+            work[0][...] = mask
         merged = np.where(mask[..., None], block, old)
         canvas[np.ix_(iy, ix)] = merged
         f = filled[np.ix_(iy, ix)]

@@ -284,6 +284,7 @@ def synthesize(
     rng: None | int | np.random.Generator = None,
     progress: Callable[[Progress], None] | None = None,
     cancel: CancelToken | None = None,
+    record: dict | None = None,
 ) -> np.ndarray:
     """Synthesize a texture of ``size`` from the sample ``texture`` by quilting blocks (E&F §2).
 
@@ -331,6 +332,9 @@ def synthesize(
     progress, cancel
         Progress callback (called once per block row, with the partial image as preview) and
         cancel token (checked once per block row).
+    record : dict, optional
+        Receives ``"sources"``: the (height, width, 2) int32 sample coordinates each output pixel
+        was copied from (-1 where none), for :func:`core.metrics.verbatim_fraction`.
 
     Returns
     -------
@@ -345,10 +349,11 @@ def synthesize(
     """
     params = QuiltParams(mode=mode, block=block, overlap=overlap, size=size, tol=tol, rule=rule,
                          epsilon=epsilon, tile=tile, poisson=poisson, band=band)
-    return _synthesize(texture, params, rng=rng, progress=progress, cancel=cancel)
+    return _synthesize(texture, params, rng=rng, progress=progress, cancel=cancel, record=record)
 
 
-def _synthesize(texture: np.ndarray, params: QuiltParams, *, rng=None, progress=None, cancel=None) -> np.ndarray:
+def _synthesize(texture: np.ndarray, params: QuiltParams, *, rng=None, progress=None, cancel=None,
+                record: dict | None = None) -> np.ndarray:
     """:func:`synthesize` with its options in ``params`` (``None`` block and tol: the synthesis defaults)."""
     if params.block is None or params.tol is None:
         params = params.replace(block=params.block or SYNTH_BLOCK, tol=params.tol or SYNTH_TOL)
@@ -377,7 +382,8 @@ def _synthesize(texture: np.ndarray, params: QuiltParams, *, rng=None, progress=
     report = ProgressReporter(progress, "quilting", rows)
     if params.mode == "random":
         p = _Pass("random", b, 0, "tol", 1, 0.0, False, False, 1)
-    img, _ = _quilt_pass(tex, out_h, out_w, p, rng, report=report, cancel=cancel, channels_out=tex.shape[2])
+    img, _ = _quilt_pass(tex, out_h, out_w, p, rng, report=report, cancel=cancel, channels_out=tex.shape[2],
+                         record=record)
     return _finish(img, tex.shape[2])
 
 
@@ -558,14 +564,18 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
             raise out_of_range("iterations", params.iterations, 1, 1, "more passes need a target (--target)")
         mode = params.mode
         block = params.block or SYNTH_BLOCK
-        image = _synthesize(texture, params, rng=rng, progress=progress, cancel=cancel)
+        record: dict = {}
+        image = _synthesize(texture, params, rng=rng, progress=progress, cancel=cancel, record=record)
         h, w = image.shape[:2]
         if mode == "random":
             blocks = -(-h // block) * -(-w // block)
         else:
             ov = params.overlap if params.overlap is not None else max(1, -(-block // 6))
             blocks = _blocks(h, w, block, ov, params.tile)
-        return Result(image, {"blocks": blocks})
+        from ..metrics import verbatim_fraction
+
+        return Result(image, {"blocks": blocks,
+                              "verbatim_fraction": round(verbatim_fraction(record["sources"], texture.shape), 4)})
     if params.size is not None:
         raise InvalidParameter("parameter 'size' cannot be given with a target: the transfer has the target's size",
                                name="size", value=params.size)

@@ -267,3 +267,51 @@ def test_psnr_of_a_known_error():
     assert psnr_db(orig, orig) == math.inf
     with pytest.raises(ImageError, match="shape"):
         psnr_db(orig, orig[:8])
+
+
+# --------------------------------------------------------------------------------------------
+# verbatim regions
+
+
+def _copy_map(h, w, dy, dx):
+    yy, xx = np.mgrid[0:h, 0:w]
+    return np.stack([yy + dy, xx + dx], axis=2).astype(np.int32)
+
+
+def test_verbatim_region_of_one_offset_is_everything():
+    from core.metrics import verbatim_fraction, verbatim_region
+
+    src = _copy_map(20, 30, 3, 5)
+    assert verbatim_region(src) == 600
+    assert verbatim_fraction(src, (40, 30)) == 0.5
+
+
+def test_verbatim_regions_split_by_offset_and_by_connectivity():
+    from core.metrics import verbatim_region
+
+    src = _copy_map(10, 10, 0, 0)
+    src[:, 6:] = _copy_map(10, 10, 1, 0)[:, 6:]  # another offset on the right: 60 and 40 pixels
+    assert verbatim_region(src) == 60
+    src[:, 2] = -1  # a column that is not a copy cuts the left region into 20 and 30 pixels
+    assert verbatim_region(src) == 40
+    # the same offset in two places that do not touch is two regions
+    src = _copy_map(10, 10, 0, 0)
+    src[4:6] = _copy_map(10, 10, 2, 2)[4:6]
+    assert verbatim_region(src) == 40
+    # diagonal contact does not join (4-connectivity)
+    src = np.full((4, 4, 2), -1, np.int32)
+    src[0, 0] = (0, 0)
+    src[1, 1] = (1, 1)
+    assert verbatim_region(src) == 1
+
+
+def test_verbatim_region_of_nothing_copied_and_bad_maps():
+    from core.metrics import verbatim_fraction, verbatim_region
+
+    assert verbatim_region(np.full((5, 6, 2), -1, np.int32)) == 0
+    with pytest.raises(ImageError, match=r"source map has shape \(5, 6\) and type int32; it must be \(H, W, 2\) integers"):
+        verbatim_region(np.zeros((5, 6), np.int32))
+    with pytest.raises(ImageError, match="must be"):
+        verbatim_region(np.zeros((5, 6, 2), np.float32))
+    with pytest.raises(ImageError, match=r"sample shape \(0, 4\) has no area"):
+        verbatim_fraction(np.zeros((5, 6, 2), np.int32), (0, 4))
