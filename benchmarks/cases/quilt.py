@@ -95,12 +95,22 @@ CASES: list[Case] = [
              "(peers: Texturize 0.027/0.015, G'MIC 0.037/0.021, numpy quilting 0.027/0.046)",
     ),
     Case(
-        name="quilt-t2-front-a",
+        name="quilt-t2-block9",
         method="quilt",
         inputs={"texture": PEER_GRAVEL, "target": PEER_CAMERA},
         params={"block": 9, "overlap": 3, "alpha": 0.1, "iterations": 3},
         metrics=("fidelity", "coherence"),
         quick={"iterations": 1},
         note="T2: camera_256 in gravel_128, block 9 / overlap 3, alpha 0.1, 3 iterations",
+    ),
+    Case(
+        name="quilt-t2-block5",
+        method="quilt",
+        inputs={"texture": PEER_GRAVEL, "target": PEER_CAMERA},
+        params={"block": 5, "overlap": 2, "alpha": 0.1, "iterations": 3},
+        metrics=("fidelity", "coherence"),
+        quick={"iterations": 1},
+        note="T2: camera_256 in gravel_128, block 5 / overlap 2, alpha 0.1, 3 iterations "
+             "(beats numpy quilting 0.984/0.41, Ashikhmin 0.94/0.50 and G'MIC 0.54/0.35 on both)",
     ),
 ]

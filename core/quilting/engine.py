@@ -28,7 +28,7 @@ NUMPY_ENGINE_MAX_BLOCKS = 1024
 STATIC_AHEAD = True  # transfer: static terms one row ahead on a second thread
 #: Synthesis never takes a source position within this many pixels of the continuation of a
 #: neighbouring block's piece of the sample, across the seam (see ``_forbid_continuations``); -1: off.
-AVOID_RADIUS = 8
+AVOID_RADIUS = 4
 #: The cross-correlation written at a forbidden position: its SSD becomes ~2e30, so every rule ranks
 #: it behind every allowed position (and still picks among them when nothing else is left).
 _FORBIDDEN_CROSS = np.float32(-1e30)

@@ -134,9 +134,16 @@ def test_tileable_output_wraps_like_its_interior(brick):
     assert metrics.coherence(np.roll(plain, (40, 45), axis=(0, 1)), brick) > c_rolled
 
 
-def test_cut_and_poisson_band_lower_the_seam_and_leave_the_rest():
-    """Two blocks in a row (the second chosen alike in every mode): overwrite > cut > cut + Poisson."""
+def test_cut_and_poisson_band_lower_the_seam_and_leave_the_rest(monkeypatch):
+    """Two blocks in a row (the second chosen alike in every mode): overwrite > cut > cut + Poisson.
+
+    The seams of the blocks the seeds chose before the rule against continuations (issue 17) are
+    what is measured here, so the rule is off (the selection is not this test's subject)."""
     import cv2
+
+    import core.quilting.engine as engine
+
+    monkeypatch.setattr(engine, "AVOID_RADIUS", -1)
 
     rng = np.random.default_rng(5)
     tex = cv2.GaussianBlur(rng.random((64, 64)).astype(np.float32), (0, 0), 4)
@@ -313,9 +320,10 @@ def test_no_block_continues_its_neighbours_copy(brick64, monkeypatch):
     for seed in range(5):
         frac, out = run(seed)
         assert frac <= 0.07, seed
-        # quality bounds per seed (measured 0.062-0.075 / 0.022-0.031 with radius 8)
-        assert coherence(out, brick64) < 0.085, seed
-        assert completeness(out, brick64) < 0.035, seed
+        # quality bounds per seed (measured 0.063-0.082 / 0.022-0.027 with radius 4; without the
+        # rule 0.041-0.053 / 0.019-0.033)
+        assert coherence(out, brick64) < 0.09, seed
+        assert completeness(out, brick64) < 0.032, seed
     monkeypatch.setattr(engine, "AVOID_RADIUS", -1)
     assert max(run(seed)[0] for seed in range(5)) > 0.12
 
