@@ -164,8 +164,6 @@ def _refine(h0: np.ndarray, dst_pts, src_pts, dst_lines, src_lines, scale_px: fl
         return h0
     hn = hn / hn[2, 2]
     p0 = hn.ravel()[:8].copy()
-    if not np.all(np.isfinite(_residuals_and_jacobian(p0, dn, sn, ln, coef, jac=False)[0])):
-        return h0  # a point the start maps to infinity: nothing to refine from (the caller checks h0)
     fit = least_squares(lambda p: _residuals_and_jacobian(p, dn, sn, ln, coef, jac=False)[0], p0,
                         jac=lambda p: _residuals_and_jacobian(p, dn, sn, ln, coef)[1],
                         loss="linear" if scale_px >= 1e8 else loss, f_scale=scale_px * scale, method="trf",
