@@ -9,8 +9,8 @@ the source line. The fit minimises, in source pixels,
   points drawn in the two frames need not correspond, only the lines),
 
 with a Huber loss (quadratic up to 1 px, linear beyond) and then a Cauchy loss (scale 1 px, which
-all but ignores a badly drawn line), by ``scipy.optimize.least_squares`` on the 8 parameters of H in
-Hartley-normalised coordinates. The start is
+all but ignores a badly drawn line), by iteratively reweighted Levenberg-Marquardt on the 8
+parameters of H in Hartley-normalised coordinates. The start is
 OpenCV's ``findHomography`` on the points: RANSAC when there are 6 or more (so a badly placed line
 cannot drag the start), plain least squares otherwise.
 """
@@ -140,35 +140,64 @@ def _residuals_and_jacobian(h8: np.ndarray, dst_pts: np.ndarray, src_pts: np.nda
     return r, np.vstack([j_pts, j_lin])
 
 
-def _refine(h0: np.ndarray, dst_pts, src_pts, dst_lines, src_lines, scale_px: float,
-                  loss: str = "huber") -> np.ndarray:
-    """Refine H (8 parameters in Hartley-normalised coordinates) by ``scipy.optimize.least_squares``
-    (trust region reflective) with a robust ``loss``: ``"huber"`` (quadratic to ``scale_px`` source
-    pixels, then linear) or ``"cauchy"`` (``log(1 + (r / scale)^2)``); ``scale_px`` >= 1e8: plain
-    least squares."""
-    from scipy.optimize import least_squares
-
+def _refine(h0: np.ndarray, dst_pts, src_pts, dst_lines, src_lines, scale_px: float, loss: str = "huber") -> np.ndarray:
+    """Iteratively reweighted Levenberg-Marquardt of H in normalised coordinates, with a Huber
+    (quadratic to ``scale_px``, then linear) or Cauchy (``log(1 + (r / scale)^2)``) loss."""
     line_pts = np.vstack([dst_lines[:, :2], dst_lines[:, 2:]])
     everything_d = np.vstack([dst_pts, line_pts]) if len(dst_pts) else line_pts
     everything_s = np.vstack([src_pts, src_lines[:, :2], src_lines[:, 2:]])
     td, ts = _normaliser(everything_d), _normaliser(everything_s)
-    scale = ts[0, 0]
+    scale = ts[0, 0]  # normalised units per source pixel
     dn = apply_homography(td, dst_pts) if len(dst_pts) else dst_pts.reshape(0, 2)
     sn = apply_homography(ts, src_pts) if len(src_pts) else src_pts.reshape(0, 2)
     ln = apply_homography(td, line_pts)
     src_n = np.column_stack([apply_homography(ts, src_lines[:, :2]), apply_homography(ts, src_lines[:, 2:])])
     coef = _homogeneous_lines(src_n)
-    coef = np.vstack([coef, coef])
+    coef = np.vstack([coef, coef])  # one per end point, in the order of line_pts
     hn = ts @ h0 @ np.linalg.inv(td)
     if abs(hn[2, 2]) < 1e-12:
         return h0
     hn = hn / hn[2, 2]
-    p0 = hn.ravel()[:8].copy()
-    fit = least_squares(lambda p: _residuals_and_jacobian(p, dn, sn, ln, coef, jac=False)[0], p0,
-                        jac=lambda p: _residuals_and_jacobian(p, dn, sn, ln, coef)[1],
-                        loss="linear" if scale_px >= 1e8 else loss, f_scale=scale_px * scale, method="trf",
-                        x_scale="jac", max_nfev=20 * MAX_ITER)
-    hn = np.append(fit.x, 1.0).reshape(3, 3)
+    p = hn.ravel()[:8].copy()
+    delta = scale_px * scale
+    lam = 1e-3
+
+    def cost(r):
+        a = np.abs(r)
+        if loss == "cauchy":
+            return float((0.5 * delta * delta * np.log1p((a / delta) ** 2)).sum())
+        return float(np.where(a <= delta, 0.5 * r * r, delta * (a - 0.5 * delta)).sum())
+
+    def weights(a):
+        if loss == "cauchy":
+            return 1.0 / (1.0 + (a / delta) ** 2)
+        return np.where(a <= delta, 1.0, delta / np.maximum(a, 1e-300))
+
+    r, jm = _residuals_and_jacobian(p, dn, sn, ln, coef)
+    cur = cost(r)
+    for _ in range(MAX_ITER):
+        wts = weights(np.abs(r))
+        jw = jm * wts[:, None]
+        g = jw.T @ r
+        hess = jw.T @ jm
+        improved = False
+        for _ in range(8):
+            step = np.linalg.solve(hess + lam * np.diag(np.diag(hess) + 1e-12), -g)
+            pn = p + step
+            rn, _ = _residuals_and_jacobian(pn, dn, sn, ln, coef, jac=False)
+            cn = cost(rn)
+            if np.isfinite(cn) and cn <= cur:
+                improved = True
+                p, cur = pn, cn
+                lam = max(lam / 10, 1e-9)
+                break
+            lam *= 10
+        if not improved:
+            break
+        r, jm = _residuals_and_jacobian(p, dn, sn, ln, coef)
+        if np.abs(step).max() < 1e-10:
+            break
+    hn = np.append(p, 1.0).reshape(3, 3)
     return np.linalg.inv(ts) @ hn @ td
 
 
@@ -243,12 +272,11 @@ def fit_homography(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple
         h0 = homography_from_points(corr.dst, corr.src)
     if not np.all(np.isfinite(h0)) or abs(np.linalg.det(h0)) < 1e-300:
         raise GeometryError("the feature lines do not define a homography (degenerate configuration)")
-    refine = _refine
     if robust:
-        h = refine(h0, corr.dst, corr.src, dst_lines, src_lines, HUBER_PX, "huber")
-        h = refine(h, corr.dst, corr.src, dst_lines, src_lines, HUBER_PX, "cauchy")
+        h = _refine(h0, corr.dst, corr.src, dst_lines, src_lines, HUBER_PX, "huber")
+        h = _refine(h, corr.dst, corr.src, dst_lines, src_lines, HUBER_PX, "cauchy")
     else:
-        h = refine(h0, corr.dst, corr.src, dst_lines, src_lines, 1e9, "huber")
+        h = _refine(h0, corr.dst, corr.src, dst_lines, src_lines, 1e9, "huber")
     if not np.all(np.isfinite(h)):
         h = h0
     h = _normalise_sign(h, dst_size)

@@ -241,12 +241,7 @@ def homography_figure(h: np.ndarray) -> list[list[float]]:
 
 
 def warm_up() -> None:
-    """Load the Beier-Neely kernel (numba's cache) on a tiny frame.
-
-    Not scipy.optimize (the homography refinement; 0.4 s to import): importing it here, while the
-    studio starts, held the GIL long enough to double the first slider previews' latency
-    (``python -m benchmarks.gui_latency``: median 207 ms against 96 ms without it); the first fit
-    imports it instead."""
+    """Load the Beier-Neely kernel (numba's cache) on a tiny frame."""
     from .._kernels import warps as _k
 
     mx = np.empty((2, 2), np.float32)
