@@ -154,11 +154,11 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], 
     source position; within 0.4..1.6x of real runs (``python -m benchmarks.estimates``).
     """
     from ..limits import dft_seconds
-    from ..quilting.engine import _grid
+    from ..grid import block_grid
 
     h, w = texture_shape[:2]
     width, height = out_size
-    patches = len(_grid(height, block, overlap, False)[0]) * len(_grid(width, block, overlap, False)[0])
+    patches = len(block_grid(height, block, overlap, False)[0]) * len(block_grid(width, block, overlap, False)[0])
     positions = max(1, h - block + 1) * max(1, w - block + 1)
     return patches * (3 * dft_seconds(h, w) + SELECT_SECONDS_PER_POSITION * positions)
 

@@ -60,7 +60,7 @@ from ..errors import ImageError
 from ..image import luminance, validate_image
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng, out_of_range
-from ..quilting.engine import _grid
+from ..grid import block_grid
 
 __all__ = ["Synthesis", "synthesize_patches", "distance_weights", "SMOOTH_SIGMA"]
 
@@ -206,8 +206,8 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
                          f"(the rectified area is too small for the block; use a smaller --block)")
     rng = as_rng(rng)
     width, height = size
-    ys, _, _, hc = _grid(height, block, overlap, False)  # the one patch grid, shared with quilting
-    xs, _, _, wc = _grid(width, block, overlap, False)
+    ys, _, _, hc = block_grid(height, block, overlap, False)  # the patch grid quilting uses too
+    xs, _, _, wc = block_grid(width, block, overlap, False)
     rows, cols = len(ys), len(xs)
 
     src_y = luminance(tex[..., 0] if nc == 1 else tex)

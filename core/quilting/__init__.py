@@ -28,7 +28,7 @@ compiles only what it uses). Source and templates are centred on the source's me
 FFT loses little to cancellation.
 """
 
-from .engine import RULES, _K, _Pass, _grid, _pad_to, _quilt_pass  # noqa: F401 (tests compare _K to the kernel)
+from .engine import RULES, _K, _Pass, _pad_to, _quilt_pass  # noqa: F401 (tests compare _K to the kernel)
 from .method import (CORR_SIGMA, CORRESPONDENCES, ITERATIVE_BLOCK, METHOD, MIN_BLOCK, MIN_OVERLAP, MODES, SYNTH_BLOCK,
                      SYNTH_TOL, TRANSFER_BLOCK, QuiltParams, estimate_seconds, memory_estimate, synthesize, transfer,
                      transfer_schedule, warm_up)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._kernels import quilting_codes as _K  # the kernel's array codes, without importing numba
+from ..grid import block_grid
 from ..jobs import CancelToken, ProgressReporter
 
 RULES = ("tol", "epsilon", "sampled")
@@ -25,7 +26,6 @@ RULES = ("tol", "epsilon", "sampled")
 # is not loaded yet: numba's one-time start-up (~0.6 s: import, registries, kernel cache) costs more
 # than the numpy step (~0.3 ms a block) there. Both engines give the same pixels.
 NUMPY_ENGINE_MAX_BLOCKS = 1024
-STATIC_AHEAD = True  # transfer: static terms one row ahead on a second thread
 #: Synthesis never takes a source position within this many pixels of the continuation of a
 #: neighbouring block's piece of the sample, across the seam (see ``_forbid_continuations``); -1: off.
 AVOID_RADIUS = 4
@@ -52,25 +52,6 @@ class _Pass:
     avoid: int | None = None  # radius of _forbid_continuations, -1 off; None: AVOID_RADIUS for synthesis, off for transfer
 
 
-def _grid(n: int, block: int, overlap: int, tile: bool) -> tuple[list[int], list[int], list[int], int]:
-    """Block starts along one axis, the overlaps before/after each block, and the canvas length.
-
-    Without ``tile`` the blocks step by ``block - overlap`` and the canvas is cropped to ``n``
-    afterwards. With ``tile`` the canvas is exactly ``n`` and wraps: ``k = ceil(n / step)`` blocks
-    start at ``round(j n / k)``, so their overlaps are ``overlap`` or a pixel more, and the last
-    block overlaps the first one by its ``after`` width.
-    """
-    step = block - overlap
-    if tile:
-        k = -(-n // step)
-        starts = [(j * n + k // 2) // k for j in range(k)]
-        before = [0] + [starts[j - 1] + block - starts[j] for j in range(1, k)]
-        after = [0] * (k - 1) + [starts[-1] + block - n]
-        return starts, before, after, n
-    k = 1 if n <= block else -(-(n - overlap) // step)
-    starts = [j * step for j in range(k)]
-    before = [0] + [overlap] * (k - 1)
-    return starts, before, [0] * k, max(block, starts[-1] + block)
 
 
 def _forbid_continuations(cross: np.ndarray, ph: int, pw: int, y0: int, x0: int,
@@ -223,8 +204,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
 
     b = p.block
     th, tw, nc = tex.shape
-    ys, tops, bottoms, hc = _grid(out_h, b, p.overlap, p.tile)
-    xs, lefts, rights, wc = _grid(out_w, b, p.overlap, p.tile)
+    ys, tops, bottoms, hc = block_grid(out_h, b, p.overlap, p.tile)
+    xs, lefts, rights, wc = block_grid(out_w, b, p.overlap, p.tile)
     rows, cols = len(ys), len(xs)
     canvas = np.zeros((hc, wc, nc), dtype=np.float32)
     filled = np.zeros((hc, wc), dtype=np.uint8)
@@ -343,14 +324,14 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                 out.append((spec, cst))
             return out
 
-        if STATIC_AHEAD:
-            static_rows = ThreadPoolExecutor(max_workers=1, thread_name_prefix="weft-quilt")
+        # transfer: the static terms of the next row are computed one row ahead on a second thread
+        static_rows = ThreadPoolExecutor(max_workers=1, thread_name_prefix="weft-quilt")
     try:
         ahead = static_rows.submit(static_row, 0) if static_rows is not None else None
         for i in range(rows):
             if cancel is not None:
                 cancel.raise_if_cancelled()
-            row_static = static_row(i) if has_static and static_rows is None else None
+            row_static = None
             if ahead is not None:
                 row_static = ahead.result()
                 ahead = static_rows.submit(static_row, i + 1) if i + 1 < rows else None

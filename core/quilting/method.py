@@ -13,7 +13,8 @@ from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import Params, as_rng, out_of_range, param
 from ..registry import InputSpec, Method, Result
 from ..studio import SQUARE, Geometry, Studio
-from .engine import RULES, _grid, _K, _Pass, _pad_to, _quilt_pass  # noqa: F401 (_K: tests compare it to the kernel)
+from ..grid import block_grid
+from .engine import RULES, _K, _Pass, _pad_to, _quilt_pass  # noqa: F401 (_K: tests compare it to the kernel)
 
 __all__ = ["QuiltParams", "synthesize", "transfer", "transfer_schedule", "METHOD"]
 
@@ -218,7 +219,7 @@ def _memory_need(tex_shape: tuple[int, ...], out_w: int, out_h: int, passes: lis
     if transfer:  # two block rows of texture-sized spectra (the row in use and the one computed ahead)
         import cv2
 
-        cols = max(len(_grid(out_w, b, o, tile)[0]) for b, o in passes)
+        cols = max(len(block_grid(out_w, b, o, tile)[0]) for b, o in passes)
         need += 2 * cols * cv2.getOptimalDFTSize(h) * cv2.getOptimalDFTSize(w) * 4
     return need
 
@@ -378,7 +379,7 @@ def _synthesize(texture: np.ndarray, params: QuiltParams, *, rng=None, progress=
     p = _Pass(params.mode, b, ov, params.rule, params.tol, params.epsilon, params.tile,
               params.poisson, params.band)
     rng = as_rng(rng)
-    rows = len(_grid(out_h, b, ov if params.mode != "random" else 0, params.tile and params.mode != "random")[0])
+    rows = len(block_grid(out_h, b, ov if params.mode != "random" else 0, params.tile and params.mode != "random")[0])
     report = ProgressReporter(progress, "quilting", rows)
     if params.mode == "random":
         p = _Pass("random", b, 0, "tol", 1, 0.0, False, False, 1)
@@ -535,7 +536,7 @@ def _transfer(texture: np.ndarray, target: np.ndarray, params: QuiltParams, *, s
     for i, (bi, oi, ai) in enumerate(schedule):
         p = _Pass(params.mode, bi, oi, params.rule, params.tol, params.epsilon, params.tile,
                   params.poisson, params.band, w_overlap=ai, w_prev=ai if i > 0 else 0.0, w_corr=1.0 - ai)
-        rows = len(_grid(H, bi, oi, params.tile)[0])
+        rows = len(block_grid(H, bi, oi, params.tile)[0])
         report = ProgressReporter(progress, f"transfer {i + 1}/{n}", rows)
         img, _ = _quilt_pass(tex, H, W, p, rng, prev=prev, corr=(cs, ct), report=report, cancel=cancel,
                              channels_out=tex.shape[2])
@@ -549,7 +550,7 @@ def _transfer(texture: np.ndarray, target: np.ndarray, params: QuiltParams, *, s
 
 
 def _blocks(n_h: int, n_w: int, block: int, overlap: int, tile: bool) -> int:
-    return len(_grid(n_h, block, overlap, tile)[0]) * len(_grid(n_w, block, overlap, tile)[0])
+    return len(block_grid(n_h, block, overlap, tile)[0]) * len(block_grid(n_w, block, overlap, tile)[0])
 
 
 def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, progress=None, cancel=None) -> Result:
