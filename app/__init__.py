@@ -1,1 +1,1 @@
-"""weft front ends: the ``weft`` command (``app.cli``) and the desktop studio (``app.gui``)."""
+"""weft front ends: the ``weft`` command (``weft.app.cli``) and the desktop studio (``weft.app.gui``)."""

@@ -1,4 +1,4 @@
-"""``weft batch``: one recipe over many files (the command-line face of :mod:`core.batch`).
+"""``weft batch``: one recipe over many files (the command-line face of :mod:`weft.core.batch`).
 
 Exit status: 0 when every item was written (or was already done), 1 when any item failed (the
 others are written; the last line on stderr says which failed and why), 2 for a bad recipe, list or
@@ -93,9 +93,9 @@ class _BatchBar:
 
 
 def run_batch(args: argparse.Namespace) -> int:
-    from app.options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
-    from core import batch
-    from core.errors import WeftError
+    from weft.app.options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
+    from weft.core import batch
+    from weft.core.errors import WeftError
 
     bit_depth = _parse_bit_depth(args)
     seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)

@@ -3,7 +3,7 @@
 ``weft`` with no arguments opens the desktop studio; ``weft METHOD INPUT... -o OUT [options]`` runs a
 method headless; ``weft run RECIPE -o OUT`` reproduces a recipe (a ``.json`` file, or a PNG exported
 by weft, which carries its recipe); ``weft batch RECIPE --over INPUT FILES -o PATTERN`` applies it to
-many files (:mod:`app.batch_cli`). Method options are generated from the method's ``Params`` specs,
+many files (:mod:`weft.app.batch_cli`). Method options are generated from the method's ``Params`` specs,
 so the CLI and the GUI share one definition of every parameter and its range.
 
 Contract: any bad input (a file, a parameter, a geometry) prints exactly one line on stderr and exits
@@ -24,9 +24,9 @@ import time
 from pathlib import Path
 from typing import Sequence
 
-from core import __version__
-from core.errors import Cancelled, WeftError
-from core.params import Params, specs
+from weft.core import __version__
+from weft.core.errors import Cancelled, WeftError
+from weft.core.params import Params, specs
 
 from .options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
 
@@ -103,7 +103,7 @@ class _PreparingLine:
         self.thread: threading.Thread | None = None
 
     def text(self) -> str:
-        from core import registry
+        from weft.core import registry
 
         if registry.kernel_cache_notice() is not None:
             return f"weft: compiling the {self.method} method's kernels (no cache: every run)"
@@ -153,7 +153,7 @@ def _add_common(p: argparse.ArgumentParser) -> None:
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The ``weft`` parser; with ``only``, just that method's subcommand (and ``run``) is built, so
     only that method's module is imported."""
-    from core import registry
+    from weft.core import registry
 
     parser = _Parser(prog="weft", description="Example-based texture synthesis and transfer. "
                      "Without arguments, opens the desktop studio.")
@@ -198,7 +198,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     r.add_argument("recipe", metavar="RECIPE", help="recipe JSON file, or a PNG exported by weft")
     _add_common(r)
     r.set_defaults(method=None)
-    from app.batch_cli import add_batch_parser
+    from weft.app.batch_cli import add_batch_parser
 
     add_batch_parser(sub)
     return parser
@@ -222,9 +222,9 @@ def _check_output(output: str, inputs: Sequence[str]) -> Path:
 
 def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
              args: argparse.Namespace, region: tuple[int, int, int] | None = None) -> int:
-    from core import registry
-    from core.image import save_image
-    from core.run import output_recipe, render
+    from weft.core import registry
+    from weft.core.image import save_image
+    from weft.core.run import output_recipe, render
 
     method = registry.get(method_name)
     # typed parameters (a method's own command line) or their JSON form (a recipe's, read at its edge)
@@ -262,7 +262,7 @@ def _warm_up_all(args: argparse.Namespace) -> int:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    from core import registry
+    from weft.core import registry
 
     chosen = [registry.get(name) for name in args.methods] if args.methods else registry.methods().values()
     names = [m.name for m in chosen if m.warm_up is not None]
@@ -303,17 +303,17 @@ def _warm_up_all(args: argparse.Namespace) -> int:
 
 
 def _dispatch(args: argparse.Namespace) -> int:
-    from core import registry
-    from core.geometry import Square
+    from weft.core import registry
+    from weft.core.geometry import Square
 
     if args.command == "batch":
-        from app.batch_cli import run_batch
+        from weft.app.batch_cli import run_batch
 
         return run_batch(args)
     if args.command == "warm-up":
         return _warm_up_all(args)
     if args.command == "run":
-        from core.run import check_recipe, load_recipe
+        from weft.core.run import check_recipe, load_recipe
 
         recipe = load_recipe(args.recipe)
         try:  # what the recipe itself gets wrong is said with the recipe's name in front
@@ -349,11 +349,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``weft`` console script; returns the exit status."""
     argv = list(sys.argv[1:] if argv is None else argv)
     if not argv:
-        from app.gui import run_gui
+        from weft.app.gui import run_gui
 
         return run_gui()
     try:
-        from core import registry
+        from weft.core import registry
 
         parser = build_parser(only=argv[0] if argv[0] in registry.names() else None)
         args = parser.parse_args(argv)

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from core.errors import WeftError
+from weft.core.errors import WeftError
 
 
 def parse_int(text: str | None, name: str, lo: int, hi: int) -> int | None:
     """``text`` as an integer in ``lo..hi`` (None stays None); ``WeftError`` naming the option."""
     if text is None:
         return None
-    from core.params import out_of_range
+    from weft.core.params import out_of_range
 
     try:
         value = int(text)

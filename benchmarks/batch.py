@@ -11,7 +11,7 @@ one run of this script:
 
 Each recipe runs on a local pool of 1 worker, a local pool of 2 workers, and a Dask
 ``LocalCluster`` of 2 worker processes with 1 thread each (loopback). The pools are started and their
-kernels loaded before the clock starts (``ready()``); the time is that of :func:`core.batch.run`
+kernels loaded before the clock starts (``ready()``); the time is that of :func:`weft.core.batch.run`
 over all frames, outputs written as PNG with their recipe (``force``: every repeat redoes them),
 median of ``--repeats`` (default 3), the configurations alternating run by run. The start-up of
 each pool (spawning, imports, kernels; the Dask cluster's own start included) and the 1-minute
@@ -41,7 +41,7 @@ from pathlib import Path
 def make_frames(folder: Path, n: int) -> list[Path]:
     import cv2
 
-    from core.examples import example
+    from weft.core.examples import example
 
     src = cv2.imread(str(example("perspective-frontal")), cv2.IMREAD_COLOR)
     big = cv2.resize(src, (800, 600), interpolation=cv2.INTER_CUBIC)
@@ -58,7 +58,7 @@ def make_frames(folder: Path, n: int) -> list[Path]:
 def make_recipes(folder: Path, first_frame: Path) -> dict[str, Path]:
     import cv2
 
-    from core.examples import example
+    from weft.core.examples import example
 
     gravel = cv2.imread(str(example("gravel")), cv2.IMREAD_GRAYSCALE)
     cv2.imwrite(str(folder / "gravel128.png"), gravel[:128, :128])
@@ -80,7 +80,7 @@ def time_batch(plan_factory, pool, slots: int) -> tuple[float, float, float, flo
     """One batch: (wall seconds, busy fraction, seconds per item on its worker, CPU seconds per item).
     Busy = the items' whole times on their workers / (wall x workers): how well the pool keeps its
     workers fed."""
-    from core import batch
+    from weft.core import batch
 
     plan = plan_factory()
     done = []
@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", type=Path, help="write the rows here")
     args = ap.parse_args(argv)
 
-    from core import batch
+    from weft.core import batch
 
     rows = []
     with tempfile.TemporaryDirectory(prefix="weft-bench-batch-") as tmp:

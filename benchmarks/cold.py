@@ -36,7 +36,7 @@ def commands(tmp: Path, python: str = sys.executable) -> dict[str, list[str]]:
     """The timed commands (the issue's table, plus blend and rectify in their kernel modes), run by
     ``python`` (another checkout's interpreter measures that checkout: a baseline)."""
     out = str(tmp / "out.png")
-    weft = [python, "-c", "import sys; from app.cli import main; sys.exit(main())"]
+    weft = [python, "-c", "import sys; from weft.app.cli import main; sys.exit(main())"]
 
     return {
         "studio": [python, str(Path(__file__).resolve()), "--probe-studio"],
@@ -57,7 +57,7 @@ def commands(tmp: Path, python: str = sys.executable) -> dict[str, list[str]]:
 def _blend_inputs(tmp: Path) -> None:
     import numpy as np
 
-    from core.image import load_image, save_image
+    from weft.core.image import load_image, save_image
 
     fg = load_image(RES / "brick.png").image[:256, :256]
     bg = load_image(RES / "gravel.png").image[:256, :256]
@@ -167,7 +167,7 @@ def probe_studio() -> int:
     from PySide6.QtCore import QSettings, QTimer
     from PySide6.QtWidgets import QApplication
 
-    from app.gui.main_window import MainWindow
+    from weft.app.gui.main_window import MainWindow
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     with tempfile.TemporaryDirectory() as tmp:

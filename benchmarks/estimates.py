@@ -1,4 +1,4 @@
-"""How close the up-front running-time estimates (core.limits) come to real runs.
+"""How close the up-front running-time estimates (weft.core.limits) come to real runs.
 
     python -m benchmarks.estimates [--repeat N]
 
@@ -18,8 +18,8 @@ import numpy as np
 
 
 def _texture(side: int, seed: int = 0) -> np.ndarray:
-    from core.examples import example
-    from core.image import load_image
+    from weft.core.examples import example
+    from weft.core.image import load_image
 
     base = load_image(example("gravel")).image
     reps = -(-side // base.shape[0])
@@ -28,7 +28,7 @@ def _texture(side: int, seed: int = 0) -> np.ndarray:
 
 
 def _cases():
-    from core import nfpt, quilting
+    from weft.core import nfpt, quilting
 
     def quilt_synth(tex_side, out_side, block):
         tex = _texture(tex_side)
@@ -75,7 +75,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3, help="runs per case (median), default 3")
     args = parser.parse_args(argv)
-    from core import nfpt, quilting
+    from weft.core import nfpt, quilting
 
     quilting.warm_up()
     nfpt.warm_up()

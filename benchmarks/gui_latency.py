@@ -36,10 +36,10 @@ class _PaintWatch(QObject):
 
 
 def measure(values: int = 30, hz: float = 60.0) -> dict:
-    from app.gui.document import DocumentState, InputImage
-    from app.gui.main_window import MainWindow
-    from core.examples import example
-    from core.image import load_image, resize
+    from weft.app.gui.document import DocumentState, InputImage
+    from weft.app.gui.main_window import MainWindow
+    from weft.core.examples import example
+    from weft.core.image import load_image, resize
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     with tempfile.TemporaryDirectory() as tmp:

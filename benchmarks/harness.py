@@ -4,7 +4,7 @@ Timing: one untimed warm-up run (numba kernels compile or load from cache, OpenC
 then ``repeats`` timed runs of the method's compute only (inputs already decoded); the table shows
 the median and the minimum. Peak memory is measured in one extra run under ``tracemalloc`` (so its
 overhead never touches the timings): it counts numpy's and Python's allocations during compute, not
-the interpreter or libraries already loaded. Quality figures come from ``core.metrics`` on the output
+the interpreter or libraries already loaded. Quality figures come from ``weft.core.metrics`` on the output
 of the last timed run. A case with a G'MIC counterpart, when ``gmic`` is on the PATH, also times the
 whole ``weft`` process against the whole ``gmic`` process on the same input file, alternating the two
 so that machine noise hits both alike.
@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from core import metrics, registry
-from core.examples import example
-from core.image import load_image, luminance, resize, save_image
+from weft.core import metrics, registry
+from weft.core.examples import example
+from weft.core.image import load_image, luminance, resize, save_image
 
 from .cases.base import Case
 
@@ -94,7 +94,7 @@ def _time_process(cmd: list[str]) -> float:
 def weft_command(case: Case, input_files: dict[str, Path], output: Path, params: dict[str, Any]) -> list[str]:
     """The ``weft`` command line that runs ``case`` on the given input files."""
     method = registry.get(case.method)
-    cmd = [sys.executable, "-m", "app.cli", case.method]
+    cmd = [sys.executable, "-m", "weft.app.cli", case.method]
     for spec in method.inputs:
         if spec.name in input_files:
             path = str(input_files[spec.name])

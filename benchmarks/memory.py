@@ -26,7 +26,7 @@ LIMIT = 2 * 2**30
 def _inputs(folder: Path) -> dict[str, str]:
     import cv2
 
-    from core.examples import example
+    from weft.core.examples import example
 
     picture = cv2.imread(str(example("astronaut")), cv2.IMREAD_COLOR)
     out = {"texture": str(example("gravel"))}
@@ -71,7 +71,7 @@ def main(argv=None) -> int:
         print("| job | peak RSS (median) | runs | wall s (median) | under 2 GiB |")
         print("|---|---:|---|---:|---|")
         for name, cmd in _jobs(files):
-            full = [sys.executable, "-m", "app.cli", *cmd, "-o", out, "-q", "--seed", "1"]
+            full = [sys.executable, "-m", "weft.app.cli", *cmd, "-o", out, "-q", "--seed", "1"]
             runs = [peak_rss(full) for _ in range(args.repeat)]
             if any(code for _, _, code in runs):
                 print(f"| {name} | failed | | | |")

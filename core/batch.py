@@ -12,7 +12,7 @@ output that would overwrite an input). :func:`run` then runs the items
 * on a Dask distributed cluster when given a scheduler address (``pip install -e '.[cluster]'``),
 
 through one code path: both pools run :func:`run_item` on each item and hand back an
-:class:`Outcome`. An item runs exactly as ``weft run`` on its recipe (:mod:`core.run`), so its output
+:class:`Outcome`. An item runs exactly as ``weft run`` on its recipe (:mod:`weft.core.run`), so its output
 is byte for byte the same, recipe chunk included. An item's failure (a corrupt frame) is that
 item's: it becomes a failed outcome with a one-line reason and the batch goes on. Outputs are
 written atomically; an item whose output already exists with the same recipe is skipped (a re-run
@@ -21,7 +21,7 @@ memory) has its items run again: Dask reschedules them itself; the local pool is
 its unfinished items resubmitted, up to :data:`MAX_ATTEMPTS` times each.
 
 Memory: before any work the largest item's estimate (``Method.memory``) times the number of
-workers must fit in the memory available (:mod:`core.limits`); a Dask worker's own memory limit
+workers must fit in the memory available (:mod:`weft.core.limits`); a Dask worker's own memory limit
 is checked against the estimate times its threads.
 
 Importing this module imports neither Dask nor the method modules.
@@ -48,9 +48,9 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 from .errors import Cancelled, WeftError
 from .limits import LimitError, _bytes, available_memory
 
-#: File extensions a folder given to ``--over`` contributes (what :func:`core.image.load_image` reads).
+#: File extensions a folder given to ``--over`` contributes (what :func:`weft.core.image.load_image` reads).
 IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp", ".gif")
-#: Output extensions (what :func:`core.image.save_image` writes).
+#: Output extensions (what :func:`weft.core.image.save_image` writes).
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 #: Times an item is started before a worker dying under it fails the item (Dask's default too).
 MAX_ATTEMPTS = 3
@@ -290,7 +290,7 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     ----------
     recipe_path : str
         A recipe ``.json`` or a PNG exported by weft (its relative paths resolve against its folder).
-        With ``recipe`` (a :class:`~core.params.Recipe` with absolute paths, e.g. the studio's), the
+        With ``recipe`` (a :class:`~weft.core.params.Recipe` with absolute paths, e.g. the studio's), the
         path is only used in messages and as the folder file parameters resolve against.
     over : sequence of (input name, folder / glob / file)
         Each replaces that input of the recipe, file by file; several zip together (equal lengths).

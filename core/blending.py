@@ -3,8 +3,8 @@
 * :func:`poisson_blend` -- Pérez, Gangnet & Blake's seamless cloning on an arbitrary mask: inside
   the mask the result has the source's gradients, on the mask's border it meets the target. The
   quilting write-up (``image-quilting-poisson-blending.txt``, "Poisson Blending") runs it on a
-  band of at most 5 pixels around every seam; ``core.quilting`` does that block by block with the
-  same solver (``core._kernels.poisson.poisson_cg``).
+  band of at most 5 pixels around every seam; ``weft.core.quilting`` does that block by block with the
+  same solver (``weft.core._kernels.poisson.poisson_cg``).
 * :func:`pyramid_blend` -- Burt & Adelson's multiresolution spline: the Laplacian pyramids of the
   two images are mixed level by level with a Gaussian pyramid of the mask and collapsed, the
   "face in toast" compositing step of Ngo's write-up.
@@ -84,7 +84,7 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, mask: np.ndarray, *, t
     on the mask's border (Dirichlet). Image borders are Neumann (no neighbour, no term), unless
     ``wrap``. The quilting write-up applies exactly this with the existing pixels as the source of
     gradients and the quilt after pasting as the target, on a band of at most 5 pixels around each
-    seam (``core.quilting``, ``--poisson``).
+    seam (``weft.core.quilting``, ``--poisson``).
 
     Parameters
     ----------

@@ -44,7 +44,7 @@ from .registry import InputSpec, Method, Result
 from .studio import SQUARE, Geometry, Studio
 
 MODES = ("auto", "transfer", "synthesis", "superres", "novel")
-# Metric codes of the kernel (core._kernels.fast), which is imported on first use: importing numba
+# Metric codes of the kernel (weft.core._kernels.fast), which is imported on first use: importing numba
 # costs a quarter of a second that `weft --help` or another method's run need not pay.
 METRICS = {"full": 0, "target": 1, "artistic": 2}
 _ROWS_PER_BAND = 16
@@ -303,7 +303,7 @@ def _check_limits(texture: np.ndarray, target: np.ndarray | None, params: FastPa
     """Refuse up front an output over the pixel limit or beyond the memory available.
 
     No running-time limit: the method is linear in the output, ~0.2 µs per pixel and iteration, so
-    the pixel limit (50 Mpx) bounds a job to well under the ten minutes of :mod:`core.limits`.
+    the pixel limit (50 Mpx) bounds a job to well under the ten minutes of :mod:`weft.core.limits`.
     """
     from .limits import check_memory, check_output_size
 

@@ -7,7 +7,7 @@ is written once, by :meth:`to_json` (and :meth:`to_text` for a command line). No
 text and parsed again per render.
 
 A ``Params`` field holds one with ``param(None, kind="geometry", type=Square)`` (see
-:mod:`core.params`); any class with these four methods can be such a type (:class:`core.rectify.View`
+:mod:`weft.core.params`); any class with these four methods can be such a type (:class:`weft.core.rectify.View`
 is one more).
 
 Command-line rule for lines and views (one rule, stated here and in ``--help``): text that starts with

@@ -34,7 +34,7 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
-from core.errors import Cancelled
+from weft.core.errors import Cancelled
 
 __all__ = ["Cancelled", "CancelToken", "Job", "JobResult", "JobRunner", "Progress", "ProgressReporter"]
 

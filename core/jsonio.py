@@ -17,7 +17,7 @@ def parse_json(text: str) -> Any:
 
     Stricter than :func:`json.loads`: ``NaN`` and ``Infinity`` (not JSON) are refused, and every
     failure (bad syntax, nesting too deep for the parser, a number with thousands of digits) is a
-    :class:`~core.errors.WeftError` saying so in one line. Nothing is evaluated.
+    :class:`~weft.core.errors.WeftError` saying so in one line. Nothing is evaluated.
     """
     def no_constant(name: str):
         raise WeftError(f"not valid JSON: {name} is not a JSON number")

@@ -3,7 +3,7 @@
 Three checks, each one line when it refuses (``LimitError``, a ``WeftError``):
 
 * :func:`check_output_size`: an output may not have more pixels than an input may
-  (:func:`core.image.get_max_pixels`, 50 Mpx unless ``WEFT_MAX_PIXELS`` says otherwise).
+  (:func:`weft.core.image.get_max_pixels`, 50 Mpx unless ``WEFT_MAX_PIXELS`` says otherwise).
 * :func:`check_memory`: a method's estimate of its peak memory must fit in the memory the system
   has available (``MemAvailable`` of ``/proc/meminfo``; no check where it cannot be read).
 * :func:`check_duration`: a method's estimate of its running time on this machine must not exceed

@@ -18,9 +18,9 @@ Example
 >>> DemoParams(block=32, overlap=40)
 Traceback (most recent call last):
 ...
-core.errors.InvalidParameter: parameter 'overlap' = 40 is outside 1..31 (must be smaller than block = 32)
+weft.core.errors.InvalidParameter: parameter 'overlap' = 40 is outside 1..31 (must be smaller than block = 32)
 
-Rules: a value of the wrong type or outside its range raises :class:`~core.errors.InvalidParameter`
+Rules: a value of the wrong type or outside its range raises :class:`~weft.core.errors.InvalidParameter`
 naming the parameter, the value and the allowed range. Nothing is clamped silently. Integral
 numpy scalars are accepted for ``int`` parameters and stored as ``int``; ``bool`` is never an ``int``.
 """
@@ -55,7 +55,7 @@ class Spec:
     ----------
     name : parameter name (the dataclass field); the CLI option is ``--name`` with ``_`` -> ``-``.
     kind : one of ``int, float, bool, choice, size, str, geometry``; ``size`` is a ``(width, height)``
-        pair; ``geometry`` a typed value of class ``type`` (:mod:`core.geometry`: a square, feature
+        pair; ``geometry`` a typed value of class ``type`` (:mod:`weft.core.geometry`: a square, feature
         lines, a view), parsed at the edges by the type's ``parse`` (command line), ``from_json``
         (recipes, sessions) and ``coerce`` (Python callers), written by its ``to_json``.
     default : the default value (from the paper where it gives one).

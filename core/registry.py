@@ -5,7 +5,7 @@ modules to import; the CLI turns each into a subcommand (inputs become positiona
 parameters become options generated from the ``Params`` specs) and ``weft run`` finds a recipe's
 method here. Adding a method = writing its module + one line in ``_MODULES`` (or, at run time,
 :func:`register`). A method the studio offers says so, and what it needs, in ``Method.studio``
-(:class:`core.studio.Studio`).
+(:class:`weft.core.studio.Studio`).
 """
 
 from __future__ import annotations
@@ -25,12 +25,12 @@ from .studio import Studio
 # Method name -> the module that defines it as a module-level ``METHOD``; imported on first use, one
 # at a time where possible (``weft quilt`` need not import the affine model's FFT machinery).
 _MODULES = {
-    "quilt": "core.quilting",
-    "fast": "core.fast",
-    "blend": "core.blending",
-    "rectify": "core.rectify",
-    "nfpt": "core.nfpt",
-    "affine": "core.affine",
+    "quilt": "weft.core.quilting",
+    "fast": "weft.core.fast",
+    "blend": "weft.core.blending",
+    "rectify": "weft.core.rectify",
+    "nfpt": "weft.core.nfpt",
+    "affine": "weft.core.affine",
 }
 
 
@@ -74,7 +74,7 @@ class Method:
     tiny inputs, so that the first real run is not charged with it; the GUI calls it once in a
     background thread at start, the CLI before timing unless ``warm_up_in_cli`` is false (a method
     that can avoid its kernels on small inputs, such as quilting's numpy engine, would only pay).
-    ``studio``, when given, puts the method in the studio (:class:`core.studio.Studio`).
+    ``studio``, when given, puts the method in the studio (:class:`weft.core.studio.Studio`).
     """
 
     name: str
@@ -86,7 +86,7 @@ class Method:
     warm_up_in_cli: bool = True
     #: ``memory(shapes, params) -> bytes``: the estimated peak memory of one run on inputs of these
     #: shapes (input name -> array shape), the figure the run checks against the memory available;
-    #: a batch multiplies it by its workers to refuse up front (:mod:`core.batch`). None: no estimate.
+    #: a batch multiplies it by its workers to refuse up front (:mod:`weft.core.batch`). None: no estimate.
     memory: Callable[[Mapping[str, tuple[int, ...]], Params], float] | None = None
     studio: Studio | None = None
 
@@ -143,7 +143,7 @@ def get(name: str) -> Method:
 # ``warm_up(name)`` runs a method's ``warm_up`` at most once per process (concurrent callers wait for
 # the one running it); ``is_warm(name)`` then tells a front end that the method's kernels are loaded,
 # so a render can be timed without them. Whether a real compile is happening (a first run: numba's
-# cache is cold) is known from numba's compile events, which ``core._kernels`` forwards here:
+# cache is cold) is known from numba's compile events, which ``weft.core._kernels`` forwards here:
 # ``watch_compiles()`` counts them and their time, ``compiling()`` tells whether one is under way.
 
 #: What a front end shows while a method's kernels compile (``{name}`` is the method's name) ...
@@ -279,18 +279,18 @@ def _notify(started: bool, outermost: bool) -> None:
 
 
 def compile_started(outermost: bool = True) -> None:
-    """Called by ``core._kernels`` when a thread starts compiling a function (a cache miss);
+    """Called by ``weft.core._kernels`` when a thread starts compiling a function (a cache miss);
     ``outermost``: not a function compiled inside another one's compile."""
     _notify(True, outermost)
 
 
 def compile_ended(outermost: bool = True) -> None:
-    """Called by ``core._kernels`` when that compilation ends."""
+    """Called by ``weft.core._kernels`` when that compilation ends."""
     _notify(False, outermost)
 
 
 def note_kernel_cache(message: str) -> None:
-    """Called by ``core._kernels`` when numba's cache cannot be used (kept once)."""
+    """Called by ``weft.core._kernels`` when numba's cache cannot be used (kept once)."""
     if message not in _cache_notes:
         _cache_notes.append(message)
 

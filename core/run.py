@@ -1,6 +1,6 @@
 """One item: a method run on image files, and the recipe its output carries.
 
-``weft METHOD``, ``weft run`` and every item of a batch (:mod:`core.batch`) go through these same
+``weft METHOD``, ``weft run`` and every item of a batch (:mod:`weft.core.batch`) go through these same
 functions, so a batch output is byte for byte what ``weft run`` gives for that item's recipe:
 
 * :func:`load_recipe` reads a recipe (``.json``, or a PNG exported by weft) and
@@ -9,7 +9,7 @@ functions, so a batch output is byte for byte what ``weft run`` gives for that i
 * :func:`output_recipe` is the recipe an output at a given path carries (paths relative to its folder);
 * :func:`render` loads the inputs, checks their sizes, runs the method and names the file behind an
   error about one input; the caller encodes or saves the result with the recipe
-  (:func:`core.image.save_image` / :func:`core.image.encode_image`).
+  (:func:`weft.core.image.save_image` / :func:`weft.core.image.encode_image`).
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ they agree. Given the per-pixel error ``e = (existing - new)²`` over the overla
 ``E[y, x] = e[y, x] + min(E[y+1, x-1], E[y+1, x], E[y+1, x+1])`` and a backtrace (the Poisson
 write-up's "accumulated cost matrix", neighbours beyond the strip's edges simply not used).
 
-Used by ``core.quilting`` (modes ``mincut``) and meant for any other method that stitches patches
+Used by ``weft.core.quilting`` (modes ``mincut``) and meant for any other method that stitches patches
 (the NFPT synthesis): :func:`min_cut_mask` for a block with overlaps on any of its four sides,
 :func:`min_error_path` for one strip, :func:`overlap_error` for the error surface.
 """

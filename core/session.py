@@ -30,7 +30,7 @@ MAX_SEED = 2**31 - 1  # the studio's seed box
 
 
 def read_session(path: str | Path) -> dict:
-    """Parse and validate a session file (JSON only, at most ``core.params.MAX_FILE_BYTES``); input
+    """Parse and validate a session file (JSON only, at most ``weft.core.params.MAX_FILE_BYTES``); input
     paths come back absolute, relative ones resolved against the session's folder. ``WeftError`` with
     one line naming the file if anything is wrong, so a bad file never half-replaces a document."""
     path = Path(path)

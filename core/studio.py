@@ -34,11 +34,11 @@ class Geometry:
 
     Attributes
     ----------
-    kind : ``"square"`` or ``"lines"`` (:data:`core.geometry.KINDS`): which tool edits it.
+    kind : ``"square"`` or ``"lines"`` (:data:`weft.core.geometry.KINDS`): which tool edits it.
     on : the inputs it is drawn on, in order of preference: the first one that is open is used (the
         affine prototype lies on the prototype image when one is open, else on the texture).
-    param : the ``Params`` field it fills (typed: a :class:`~core.geometry.Square`,
-        :class:`~core.geometry.FeatureLines`); ``None`` for a square means the recipe's source
+    param : the ``Params`` field it fills (typed: a :class:`~weft.core.geometry.Square`,
+        :class:`~weft.core.geometry.FeatureLines`); ``None`` for a square means the recipe's source
         ``region``: the first input of ``on`` is cropped to it before the method runs.
     help : what the user does, shown as the view's title.
     live : ``live(params) -> bool``: re-render a preview while the geometry is being dragged.
@@ -84,7 +84,7 @@ class Studio:
     auto : ``auto(params, open_inputs) -> {name: value}``: what the optional ("auto") parameters
         resolve to for these inputs, shown greyed beside their "auto" box; may raise ``WeftError``.
     compare : the "before" image of Compare: the first of these inputs that is open (default the canvas).
-    examples : a bundled example (``core.examples``) per input, opened when the studio starts.
+    examples : a bundled example (``weft.core.examples``) per input, opened when the studio starts.
     rank : position in the method list (lowest first; the first is the studio's starting method).
     """
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import sys
 
-from core import registry
-from core.params import specs
+from weft.core import registry
+from weft.core.params import specs
 
 
 def _default(spec) -> str:

@@ -12,7 +12,7 @@
 * ``affine-fields.jpg``: textures synthesized from parametric transform fields with the shaker
   box providing the translations (Fig. 6).
 
-Every panel is computed here by ``core.affine`` with fixed seeds; labels are drawn with OpenCV.
+Every panel is computed here by ``weft.core.affine`` with fixed seeds; labels are drawn with OpenCV.
 """
 
 from __future__ import annotations
@@ -25,13 +25,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from core.affine import (analyse, field_model, make_prototype, match_boundaries,  # noqa: E402
+from weft.core.affine import (analyse, field_model, make_prototype, match_boundaries,  # noqa: E402
                          render, synthesize)
 from benchmarks.fixtures.procedural import cells, weave  # noqa: E402
 from panels import grid, label  # noqa: E402 (docs/panels.py)
-from core.examples import example  # noqa: E402
-from core.image import load_image, save_image  # noqa: E402
-from core.metrics import snr_db  # noqa: E402
+from weft.core.examples import example  # noqa: E402
+from weft.core.image import load_image, save_image  # noqa: E402
+from weft.core.metrics import snr_db  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "images"
 
@@ -59,7 +59,7 @@ def boundary() -> np.ndarray:
         model = analyse(tex)
         start, _ = match_boundaries(model, "partial")
         shaken, rep = match_boundaries(model, "shaker", rng=1)
-        from core.affine import total_boundary_error
+        from weft.core.affine import total_boundary_error
 
         e0 = total_boundary_error(model.with_shifts(np.round(model.shifts)))
         panels += [

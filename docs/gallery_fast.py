@@ -5,7 +5,7 @@
 * ``fast-transfer.jpg``: style and texture transfer (hatching drawing, wood grain, gravel);
 * ``fast-superres.jpg``: x4 super-resolution of a fractal image next to cubic magnification.
 
-Every panel is computed here by ``core.fast.transfer`` with a fixed seed; labels are drawn with OpenCV.
+Every panel is computed here by ``weft.core.fast.transfer`` with a fixed seed; labels are drawn with OpenCV.
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from core.examples import example
-from core.fast import transfer
-from core.image import load_image, resize, save_image
+from weft.core.examples import example
+from weft.core.fast import transfer
+from weft.core.image import load_image, resize, save_image
 from panels import grid, label  # docs/panels.py
 
 OUT = Path(__file__).resolve().parent / "images"

@@ -23,11 +23,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from core.examples import RESOURCES, example
-from core.image import load_image, resize, save_image
-from core.metrics import coherence
-from core.nfpt import nfpt, synthesize
-from core.rectify import load_feature_lines, rectify, rectify_feature_lines
+from weft.core.examples import RESOURCES, example
+from weft.core.image import load_image, resize, save_image
+from weft.core.metrics import coherence
+from weft.core.nfpt import nfpt, synthesize
+from weft.core.rectify import load_feature_lines, rectify, rectify_feature_lines
 from benchmarks.fixtures.synthetic import folded_case, perspective_case
 
 OUT = Path(__file__).resolve().parent / "images"
@@ -120,7 +120,7 @@ def comparison() -> np.ndarray:
     rect = rectify(case.photo, case.image_lines, case.frontal_lines, case.frontal_size).image
     mask = np.zeros(case.photo.shape[:2], np.uint8)
     corners = np.array([[-0.5, -0.5], [399.5, -0.5], [399.5, 299.5], [-0.5, 299.5]])
-    from core.rectify import apply_homography
+    from weft.core.rectify import apply_homography
 
     cv2.fillConvexPoly(mask, np.round(apply_homography(case.homography, corners)).astype(np.int32), 1)
     box = _largest_rectangle(cv2.erode(mask, np.ones((5, 5), np.uint8)))
@@ -165,7 +165,7 @@ def warps() -> np.ndarray:
     gravel = resize(load_image(example("gravel")).image, (400, 300), interpolation="cubic")
     case = perspective_case(gravel, seed=1)
     r = rectify(case.photo, case.image_lines, case.frontal_lines, case.frontal_size)
-    from core.metrics import psnr_db
+    from weft.core.metrics import psnr_db
 
     m = 15
     psnr = psnr_db(case.frontal[m:-m, m:-m], r.image[m:-m, m:-m])

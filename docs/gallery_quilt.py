@@ -2,7 +2,7 @@
 
     .venv/bin/python docs/gallery_quilt.py
 
-Every picture is made by the real code (``core.quilting``, ``core.blending``) on the bundled
+Every picture is made by the real code (``weft.core.quilting``, ``weft.core.blending``) on the bundled
 examples, with fixed seeds, so re-running reproduces the files:
 
 * ``quilt-modes.png``: the 128x128 brick sample, then 256x256 quilts with block 32 / overlap 6 in
@@ -24,10 +24,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from core.blending import poisson_blend, pyramid_blend  # noqa: E402
-from core.examples import example  # noqa: E402
-from core.image import load_image, save_image  # noqa: E402
-from core.quilting import synthesize, transfer  # noqa: E402
+from weft.core.blending import poisson_blend, pyramid_blend  # noqa: E402
+from weft.core.examples import example  # noqa: E402
+from weft.core.image import load_image, save_image  # noqa: E402
+from weft.core.quilting import synthesize, transfer  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 GAP = 6

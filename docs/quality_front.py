@@ -5,7 +5,7 @@
 T2 renders ``camera_256`` (``skimage.data.camera()`` box-downscaled 2x) in ``gravel_128``
 (``gravel()[0:256, 0:256]`` box-downscaled 2x), the peers' own inputs (issue 17). For each weft
 setting below it runs the real code, measures fidelity (higher is better) and coherence (lower is
-better) with ``core.metrics``, prints a markdown table (with, for each peer, the first setting that
+better) with ``weft.core.metrics``, prints a markdown table (with, for each peer, the first setting that
 beats it on both) and draws ``docs/images/quality-front.png``: fidelity against coherence, weft's
 settings as a line, the peers (measured on the project's machine, same inputs; figures from the
 issue) as points. Drawn with OpenCV (no plotting library).
@@ -21,7 +21,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from core.metrics import coherence, fidelity  # noqa: E402
+from weft.core.metrics import coherence, fidelity  # noqa: E402
 
 OUT = ROOT / "docs" / "images" / "quality-front.png"
 
@@ -58,7 +58,7 @@ def inputs() -> tuple[np.ndarray, np.ndarray]:
 
 def measure(seed: int = 1) -> list[tuple[str, float, float]]:
     """(label, fidelity, coherence) of every setting."""
-    from core import fast, quilting
+    from weft.core import fast, quilting
 
     gravel, camera = inputs()
     rows = []

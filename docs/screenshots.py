@@ -18,11 +18,11 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QSettings  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
-from app.gui.document import DocumentState, InputImage  # noqa: E402
-from app.gui.main_window import MainWindow  # noqa: E402
-from core import registry  # noqa: E402
-from core.examples import RESOURCES, example  # noqa: E402
-from core.image import load_image  # noqa: E402
+from weft.app.gui.document import DocumentState, InputImage  # noqa: E402
+from weft.app.gui.main_window import MainWindow  # noqa: E402
+from weft.core import registry  # noqa: E402
+from weft.core.examples import RESOURCES, example  # noqa: E402
+from weft.core.image import load_image  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "images"
 

@@ -44,13 +44,13 @@ NOISE_SIGMA = 0.012
 
 
 def _save(name: str, image: np.ndarray) -> Path:
-    """Save float [0, 1] (H, W) or (H, W, 3) RGB as PNG, via core.image.save_image when available."""
+    """Save float [0, 1] (H, W) or (H, W, 3) RGB as PNG, via weft.core.image.save_image when available."""
     path = HERE / name
     image = np.clip(np.asarray(image, dtype=np.float32), 0.0, 1.0)
     if str(HERE.parent) not in sys.path:
         sys.path.insert(0, str(HERE.parent))
     try:
-        from core.image import save_image
+        from weft.core.image import save_image
     except ImportError:
         save_image = None
     if save_image is not None:

@@ -4,8 +4,8 @@ import ast
 import inspect
 from pathlib import Path
 
-from core import registry
-from core.params import specs
+from weft.core import registry
+from weft.core.params import specs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -24,7 +24,7 @@ def _method_words() -> dict[str, str]:
 
 def test_app_gui_names_no_method_input_or_parameter():
     """app/gui is generic over methods: none of its string literals is a method, input or parameter
-    name (it learns them from core.registry and each method's studio description)."""
+    name (it learns them from weft.core.registry and each method's studio description)."""
     words = _method_words()
     found = []
     for path in sorted((ROOT / "app" / "gui").rglob("*.py")):
@@ -63,7 +63,7 @@ def _imports(path: Path, package: str) -> set[str]:
             elif node.module:
                 out.add(node.module)
                 out.update(f"{node.module}.{a.name}" for a in node.names)
-    return {m for m in out if m.split(".")[0] in ("app", "core")}
+    return {m for m in out if m.startswith(("weft.app", "weft.core"))}
 
 
 def _module_graph() -> dict[str, set[str]]:
@@ -75,13 +75,13 @@ def _module_graph() -> dict[str, set[str]]:
             is_pkg = parts[-1] == "__init__"
             if is_pkg:
                 parts = parts[:-1]
-            name = ".".join(parts)
-            modules[name] = (path, name if is_pkg else ".".join(parts[:-1]))
+            name = ".".join(["weft", *parts])
+            modules[name] = (path, name if is_pkg else ".".join(["weft", *parts[:-1]]))
     graph = {}
     for name, (path, package) in modules.items():
         deps = set()
         for imp in _imports(path, package):
-            while imp and imp not in modules:  # "core.image.load_image" -> "core.image"
+            while imp and imp not in modules:  # "weft.core.image.load_image" -> "weft.core.image"
                 imp = imp.rpartition(".")[0]
             if imp and imp != name and not name.startswith(imp + "."):  # a package's own __init__ is no cycle
                 deps.add(imp)
@@ -92,7 +92,7 @@ def _module_graph() -> dict[str, set[str]]:
 def test_no_import_cycle_in_app_and_core():
     """Walk every import of app/ and core/ (module level and inside functions): no cycle."""
     graph = _module_graph()
-    assert "app.gui.main_window" in graph and "core.registry" in graph
+    assert "weft.app.gui.main_window" in graph and "weft.core.registry" in graph
     state: dict[str, int] = {}
     stack: list[str] = []
     cycles = []
@@ -117,8 +117,8 @@ def test_no_import_cycle_in_app_and_core():
 def test_public_functions_take_the_options_of_their_params():
     """One source per option: each method's one-call Python function takes exactly its Params'
     options (same names, same defaults), so the two cannot drift apart."""
-    from core import affine, fast, nfpt, quilting
-    from core.rectify import WarpParams
+    from weft.core import affine, fast, nfpt, quilting
+    from weft.core.rectify import WarpParams
 
     cases = [
         (fast.transfer, fast.FastParams, set()),

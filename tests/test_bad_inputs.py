@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from app import cli
-from core.image import load_image
+from weft.app import cli
+from weft.core.image import load_image
 from tests.data.make_corpus import BROKEN, ODD, make_corpus
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -97,7 +97,7 @@ def test_unreadable_file_is_refused_in_one_line(corpus, tmp_path, capsys, monkey
             raise PermissionError(13, "Permission denied", str(path))
         return real_stat(p, *a, **k)
 
-    monkeypatch.setattr("core.image.files.os.stat", denied)
+    monkeypatch.setattr("weft.core.image.files.os.stat", denied)
     out = tmp_path / "out.png"
     code = cli.main(argv(method, str(path), str(out)))
     err = capsys.readouterr().err
@@ -112,7 +112,7 @@ def test_bomb_is_refused_without_decoding(corpus, tmp_path, capsys, monkeypatch)
         raise AssertionError("the bomb's pixels were decoded")
 
     monkeypatch.setattr(cv2, "imdecode", no_decode)
-    monkeypatch.setattr("core.image.files._decode_pillow", no_decode)
+    monkeypatch.setattr("weft.core.image.files._decode_pillow", no_decode)
     out = tmp_path / "out.png"
     code = cli.main(argv("quilt", str(corpus["bomb"]), str(out)))
     err = capsys.readouterr().err
@@ -125,14 +125,14 @@ def test_bomb_is_refused_without_decoding(corpus, tmp_path, capsys, monkeypatch)
 def test_real_process_refuses_broken_file(corpus, tmp_path, method, item):
     path = corpus[item]
     out = tmp_path / "out.png"
-    proc = subprocess.run([sys.executable, "-m", "app.cli", *argv(method, str(path), str(out))],
+    proc = subprocess.run([sys.executable, "-m", "weft.app.cli", *argv(method, str(path), str(out))],
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     check_refusal(proc.stderr, path, proc.returncode, out)
 
 
 def test_real_process_reads_non_ascii_path(corpus, tmp_path):
     out = tmp_path / "sortie ü.png"
-    proc = subprocess.run([sys.executable, "-m", "app.cli", *argv("quilt", str(corpus["non_ascii"]), str(out))],
+    proc = subprocess.run([sys.executable, "-m", "weft.app.cli", *argv("quilt", str(corpus["non_ascii"]), str(out))],
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert out.is_file()

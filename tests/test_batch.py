@@ -18,14 +18,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli import main
-from core import batch
-from core.errors import WeftError
-from core.image import load_image, read_recipe, save_image
-from core.limits import LimitError
+from weft.app.cli import main
+from weft.core import batch
+from weft.core.errors import WeftError
+from weft.core.image import load_image, read_recipe, save_image
+from weft.core.limits import LimitError
 
 ROOT = Path(__file__).resolve().parents[1]
-WEFT = [sys.executable, "-c", "import sys; from app.cli import main; sys.exit(main())"]
+WEFT = [sys.executable, "-c", "import sys; from weft.app.cli import main; sys.exit(main())"]
 
 
 def make_frames(folder: Path, n: int, size=(40, 48)) -> list[Path]:
@@ -249,7 +249,7 @@ def test_plan_lists_in_natural_order_and_zips_several_inputs(scene):
 
 def test_cancel_stops_the_batch_between_items(scene):
     tmp, frames = scene
-    from core.jobs import CancelToken
+    from weft.core.jobs import CancelToken
 
     p = batch.plan(str(tmp / "look.json"), [("target", str(tmp / "frames"))], str(tmp / "o" / "{stem}.png"))
     token = CancelToken()
@@ -370,7 +370,7 @@ def test_check_memory_names_the_largest_item(scene):
 
 
 def test_importing_weft_does_not_import_dask():
-    code = ("import sys, app.cli, core.batch, app.batch_cli; app.cli.build_parser(); "
+    code = ("import sys, weft.app.cli, weft.core.batch, weft.app.batch_cli; weft.app.cli.build_parser(); "
             "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"

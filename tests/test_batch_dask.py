@@ -14,9 +14,9 @@ import pytest
 
 distributed = pytest.importorskip("distributed")
 
-from app.cli import main  # noqa: E402
-from core import batch  # noqa: E402
-from core.image import load_image, read_recipe  # noqa: E402
+from weft.app.cli import main  # noqa: E402
+from weft.core import batch  # noqa: E402
+from weft.core.image import load_image, read_recipe  # noqa: E402
 
 from .test_batch import make_frames, scene, slow_scene  # noqa: E402,F401  (fixtures)
 

@@ -12,7 +12,7 @@ from benchmarks.harness import markdown_table, prepare_inputs, run_case
 def test_cases_are_well_formed():
     names = [c.name for c in CASES]
     assert len(names) == len(set(names))
-    from core import registry
+    from weft.core import registry
 
     for c in CASES:
         method = registry.get(c.method)

@@ -7,8 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from app.cli import main
-from core.image import load_image, read_recipe, save_image
+from weft.app.cli import main
+from weft.core.image import load_image, read_recipe, save_image
 
 
 @pytest.fixture
@@ -162,7 +162,7 @@ def test_real_process_prints_one_line_and_no_traceback(tmp_path, texture_path, k
     if kind == "truncated":
         bad.write_bytes(texture_path.read_bytes()[:600])
     out_path = tmp_path / "out.png"
-    proc = subprocess.run([sys.executable, "-m", "app.cli", "quilt", str(bad), "-o", str(out_path)],
+    proc = subprocess.run([sys.executable, "-m", "weft.app.cli", "quilt", str(bad), "-o", str(out_path)],
                           capture_output=True, text=True)
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr and "input.png" in proc.stderr

@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from app.cli import main
+from weft.app.cli import main
 from benchmarks.fixtures.procedural import cells
-from core.examples import example
-from core.image import load_image, read_recipe, save_image
+from weft.core.examples import example
+from weft.core.image import load_image, read_recipe, save_image
 
 
 def run(argv, capsys):

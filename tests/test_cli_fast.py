@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from app.cli import main
-from core.examples import example
-from core.image import load_image, read_recipe
+from weft.app.cli import main
+from weft.core.examples import example
+from weft.core.image import load_image, read_recipe
 
 
 def run(argv, capsys):
@@ -47,7 +47,7 @@ def test_super_resolution_and_novel_style(tmp_path, capsys):
 
 
 def test_synthesis_with_size_and_mask(tmp_path, capsys):
-    from core.image import save_image
+    from weft.core.image import save_image
 
     mask = np.zeros((104, 104), np.float32)
     mask[:, 52:] = 1

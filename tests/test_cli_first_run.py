@@ -13,13 +13,13 @@ import threading
 import numpy as np
 import pytest
 
-import core._kernels  # noqa: F401  (the compile-event listener)
-from app import cli
-from app.cli import main
-from core import registry
-from core.image import save_image
-from core.jobs import Progress, ProgressReporter
-from core.registry import Result
+import weft.core._kernels  # noqa: F401  (the compile-event listener)
+from weft.app import cli
+from weft.app.cli import main
+from weft.core import registry
+from weft.core.image import save_image
+from weft.core.jobs import Progress, ProgressReporter
+from weft.core.registry import Result
 
 
 class TTY(io.StringIO):
@@ -167,7 +167,7 @@ def test_warm_up_command_for_real_in_processes(tmp_path):
     import sys
 
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    cmd = [sys.executable, "-c", "import sys; from app.cli import main; sys.exit(main(['warm-up', 'blend', 'rectify', '--jobs', '2']))"]
+    cmd = [sys.executable, "-c", "import sys; from weft.app.cli import main; sys.exit(main(['warm-up', 'blend', 'rectify', '--jobs', '2']))"]
     first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
     assert first.returncode == 0, first.stderr
     lines = first.stdout.splitlines()

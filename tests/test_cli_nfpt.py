@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli import main
-from core.examples import example
-from core.image import load_image, read_recipe
+from weft.app.cli import main
+from weft.core.examples import example
+from weft.core.image import load_image, read_recipe
 
 PHOTO = example("perspective")
 LINES = PHOTO.parent / "perspective-lines.json"
@@ -108,9 +108,9 @@ def test_recipe_finds_the_lines_file_from_any_folder(tmp_path, monkeypatch):
 
     import numpy as np
 
-    from app.cli import main
-    from core.examples import RESOURCES
-    from core.image import load_image, read_recipe
+    from weft.app.cli import main
+    from weft.core.examples import RESOURCES
+    from weft.core.image import load_image, read_recipe
 
     for name in ("perspective.png", "perspective-lines.json"):
         shutil.copy(RESOURCES / name, tmp_path / name)
@@ -130,9 +130,9 @@ def test_lines_given_as_json_text_on_the_command_line(tmp_path):
     """--lines also takes the JSON itself; the recipe keeps it as text (no file to find later)."""
     import json
 
-    from app.cli import main
-    from core.examples import RESOURCES
-    from core.image import read_recipe
+    from weft.app.cli import main
+    from weft.core.examples import RESOURCES
+    from weft.core.image import read_recipe
 
     text = (RESOURCES / "perspective-lines.json").read_text()
     out = tmp_path / "r.png"

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from app.cli import main
-from core.examples import example
-from core.image import load_image, read_recipe, save_image
+from weft.app.cli import main
+from weft.core.examples import example
+from weft.core.image import load_image, read_recipe, save_image
 
 
 @pytest.fixture

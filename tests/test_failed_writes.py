@@ -13,9 +13,9 @@ import os
 import numpy as np
 import pytest
 
-from app import cli
-from core.errors import ImageError
-from core.image import save_image
+from weft.app import cli
+from weft.core.errors import ImageError
+from weft.core.image import save_image
 from tests.data.make_corpus import make_corpus
 
 
@@ -34,7 +34,7 @@ def _full_disk(monkeypatch):
         os.close(fd)
         return open("/dev/full", mode, buffering=0)
 
-    monkeypatch.setattr("core.image.files.os.fdopen", to_dev_full)
+    monkeypatch.setattr("weft.core.image.files.os.fdopen", to_dev_full)
 
 
 def _read_only(folder, monkeypatch):
@@ -44,7 +44,7 @@ def _read_only(folder, monkeypatch):
 
     def denied(*_a, **_k):
         raise PermissionError(errno.EACCES, "Permission denied")
-    monkeypatch.setattr("core.image.files.tempfile.mkstemp", denied)
+    monkeypatch.setattr("weft.core.image.files.tempfile.mkstemp", denied)
 
 
 def _quilt(texture, out):

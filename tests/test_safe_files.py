@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.cli import main
-from app.gui.document import read_session
-from core.errors import WeftError
-from core.image import load_image, read_recipe, save_image
-from core.params import MAX_FILE_BYTES
+from weft.app.cli import main
+from weft.app.gui.document import read_session
+from weft.core.errors import WeftError
+from weft.core.image import load_image, read_recipe, save_image
+from weft.core.params import MAX_FILE_BYTES
 
 ROOT = Path(__file__).resolve().parents[1]
 UNSAFE_MODULES = {"pickle", "cPickle", "_pickle", "shelve", "marshal", "dill", "cloudpickle", "jsonpickle", "joblib",

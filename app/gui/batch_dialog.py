@@ -1,6 +1,6 @@
 """File > Apply to Folder…: the current result's recipe over every image of a folder.
 
-The dialog runs the same engine as ``weft batch`` (:mod:`core.batch`: a local process pool, outputs
+The dialog runs the same engine as ``weft batch`` (:mod:`weft.core.batch`: a local process pool, outputs
 byte for byte ``weft run`` on each item's recipe, written atomically, finished items skipped on a
 re-run) on a Python thread, never the GUI thread: progress, failures and time left arrive through
 queued signals, Cancel stops the batch between items (running ones at their next cancel check), and
@@ -35,10 +35,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from core import batch, registry
-from core.errors import WeftError
-from core.jobs import CancelToken
-from core.params import Recipe
+from weft.core import batch, registry
+from weft.core.errors import WeftError
+from weft.core.jobs import CancelToken
+from weft.core.params import Recipe
 
 DEFAULT_NAMES = "{stem}.png"
 OUTPUT_SUBFOLDER = "weft"

@@ -2,7 +2,7 @@
 
 Contract
 --------
-* Built from the document and the current method's studio description (``core.studio``) only: the
+* Built from the document and the current method's studio description (``weft.core.studio``) only: the
   canvas input in the large view on top, the other inputs (and a lines tool's frontal frame) in tabs
   below. It knows no method, input or parameter by name.
 * It reads the document and changes it only through the tools (``Document.set_geometry`` /
@@ -18,7 +18,7 @@ from __future__ import annotations
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QLabel, QSizePolicy, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout, QWidget
 
-from core.studio import LINES, SQUARE
+from weft.core.studio import LINES, SQUARE
 
 from .lines_panel import FeatureLinesPanel
 from .tools import PatchTool, QuadTool, Tool

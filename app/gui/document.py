@@ -19,19 +19,19 @@ import numpy as np
 from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoCommand, QUndoStack
 
-from core import registry
-from core.errors import WeftError
-from core.geometry import LINES, SQUARE, LineDraft, Square
-from core.params import Params, Recipe, relative_path
-from core.session import SESSION_VERSION, read_session  # noqa: F401 (read_session: the studio reads sessions)
-from core.studio import Geometry, Studio
+from weft.core import registry
+from weft.core.errors import WeftError
+from weft.core.geometry import LINES, SQUARE, LineDraft, Square
+from weft.core.params import Params, Recipe, relative_path
+from weft.core.session import SESSION_VERSION, read_session  # noqa: F401 (read_session: the studio reads sessions)
+from weft.core.studio import Geometry, Studio
 
 _MERGE_PARAM = 1001
 
 
 @dataclass(frozen=True)
 class InputImage:
-    """An input picture: where it came from and its pixels (float32, as ``core.image.load_image``)."""
+    """An input picture: where it came from and its pixels (float32, as ``weft.core.image.load_image``)."""
 
     path: str | None
     image: np.ndarray
@@ -41,7 +41,7 @@ class InputImage:
 class DocumentState:
     """A whole document at once, for :meth:`Document.restore` (sessions, crash recovery, the bundled
     examples, screenshots, benchmarks). ``geometry`` maps method -> geometry key -> typed value
-    (:class:`~core.geometry.Square`, :class:`~core.geometry.LineDraft`); what is not given is empty
+    (:class:`~weft.core.geometry.Square`, :class:`~weft.core.geometry.LineDraft`); what is not given is empty
     or default."""
 
     inputs: dict[str, InputImage] = field(default_factory=dict)
@@ -279,7 +279,7 @@ class Document(QObject):
         }
 
     def save_session(self, path: str | Path) -> None:
-        from core.image import atomic_write_bytes
+        from weft.core.image import atomic_write_bytes
 
         path = Path(path)
         text = json.dumps(self.session_dict(relative_to=path.resolve().parent), indent=1)

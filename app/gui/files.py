@@ -18,10 +18,10 @@ from typing import Callable, TypeVar
 from PySide6.QtCore import QEventLoop, QMetaObject, QObject, QStandardPaths, Qt, QTimer
 from PySide6.QtWidgets import QFileDialog
 
-from core import registry
-from core.errors import WeftError
-from core.studio import SQUARE
-from core.image import atomic_write_bytes, load_image, save_image
+from weft.core import registry
+from weft.core.errors import WeftError
+from weft.core.studio import SQUARE
+from weft.core.image import atomic_write_bytes, load_image, save_image
 
 from .document import DocumentState, InputImage, read_session
 

@@ -15,8 +15,8 @@ import numpy as np
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QFileDialog, QHBoxLayout, QLabel, QPushButton, QSizePolicy, QSpinBox, QVBoxLayout, QWidget
 
-from core.errors import WeftError
-from core.jobs import JobResult, JobRunner
+from weft.core.errors import WeftError
+from weft.core.jobs import JobResult, JobRunner
 
 from .tools import LineTool, QuadTool
 from .views import ImageView
@@ -120,7 +120,7 @@ class FeatureLinesPanel(QWidget):
             self.rectify_status.setText("draw line pairs: line i on the photo, line i here")
             return
         if self._rectifier is None:
-            from core.rectify import Rectifier
+            from weft.core.rectify import Rectifier
 
             self._rectifier = Rectifier(photo, interpolation="linear")
         rectifier, size = self._rectifier, self.doc.frontal_size
@@ -146,7 +146,7 @@ class FeatureLinesPanel(QWidget):
             self.load_lines(path)
 
     def load_lines(self, path: str) -> bool:
-        from core.rectify import load_feature_lines
+        from weft.core.rectify import load_feature_lines
 
         try:
             fl = load_feature_lines(path)
@@ -163,7 +163,7 @@ class FeatureLinesPanel(QWidget):
             self.save_lines(path)
 
     def save_lines(self, path: str) -> bool:
-        from core.image import atomic_write_bytes
+        from weft.core.image import atomic_write_bytes
 
         lines = self.doc.lines.complete()
         if lines is None:

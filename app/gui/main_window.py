@@ -1,16 +1,16 @@
 """The weft studio's main window: it assembles a few parts, each with a written contract.
 
-* :class:`~app.gui.document.Document`: the state (inputs, method, parameters and geometry per
+* :class:`~weft.app.gui.document.Document`: the state (inputs, method, parameters and geometry per
   method, seed); every edit an undo command.
-* :class:`~app.gui.canvas.InputsPane` (left): the method's inputs, the canvas on top, with the
+* :class:`~weft.app.gui.canvas.InputsPane` (left): the method's inputs, the canvas on top, with the
   tool of each geometry.
-* :class:`~app.gui.method_panel.MethodPanel` (dock): method list, parameters, seed, buttons.
-* :class:`~app.gui.render.Renderer`: preview and final jobs on the worker pool; a result carries
+* :class:`~weft.app.gui.method_panel.MethodPanel` (dock): method list, parameters, seed, buttons.
+* :class:`~weft.app.gui.render.Renderer`: preview and final jobs on the worker pool; a result carries
   its recipe.
-* :class:`~app.gui.files.FileActions`: export, recipes, sessions, autosave and recovery.
+* :class:`~weft.app.gui.files.FileActions`: export, recipes, sessions, autosave and recovery.
 
 The window wires them (document changes -> parts; results -> result view, status bar) and holds the
-menus. Everything method-specific comes from the methods' studio descriptions (``core.studio``).
+menus. Everything method-specific comes from the methods' studio descriptions (``weft.core.studio``).
 """
 
 from __future__ import annotations
@@ -34,10 +34,10 @@ from PySide6.QtWidgets import (
     QSplitter,
 )
 
-from core.errors import WeftError
-from core.examples import example, examples
-from core.image import load_image
-from core.jobs import JobRunner
+from weft.core.errors import WeftError
+from weft.core.examples import example, examples
+from weft.core.image import load_image
+from weft.core.jobs import JobRunner
 
 from .canvas import InputsPane, titled
 from .document import Document, DocumentState, InputImage

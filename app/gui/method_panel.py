@@ -2,7 +2,7 @@
 
 Contract
 --------
-* Built from ``core.registry.studio_methods()`` and the current method's ``Params`` specs and studio
+* Built from ``weft.core.registry.studio_methods()`` and the current method's ``Params`` specs and studio
   description; it names no method, input or parameter.
 * It changes the document only through its setters (``set_method``, ``set_param``, ``set_seed``) and
   shows the document after each ``changed`` through :meth:`show_method`, :meth:`show_params`,
@@ -30,8 +30,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from core.errors import WeftError
-from core.studio import SQUARE
+from weft.core.errors import WeftError
+from weft.core.studio import SQUARE
 
 from .convert import to_qimage
 from .params_panel import ParamsPanel

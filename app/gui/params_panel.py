@@ -25,7 +25,7 @@ from PySide6.QtWidgets import (
 )
 from superqt import QLabeledDoubleSlider, QLabeledSlider
 
-from core.params import BOOL, CHOICE, FLOAT, INT, SIZE, Params, Spec, specs
+from weft.core.params import BOOL, CHOICE, FLOAT, INT, SIZE, Params, Spec, specs
 
 
 class _Row(QWidget):

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
-from core import registry
-from core.jobs import JobResult, JobRunner, Progress
-from core.params import Params, Recipe
-from core.studio import reduce_for_preview
+from weft.core import registry
+from weft.core.jobs import JobResult, JobRunner, Progress
+from weft.core.params import Params, Recipe
+from weft.core.studio import reduce_for_preview
 
 PREVIEW_SIDE = 400
 PROGRESS_DELAY_MS = 300

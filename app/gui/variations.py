@@ -22,10 +22,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from core.errors import WeftError
-from core.jobs import JobResult, JobRunner
-from core.params import FLOAT, INT, specs
-from core.studio import reduce_for_preview
+from weft.core.errors import WeftError
+from weft.core.jobs import JobResult, JobRunner
+from weft.core.params import FLOAT, INT, specs
+from weft.core.studio import reduce_for_preview
 
 from .convert import to_qimage
 

@@ -2,7 +2,7 @@
 
 ``ImageView`` shows one float image. Wheel zooms under the cursor; middle-drag, or left-drag with
 Space held (or with no tool active), pans; ``fit()`` and ``actual_size()`` reset the zoom. A *tool*
-(``app.gui.tools``) may be attached: it receives the left-button events in image coordinates and
+(``weft.app.gui.tools``) may be attached: it receives the left-button events in image coordinates and
 draws its overlay items in the view's scene. ``ResultView`` adds a before/after split.
 """
 

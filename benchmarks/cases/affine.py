@@ -1,4 +1,4 @@
-"""Benchmark cases of the affine prototype model (``core.affine``, Smith & Bhalerao).
+"""Benchmark cases of the affine prototype model (``weft.core.affine``, Smith & Bhalerao).
 
 The harness decodes bundled examples only, so the timed run of every case is a bundled picture
 (brick, enlarged to 512x512 where the target is about 512²). The procedural textures the paper's
@@ -17,7 +17,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from core.metrics import snr_db
+from weft.core.metrics import snr_db
 
 from .base import Case, Input
 
@@ -43,8 +43,8 @@ def _procedural(name: str, **kw) -> np.ndarray:
 
 def _procedural_figures(name: str):
     def figures(inputs, out):
-        from core.affine import synthesize
-        from core.affine.model import decompose
+        from weft.core.affine import synthesize
+        from weft.core.affine.model import decompose
 
         tex = _procedural(name)
         s, img = _median_time(lambda: synthesize(tex))
@@ -66,7 +66,7 @@ def _procedural_figures(name: str):
 
 def _brick_figures(inputs, out):
     """The paper-only pipeline on the same input, for comparison."""
-    from core.affine import synthesize
+    from weft.core.affine import synthesize
 
     tex = inputs["texture"]
     s, paper = _median_time(lambda: synthesize(tex, **PAPER))
@@ -75,7 +75,7 @@ def _brick_figures(inputs, out):
 
 def _shaker_figures(inputs, out):
     """The shaker box alone (20 iterations at most, forced schedule) on the analysed texture."""
-    from core.affine import analyse, match_boundaries
+    from weft.core.affine import analyse, match_boundaries
 
     model = analyse(inputs["texture"])
     s, (matched, rep) = _median_time(lambda: match_boundaries(model, "shaker", iterations=20, rng=1))
@@ -88,7 +88,7 @@ def _shaker_figures(inputs, out):
 def _rerender_figures(inputs, out):
     """The GUI's live preview with "reuse transforms": render the analysed model with the
     prototype square moved by the mouse (a new prototype cut out each time), median of 25."""
-    from core.affine import analyse, make_prototype, render
+    from weft.core.affine import analyse, make_prototype, render
 
     tex = inputs["texture"]
     model = analyse(tex)

@@ -2,7 +2,7 @@
 
 An input is ``Input(example, crop=(x, y, w, h) | None, resize=(w, h) | None, grey=False)`` over a
 bundled example of ``resources/``, or over ``skimage.data``'s image NAME with ``example="skimage:NAME"``
-(the peers' inputs, rebuilt exactly). ``metrics`` names the figures of ``core.metrics`` to compute on
+(the peers' inputs, rebuilt exactly). ``metrics`` names the figures of ``weft.core.metrics`` to compute on
 the output: ``coherence`` / ``completeness`` against the ``texture`` input, ``fidelity`` against the
 ``target`` input, ``snr_db`` against the ``texture`` input. ``gmic`` is a G'MIC command line run on
 the texture input in the same run (whole process against whole ``weft`` process) when ``gmic`` is

@@ -1,10 +1,10 @@
-"""Benchmark cases of fast texture transfer (``core.fast``)."""
+"""Benchmark cases of fast texture transfer (``weft.core.fast``)."""
 
 from __future__ import annotations
 
-from core.examples import example
-from core.image import load_image, resize
-from core.metrics import psnr_db
+from weft.core.examples import example
+from weft.core.image import load_image, resize
+from weft.core.metrics import psnr_db
 
 from .base import Case, Input
 

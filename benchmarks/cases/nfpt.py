@@ -1,4 +1,4 @@
-"""Benchmark cases of rectification (``core.rectify``) and NFPT synthesis (``core.nfpt``).
+"""Benchmark cases of rectification (``weft.core.rectify``) and NFPT synthesis (``weft.core.nfpt``).
 
 The figures of the rectification case come from the synthetic known-geometry case of
 :func:`benchmarks.fixtures.synthetic.perspective_case` (gravel enlarged to 400x300, photographed at
@@ -16,9 +16,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from core.examples import RESOURCES, example
-from core.image import load_image, resize
-from core.metrics import coherence, completeness, psnr_db
+from weft.core.examples import RESOURCES, example
+from weft.core.image import load_image, resize
+from weft.core.metrics import coherence, completeness, psnr_db
 
 from .base import Case, Input
 
@@ -43,7 +43,7 @@ def _interior(img: np.ndarray, frac: float = 0.05) -> np.ndarray:
 @lru_cache(maxsize=1)
 def synthetic_accuracy() -> dict[str, float]:
     """Accuracy (and the time of the fit + warp alone) on the synthetic known-geometry case."""
-    from core.rectify import Rectifier, apply_homography
+    from weft.core.rectify import Rectifier, apply_homography
     from benchmarks.fixtures.synthetic import perspective_case
 
     frontal = resize(load_image(example("gravel")).image, (400, 300), interpolation="cubic")
@@ -74,7 +74,7 @@ def _rectify_figures(inputs, out):
 
 @lru_cache(maxsize=1)
 def _rectified_wall() -> np.ndarray:
-    from core.rectify import rectify_feature_lines
+    from weft.core.rectify import rectify_feature_lines
 
     return rectify_feature_lines(load_image(example("perspective")).image, str(LINES)).image
 

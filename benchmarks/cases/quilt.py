@@ -1,4 +1,4 @@
-"""Benchmark cases of image quilting (``core.quilting``).
+"""Benchmark cases of image quilting (``weft.core.quilting``).
 
 The ``quilt-t1-*`` and ``quilt-t2-*`` cases use the peers' own inputs (issue 17), rebuilt from
 scikit-image's data: ``brick_128`` = ``brick()[0:256, 256:512]`` box-downscaled 2x, ``gravel_128``
@@ -21,9 +21,9 @@ T1_SEEDS = range(10)
 
 def t1_over_seeds(inputs, out, seeds=T1_SEEDS, size=(512, 512)) -> dict[str, float]:
     """T1's figures over ``seeds``: the median and worst coherence and completeness, and the
-    largest verbatim region (``core.metrics.verbatim_fraction``) of any seed."""
-    from core.metrics import coherence, completeness
-    from core.quilting import METHOD, QuiltParams
+    largest verbatim region (``weft.core.metrics.verbatim_fraction``) of any seed."""
+    from weft.core.metrics import coherence, completeness
+    from weft.core.quilting import METHOD, QuiltParams
 
     tex = inputs["texture"]
     coh, comp, verb = [], [], []

@@ -13,13 +13,13 @@ reports compilations; it is the only place that knows about numba's caching mach
   loading a planted one would run its code). The user-wide and the temporary folder are seeded
   from the package's own ``__pycache__`` (what ``weft warm-up`` wrote there at install time), so a
   read-only install that was warmed up stays warm for every user. If even that fails, the kernels are compiled without a
-  cache (every run pays the compile) and :func:`core.registry.kernel_cache_notice` says so in one
+  cache (every run pays the compile) and :func:`weft.core.registry.kernel_cache_notice` says so in one
   line for the front ends to show.
 * **Safe concurrent saves.** numba's cache saves a new signature by rewriting the function's index
   and a numbered data file, without a lock; weft takes a file lock around each save (POSIX), so
   processes compiling at once (``weft warm-up``'s workers) cannot cross their files.
 * **Compile events.** numba announces every real compilation (a cache miss, never a cache load) as
-  a ``numba:compile`` event; we forward their start and end to :mod:`core.registry`, which lets a
+  a ``numba:compile`` event; we forward their start and end to :mod:`weft.core.registry`, which lets a
   front end say "preparing ... — first run only" exactly while a compile happens, and leave the
   compile out of a render's time.
 """

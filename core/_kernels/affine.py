@@ -1,4 +1,4 @@
-"""numba kernels of the affine prototype model (``core.affine``, Smith & Bhalerao).
+"""numba kernels of the affine prototype model (``weft.core.affine``, Smith & Bhalerao).
 
 Every kernel takes all its arrays as arguments, allocates at most small per-call buffers, and
 releases the GIL (``nogil=True``), so two jobs use two cores. Coordinates are ``(y, x)`` row-major
@@ -8,7 +8,7 @@ prototype (the *sampling* matrix ``M = T^-1`` of the paper's eq. 1 and 22).
 Layout
 ------
 proto      (Sp, Sp) or (Sp, Sp, C) f32   the prototype patch (S x S) padded by mirroring
-                                         (reflect-101) on every side (``core.affine`` pads by S);
+                                         (reflect-101) on every side (``weft.core.affine`` pads by S);
                                          sampled bilinearly, coordinates clamped to the padded
                                          array (so no branch in the inner loops)
 cy, cx     float                         the prototype's centre in the padded array
@@ -522,7 +522,7 @@ def lk_systems(proto, gy, gx, cy, cx, params, targets, weights, JtJ, Jtr, err):
     """The refinement's error and normal equations for every patch i at ``params[i]`` =
     (M00, M01, M10, M11, offset y, offset x, gain): the residual is
     ``w (g P(c + M y + o) - s_t)`` over the patch (an addition to the paper, see
-    ``core.affine.analysis``); the Levenberg-Marquardt steps are taken by the caller."""
+    ``weft.core.affine.analysis``); the Levenberg-Marquardt steps are taken by the caller."""
     for i in range(params.shape[0]):
         err[i] = _lk_system(proto, gy, gx, cy, cx, params[i], params[i, 4], params[i, 5], params[i, 6],
                             targets[i], weights[i], JtJ[i], Jtr[i])

@@ -1,4 +1,4 @@
-"""numba kernel of Ashikhmin's coherent synthesis / fast texture transfer (``core.fast``).
+"""numba kernel of Ashikhmin's coherent synthesis / fast texture transfer (``weft.core.fast``).
 
 One call synthesizes a band of rows ``[y0, y1)`` of the result in scan-line order, so the Python
 side can report progress and honour cancellation between bands. Everything the kernel needs is an
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-METRIC_FULL = 0  # the codes of core.fast.METRICS
+METRIC_FULL = 0  # the codes of weft.core.fast.METRICS
 METRIC_TARGET = 1
 METRIC_ARTISTIC = 2
 

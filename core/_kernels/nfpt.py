@@ -1,5 +1,5 @@
-"""numba kernels of the NFPT method (``core.nfpt``); its field morph is ``core._kernels.warps``
-and its seams ``core._kernels.seams``.
+"""numba kernels of the NFPT method (``weft.core.nfpt``); its field morph is ``weft.core._kernels.warps``
+and its seams ``weft.core._kernels.seams``.
 
 * :func:`l_template` -- the feature-weighted template of one patch's L-shaped neighbourhood (eqs.
   1-3 of Yan, Lee & Lin): writes the weights and weighted pixels into zero-padded FFT buffers.

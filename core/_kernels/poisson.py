@@ -1,5 +1,5 @@
-"""numba kernel of the Poisson solve shared by ``core.blending.poisson_blend`` and quilting's
-Poisson seam band (``core._kernels.quilting``).
+"""numba kernel of the Poisson solve shared by ``weft.core.blending.poisson_blend`` and quilting's
+Poisson seam band (``weft.core._kernels.quilting``).
 
 * :func:`poisson_cg` -- a conjugate-gradient solve of the discrete Poisson equation on an arbitrary
   set of pixels (matrix-free, 4-neighbours, Dirichlet values from the image, Neumann at invalid

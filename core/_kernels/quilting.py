@@ -1,11 +1,11 @@
-"""numba kernels of image quilting (``core.quilting``).
+"""numba kernels of image quilting (``weft.core.quilting``).
 
 * :func:`choose_best`, :func:`choose_tol`, :func:`choose_epsilon`, :func:`choose_sampled` -- the
   source position of one block from the SSD map of every position, one kernel per selection rule.
 * :func:`block_error` -- the error surface of one block's overlap, which the engine cuts with
-  ``core._kernels.seams.cut_mask``; :func:`place_block` -- paste the block where the cut says.
+  ``weft.core._kernels.seams.cut_mask``; :func:`place_block` -- paste the block where the cut says.
 * :func:`poisson_band` -- Poisson-blend a band around the seam of the block just placed
-  (``core._kernels.poisson.poisson_cg``).
+  (``weft.core._kernels.poisson.poisson_cg``).
 * :func:`make_template` -- writes the correlation templates of one block (the overlap, the previous
   iteration and the correspondence terms) into the zero-padded FFT buffers.
 
@@ -281,7 +281,7 @@ def make_template(canvas, prev, corr_t, y0, x0, bsz, top, left, right, bottom, w
 
 @njit(cache=True, nogil=True)
 def block_error(canvas, filled, tex, iparams, err):
-    """The input of the minimum-error cut (``core._kernels.seams.cut_mask``) of one block:
+    """The input of the minimum-error cut (``weft.core._kernels.seams.cut_mask``) of one block:
     ``err[by, bx]`` = the squared difference, summed over channels, between the canvas and the
     source block at (P_SY, P_SX) on the block's overlap strips where the canvas is filled, else 0.
 

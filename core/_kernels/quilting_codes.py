@@ -1,6 +1,6 @@
 """Indices and codes of the quilting kernel's parameter array, in a module without numba.
 
-``core._kernels.quilting`` (numba) and the numpy engine of ``core.quilting.engine`` both read them
+``weft.core._kernels.quilting`` (numba) and the numpy engine of ``weft.core.quilting.engine`` both read them
 from here, so a small synthesis can run without importing numba and the two cannot disagree.
 """
 

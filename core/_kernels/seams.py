@@ -1,4 +1,4 @@
-"""numba kernel of the minimum-error boundary cut (``core.seams``), shared by quilting's
+"""numba kernel of the minimum-error boundary cut (``weft.core.seams``), shared by quilting's
 ``place_block`` and the NFPT synthesis.
 
 * :func:`cut_mask` -- the cut of one block: dynamic programming over the overlap strips, the

@@ -1,5 +1,5 @@
 """numba kernel of the Beier-Neely feature-based field morph, shared by the rectification warps
-(``core.rectify.warps``: field morph and view morphing) and the NFPT method that uses them.
+(``weft.core.rectify.warps``: field morph and view morphing) and the NFPT method that uses them.
 
 * :func:`field_map` -- the morph as a backward map: for every destination pixel, where to sample
   the source; optionally behind a pre-homography and before a post-homography (the pre-warp and

@@ -6,18 +6,18 @@ B/2), an affine transform and an intensity factor that map the prototype onto it
 per section of the paper:
 
 ==========================  =====================================================================
-§2.1 centroids              :func:`centroids` (:mod:`core.affine.spectral`)
-§2.2 linear transforms      :func:`candidate_transforms` (:mod:`core.affine.transforms`)
+§2.1 centroids              :func:`centroids` (:mod:`weft.core.affine.spectral`)
+§2.2 linear transforms      :func:`candidate_transforms` (:mod:`weft.core.affine.transforms`)
 §2.3 translation            :func:`correlate_shifts`
-§2.4 best transform         :func:`analyse` (:mod:`core.affine.analysis`)
+§2.4 best transform         :func:`analyse` (:mod:`weft.core.affine.analysis`)
 §3.1 cos² windows           :func:`cos2_window`
 §3.2 intensity factors      :func:`analyse`
-§3 synthesis               :func:`render` (:mod:`core.affine.synthesis`), :class:`Grid`
-§3.3 lowpass (add/absorb)   :func:`lowpass`, :func:`decompose` (:mod:`core.affine.model`)
+§3 synthesis               :func:`render` (:mod:`weft.core.affine.synthesis`), :class:`Grid`
+§3.3 lowpass (add/absorb)   :func:`lowpass`, :func:`decompose` (:mod:`weft.core.affine.model`)
 §3.4 colour (YUV/PCA)       :func:`decompose`, :func:`make_prototype`
 §4 transfer                 ``analyse(prototype_image=...)``; :func:`render` with another prototype
 §4 boundary matching        :func:`match_boundaries` (partial correlation, shaker box)
-Fig. 6 parametric fields    :func:`field_model` (:mod:`core.affine.fields`)
+Fig. 6 parametric fields    :func:`field_model` (:mod:`weft.core.affine.fields`)
 ==========================  =====================================================================
 
 :func:`synthesize` does it all in one call with the parameters of ``weft affine``
@@ -26,9 +26,9 @@ call :func:`render` with each new prototype (``reuse transforms``).
 
 Example
 -------
->>> from core.affine import analyse, render, make_prototype
->>> from core.examples import example
->>> from core.image import load_image
+>>> from weft.core.affine import analyse, render, make_prototype
+>>> from weft.core.examples import example
+>>> from weft.core.image import load_image
 >>> tex = load_image(example("brick")).image[:128, :128]
 >>> model = analyse(tex, prototype=(32, 32, 64), block=32)
 >>> out = render(model)                                   # the synthesis

@@ -60,7 +60,7 @@ def analyse(
         The image to model (a texture, or any picture for a transfer onto it, §4).
     prototype : (x, y, s), "X,Y,S" or Prototype, optional
         The prototype square in ``prototype_image`` (or in the texture); default a 2B square in
-        the middle (:func:`~core.affine.params.default_rect`). A :class:`Prototype` is used as is.
+        the middle (:func:`~weft.core.affine.params.default_rect`). A :class:`Prototype` is used as is.
     prototype_image : float32 image, optional
         Another picture to take the prototype from: texture transfer with transforms computed for
         the new prototype (§4).

@@ -50,9 +50,9 @@ def synthesize(
 ) -> np.ndarray:
     """Synthesis and texture transfer with the affine prototype model (Smith & Bhalerao).
 
-    One call = :func:`~core.affine.analyse` (or a parametric field), optional boundary matching
-    (:func:`~core.affine.match_boundaries`) and :func:`~core.affine.render`. Parameters are those
-    of :class:`~core.affine.AffineParams` (same names, ranges and defaults as ``weft affine``).
+    One call = :func:`~weft.core.affine.analyse` (or a parametric field), optional boundary matching
+    (:func:`~weft.core.affine.match_boundaries`) and :func:`~weft.core.affine.render`. Parameters are those
+    of :class:`~weft.core.affine.AffineParams` (same names, ranges and defaults as ``weft affine``).
 
     Parameters
     ----------
@@ -68,7 +68,7 @@ def synthesize(
     segments : even int, 4..128, default 32
         N, angular segments of the centroid estimation (§2.1).
     lowpass : {"add", "absorb"}, default "add"
-        §3.3 and §3.4 (see :func:`~core.affine.analyse`).
+        §3.3 and §3.4 (see :func:`~weft.core.affine.analyse`).
     colour : {"pca", "yuv"}, default "pca"
         Grey channel of colour images (§3.4).
     propagate : bool, default True
@@ -82,7 +82,7 @@ def synthesize(
     boundary : {"auto", "none", "partial", "shaker"}, default "auto"
         Boundary matching (§4); auto = shaker with a field, none otherwise.
     iterations, per_radius, shaker_start
-        Shaker box schedule (see :func:`~core.affine.match_boundaries`).
+        Shaker box schedule (see :func:`~weft.core.affine.match_boundaries`).
     field : {"none", "swirl", "zoom", "rotate"}, default "none"
         Synthesize from a parametric transform field instead (Fig. 6); ``field_strength`` 0..2
         scales it; ``size`` (width, height) is the output size (default the texture's).

@@ -69,7 +69,7 @@ def decompose(image: np.ndarray, block: int, colour: str = "pca", *, need_chroma
     colour : {"pca", "yuv"}, default "pca"
         ``pca``: grey = the first principal component of the image's colours (offset by the mean's
         projection, so it reads as brightness), chroma = the other two components; ``yuv``:
-        grey = Y, chroma = I and Q of YIQ (weft's YUV-family space, as in ``core.image``). Grey
+        grey = Y, chroma = I and Q of YIQ (weft's YUV-family space, as in ``weft.core.image``). Grey
         images pass through.
     need_chroma : bool, default True
         Compute the lowpassed chroma (``add`` keeps it; ``absorb`` does not need it).
@@ -154,7 +154,7 @@ def make_prototype(image: np.ndarray, rect: Rect | str | None = None, *, block: 
     image : float32 (H, W) or (H, W, 3) in [0, 1]
         The image it is taken from (the texture, or another picture for a transfer, §4).
     rect : (x, y, s) or "X,Y,S", optional
-        The square; default :func:`~core.affine.params.default_rect` (a 2B square in the middle).
+        The square; default :func:`~weft.core.affine.params.default_rect` (a 2B square in the middle).
     block : int, default 32
         B, which sets the lowpass (σ = B/4) the highpass is taken against.
     colour : {"pca", "yuv"}

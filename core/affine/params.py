@@ -1,4 +1,4 @@
-"""Parameters of the affine prototype model; the prototype square (:class:`core.geometry.Square`)."""
+"""Parameters of the affine prototype model; the prototype square (:class:`weft.core.geometry.Square`)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ def check_rect(rect: Rect, shape: tuple[int, ...], what: str = "texture", name: 
     Parameters
     ----------
     rect : (x, y, s)
-        A :class:`~core.geometry.Square` (or any ``(x, y, side)``).
+        A :class:`~weft.core.geometry.Square` (or any ``(x, y, side)``).
     shape : tuple
         The image's shape (H, W[, C]).
     what, name : str

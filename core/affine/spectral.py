@@ -200,7 +200,7 @@ def centroid_pairs(M: np.ndarray, f1: np.ndarray, f2: np.ndarray) -> Centroids:
     with no energy makes that split invalid (its variance is undefined). Ambiguity resolved here:
     when no split is valid (a flat patch, or one whose energy falls in a single segment), μ1 is the
     centroid of the whole half-plane and μ2 is μ1 turned by 90°, flagged ``degenerate`` (a zero
-    vector for an empty spectrum); :func:`core.affine.transforms.candidate_transforms` then
+    vector for an empty spectrum); :func:`weft.core.affine.transforms.candidate_transforms` then
     treats the pair as a similarity frame.
     """
     M = np.atleast_2d(np.asarray(M, dtype=np.float64))

@@ -1,6 +1,6 @@
 """Rendering with the affine prototype model (Smith & Bhalerao §3, §4).
 
-:func:`~core.affine.analysis.analyse` models a texture as one prototype patch and, for every
+:func:`~weft.core.affine.analysis.analyse` models a texture as one prototype patch and, for every
 target patch, the affine transform (linear part, translation) and intensity factor that best map
 the prototype onto it (§2); :func:`render` draws a model with its prototype or with another one
 (a prototype swap, §4). Keeping the two apart is what makes a live re-render possible when the
@@ -84,7 +84,7 @@ def render(model: AffineModel, prototype: Prototype | np.ndarray | None = None, 
     Parameters
     ----------
     model : AffineModel
-        From :func:`analyse` (or :func:`~core.affine.fields.field_model`, or after boundary matching).
+        From :func:`analyse` (or :func:`~weft.core.affine.fields.field_model`, or after boundary matching).
     prototype : Prototype, float32 (S, S) / (S, S, 3) patch, or None
         The prototype to draw; None = the model's. A bare patch is split into grey/highpass with
         its own lowpass (:func:`prototype_from_patch`); use :func:`make_prototype` to cut one out

@@ -2,7 +2,7 @@
 
 Loading reads the header with Pillow (lazy, no pixels) to check the pixel limit, then decodes with
 OpenCV from bytes (non-ASCII paths work) and falls back to Pillow for what OpenCV cannot decode.
-Every failure is an :class:`~core.errors.ImageError` whose message is one line starting with the path.
+Every failure is an :class:`~weft.core.errors.ImageError` whose message is one line starting with the path.
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
 """NFPT: patch-based synthesis for non-frontal-parallel textures (Yan, Lee & Lin).
 
 The pipeline of Fig. 2: a photo of a texture seen at an angle (I_0) is rectified from feature lines
-(:mod:`core.rectify`, §3) into a frontal texture I_r; a larger texture I_s is synthesized from it
+(:mod:`weft.core.rectify`, §3) into a frontal texture I_r; a larger texture I_s is synthesized from it
 patch by patch with the feature-weighted similarity and seam repair of §2
-(:mod:`core.nfpt.synthesis`); optionally I_s is put back into a chosen view (a quad or feature
+(:mod:`weft.core.nfpt.synthesis`); optionally I_s is put back into a chosen view (a quad or feature
 lines, Fig. 2b) or into the photo itself, replacing the textured plane with a larger one.
 
 Python API: :func:`synthesize` (§2 alone, any frontal texture), :func:`nfpt` (the whole pipeline).

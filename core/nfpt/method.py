@@ -121,7 +121,7 @@ def synthesize(
         Progress callback, once per patch row (preview: the partial result) and once for the repair;
         cancel token, checked before every patch row and 16 times during the repair.
     return_details : bool, default False
-        Return a :class:`~core.nfpt.synthesis.Synthesis` (image, patches, repaired pixel count, source
+        Return a :class:`~weft.core.nfpt.synthesis.Synthesis` (image, patches, repaired pixel count, source
         positions, repaired mask) instead of the image.
 
     Returns
@@ -131,7 +131,7 @@ def synthesize(
     Notes
     -----
     Eqs. 1-3 and steps 1-7 of §2; the choices where the paper is silent are listed in
-    :mod:`core.nfpt.synthesis` (luminance P_diff, units and sigmas, |P - M|, the tol rule, the
+    :mod:`weft.core.nfpt.synthesis` (luminance P_diff, units and sigmas, |P - M|, the tol rule, the
     mismatch test, coherent repair candidates).
     """
     params = NfptParams(size=size, block=block, overlap=overlap, sigma_d=sigma_d, sigma_s=sigma_s, tol=tol,
@@ -147,7 +147,7 @@ SELECT_SECONDS_PER_POSITION = 1e-9
 
 
 def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], block: int, overlap: int) -> float:
-    """Estimated running time of the patch synthesis on the 2-core reference machine (:mod:`core.limits`).
+    """Estimated running time of the patch synthesis on the 2-core reference machine (:mod:`weft.core.limits`).
 
     Every patch but the first costs three DFTs of the padded source luminance (eqs. 1-3 for all
     positions at once: two spectra of the weighted template and the inverse) and a choice over every
@@ -221,17 +221,17 @@ def nfpt(
     photo : float32 (H, W) or (H, W, 3) in [0, 1]
         I_0, the texture photographed at an angle.
     lines : FeatureLines, str or None
-        Feature lines (:class:`core.rectify.FeatureLines`, or a JSON file name / JSON text). None:
+        Feature lines (:class:`weft.core.rectify.FeatureLines`, or a JSON file name / JSON text). None:
         the photo is frontal already and is synthesized as it is.
     view : View, str or None
-        Put the synthesized texture into this view (:mod:`core.rectify.view`: a quad or line pairs,
+        Put the synthesized texture into this view (:mod:`weft.core.rectify.view`: a quad or line pairs,
         in the synthesized texture's pixel coordinates); the output has the view's size (default
         the photo's), black where the texture does not reach.
     into_photo : bool, default False
         Put the synthesized texture back into the photo over the rectified plane, centred on the
         frontal frame, so a larger texture extends the plane (needs ``lines``).
     warp, a, b, p
-        Rectification (and re-projection) warp; see :func:`core.rectify.rectify`.
+        Rectification (and re-projection) warp; see :func:`weft.core.rectify.rectify`.
     rng, progress, cancel
         As :func:`synthesize`; progress stages "rectify", "nfpt synthesis", "re-project".
     **synthesis
@@ -245,7 +245,7 @@ def nfpt(
     Raises
     ------
     GeometryError
-        Bad feature lines or view (see :func:`core.rectify.rectify`); ``into_photo`` without lines.
+        Bad feature lines or view (see :func:`weft.core.rectify.rectify`); ``into_photo`` without lines.
     """
     params = NfptParams(warp=warp, a=a, b=b, p=p, into_photo=into_photo, **synthesis)
     return _nfpt(photo, lines, view, params, rng=rng, progress=progress, cancel=cancel)
@@ -320,7 +320,7 @@ def _run(inputs: Mapping[str, np.ndarray], params: NfptParams, *, rng=None, prog
 
 def warm_up() -> None:
     """Load (or compile) every kernel a run can use, on a tiny input: template, selection, repair,
-    seams, and the Beier-Neely field morph of ``--warp lines``/``morph`` (``core.rectify``'s)."""
+    seams, and the Beier-Neely field morph of ``--warp lines``/``morph`` (``weft.core.rectify``'s)."""
     from .. import rectify
 
     rectify.warm_up()

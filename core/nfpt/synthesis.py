@@ -7,7 +7,7 @@
    ``Sim = sum_L P_diff (W_d + W_s)`` with ``W_d`` a Gaussian of the pixel's distance to the patch
    boundary (eq. 1) and ``W_s`` a Gaussian of its feature strength, its difference to the L-shape's
    dominant colour (eq. 2). Every position of the source is searched, by FFT correlation.
-3. The patch is pasted on its side of the minimum-error boundary cut (step 4; :mod:`core.seams`).
+3. The patch is pasted on its side of the minimum-error boundary cut (step 4; :mod:`weft.core.seams`).
 6. Pixels in a band around each cut where the two patches disagree by more than a threshold are
    re-synthesized pixel by pixel by neighbourhood matching against the source.
 7. Optionally, the re-synthesized pixels are replaced by a Gaussian filtering of the result.
@@ -25,7 +25,7 @@ what was measured where it mattered:
   own sigma: ``sigma_d`` in pixels (default overlap / 2), ``sigma_s`` in intensity (default 0.35,
   where W_s ranges from ~0 on the background to 1.1 on a full-contrast feature, against W_d's
   0.07 maximum for the default overlap, so features dominate as the paper intends). Measured with
-  ``core.metrics.coherence`` on five textures x 8 seeds, the weighting is within 1-2% of a plain SSD
+  ``weft.core.metrics.coherence`` on five textures x 8 seeds, the weighting is within 1-2% of a plain SSD
   (neither better nor worse by that measure).
 * Eq. 2 reads ``(M - P) - 255``; that sign would count only pixels darker than the background as
   features, so the feature strength is ``|P - M|`` (the RMS over colour channels). ``M`` is the mean
@@ -138,7 +138,7 @@ class _Search:
 
     With S the source luminance centred on its mean and T the output's L-shape (centred alike), the
     sum is ``corr(S^2, w) - 2 corr(S, w T) + sum w T^2``: two template spectra and one inverse DFT
-    per patch, the source spectra computed once (as :mod:`core.quilting` does for its SSD).
+    per patch, the source spectra computed once (as :mod:`weft.core.quilting` does for its SSD).
     """
 
     def __init__(self, src_y: np.ndarray, mean: float, levels: int, sigma_s: float):
@@ -184,7 +184,7 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
                        rng: None | int | np.random.Generator = None,
                        progress: Callable[[Progress], None] | None = None,
                        cancel: CancelToken | None = None) -> Synthesis:
-    """The engine of :func:`core.nfpt.synthesize` (parameters already validated; see there)."""
+    """The engine of :func:`weft.core.nfpt.synthesize` (parameters already validated; see there)."""
     import cv2
 
     from .. import seams

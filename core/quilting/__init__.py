@@ -6,7 +6,7 @@ Transfer" and the "Image Quilting ... Poisson Blending" write-up):
 * :func:`synthesize` -- a larger texture from a sample, in three modes (E&F §2, Fig. 2):
   ``random`` blocks tiled side by side; ``overlap`` blocks overlapping their left and top
   neighbours, each chosen by the SSD over the overlap against *every* source position; ``mincut``
-  as ``overlap`` plus the minimum-error boundary cut (:mod:`core.seams`). Three rules pick among the
+  as ``overlap`` plus the minimum-error boundary cut (:mod:`weft.core.seams`). Three rules pick among the
   positions: the ``tol`` best at random (Ngo), all within ``(1 + epsilon)`` times the best (E&F
   §2.1), or the best 10% of a random 10% (the Poisson write-up). Options: ``poisson`` blends a band
   around every seam by a Poisson solve (the Poisson write-up); ``tile`` makes the output wrap.
@@ -23,7 +23,7 @@ place, the target's correspondence map, the previous pass) against every source 
 computed once per overlap shape (``cv2.filter2D`` of the squared source); the cross-correlation
 is one FFT product with source spectra computed once per pass (``cv2.dft``); the per-block work
 -- choosing, the dynamic-programming cut, pasting and the Poisson band -- is done by numba kernels
-(``core._kernels.quilting``; one per selection rule and a separate Poisson band, so that a run
+(``weft.core._kernels.quilting``; one per selection rule and a separate Poisson band, so that a run
 compiles only what it uses). Source and templates are centred on the source's mean so the float32
 FFT loses little to cancellation.
 """

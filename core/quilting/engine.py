@@ -2,8 +2,8 @@
 
 For every block: the SSD of its template against every source position (the squared-sum term once
 per overlap shape with ``cv2.filter2D``, the cross-term as one FFT product with the source spectra
-computed once per pass), then the numba kernels of ``core._kernels.quilting``: the choice (one
-kernel per selection rule), the overlap error, the cut (``core._kernels.seams``), the paste, the
+computed once per pass), then the numba kernels of ``weft.core._kernels.quilting``: the choice (one
+kernel per selection rule), the overlap error, the cut (``weft.core._kernels.seams``), the paste, the
 Poisson band (only with ``poisson``), so that a run compiles only the kernels it uses -- or, for small syntheses while numba is not loaded yet, the
 same steps in numpy (``_choose_*_numpy``, ``_place_block_numpy``, pixel for pixel the same; a test
 checks it).
@@ -198,7 +198,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
 
     With ``record`` (a dict), ``record["sources"]`` is set to the (out_h, out_w, 2) int32 source
     coordinates each output pixel was copied from (-1 where none), for
-    ``core.metrics.verbatim_fraction``; a Poisson band's pixels count as copied.
+    ``weft.core.metrics.verbatim_fraction``; a Poisson band's pixels count as copied.
     """
     import cv2
 
@@ -241,7 +241,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     import sys
 
     use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and prev is None and corr is None
-                 and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "core._kernels.quilting" not in sys.modules)
+                 and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "weft.core._kernels.quilting" not in sys.modules)
     if use_numpy:
         place, template, blend, error, cut = _place_block_numpy, _make_template_numpy, None, None, None
         by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,

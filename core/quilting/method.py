@@ -188,7 +188,7 @@ BYTES_PER_SOURCE_PIXEL = 60
 
 def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
                      passes: list[tuple[int, int]], *, tile: bool = False) -> float:
-    """Estimated running time of quilting on the 2-core reference machine (see :mod:`core.limits`).
+    """Estimated running time of quilting on the 2-core reference machine (see :mod:`weft.core.limits`).
 
     Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel
     and the inverse; a transfer adds its correspondence and previous-pass spectra, computed on a
@@ -305,7 +305,7 @@ def synthesize(
         ``overlap``: blocks step by B - overlap; each is chosen by the SSD between its overlap with
         the pixels already in place (left and top strips) and the same strips at *every* position
         of the texture, and pasted over them (Fig. 2b). ``mincut``: as ``overlap``, then pasted only
-        on its side of the minimum-error boundary cut through the overlap (Fig. 2c, :mod:`core.seams`).
+        on its side of the minimum-error boundary cut through the overlap (Fig. 2c, :mod:`weft.core.seams`).
     tol : int, optional
         Default (None) 2. Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD positions (Ngo's ``tol``; 1 =
         always the best). 2 keeps seams nearly invisible yet uses the whole sample (brick 128² ->
@@ -324,7 +324,7 @@ def synthesize(
     poisson : bool, default False
         After each paste, solve a Poisson equation on a band of ``band`` pixels around the seam
         with the existing pixels as the source of gradients (the Poisson write-up; modes
-        ``overlap`` and ``mincut``). See :func:`core.blending.poisson_blend`.
+        ``overlap`` and ``mincut``). See :func:`weft.core.blending.poisson_blend`.
     band : int, default 4
         Width of the Poisson band, 1..5 pixels: ceil(band/2) on the existing side of the seam,
         floor(band/2) on the new block's side, limited to pixels that existed before the paste.
@@ -335,7 +335,7 @@ def synthesize(
         cancel token (checked once per block row).
     record : dict, optional
         Receives ``"sources"``: the (height, width, 2) int32 sample coordinates each output pixel
-        was copied from (-1 where none), for :func:`core.metrics.verbatim_fraction`.
+        was copied from (-1 where none), for :func:`weft.core.metrics.verbatim_fraction`.
 
     Returns
     -------

@@ -6,7 +6,7 @@ The user draws lines on the photo and gives where they lie in the frontal (recti
 maps the photo onto the frontal frame:
 
 * ``homography`` (default) -- least squares + robust refinement from the points and the lines;
-  exact for a planar texture (:mod:`core.rectify.homography`).
+  exact for a planar texture (:mod:`weft.core.rectify.homography`).
 * ``morph`` -- the paper's view-morphing route: fundamental matrix (>= 8 points), pre-warp to
   parallel views, Beier-Neely morph, post-warp. **Degenerate when all the points lie on one plane**
   (the usual case for a texture photo): that is detected and reported instead of producing garbage.
@@ -20,7 +20,7 @@ Python API
 end point, build a :class:`Rectifier` once per photo and call ``.rectify(...)`` per drag event (the
 photo is validated once), or ``.warp(homography, frontal_size)`` when the homography is known.
 :func:`load_feature_lines` reads the JSON. Re-projection into a view or back into the photo lives
-in :mod:`core.rectify.view` and is driven by :mod:`core.nfpt`.
+in :mod:`weft.core.rectify.view` and is driven by :mod:`weft.core.nfpt`.
 
 ``weft rectify PHOTO --lines L.json -o OUT`` is the command line of it.
 """

@@ -1,6 +1,6 @@
 """A homography from corresponding feature lines: least squares, then a robust refinement.
 
-The points are the lines' intersections (:func:`~core.rectify.lines.line_correspondences`); the
+The points are the lines' intersections (:func:`~weft.core.rectify.lines.line_correspondences`); the
 lines themselves add a constraint each point lacks: the destination line, mapped by H, must lie on
 the source line. The fit minimises, in source pixels,
 
@@ -231,14 +231,14 @@ def fit_homography(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple
         Start from a RANSAC fit (3 px) when there are 6 or more points and refine with a Huber then
         a Cauchy loss (1 px); ``False`` uses plain least squares throughout.
     min_angle, margin
-        Which line pairs give points; see :func:`~core.rectify.lines.line_correspondences`.
+        Which line pairs give points; see :func:`~weft.core.rectify.lines.line_correspondences`.
 
     Returns
     -------
     HomographyFit
         ``matrix`` maps destination -> source (frontal -> photo), the paper's direction of
         rectification being its inverse. It is exact for a planar texture (section 3 of Yan, Lee &
-        Lin uses a view morph instead; see :mod:`core.rectify.warps` for that route).
+        Lin uses a view morph instead; see :mod:`weft.core.rectify.warps` for that route).
 
     Raises
     ------

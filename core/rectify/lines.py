@@ -11,7 +11,7 @@ top-left, OpenCV convention (pixel (x, y) has its centre at integer (x, y), so a
 spans x in [-0.5, w - 0.5]). Other keys (e.g. the ``"homography"`` of the bundled example) are
 ignored.
 
-Every problem is a one-line :class:`~core.errors.GeometryError` naming the file (when there is
+Every problem is a one-line :class:`~weft.core.errors.GeometryError` naming the file (when there is
 one), the key, the line index and the value.
 """
 

@@ -55,7 +55,7 @@ class View:
     def with_size(self, default: tuple[int, int]) -> tuple[int, int]:
         return self.size if self.size is not None else tuple(default)
 
-    # A typed geometry parameter (core.geometry): parsed at the edges, written once.
+    # A typed geometry parameter (weft.core.geometry): parsed at the edges, written once.
     METAVAR = "VIEW"
 
     def to_json(self) -> dict[str, Any]:
@@ -180,7 +180,7 @@ def view_plan(view: View, texture_size: tuple[int, int], default_size: tuple[int
     default_size : (width, height)
         The view's size when the view file gives none (the photo's).
     warp, a, b, p
-        As for rectification (:func:`~core.rectify.warps.plan_warp`); a quad always uses its
+        As for rectification (:func:`~weft.core.rectify.warps.plan_warp`); a quad always uses its
         homography.
     """
     size = view.with_size(default_size)

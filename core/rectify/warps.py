@@ -1,6 +1,6 @@
 """The three ways a frame is warped onto another from corresponding feature lines.
 
-* ``homography`` -- one projective map fitted to the lines (:mod:`core.rectify.homography`); exact
+* ``homography`` -- one projective map fitted to the lines (:mod:`weft.core.rectify.homography`); exact
   for a planar texture, which is what a non-frontal-parallel texture photo usually is.
 * ``morph`` -- the paper's route (Yan, Lee & Lin §3, after Seitz & Dyer's view morphing): the
   fundamental matrix from >= 8 intersection points, pre-warps of both frames to parallel views
@@ -235,7 +235,7 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
         line's influence falls off with distance; their paper: 0.5..2), ``p`` 0..2 (0: all lines
         equal; 1: longer lines stronger).
     robust : bool, default True
-        Robust homography fit (see :func:`~core.rectify.homography.fit_homography`).
+        Robust homography fit (see :func:`~weft.core.rectify.homography.fit_homography`).
     planar_tol : float, default 1 px
         ``morph``: if every intersection point fits one homography within this RMS, the points are
         on one plane and the fundamental matrix is undetermined: GeometryError.
@@ -244,7 +244,7 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
     dst_name, src_name, dst_key, src_key : str
         How the frames and lines are named in error messages.
     src_input : str, optional
-        The method input the source frame is (see :func:`~core.rectify.lines.check_lines`).
+        The method input the source frame is (see :func:`~weft.core.rectify.lines.check_lines`).
 
     Returns
     -------

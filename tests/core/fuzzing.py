@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
-from core.errors import InvalidParameter, WeftError
+from weft.core.errors import InvalidParameter, WeftError
 
 # Per example: generous enough for the first example to compile numba kernels in a fresh clone
 # (measured 14.7 s in CI, cold cache), still a bound that turns a hang into a failure.

@@ -3,14 +3,14 @@
 import numpy as np
 import pytest
 
-from core.affine import (analyse, field_model, field_transforms, make_prototype, match_boundaries, render,
+from weft.core.affine import (analyse, field_model, field_transforms, make_prototype, match_boundaries, render,
                          synthesize, total_boundary_error)
-from core.affine.boundary import _Canvas
+from weft.core.affine.boundary import _Canvas
 from benchmarks.fixtures.procedural import cells
-from core.affine.model import Grid
-from core.errors import InvalidParameter
-from core.examples import example
-from core.image import load_image
+from weft.core.affine.model import Grid
+from weft.core.errors import InvalidParameter
+from weft.core.examples import example
+from weft.core.image import load_image
 
 
 @pytest.fixture(scope="module")

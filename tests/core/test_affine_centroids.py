@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from core.affine import centroid_pairs, centroids, cos2_window, segment_sums
-from core.errors import InvalidParameter
+from weft.core.affine import centroid_pairs, centroids, cos2_window, segment_sums
+from weft.core.errors import InvalidParameter
 
 
 @pytest.mark.parametrize("B", [8, 16, 32, 64])
@@ -57,7 +57,7 @@ def test_two_sinusoids_give_the_two_frequencies():
 
 def _brute_force(patch, segments):
     """Eqs. 3-6 directly: every split (k, l) of every half-plane, variances from the bins."""
-    from core.affine.spectral import _bins
+    from weft.core.affine.spectral import _bins
 
     n = patch.shape[0]
     bins = _bins(n, segments, 1.0 / n)

@@ -6,14 +6,14 @@ import threading
 import numpy as np
 import pytest
 
-from core import metrics
-from core.affine import (METHOD, AffineParams, analyse, decompose, make_prototype, prototype_from_patch, render,
+from weft.core import metrics
+from weft.core.affine import (METHOD, AffineParams, analyse, decompose, make_prototype, prototype_from_patch, render,
                          synthesize)
 from benchmarks.fixtures.procedural import cells, weave
-from core.errors import Cancelled, GeometryError, ImageError, InvalidParameter
-from core.examples import example
-from core.image import load_image, resize
-from core.jobs import CancelToken
+from weft.core.errors import Cancelled, GeometryError, ImageError, InvalidParameter
+from weft.core.examples import example
+from weft.core.image import load_image, resize
+from weft.core.jobs import CancelToken
 
 
 @pytest.fixture(scope="module")
@@ -220,7 +220,7 @@ def test_two_jobs_in_two_threads_give_the_same_pixels(scales):
 
 
 def test_method_is_registered_with_its_inputs():
-    from core import registry
+    from weft.core import registry
 
     m = registry.get("affine")
     assert m is METHOD
@@ -232,7 +232,7 @@ def test_method_is_registered_with_its_inputs():
 def test_reused_transforms_are_cached_between_runs(scales):
     """The studio re-runs the method for every move of the prototype square: with reused
     transforms the analysis is remembered (by content and parameters) and only the render redone."""
-    from core.affine import method
+    from weft.core.affine import method
 
     method._cache.clear()
     params = AffineParams(reuse_transforms=True, prototype="40,40,64")

@@ -4,8 +4,8 @@ import cv2
 import numpy as np
 import pytest
 
-from core.affine import analyse, candidate_transforms, correlate_shifts, regularise_pairs
-from core.affine.transforms import MAX_SCALE, MIN_SCALE, PAIRINGS, singular_values
+from weft.core.affine import analyse, candidate_transforms, correlate_shifts, regularise_pairs
+from weft.core.affine.transforms import MAX_SCALE, MIN_SCALE, PAIRINGS, singular_values
 
 
 def _rotation_scale(deg, scale):
@@ -54,9 +54,9 @@ def _centre_patch(model):
 
 
 def test_rotation_by_30_scale_by_1_2_is_among_the_candidates_and_chosen(rotated_case):
-    from core.affine.spectral import centroids
-    from core.affine.analysis import _central
-    from core.affine.model import decompose, make_prototype
+    from weft.core.affine.spectral import centroids
+    from weft.core.affine.analysis import _central
+    from weft.core.affine.model import decompose, make_prototype
 
     proto_img, target, T, rect, B = rotated_case
     # §2.2: the eight candidates from the centroid pairs contain T (within the centroids' bias)

@@ -5,8 +5,8 @@ import pytest
 import scipy.sparse
 import scipy.sparse.linalg
 
-from core.blending import BlendParams, METHOD, max_levels, poisson_blend, pyramid_blend
-from core.errors import ImageError, InvalidParameter
+from weft.core.blending import BlendParams, METHOD, max_levels, poisson_blend, pyramid_blend
+from weft.core.errors import ImageError, InvalidParameter
 
 
 def _laplacian(img: np.ndarray) -> np.ndarray:

@@ -6,7 +6,11 @@ import subprocess
 import sys
 
 CORE = pathlib.Path(__file__).resolve().parents[2] / "core"
-FORBIDDEN = ("PySide6", "shiboken6", "superqt", "qtpy", "app")
+FORBIDDEN = ("PySide6", "shiboken6", "superqt", "qtpy", "weft.app")
+
+
+def _forbidden(module: str) -> bool:
+    return module.split(".")[0] in FORBIDDEN or module.startswith("weft.app")
 
 
 def test_no_qt_import_statements_in_core():
@@ -19,17 +23,17 @@ def test_no_qt_import_statements_in_core():
                 names = [a.name for a in node.names]
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
                 names = [node.module]
-            offenders += [f"{path.name}: {n}" for n in names if n.split(".")[0] in FORBIDDEN]
+            offenders += [f"{path.name}: {n}" for n in names if _forbidden(n)]
     assert offenders == []
 
 
 def test_importing_every_core_module_loads_no_qt():
-    modules = sorted(f"core.{p.stem}" for p in CORE.glob("*.py") if p.stem != "__init__")
+    modules = sorted(f"weft.core.{p.stem}" for p in CORE.glob("*.py") if p.stem != "__init__")
     code = (
         "import importlib, sys\n"
         f"for m in {modules!r}: importlib.import_module(m)\n"
         "from core import registry; registry.methods()\n"
-        f"bad = [m for m in sys.modules if m.split('.')[0] in {FORBIDDEN!r}]\n"
+        f"bad = [m for m in sys.modules if m.split('.')[0] in {FORBIDDEN!r} or m.startswith('weft.app')]\n"
         "print(bad); sys.exit(1 if bad else 0)\n"
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from core.errors import WeftError
-from core.examples import RESOURCES, example, examples
-from core.image import load_image
+from weft.core.errors import WeftError
+from weft.core.examples import RESOURCES, example, examples
+from weft.core.image import load_image
 
 
 def test_every_example_loads_as_a_float_image():

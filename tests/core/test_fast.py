@@ -5,12 +5,12 @@ import threading
 import numpy as np
 import pytest
 
-from core import metrics
-from core.errors import Cancelled, ImageError, InvalidParameter
-from core.examples import example
-from core.fast import FastParams, METHOD, _transfer, transfer
-from core.image import load_image, resize, rgb_to_yiq
-from core.jobs import CancelToken
+from weft.core import metrics
+from weft.core.errors import Cancelled, ImageError, InvalidParameter
+from weft.core.examples import example
+from weft.core.fast import FastParams, METHOD, _transfer, transfer
+from weft.core.image import load_image, resize, rgb_to_yiq
+from weft.core.jobs import CancelToken
 
 
 @pytest.fixture(scope="module")
@@ -214,7 +214,7 @@ def test_two_threads_give_the_same_pixels_as_one(gravel, camera):
 
 
 def test_metric_codes_match_the_kernel():
-    from core._kernels import fast as kernel
-    from core.fast import METRICS
+    from weft.core._kernels import fast as kernel
+    from weft.core.fast import METRICS
 
     assert METRICS == {"full": kernel.METRIC_FULL, "target": kernel.METRIC_TARGET, "artistic": kernel.METRIC_ARTISTIC}

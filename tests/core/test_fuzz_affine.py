@@ -1,4 +1,4 @@
-"""Issue 8.2 / 8.3 for the affine prototype model (``core.affine``).
+"""Issue 8.2 / 8.3 for the affine prototype model (``weft.core.affine``).
 
 Hypothesis over the public functions: ``synthesize`` end to end (analysis, reuse of transforms,
 fields, boundary matching), ``analyse`` + ``render`` with swapped prototypes, the prototype
@@ -21,7 +21,7 @@ import pytest
 from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
-from core.affine import (
+from weft.core.affine import (
     AffineModel,
     Prototype,
     analyse,
@@ -40,9 +40,9 @@ from core.affine import (
     synthesize,
     total_boundary_error,
 )
-from core.affine.transforms import MAX_SCALE, MIN_SCALE, singular_values
-from core.errors import WeftError
-from core.geometry import Square
+from weft.core.affine.transforms import MAX_SCALE, MIN_SCALE, singular_values
+from weft.core.errors import WeftError
+from weft.core.geometry import Square
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS

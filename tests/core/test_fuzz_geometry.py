@@ -9,8 +9,8 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from core.errors import WeftError
-from core.rectify import rectify
+from weft.core.errors import WeftError
+from weft.core.rectify import rectify
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, fuzz
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS

@@ -1,10 +1,10 @@
 """Issue 8.2 for the shared building blocks: blending, seams, metrics, colour, square regions.
 
-Hypothesis over ``core.blending`` (Laplacian pyramid and Poisson blend: random, all-black and
-all-white masks, sizes 1..16, grey/colour mixes, mismatched sizes), ``core.seams`` (minimum cuts on
-random and constant error surfaces, checked against a brute-force dynamic program), ``core.metrics``
+Hypothesis over ``weft.core.blending`` (Laplacian pyramid and Poisson blend: random, all-black and
+all-white masks, sizes 1..16, grey/colour mixes, mismatched sizes), ``weft.core.seams`` (minimum cuts on
+random and constant error surfaces, checked against a brute-force dynamic program), ``weft.core.metrics``
 (identical, constant, tiny images: finite values in the documented ranges, the documented values for
-the degenerate cases), ``core.image`` colour helpers and ``Square.parse``/``Square.crop``. Valid
+the degenerate cases), ``weft.core.image`` colour helpers and ``Square.parse``/``Square.crop``. Valid
 inputs give finite results of the documented shape and range; invalid ones a one-line
 ``WeftError`` naming the parameter or the image. Numpy ``RuntimeWarning``s are errors throughout.
 """
@@ -18,11 +18,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core import metrics
-from core.blending import max_levels, poisson_blend, pyramid_blend
-from core.errors import ImageError, InvalidParameter, WeftError
-from core.geometry import Square
-from core.image import (
+from weft.core import metrics
+from weft.core.blending import max_levels, poisson_blend, pyramid_blend
+from weft.core.errors import ImageError, InvalidParameter, WeftError
+from weft.core.geometry import Square
+from weft.core.image import (
     from_pca,
     luminance,
     pca_basis,
@@ -31,7 +31,7 @@ from core.image import (
     to_pca,
     yiq_to_rgb,
 )
-from core.seams import min_cut_mask, min_error_path, overlap_error
+from weft.core.seams import min_cut_mask, min_error_path, overlap_error
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS

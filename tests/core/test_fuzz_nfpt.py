@@ -1,4 +1,4 @@
-"""Issue 8.2 / 8.3 for NFPT (``core.nfpt``): parameter fuzzing and degenerate geometry.
+"""Issue 8.2 / 8.3 for NFPT (``weft.core.nfpt``): parameter fuzzing and degenerate geometry.
 
 * ``synthesize`` (§2 alone) over block, overlap, weights, repair, smooth, size and source masks, on
   tiny textures of every awkward kind (flat patches, a lone dot, noise): a finite float32 image in
@@ -21,10 +21,10 @@ import pytest
 from hypothesis import event, given
 from hypothesis import strategies as st
 
-from core.errors import GeometryError, WeftError
-from core.nfpt import nfpt, synthesize
-from core.rectify import FeatureLines, rectify
-from core.rectify.view import View
+from weft.core.errors import GeometryError, WeftError
+from weft.core.nfpt import nfpt, synthesize
+from weft.core.rectify import FeatureLines, rectify
+from weft.core.rectify.view import View
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS

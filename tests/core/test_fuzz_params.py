@@ -3,7 +3,7 @@
 Every registered method's ``Params`` class, built from arbitrary values (in and out of range, wrong
 types, None, non-finite numbers, odd text), either builds (and round-trips through to_dict/from_dict)
 or raises ``WeftError`` whose one-line message names the parameter; never another exception. Then a
-small bounded end-to-end fuzz of ``core.fast.transfer`` (all modes) and ``core.quilting.synthesize``
+small bounded end-to-end fuzz of ``weft.core.fast.transfer`` (all modes) and ``weft.core.quilting.synthesize``
 and ``transfer``.
 """
 
@@ -16,9 +16,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from core import registry
-from core.errors import InvalidParameter, WeftError
-from core.params import specs
+from weft.core import registry
+from weft.core.errors import InvalidParameter, WeftError
+from weft.core.params import specs
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, fuzz
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
@@ -133,7 +133,7 @@ def _image(seed: int, h: int, w: int, colour: bool) -> np.ndarray:
        transfer=st.booleans(), n=st.sampled_from([3, 5]), p=st.floats(0, 1), p_l=st.floats(0, 1),
        metric=st.sampled_from(["full", "target", "artistic"]), iterations=st.integers(1, 2))
 def test_fast_transfer_fuzz(seed, hs, ws, colour, transfer, n, p, p_l, metric, iterations):
-    from core.fast import transfer as fast_transfer
+    from weft.core.fast import transfer as fast_transfer
 
     n = min(n, hs, ws) | 1
     texture = _image(seed, hs, ws, colour)
@@ -154,7 +154,7 @@ def test_fast_transfer_fuzz(seed, hs, ws, colour, transfer, n, p, p_l, metric, i
        tol=st.integers(1, 4), block=st.integers(2, 6), width=st.integers(1, 30), height=st.integers(1, 30),
        poisson=st.booleans())
 def test_quilting_synthesize_fuzz(seed, hs, ws, colour, mode, rule, tol, block, width, height, poisson):
-    from core.quilting import synthesize
+    from weft.core.quilting import synthesize
 
     texture = _image(seed, hs, ws, colour)
     overlap = max(1, block // 3)
@@ -177,7 +177,7 @@ def test_quilting_synthesize_fuzz(seed, hs, ws, colour, mode, rule, tol, block, 
        correspondence=st.sampled_from(["blur", "luminance"]), remap=st.booleans(), poisson=st.booleans())
 def test_quilting_transfer_fuzz(seed, hs, ws, colour, th, tw, block, iterations, alpha, mode, correspondence, remap,
                                 poisson):
-    from core.quilting import transfer
+    from weft.core.quilting import transfer
 
     texture = _image(seed, hs, ws, colour)
     target = _image(seed + 1, th, tw, colour)
@@ -202,7 +202,7 @@ def test_quilting_transfer_fuzz(seed, hs, ws, colour, th, tw, block, iterations,
        mode=st.sampled_from(["superres", "novel"]), magnify=st.integers(1, 4), p_l=st.floats(0, 1),
        iterations=st.integers(1, 2))
 def test_fast_superres_and_novel_fuzz(seed, hs, ws, colour, mode, magnify, p_l, iterations):
-    from core.fast import transfer as fast_transfer
+    from weft.core.fast import transfer as fast_transfer
 
     texture = _image(seed, hs, ws, colour)
     n = 3

@@ -1,15 +1,15 @@
-"""Typed geometry (core.geometry) and the studio descriptions (core.studio), without Qt."""
+"""Typed geometry (weft.core.geometry) and the studio descriptions (weft.core.studio), without Qt."""
 
 import json
 
 import numpy as np
 import pytest
 
-from core import registry
-from core.errors import GeometryError, InvalidParameter
-from core.geometry import FeatureLines, LineDraft, Square
-from core.params import Recipe
-from core.studio import reduce_for_preview
+from weft.core import registry
+from weft.core.errors import GeometryError, InvalidParameter
+from weft.core.geometry import FeatureLines, LineDraft, Square
+from weft.core.params import Recipe
+from weft.core.studio import reduce_for_preview
 
 LINES = {"image_lines": [[1, 1, 30, 2], [2, 20, 31, 22]], "frontal_lines": [[0, 0, 32, 0], [0, 20, 32, 20]],
          "frontal_size": [32, 24]}

@@ -1,4 +1,4 @@
-"""Tests for core.image: loading, saving, recipes in PNGs, validation, resizing, colour helpers."""
+"""Tests for weft.core.image: loading, saving, recipes in PNGs, validation, resizing, colour helpers."""
 
 from __future__ import annotations
 
@@ -16,9 +16,9 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 from PIL import Image, ImageOps
 
-from core import image as ci
-from core.errors import ImageError, InvalidParameter, WeftError
-from core.image import (
+from weft.core import image as ci
+from weft.core.errors import ImageError, InvalidParameter, WeftError
+from weft.core.image import (
     DEFAULT_MAX_PIXELS,
     ImageInfo,
     Loaded,
@@ -490,7 +490,7 @@ def test_atomic_write_modes_and_overwrite(tmp_path):
 
 
 def test_params_can_use_atomic_write():
-    from core import params
+    from weft.core import params
 
     assert params is not None and ci.atomic_write_bytes is atomic_write_bytes
 

@@ -1,4 +1,4 @@
-"""Behaviour of core.jobs: results, errors, cancellation, latest-wins slots, progress, shutdown.
+"""Behaviour of weft.core.jobs: results, errors, cancellation, latest-wins slots, progress, shutdown.
 
 No timing assertions: threads are orchestrated with ``threading.Event``; timeouts are hang guards.
 """
@@ -15,9 +15,9 @@ from collections import defaultdict
 import numpy as np
 import pytest
 
-import core.errors
-from core.errors import WeftError
-from core.jobs import Cancelled, CancelToken, JobResult, JobRunner, Progress, ProgressReporter
+import weft.core.errors
+from weft.core.errors import WeftError
+from weft.core.jobs import Cancelled, CancelToken, JobResult, JobRunner, Progress, ProgressReporter
 
 WAIT = 20.0  # hang guard only, never a timing assertion
 
@@ -100,7 +100,7 @@ def returns(value):
 
 
 def test_cancelled_is_reexported_from_errors():
-    assert Cancelled is core.errors.Cancelled
+    assert Cancelled is weft.core.errors.Cancelled
 
 
 def test_progress_fraction():
@@ -374,7 +374,7 @@ def test_on_progress_exception_does_not_fail_job(make_runner, caplog):
         progress(Progress("s", 1, 1))
         return 5
 
-    with caplog.at_level(logging.ERROR, logger="core.jobs"):
+    with caplog.at_level(logging.ERROR, logger="weft.core.jobs"):
         assert runner.submit("s", fn).result(WAIT).value == 5
     assert "on_progress" in caplog.text
 
@@ -417,7 +417,7 @@ def test_on_result_that_raises_does_not_break_later_jobs(make_runner, caplog):
             raise RuntimeError("handler broke")
 
     runner = make_runner(max_workers=1, on_result=on_result)
-    with caplog.at_level(logging.ERROR, logger="core.jobs"):
+    with caplog.at_level(logging.ERROR, logger="weft.core.jobs"):
         first = runner.submit("a", returns("first")).result(WAIT)
         second = runner.submit("a", returns("second")).result(WAIT)
     assert first.ok and second.ok
@@ -564,7 +564,7 @@ def test_stress_random_submit_and_cancel(make_runner):
 
 
 def test_reporter_builds_previews_at_most_every_preview_interval(monkeypatch):
-    import core.jobs as jobs
+    import weft.core.jobs as jobs
 
     clock = [100.0]
     monkeypatch.setattr(jobs.time, "monotonic", lambda: clock[0])

@@ -14,7 +14,7 @@ import tracemalloc
 
 import numpy as np
 
-from core.jobs import JobRunner
+from weft.core.jobs import JobRunner
 
 HANG = 10.0  # seconds: far beyond any sequence here; only a deadlock reaches it
 SLOTS = ("preview", "final", "other")

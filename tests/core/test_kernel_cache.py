@@ -5,7 +5,7 @@ when none could be written, decorating a kernel raised ``RuntimeError: cannot ca
 no locator available`` (``weft: internal error``, exit 1). Each case runs ``weft blend --mode poisson``
 (a numba kernel) in a fresh process, on a copy of the package. The tests run as root in CI, where
 file permissions do not stop writes, so unwritability is made of paths that cannot be folders: the
-copy's ``core/_kernels/__pycache__`` is a regular file, ``HOME`` and ``NUMBA_CACHE_DIR`` point under
+copy's ``weft/core/_kernels/__pycache__`` is a regular file, ``HOME`` and ``NUMBA_CACHE_DIR`` point under
 a regular file.
 """
 
@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.image import save_image
+from weft.core.image import save_image
 
 ROOT = Path(__file__).resolve().parents[2]
 NO_CACHE = "numba can write its cache nowhere"
@@ -28,7 +28,7 @@ NO_CACHE = "numba can write its cache nowhere"
 def setup(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("cache")
     for pkg in ("core", "app"):
-        shutil.copytree(ROOT / pkg, tmp / "pkg" / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copytree(ROOT / pkg, tmp / "pkg" / "weft" / pkg, ignore=shutil.ignore_patterns("__pycache__"))
     (tmp / "file").write_text("not a folder")
     rng = np.random.default_rng(0)
     img = rng.random((24, 24, 3)).astype(np.float32)
@@ -44,7 +44,7 @@ def run_blend(setup, *, package_writable=True, home_writable=True, numba_dir_wri
               no_temp=False):
     """``weft blend --mode poisson`` on the package copy; returns (exit code, stderr, env)."""
     pkg = setup / "pkg"
-    cache = pkg / "core" / "_kernels" / "__pycache__"
+    cache = pkg / "weft" / "core" / "_kernels" / "__pycache__"
     if cache.is_dir():
         shutil.rmtree(cache)
     elif cache.exists():
@@ -59,9 +59,9 @@ def run_blend(setup, *, package_writable=True, home_writable=True, numba_dir_wri
     env["TMPDIR"] = str(tmpdir if tmpdir is not None else setup / "tmp")
     Path(env["TMPDIR"]).mkdir(exist_ok=True)
     env["PYTHONPATH"] = str(pkg)
-    patch = ("import core._kernels as k; k.fallback_cache_root = lambda: " + repr(str(setup / "file" / "t")) + "; "
+    patch = ("import weft.core._kernels as k; k.fallback_cache_root = lambda: " + repr(str(setup / "file" / "t")) + "; "
              if no_temp else "")
-    code = (f"import sys; {patch}from app.cli import main; sys.exit(main(['blend', {str(setup / 'fg.png')!r}, "
+    code = (f"import sys; {patch}from weft.app.cli import main; sys.exit(main(['blend', {str(setup / 'fg.png')!r}, "
             f"{str(setup / 'bg.png')!r}, '--mask', {str(setup / 'mask.png')!r}, '--mode', 'poisson', "
             f"'-o', {str(setup / 'out.png')!r}]))")
     r = subprocess.run([sys.executable, "-c", code], cwd=setup, env=env, capture_output=True, text=True, timeout=300)
@@ -73,7 +73,7 @@ def test_unwritable_numba_cache_dir_runs(setup):
     code, err, _ = run_blend(setup, numba_dir_writable=False)
     assert code == 0, err
     assert err == ""
-    assert list((setup / "pkg" / "core" / "_kernels" / "__pycache__").glob("poisson.poisson_cg-*.nbi"))  # numba's next folder
+    assert list((setup / "pkg" / "weft" / "core" / "_kernels" / "__pycache__").glob("poisson.poisson_cg-*.nbi"))  # numba's next folder
 
 
 def test_unwritable_package_folder_runs(setup):
@@ -148,6 +148,6 @@ def _hammer(folder):
 
 
 def test_concurrent_cache_saves_never_cross_signatures(tmp_path):
-    import core._kernels  # noqa: F401  (the lock around numba's saves)
+    import weft.core._kernels  # noqa: F401  (the lock around numba's saves)
 
     assert _hammer(tmp_path) == []

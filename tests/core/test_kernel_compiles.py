@@ -3,7 +3,7 @@ kernel compiles more than one specialisation (the literal-argument and C/F-layou
 made a cold quilting transfer compile 122 functions must not come back silently).
 
 Each method runs in a fresh interpreter (in this one other tests have already compiled kernels for
-their own inputs): ``warm_up()``, then the signatures of every kernel in ``core._kernels``, then
+their own inputs): ``warm_up()``, then the signatures of every kernel in ``weft.core._kernels``, then
 representative runs (the README's commands on smaller inputs, and the options that take other code
 paths), then the signatures again. A kernel loaded from numba's on-disk cache counts like a compiled
 one, so the check holds with a warm cache or a cold one. No timing here (that is
@@ -20,10 +20,10 @@ import json, pkgutil, sys
 
 import numpy as np
 
-import core._kernels
-from core import registry
-from core.examples import example
-from core.image import load_image
+import weft.core._kernels
+from weft.core import registry
+from weft.core.examples import example
+from weft.core.image import load_image
 
 def image(name, h=None, w=None):
     return np.ascontiguousarray(load_image(example(name)).image[:h, :w])
@@ -53,8 +53,8 @@ RUNS = {
 def signatures():
     from numba.core.registry import CPUDispatcher
     out = {}
-    for info in pkgutil.iter_modules(core._kernels.__path__):
-        module = sys.modules.get("core._kernels." + info.name)
+    for info in pkgutil.iter_modules(weft.core._kernels.__path__):
+        module = sys.modules.get("weft.core._kernels." + info.name)
         if module is None:  # not imported by this method
             continue
         for name, obj in vars(module).items():

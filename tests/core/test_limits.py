@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app import cli
-from core import fast, limits, nfpt, quilting
-from core.errors import WeftError
-from core.image import set_max_pixels
-from core.limits import LimitError
+from weft.app import cli
+from weft.core import fast, limits, nfpt, quilting
+from weft.core.errors import WeftError
+from weft.core.image import set_max_pixels
+from weft.core.limits import LimitError
 
 
 @pytest.fixture(autouse=True)
@@ -119,7 +119,7 @@ def test_max_seconds_from_environment(monkeypatch):
 
 
 def test_cli_refuses_a_long_job_in_one_line_and_writes_nothing(tmp_path, capsys, monkeypatch):
-    from core.examples import example
+    from weft.core.examples import example
 
     monkeypatch.setenv("WEFT_MAX_SECONDS", "5")
     out = tmp_path / "out.png"

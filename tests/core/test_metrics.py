@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from skimage import data
 
-from core.errors import ImageError, InvalidParameter, WeftError
-from core.metrics import _nearest_distances, coherence, completeness, fidelity, snr_db
+from weft.core.errors import ImageError, InvalidParameter, WeftError
+from weft.core.metrics import _nearest_distances, coherence, completeness, fidelity, snr_db
 
 
 @pytest.fixture(scope="module")
@@ -259,7 +259,7 @@ def test_errors_are_weft_errors(tile):
 
 
 def test_psnr_of_a_known_error():
-    from core.metrics import psnr_db
+    from weft.core.metrics import psnr_db
 
     orig = np.full((16, 16), 0.5, np.float32)
     synth = orig + np.float32(0.1)  # mse 0.01 -> 20 dB
@@ -279,7 +279,7 @@ def _copy_map(h, w, dy, dx):
 
 
 def test_verbatim_region_of_one_offset_is_everything():
-    from core.metrics import verbatim_fraction, verbatim_region
+    from weft.core.metrics import verbatim_fraction, verbatim_region
 
     src = _copy_map(20, 30, 3, 5)
     assert verbatim_region(src) == 600
@@ -287,7 +287,7 @@ def test_verbatim_region_of_one_offset_is_everything():
 
 
 def test_verbatim_regions_split_by_offset_and_by_connectivity():
-    from core.metrics import verbatim_region
+    from weft.core.metrics import verbatim_region
 
     src = _copy_map(10, 10, 0, 0)
     src[:, 6:] = _copy_map(10, 10, 1, 0)[:, 6:]  # another offset on the right: 60 and 40 pixels
@@ -306,7 +306,7 @@ def test_verbatim_regions_split_by_offset_and_by_connectivity():
 
 
 def test_verbatim_region_of_nothing_copied_and_bad_maps():
-    from core.metrics import verbatim_fraction, verbatim_region
+    from weft.core.metrics import verbatim_fraction, verbatim_region
 
     assert verbatim_region(np.full((5, 6, 2), -1, np.int32)) == 0
     with pytest.raises(ImageError, match=r"source map has shape \(5, 6\) and type int32; it must be \(H, W, 2\) integers"):

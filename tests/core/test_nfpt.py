@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from core import metrics
-from core.errors import Cancelled, GeometryError, ImageError, InvalidParameter
-from core.examples import example
-from core.image import load_image
-from core.jobs import CancelToken
-from core.nfpt import METHOD, NfptParams, distance_weights, nfpt, synthesize
+from weft.core import metrics
+from weft.core.errors import Cancelled, GeometryError, ImageError, InvalidParameter
+from weft.core.examples import example
+from weft.core.image import load_image
+from weft.core.jobs import CancelToken
+from weft.core.nfpt import METHOD, NfptParams, distance_weights, nfpt, synthesize
 
 LINES_JSON = str(example("perspective").parent / "perspective-lines.json")
 
@@ -62,7 +62,7 @@ def test_distance_weight_is_eq_1_on_the_l_shape():
 
 
 def test_feature_weight_is_eq_2_and_3():
-    from core._kernels import nfpt as _k
+    from weft.core._kernels import nfpt as _k
 
     canvas = np.full((8, 8, 1), 0.5, np.float32)
     canvas[2, 0, 0] = 0.9  # one feature pixel on a background of 0.5
@@ -162,8 +162,8 @@ def test_method_runs_with_params_and_reports_figures(photo):
 
 
 def test_fft_search_equals_the_direct_sum_of_eq_3(fur):
-    from core.image import luminance
-    from core.nfpt.synthesis import _Search
+    from weft.core.image import luminance
+    from weft.core.nfpt.synthesis import _Search
 
     rng = np.random.default_rng(0)
     src = fur[:40, :50]

@@ -5,8 +5,8 @@ from dataclasses import dataclass, FrozenInstanceError
 import numpy as np
 import pytest
 
-from core.errors import InvalidParameter, WeftError
-from core.params import Params, Recipe, Spec, as_rng, out_of_range, param, parse_size, specs
+from weft.core.errors import InvalidParameter, WeftError
+from weft.core.params import Params, Recipe, Spec, as_rng, out_of_range, param, parse_size, specs
 
 
 @dataclass(frozen=True)

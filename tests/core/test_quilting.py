@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from core.errors import Cancelled, InvalidParameter
-from core.jobs import CancelToken
-from core.quilting import QuiltParams, synthesize
+from weft.core.errors import Cancelled, InvalidParameter
+from weft.core.jobs import CancelToken
+from weft.core.quilting import QuiltParams, synthesize
 
 
 @pytest.fixture
@@ -71,10 +71,10 @@ def test_progress_previews_and_cancel(texture):
 # --------------------------------------------------------------------------------------------
 # overlap / min-cut synthesis, tileability, Poisson seams, transfer
 
-from core import metrics  # noqa: E402
-from core.examples import example  # noqa: E402
-from core.image import load_image  # noqa: E402
-from core.quilting import METHOD, transfer, transfer_schedule  # noqa: E402
+from weft.core import metrics  # noqa: E402
+from weft.core.examples import example  # noqa: E402
+from weft.core.image import load_image  # noqa: E402
+from weft.core.quilting import METHOD, transfer, transfer_schedule  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -141,7 +141,7 @@ def test_cut_and_poisson_band_lower_the_seam_and_leave_the_rest(monkeypatch):
     what is measured here, so the rule is off (the selection is not this test's subject)."""
     import cv2
 
-    import core.quilting.engine as engine
+    import weft.core.quilting.engine as engine
 
     monkeypatch.setattr(engine, "AVOID_RADIUS", -1)
 
@@ -252,9 +252,9 @@ def test_method_run_synthesis_and_transfer(brick, gravel):
 def test_numpy_and_numba_engines_give_the_same_pixels(brick, monkeypatch, kw):
     import dataclasses
 
-    import core.quilting as q
-    import core.quilting.method as qm
-    from core._kernels import quilting as k
+    import weft.core.quilting as q
+    import weft.core.quilting.method as qm
+    from weft.core._kernels import quilting as k
 
     for name in ("P_Y0", "P_SX", "N_IPARAMS", "MODE_MINCUT", "SAMPLE_FRACTION", "TOP_FRACTION"):
         assert getattr(q._K, name) == getattr(k, name)
@@ -271,7 +271,7 @@ def test_numpy_and_numba_engines_give_the_same_pixels(brick, monkeypatch, kw):
 def test_kernel_selection_matches_numpy_partition_and_stable_sort():
     """The quilting kernel's hand-written selection (insertion for k <= 32, quickselect above, the
     stable-order pick of the sampled rule) agrees with np.partition / a stable argsort, ties included."""
-    from core._kernels import quilting as k
+    from weft.core._kernels import quilting as k
 
     rng = np.random.default_rng(4)
     for n, levels in ((1, 3), (7, 2), (50, 3), (500, 1000), (3000, 4)):
@@ -309,8 +309,8 @@ def test_recorded_sources_are_where_every_pixel_was_copied_from(brick64, kw):
 def test_no_block_continues_its_neighbours_copy(brick64, monkeypatch):
     """Per seed: the largest verbatim region is about one block (16² of 64², 0.0625) with the rule,
     and without it (AVOID_RADIUS -1) the best-two rule grows regions across blocks."""
-    import core.quilting.engine as engine
-    from core.metrics import coherence, completeness, verbatim_fraction
+    import weft.core.quilting.engine as engine
+    from weft.core.metrics import coherence, completeness, verbatim_fraction
 
     def run(seed):
         rec = {}
@@ -329,7 +329,7 @@ def test_no_block_continues_its_neighbours_copy(brick64, monkeypatch):
 
 
 def test_verbatim_fraction_is_a_figure_of_synthesis(brick64):
-    from core.quilting import METHOD
+    from weft.core.quilting import METHOD
 
     res = METHOD.run({"texture": brick64}, QuiltParams(block=16, size=(96, 96)), rng=3)
     assert 0.03 < res.figures["verbatim_fraction"] <= 0.07

@@ -5,11 +5,11 @@ import json
 import numpy as np
 import pytest
 
-from core.errors import GeometryError, InvalidParameter
-from core.examples import example
-from core.image import load_image, resize
-from core.metrics import psnr_db
-from core.rectify import (FeatureLines, Rectifier, apply_homography, fit_homography, line_correspondences,
+from weft.core.errors import GeometryError, InvalidParameter
+from weft.core.examples import example
+from weft.core.image import load_image, resize
+from weft.core.metrics import psnr_db
+from weft.core.rectify import (FeatureLines, Rectifier, apply_homography, fit_homography, line_correspondences,
                           load_feature_lines, parse_feature_lines, rectify, rectify_feature_lines, scale_lines)
 from benchmarks.fixtures.synthetic import folded_case, perspective_case
 
@@ -66,7 +66,7 @@ def test_a_badly_drawn_line_is_outvoted(case):
     r = rectify(case.photo, bad, case.frontal_lines, case.frontal_size)
     assert psnr_db(interior(case.frontal), interior(r.image)) >= 34
     plain = Rectifier(case.photo).apply(
-        __import__("core.rectify.warps", fromlist=["plan_warp"]).plan_warp(
+        __import__("weft.core.rectify.warps", fromlist=["plan_warp"]).plan_warp(
             case.frontal_lines, bad, case.frontal_size, (640, 480), robust=False))
     assert psnr_db(interior(case.frontal), interior(plain.image)) < 34  # least squares alone is dragged off
 

@@ -5,12 +5,12 @@ import json
 import numpy as np
 import pytest
 
-from core.errors import GeometryError
-from core.examples import example
-from core.image import load_image
-from core.rectify import load_feature_lines, rectify_feature_lines
-from core.rectify.homography import apply_homography
-from core.rectify.view import into_photo_plan, load_view, parse_view, quad_homography, view_plan
+from weft.core.errors import GeometryError
+from weft.core.examples import example
+from weft.core.image import load_image
+from weft.core.rectify import load_feature_lines, rectify_feature_lines
+from weft.core.rectify.homography import apply_homography
+from weft.core.rectify.view import into_photo_plan, load_view, parse_view, quad_homography, view_plan
 
 LINES_JSON = example("perspective").parent / "perspective-lines.json"
 
@@ -99,7 +99,7 @@ def test_into_photo_and_views_stop_at_the_horizon():
     # texture's far part runs up to it, and nothing of it shows above (no mirrored ghost)
     quad = [[140, 120], [160, 120], [300, 199], [0, 199]]
     h = quad_homography(np.array(quad, float), (100, 100))  # view -> texture, in front at the quad
-    from core.rectify.warps import homography_maps, homography_plan
+    from weft.core.rectify.warps import homography_maps, homography_plan
 
     plan = homography_plan(h, (300, 200), (100, 100), positive_at=(150, 160))
     horizon_y = -(plan.homography[2, 0] * 150 + plan.homography[2, 2]) / plan.homography[2, 1]

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from core.errors import ImageError, InvalidParameter
-from core.seams import min_cut_mask, min_error_path, overlap_error
+from weft.core.errors import ImageError, InvalidParameter
+from weft.core.seams import min_cut_mask, min_error_path, overlap_error
 
 
 def _zigzag(h: int, w: int) -> np.ndarray:

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from numba import njit
 
-import core._kernels  # noqa: F401  (installs the compile-event listener)
-from core import registry
-from core.jobs import CancelToken, Cancelled
+import weft.core._kernels  # noqa: F401  (installs the compile-event listener)
+from weft.core import registry
+from weft.core.jobs import CancelToken, Cancelled
 
 
 @pytest.fixture

@@ -3,7 +3,7 @@
 import pytest
 from PySide6.QtCore import QSettings
 
-from app.gui.main_window import MainWindow
+from weft.app.gui.main_window import MainWindow
 
 
 @pytest.fixture(autouse=True)

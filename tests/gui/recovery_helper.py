@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 from PySide6.QtCore import QSettings, QTimer  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
-from app.gui.main_window import MainWindow  # noqa: E402
+from weft.app.gui.main_window import MainWindow  # noqa: E402
 
 EDITS = {
     "p": 0.37,

@@ -9,9 +9,9 @@ from pathlib import Path
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction
 
-from app.cli import main as cli_main
-from app.gui.batch_dialog import BatchDialog
-from core.image import load_image, read_recipe, save_image
+from weft.app.cli import main as cli_main
+from weft.app.gui.batch_dialog import BatchDialog
+from weft.core.image import load_image, read_recipe, save_image
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -114,7 +114,7 @@ def test_a_refused_batch_says_why_in_one_line(window, qtbot, tmp_path):
 
 
 def test_nothing_to_apply_before_a_full_size_result(qtbot, settings):
-    from app.gui.main_window import MainWindow
+    from weft.app.gui.main_window import MainWindow
 
     w = MainWindow(settings=settings, load_defaults=False)
     qtbot.addWidget(w)

@@ -13,9 +13,9 @@ import time
 import numpy as np
 import pytest
 
-from app.gui.document import InputImage
-from app.gui.main_window import MainWindow
-from core import registry
+from weft.app.gui.document import InputImage
+from weft.app.gui.main_window import MainWindow
+from weft.core import registry
 
 
 @pytest.fixture

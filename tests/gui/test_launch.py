@@ -2,8 +2,8 @@
 
 from PySide6.QtWidgets import QApplication
 
-from app.cli import main
-from app.gui.main_window import MainWindow
+from weft.app.cli import main
+from weft.app.gui.main_window import MainWindow
 
 from .helpers import no_job_threads
 

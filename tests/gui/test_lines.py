@@ -7,8 +7,8 @@ from PySide6.QtCore import QEvent, Qt
 from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import QApplication
 
-from core.examples import RESOURCES
-from core.geometry import Square
+from weft.core.examples import RESOURCES
+from weft.core.geometry import Square
 
 from .helpers import drag, mouse
 

@@ -10,11 +10,11 @@ from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
 from PySide6.QtGui import QDragEnterEvent, QDropEvent, QWheelEvent
 from PySide6.QtWidgets import QApplication
 
-from app.cli import main as cli_main
-from core.errors import Cancelled, WeftError
-from core.examples import example
-from core.image import load_image, read_recipe
-from core.registry import Method
+from weft.app.cli import main as cli_main
+from weft.core.errors import Cancelled, WeftError
+from weft.core.examples import example
+from weft.core.image import load_image, read_recipe
+from weft.core.registry import Method
 
 from .helpers import drag, mouse, no_job_threads
 
@@ -110,7 +110,7 @@ def test_stale_results_are_dropped(window, qtbot):
 
 def _slow_method(started: threading.Event) -> Method:
     """A stand-in for ``fast`` that runs until it is cancelled."""
-    from core.fast import METHOD
+    from weft.core.fast import METHOD
 
     def run(inputs, params, *, rng=None, progress=None, cancel=None):
         started.set()
@@ -299,7 +299,7 @@ def test_variations_grid_renders_and_adopts_a_cell(window, qtbot):
 
 
 def test_no_worker_thread_left_after_close(qtbot, settings):
-    from app.gui.main_window import MainWindow
+    from weft.app.gui.main_window import MainWindow
 
     w = MainWindow(settings=settings)
     qtbot.addWidget(w)
@@ -311,7 +311,7 @@ def test_no_worker_thread_left_after_close(qtbot, settings):
 
 def test_slow_stand_in_is_cancellable_directly():
     """The stand-in used above really blocks until cancelled (so the cancel test means something)."""
-    from core.jobs import CancelToken
+    from weft.core.jobs import CancelToken
 
     started, token = threading.Event(), CancelToken()
     method = _slow_method(started)

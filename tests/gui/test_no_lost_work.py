@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QSettings
 
-from app.gui.main_window import MainWindow
-from core.image import save_image
+from weft.app.gui.main_window import MainWindow
+from weft.core.image import save_image
 
 from .helpers import no_job_threads
 from .recovery_helper import EDITS
@@ -172,7 +172,7 @@ def test_export_to_a_full_disk_keeps_the_old_file_and_says_why(window, tmp_path,
         os.close(fd)
         return open("/dev/full", mode, buffering=0)
 
-    monkeypatch.setattr("core.image.files.os.fdopen", to_dev_full)
+    monkeypatch.setattr("weft.core.image.files.os.fdopen", to_dev_full)
     messages = []
     window.message.connect(messages.append)
     assert window.export_result(str(out)) is False

@@ -11,13 +11,13 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from app.cli import main as weft
-from core import registry
-from core.geometry import Square
-from core.image import load_image, read_recipe, save_image
-from core.params import Params, param
-from core.registry import InputSpec, Method, Result
-from core.studio import SQUARE, Geometry, Studio
+from weft.app.cli import main as weft
+from weft.core import registry
+from weft.core.geometry import Square
+from weft.core.image import load_image, read_recipe, save_image
+from weft.core.params import Params, param
+from weft.core.registry import InputSpec, Method, Result
+from weft.core.studio import SQUARE, Geometry, Studio
 
 from .helpers import drag
 
@@ -53,7 +53,7 @@ def plugin():
 
 
 def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qtbot, settings, tmp_path, capsys):
-    from app.gui.main_window import MainWindow
+    from weft.app.gui.main_window import MainWindow
 
     picture = tmp_path / "picture.png"
     pixels = np.random.default_rng(3).random((64, 80, 3)).astype(np.float32)

@@ -6,7 +6,7 @@ import threading
 
 import numpy as np
 
-from core.image import load_image, read_recipe
+from weft.core.image import load_image, read_recipe
 
 
 def _slow(method, started):

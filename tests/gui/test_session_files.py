@@ -10,7 +10,7 @@ import shutil
 import numpy as np
 import pytest
 
-from core.image import load_image, save_image
+from weft.core.image import load_image, save_image
 
 
 def _image(path, seed, side=24):
@@ -177,7 +177,7 @@ def _runs_off_gui_thread(monkeypatch, module, name, action):
 
 def test_session_images_are_decoded_off_the_gui_thread_while_it_keeps_running(window, qtbot, tmp_path, monkeypatch):
     """A session's images may be large: the GUI thread keeps running its event loop while they decode."""
-    import app.gui.files as files
+    import weft.app.gui.files as files
 
     texture = _image(tmp_path / "tex.png", 7)
     window.doc.set_input("texture", str(texture), load_image(texture).image)
@@ -189,7 +189,7 @@ def test_session_images_are_decoded_off_the_gui_thread_while_it_keeps_running(wi
 
 
 def test_export_is_encoded_off_the_gui_thread(window, qtbot, tmp_path, monkeypatch):
-    import app.gui.files as files
+    import weft.app.gui.files as files
 
     qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
     out = tmp_path / "out.png"
