@@ -68,11 +68,11 @@ class BatchDialog(QDialog):
     progressed = Signal(int, int, int, float)
     batch_finished = Signal(str, int, bool)
 
-    def __init__(self, recipe_source: Callable[[], Recipe], parent: QWidget | None = None):
+    def __init__(self, recipe_source: Callable[[], Recipe | None], parent: QWidget | None = None):
         super().__init__(parent)
         self.setWindowTitle("Apply to Folder")
         self.setModal(False)
-        self.recipe_source = recipe_source  # the studio's current recipe, read again at each Run
+        self.recipe_source = recipe_source  # the shown result's recipe, read again at each Run
         self.recipe = recipe = recipe_source()
         self.method = registry.get(recipe.method)
         self._cancel: CancelToken | None = None
@@ -184,6 +184,9 @@ class BatchDialog(QDialog):
         if self.running:
             return
         recipe = self.recipe_source()
+        if recipe is None:
+            self.status.setText("nothing to apply yet: wait for the full-size result")
+            return
         if recipe.method != self.method.name:
             self.status.setText(f"the studio's method changed to {recipe.method}: close this dialog and open it again")
             return
@@ -267,6 +270,13 @@ class BatchDialog(QDialog):
         super().closeEvent(event)
 
 
+def _shown_recipe(window) -> Recipe | None:
+    """The recipe of the full-size result on screen (what an export would carry), or None while
+    only a preview or nothing is shown."""
+    shown = window.renderer.last
+    return shown.recipe if shown is not None and shown.final else None
+
+
 def open_batch_dialog(window) -> BatchDialog | None:
     """Show the dialog for ``window``'s current result (one dialog per window, raised if open)."""
     shown = window.renderer.last
@@ -279,6 +289,6 @@ def open_batch_dialog(window) -> BatchDialog | None:
             dialog.activateWindow()
             return dialog
         dialog.deleteLater()
-    dialog = BatchDialog(window.doc.recipe, window)
+    dialog = BatchDialog(lambda: _shown_recipe(window), window)
     dialog.show()
     return dialog

@@ -58,7 +58,10 @@ def test_apply_to_folder_writes_what_weft_run_writes(window, qtbot, tmp_path):
         assert cli_main(["run", str(out), "-o", str(again)]) == 0
         assert again.read_bytes() == out.read_bytes()
         again.unlink()
-    # Run again: the studio's recipe now has the new seed, so every frame is redone with it...
+    # Run again once the new seed's result is shown: its recipe has the new seed, so every frame is
+    # redone with it...
+    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.seed == window.doc.seed,
+                    timeout=60000)
     with qtbot.waitSignal(dialog.batch_finished, timeout=120000) as done:
         qtbot.mouseClick(dialog.run_button, Qt.MouseButton.LeftButton)
     assert done.args[0] == "4 written" and window.doc.seed != seed

@@ -117,3 +117,22 @@ def test_the_affine_square_is_drawn_on_the_prototype_image_once_one_is_open(wind
     assert doc.square == (10, 10, 32)
     qtbot.waitUntil(lambda: window.renderer.last.final
                     and window.renderer.last.figures.get("prototype") == [10, 10, 32], timeout=30000)
+
+
+def test_apply_to_folder_takes_the_recipe_of_the_shown_pixels(window, qtbot, monkeypatch):
+    from weft.app.gui.batch_dialog import BatchDialog
+
+    doc = window.doc
+    doc.set_param("p", 0.3)
+    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.params["p"] == 0.3,
+                    timeout=20000)
+    started = threading.Event()
+    monkeypatch.setitem(doc.methods, "fast", _slow(doc.methods["fast"], started))
+    doc.set_param("p", 0.6)  # its render is cancelled: the panel says 0.6, the pixels are 0.3's
+    qtbot.waitUntil(started.is_set, timeout=5000)
+    window.renderer.cancel()
+    qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
+    window.open_batch_dialog()
+    dialog = window.findChild(BatchDialog)
+    assert dialog.recipe.params["p"] == 0.3 and dialog.recipe_source().params["p"] == 0.3
+    dialog.close()
