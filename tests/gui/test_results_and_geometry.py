@@ -19,7 +19,9 @@ def _slow(method, started):
     return dataclasses.replace(method, run=run)
 
 
-def test_export_after_a_cancelled_render_writes_the_recipe_of_the_shown_pixels(window, qtbot, tmp_path, monkeypatch):
+def _cancelled_render(window, qtbot, monkeypatch):
+    """Show a result with p 0.3, then set p 0.6 and cancel its render: the panel says 0.6, the
+    pixels on screen are 0.3's. Returns the shown result."""
     doc = window.doc
     doc.set_param("p", 0.3)
     qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.params["p"] == 0.3,
@@ -32,6 +34,11 @@ def test_export_after_a_cancelled_render_writes_the_recipe_of_the_shown_pixels(w
     window.renderer.cancel()
     qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
     assert window.renderer.last is shown and doc.current_params.p == 0.6
+    return shown
+
+
+def test_export_after_a_cancelled_render_writes_the_recipe_of_the_shown_pixels(window, qtbot, tmp_path, monkeypatch):
+    shown = _cancelled_render(window, qtbot, monkeypatch)
     out = tmp_path / "out.png"
     assert window.export_result(str(out))
     recipe = json.loads(read_recipe(out))
@@ -122,16 +129,7 @@ def test_the_affine_square_is_drawn_on_the_prototype_image_once_one_is_open(wind
 def test_apply_to_folder_takes_the_recipe_of_the_shown_pixels(window, qtbot, monkeypatch):
     from weft.app.gui.batch_dialog import BatchDialog
 
-    doc = window.doc
-    doc.set_param("p", 0.3)
-    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.params["p"] == 0.3,
-                    timeout=20000)
-    started = threading.Event()
-    monkeypatch.setitem(doc.methods, "fast", _slow(doc.methods["fast"], started))
-    doc.set_param("p", 0.6)  # its render is cancelled: the panel says 0.6, the pixels are 0.3's
-    qtbot.waitUntil(started.is_set, timeout=5000)
-    window.renderer.cancel()
-    qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
+    _cancelled_render(window, qtbot, monkeypatch)
     window.open_batch_dialog()
     dialog = window.findChild(BatchDialog)
     assert dialog.recipe.params["p"] == 0.3 and dialog.recipe_source().params["p"] == 0.3
