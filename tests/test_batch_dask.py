@@ -70,7 +70,7 @@ def test_workers_without_scheduler_is_a_usage_error(scene, capsys):
 
 def test_an_unreachable_scheduler_is_one_line(scene, capsys, monkeypatch):
     tmp, _ = scene
-    monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr("weft.core.batch.execute.CONNECT_TIMEOUT", "1s")
     code = main(["batch", str(tmp / "look.json"), "--over", "target", str(tmp / "frames"), "-o",
                  str(tmp / "o" / "{stem}.png"), "--scheduler", "tcp://127.0.0.1:9"])
     err = capsys.readouterr().err
