@@ -28,9 +28,12 @@ compiles only what it uses). Source and templates are centred on the source's me
 FFT loses little to cancellation.
 """
 
+from .checks import estimate_seconds, memory_estimate
 from .engine import RULES, _K, _Pass, _pad_to, _quilt_pass  # noqa: F401 (tests compare _K to the kernel)
-from .method import (CORR_SIGMA, CORRESPONDENCES, ITERATIVE_BLOCK, METHOD, MIN_BLOCK, MIN_OVERLAP, MODES, SYNTH_BLOCK,
-                     SYNTH_TOL, TRANSFER_BLOCK, QuiltParams, estimate_seconds, memory_estimate, synthesize, transfer,
-                     transfer_schedule, warm_up)
+from .method import METHOD, warm_up
+from .params import (CORR_SIGMA, CORRESPONDENCES, ITERATIVE_BLOCK, MIN_BLOCK, MIN_OVERLAP, MODES, SYNTH_BLOCK, SYNTH_TOL,
+                     TRANSFER_BLOCK, QuiltParams, transfer_schedule)
+from .synthesis import synthesize
+from .transfer import transfer
 
 __all__ = ["QuiltParams", "synthesize", "transfer", "transfer_schedule", "METHOD"]

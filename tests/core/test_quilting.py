@@ -253,7 +253,7 @@ def test_numpy_and_numba_engines_give_the_same_pixels(brick, monkeypatch, kw):
     import dataclasses
 
     import weft.core.quilting as q
-    import weft.core.quilting.method as qm
+    import weft.core.quilting.synthesis as qm  # synthesize calls its _quilt_pass
     from weft.core._kernels import quilting as k
 
     for name in ("P_Y0", "P_SX", "N_IPARAMS", "MODE_MINCUT", "SAMPLE_FRACTION", "TOP_FRACTION"):

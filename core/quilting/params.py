@@ -1,0 +1,127 @@
+"""Image quilting's parameters (:class:`QuiltParams`) and the iterative transfer's pass schedule."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+from ..errors import InvalidParameter
+from ..params import Params, out_of_range, param
+from .engine import RULES
+
+MODES = ("random", "overlap", "mincut")
+CORRESPONDENCES = ("blur", "luminance")
+
+# Defaults that depend on what is being made (see QuiltParams).
+SYNTH_BLOCK = 32
+TRANSFER_BLOCK = 9  # Ngo: single-pass transfer 9 / 3
+ITERATIVE_BLOCK = 31  # Ngo: iterative transfer starts at 31 / 21 ...
+MIN_BLOCK, MIN_OVERLAP = 9, 3  # ... and goes down to 9 / 3
+SYNTH_TOL = 2
+CORR_SIGMA = 2.0  # Gaussian blur (pixels) of the luminance correspondence maps ("blur")
+
+
+@dataclass(frozen=True)
+class QuiltParams(Params):
+    """Parameters of image quilting (Efros & Freeman §2 synthesis, §3 transfer).
+
+    ``mode`` defaults to mincut, the paper's full method. ``None`` means "derived from what is
+    made": ``block`` 32 for synthesis, 9 for one transfer pass, 31 for iterative transfer;
+    ``overlap`` a sixth of the block rounded up for synthesis (E&F §2.1), a third for one transfer
+    pass (Ngo's 9 / 3) and two thirds for iterative transfer (Ngo's 31 / 21); ``tol`` 2 for
+    synthesis and 1 for transfer.
+    """
+
+    mode: str = param("mincut", choices=MODES,
+                      help="random: blocks side by side; overlap: blocks matched on their overlap; "
+                           "mincut: plus the least-error cut")
+    block: int = param(None, kind="int", lo=2, hi=1024, optional=True, symbol="B",
+                       help="side of the square blocks in pixels (default 32; transfer 9, iterative 31)")
+    overlap: int = param(None, kind="int", lo=1, hi=1023, optional=True,
+                         help="overlap between neighbouring blocks in pixels, smaller than block "
+                              "(default block/6 rounded up; transfer block/3, iterative 2*block/3)")
+    size: tuple = param(
+        None, kind="size", lo=1, hi=16384, optional=True,
+        help="output size WIDTHxHEIGHT; default twice the texture's size (transfer: the target's)",
+    )
+    tol: int = param(None, kind="int", lo=1, hi=100000, optional=True,
+                     help="rule tol: pick at random among the tol best positions (default 2; transfer 1)")
+    rule: str = param("tol", choices=RULES,
+                      help="how a position is picked: tol best; epsilon: within (1+epsilon) x the best; "
+                           "sampled: best 10% of a random 10%")
+    epsilon: float = param(0.1, lo=0.0, hi=10.0, symbol="ε", step=0.01,
+                           help="rule epsilon: candidates within (1+epsilon) times the least error")
+    tile: bool = param(False, help="make the output tileable: it wraps seamlessly left-right and top-bottom")
+    poisson: bool = param(False, help="Poisson-blend a band around every seam (modes overlap, mincut)")
+    band: int = param(4, lo=1, hi=5, help="width in pixels of the Poisson band around each seam")
+    iterations: int = param(1, lo=1, hi=10, symbol="N",
+                            help="transfer passes; block and overlap shrink by a third per pass")
+    alpha: float = param(0.1, lo=0.0, hi=1.0, symbol="α", step=0.05,
+                         help="transfer: weight of the overlap error against the correspondence error "
+                              "(first pass; later passes go linearly to 0.9)")
+    correspondence: str = param("blur", choices=CORRESPONDENCES,
+                                help="transfer correspondence map: blurred luminance or raw luminance "
+                                     "(ignored when --source-map and --target-map are given)")
+    remap: bool = param(True, help="transfer: give the target's correspondence map the texture's mean and "
+                                   "deviation first, so dark and bright areas do not repeat the texture's extremes")
+
+    def check(self) -> None:
+        if self.block is not None and self.overlap is not None and self.overlap >= self.block:
+            raise out_of_range("overlap", self.overlap, 1, self.block - 1,
+                               f"must be smaller than block = {self.block}")
+        if self.poisson and self.mode == "random":
+            raise InvalidParameter("parameter 'poisson' = true needs mode overlap or mincut "
+                                   "(random blocks do not overlap, so there is no seam to blend)",
+                                   name="poisson", value=True)
+
+
+# --------------------------------------------------------------------------------------------
+# settings of one pass
+
+
+def _round_half_up(x: float) -> int:
+    return int(math.floor(x + 0.5))
+
+
+def transfer_schedule(iterations: int, *, block: int = ITERATIVE_BLOCK, overlap: int | None = None,
+                      alpha: float = 0.1) -> list[tuple[int, int, float]]:
+    """Block, overlap and alpha of every pass of iterative texture transfer.
+
+    Parameters
+    ----------
+    iterations : int
+        N >= 1 passes.
+    block : int, default 31
+        First pass's block side (Ngo's 31).
+    overlap : int, optional
+        First pass's overlap; default two thirds of the block rounded (21 for 31), Ngo's 31 / 21.
+    alpha : float, default 0.1
+        First pass's alpha (0..1).
+
+    Returns
+    -------
+    list of (block, overlap, alpha), one per pass.
+
+    Notes
+    -----
+    E&F §3: "the block size was reduced by a third each iteration", and
+    ``alpha_i = 0.8 (i - 1)/(N - 1) + 0.1``. Here ``b_i = max(b_min, round(2/3 b_{i-1}))`` and
+    ``o_i = max(o_min, round(2/3 o_{i-1}))``, rounding halves up, with the floors of Ngo's finest
+    scale, ``b_min = min(9, block)`` and ``o_min = min(3, overlap)``, and ``o_i < b_i``. The default
+    31 / 21 gives 31/21, 21/14, 14/9, 9/6, 9/4 for N = 5. Alpha runs linearly from the given
+    ``alpha`` to 0.9, ``alpha_i = alpha + (0.9 - alpha)(i - 1)/(N - 1)``, which is the papers'
+    schedule for the default 0.1; one pass uses ``alpha`` itself.
+    """
+    if overlap is None:
+        overlap = max(1, min(block - 1, _round_half_up(2 * block / 3)))
+    b_min, o_min = min(MIN_BLOCK, block), min(MIN_OVERLAP, overlap)
+    out = []
+    b, o = block, overlap
+    for i in range(iterations):
+        if i > 0:
+            b = max(b_min, _round_half_up(b * 2 / 3))
+            o = max(o_min, _round_half_up(o * 2 / 3))
+        o = min(o, b - 1)
+        a = alpha if iterations == 1 else alpha + (0.9 - alpha) * i / (iterations - 1)
+        out.append((b, o, float(a)))
+    return out
