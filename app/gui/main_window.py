@@ -410,6 +410,7 @@ class MainWindow(QMainWindow):
 
     # --- results ---------------------------------------------------------------------------------
     def _on_shown(self, shown) -> None:
+        self.result_view.set_stale(None)  # a render succeeded: what is shown follows the panel
         self.result_view.set_image(shown.image)
         if shown.before is not None and shown.before is not self.result_view.compare_image:
             self.result_view.set_compare(shown.before)  # the input of this result, not of the panel
@@ -445,6 +446,9 @@ class MainWindow(QMainWindow):
 
     def _on_failed(self, message: str) -> None:
         self.show_message(message)
+        if message.startswith("render failed"):  # not a warm-up's: the result no longer matches the panel
+            self.result_view.set_stale(f"Out of date — {message}. The result shown is from earlier settings"
+                                       f" (F5 renders again).")
         if self.renderer.last is not None:
             self.result_view.set_image(self.renderer.last.image)
 

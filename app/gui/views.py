@@ -236,6 +236,30 @@ class ResultView(ImageView):
         self.notice.setStyleSheet("QLabel { background: rgba(20, 20, 20, 200); color: white; padding: 12px 18px;"
                                   " border-radius: 6px; font-size: 15px; }")
         self.notice.hide()
+        # "stale": the result on screen does not match the panel (its render failed); shown along
+        # the top so the pixels stay visible, until a render succeeds
+        self.stale = QLabel(self.viewport())
+        self.stale.setObjectName("result-stale")
+        self.stale.setWordWrap(True)
+        self.stale.setStyleSheet("QLabel { background: rgba(150, 30, 30, 220); color: white; padding: 6px 10px;"
+                                 " font-size: 13px; }")
+        self.stale.hide()
+
+    def set_stale(self, text: str | None) -> None:
+        """Mark the result as not matching the panel (``text`` says why); None removes the mark."""
+        if not text:
+            self.stale.hide()
+            return
+        self.stale.setText(text)
+        self.stale.setToolTip(text)
+        self._place_stale()
+        self.stale.show()
+
+    def _place_stale(self) -> None:
+        width = self.viewport().width()
+        self.stale.setFixedWidth(width)
+        self.stale.adjustSize()
+        self.stale.move(0, 0)
 
     def set_notice(self, text: str | None) -> None:
         """Words shown over the middle of the result (e.g. what a long first run is doing); None hides them."""
@@ -258,6 +282,8 @@ class ResultView(ImageView):
         super().resizeEvent(event)
         if self.notice.isVisible():
             self._place_notice()
+        if self.stale.isVisible():
+            self._place_stale()
 
     def set_compare(self, image: np.ndarray | None) -> None:
         """The "before" image (e.g. the target), shown left of the divider when comparing."""

@@ -1,0 +1,31 @@
+"""Issue 14: the studio as an artist meets it — each bug's test drives the window with real events."""
+
+import dataclasses
+
+from PySide6.QtCore import Qt
+
+from weft.core.errors import WeftError
+
+
+def _failing(method):
+    def run(inputs, params, *, rng=None, progress=None, cancel=None):
+        raise WeftError("the kernel refused these settings")
+
+    return dataclasses.replace(method, run=run)
+
+
+def test_a_failed_render_marks_the_result_stale_until_a_render_succeeds(window, qtbot, monkeypatch):
+    view = window.result_view
+    good = window.doc.methods["fast"]
+    assert not view.stale.isVisible()
+    monkeypatch.setitem(window.doc.methods, "fast", _failing(good))
+    with qtbot.waitSignal(window.renderer.failed, timeout=10000):
+        qtbot.keyClick(window, Qt.Key.Key_F5)  # View > Render
+    assert view.stale.isVisible() and "the kernel refused these settings" in view.stale.text()
+    assert view.stale.geometry().top() == 0 and view.stale.width() == view.viewport().width()
+    window.statusBar().clearMessage()  # the status bar forgets; the mark stays
+    assert view.stale.isVisible()
+    monkeypatch.setitem(window.doc.methods, "fast", good)
+    with qtbot.waitSignal(window.renderer.shown, timeout=20000):
+        qtbot.keyClick(window, Qt.Key.Key_F5)
+    assert not view.stale.isVisible()
