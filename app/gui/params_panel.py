@@ -92,9 +92,21 @@ class _Row(QWidget):
         self.setToolTip("\n".join(tip))
 
     def _auto_toggled(self, on: bool) -> None:
+        # unticked: the editor already shows what "auto" resolved to (set_value), so the value
+        # starts there, not at the range's minimum
         self.editor.setEnabled(not on)
         self.editor.setVisible(True)
+        self._auto_tip()
         self.changed.emit(self.value(), False)
+
+    def _auto_tip(self, resolved: Any = None) -> None:
+        """While "auto" is ticked the editor is disabled: its tooltip says why and how to edit it."""
+        if self.auto is not None and self.auto.isChecked():
+            now = "" if resolved is None else f" (now {resolved})"
+            self.editor.setToolTip(f"{self.spec.name} is derived from the inputs: \"auto\" is ticked{now}.\n"
+                                   f"Untick \"auto\" to set it by hand, starting from this value.")
+        else:
+            self.editor.setToolTip(self.toolTip())
 
     def _value_changed(self, _v) -> None:
         if self.auto is not None and self.auto.isChecked():
@@ -132,6 +144,7 @@ class _Row(QWidget):
                 self.editor.setEnabled(value is not None)
                 # "auto" with no known value: show no number rather than a misleading one
                 self.editor.setVisible(value is not None or shown_when_auto is not None)
+            self._auto_tip(shown_when_auto if value is None else None)
             if value is None:
                 value = shown_when_auto
             if value is None:

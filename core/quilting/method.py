@@ -9,7 +9,7 @@ from ..errors import InvalidParameter
 from ..params import out_of_range
 from ..registry import InputSpec, Method, Result
 from ..studio import SQUARE, Geometry, Studio
-from .checks import _blocks, memory_estimate
+from .checks import _blocks, _transfer_passes, memory_estimate
 from .params import SYNTH_BLOCK, QuiltParams
 from .synthesis import _synthesize, synthesize
 from .transfer import _transfer, transfer
@@ -51,6 +51,17 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
     return Result(image, {"iterations": len(images)})
 
 
+def _auto(params: QuiltParams, open_inputs: frozenset) -> dict:
+    """What "auto" block and overlap resolve to with these inputs (the studio shows them beside
+    their box, and unticking "auto" starts from them): a transfer's first pass, or the synthesis
+    defaults."""
+    if "target" in open_inputs:
+        block, overlap, _alpha = _transfer_passes(params)[0]
+        return {"block": block, "overlap": overlap}
+    block = params.block or SYNTH_BLOCK
+    return {"block": block, "overlap": params.overlap if params.overlap is not None else max(1, -(-block // 6))}
+
+
 def warm_up() -> None:
     """Load (or compile) every numba kernel a run can use, on tiny inputs, so that no run compiles:
     the four selection kernels (tol, tol 1, epsilon, sampled), the cut and paste, the Poisson band
@@ -90,6 +101,7 @@ METHOD = Method(
         canvas="texture",
         geometry=(Geometry(SQUARE, on=("texture",),
                            help="drag a square: the source region (blocks come only from it)"),),
-        preview_inputs=("target", "target_map"), preview_params=("size",), compare=("target", "texture"),
+        preview_inputs=("target", "target_map"), preview_params=("size",), auto=_auto,
+        compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=1),
 )

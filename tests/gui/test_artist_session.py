@@ -29,3 +29,19 @@ def test_a_failed_render_marks_the_result_stale_until_a_render_succeeds(window, 
     with qtbot.waitSignal(window.renderer.shown, timeout=20000):
         qtbot.keyClick(window, Qt.Key.Key_F5)
     assert not view.stale.isVisible()
+
+
+def test_unticking_auto_starts_from_the_resolved_value_and_a_disabled_slider_says_why(window, qtbot):
+    doc = window.doc
+    doc.set_method("quilt")  # a transfer (the studio opens a target): block resolves to 9, overlap 3
+    qtbot.waitUntil(lambda: "block" in window.params_panel.rows
+                    and window.params_panel.row("block").auto.isVisible(), timeout=5000)
+    row = window.params_panel.row("block")
+    assert row.auto.isChecked() and not row.editor.isEnabled()
+    assert "auto" in row.editor.toolTip() and "now 9" in row.editor.toolTip()
+    qtbot.mouseClick(row.auto, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: doc.current_params.block is not None, timeout=5000)
+    assert doc.current_params.block == 9  # the resolved value, not the minimum 2
+    assert row.editor.isEnabled() and row.editor.value() == 9
+    assert "auto" not in row.editor.toolTip().split("\n")[0]
+    window.renderer.cancel()
