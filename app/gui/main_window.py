@@ -106,6 +106,7 @@ class MainWindow(QMainWindow):
         dock.setWidget(self.method_panel)
         dock.setMinimumWidth(390)
         self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+        self.method_dock = dock
         self.files = FileActions(self, self.doc, self.renderer)
         self._build_examples()
         self._build_status()
@@ -122,6 +123,7 @@ class MainWindow(QMainWindow):
         self.renderer.failed.connect(self._on_failed)
         self.renderer.cancelled.connect(self._on_cancelled)
         self._rebuild_method()
+        self._default_layout = self.saveState()  # View > Reset Layout returns to it
         self.restoreGeometry(self.settings.value("geometry", b""))
         self.restoreState(self.settings.value("state", b""))
         # The method on screen loads (or compiles) its kernels in its own first render; the other
@@ -290,8 +292,25 @@ class MainWindow(QMainWindow):
         self._action(v, "&Compare Before/After", self.method_panel.compare_button.toggle, "C")
         self._action(v, "&Render", lambda: self.renderer.final(now=True), "F5")
         v.addSeparator()
-        v.addAction(self.examples_dock.toggleViewAction())
+        # every dock can be brought back from here (closing the Method dock hides every control)
+        for dock in (self.method_dock, self.examples_dock):
+            toggle = dock.toggleViewAction()
+            toggle.setText(f"{dock.windowTitle()} Panel")
+            toggle.setStatusTip(f"show or hide the {dock.windowTitle()} panel")
+            v.addAction(toggle)
+        self.reset_layout_action = self._action(v, "Reset &Layout", self.reset_layout,
+                                                tip="put every panel back where it was when the studio was first opened")
+        self.view_menu = v
         self._refresh_recent()
+
+    def reset_layout(self) -> None:
+        """Every panel shown and docked where the studio first put it; the result gets the larger share."""
+        self.restoreState(self._default_layout)
+        for dock in (self.method_dock, self.examples_dock):
+            dock.setFloating(False)
+            dock.show()
+        total = max(self.splitter.width(), 400)
+        self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
 
     # --- inputs ----------------------------------------------------------------------------------
     def load_examples(self) -> None:

@@ -45,3 +45,35 @@ def test_unticking_auto_starts_from_the_resolved_value_and_a_disabled_slider_say
     assert row.editor.isEnabled() and row.editor.value() == 9
     assert "auto" not in row.editor.toolTip().split("\n")[0]
     window.renderer.cancel()
+
+
+def _click_menu_item(qtbot, menu, action):
+    """Open ``menu`` and click ``action`` in it with the mouse."""
+    menu.popup(menu.parentWidget().mapToGlobal(menu.parentWidget().rect().center()))
+    qtbot.waitUntil(menu.isVisible, timeout=5000)
+    qtbot.mouseClick(menu, Qt.MouseButton.LeftButton, pos=menu.actionGeometry(action).center())
+
+
+def test_every_dock_is_in_the_view_menu_and_reset_layout_restores_it(window, qtbot):
+    from PySide6.QtWidgets import QAbstractButton, QDockWidget
+
+    docks = window.findChildren(QDockWidget)
+    menu = window.view_menu
+    assert {d.toggleViewAction() for d in docks} <= set(menu.actions())
+    method = window.method_dock
+    close = method.findChild(QAbstractButton, "qt_dockwidget_closebutton")
+    qtbot.mouseClick(close, Qt.MouseButton.LeftButton)  # every control gone ...
+    qtbot.waitUntil(lambda: not method.isVisible(), timeout=5000)
+    _click_menu_item(qtbot, menu, method.toggleViewAction())  # ... and back from the View menu
+    qtbot.waitUntil(method.isVisible, timeout=5000)
+    # move things around: Method floats, Examples closes
+    float_button = method.findChild(QAbstractButton, "qt_dockwidget_floatbutton")
+    qtbot.mouseClick(float_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(method.isFloating, timeout=5000)
+    qtbot.mouseClick(window.examples_dock.findChild(QAbstractButton, "qt_dockwidget_closebutton"),
+                     Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: not window.examples_dock.isVisible(), timeout=5000)
+    _click_menu_item(qtbot, menu, window.reset_layout_action)
+    qtbot.waitUntil(lambda: all(d.isVisible() and not d.isFloating() for d in docks), timeout=5000)
+    assert window.dockWidgetArea(method) == Qt.DockWidgetArea.RightDockWidgetArea
+    assert window.dockWidgetArea(window.examples_dock) == Qt.DockWidgetArea.LeftDockWidgetArea
