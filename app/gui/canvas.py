@@ -47,6 +47,7 @@ class InputsPane(QSplitter):
     message = Signal(str)
     dragging = Signal(str, object)
     hovered = Signal(object, int, int)  # view, x, y
+    zoomed = Signal(object, float)  # view, scale
     open_requested = Signal(str, str)
 
     def __init__(self, doc, parent=None):
@@ -68,6 +69,7 @@ class InputsPane(QSplitter):
         if view is None:
             view = ImageView(self.canvas, title=name)  # (a QSplitter parent would adopt it as a pane)
             view.hovered.connect(lambda x, y, v=view: self.hovered.emit(v, x, y))
+            view.zoomed.connect(lambda scale, v=view: self.zoomed.emit(v, scale))
             view.file_dropped.connect(lambda path, n=name: self.open_requested.emit(n, path))
             self.views[name] = view
             self._boxes[name] = titled(view, name)

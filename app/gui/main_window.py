@@ -85,6 +85,8 @@ class MainWindow(QMainWindow):
         self.inputs_pane.message.connect(self.show_message)
         self.inputs_pane.dragging.connect(self._geometry_dragged)
         self.inputs_pane.hovered.connect(self._on_hover)
+        self.inputs_pane.zoomed.connect(self._on_zoomed)
+        self._pointer_view: ImageView | None = None  # the view the mouse last moved over
         self.inputs_pane.open_requested.connect(self.open_input)
         self.splitter = QSplitter(Qt.Orientation.Horizontal)
         self.splitter.addWidget(self.inputs_pane)
@@ -240,7 +242,7 @@ class MainWindow(QMainWindow):
             self.statusBar().addPermanentWidget(w)
         self.progress_bar.hide()
         self.cancel_button.hide()
-        self.result_view.zoomed.connect(lambda s: self.zoom_label.setText(f"{s * 100:.0f}%"))
+        self.result_view.zoomed.connect(lambda s: self._on_zoomed(self.result_view, s))
         self.result_view.hovered.connect(lambda x, y: self._on_hover(self.result_view, x, y))
 
     def _action(self, menu, text, slot, shortcut=None, tip=None) -> QAction:
@@ -285,10 +287,10 @@ class MainWindow(QMainWindow):
         self._action(e, "New &Seed", self.method_panel.new_seed, "Ctrl+R")
         self.clear_square_action = self._action(e, "Clear S&quare", lambda: self.doc.set_square(None))
         v = self.menuBar().addMenu("&View")
-        self._action(v, "Zoom &In", lambda: self._focused_view().zoom_by(1.25), QKeySequence.StandardKey.ZoomIn)
-        self._action(v, "Zoom &Out", lambda: self._focused_view().zoom_by(0.8), QKeySequence.StandardKey.ZoomOut)
-        self._action(v, "&Fit to Window", lambda: self._focused_view().fit(), "Ctrl+0")
-        self._action(v, "&Actual Size", lambda: self._focused_view().actual_size(), "Ctrl+1")
+        self._action(v, "Zoom &In", lambda: self._zoom_view().zoom_by(1.25), QKeySequence.StandardKey.ZoomIn)
+        self._action(v, "Zoom &Out", lambda: self._zoom_view().zoom_by(0.8), QKeySequence.StandardKey.ZoomOut)
+        self._action(v, "&Fit to Window", lambda: self._zoom_view().fit(), "Ctrl+0")
+        self._action(v, "&Actual Size", lambda: self._zoom_view().actual_size(), "Ctrl+1")
         self._action(v, "&Compare Before/After", self.method_panel.compare_button.toggle, "C")
         self._action(v, "&Render", lambda: self.renderer.final(now=True), "F5")
         v.addSeparator()
@@ -482,6 +484,9 @@ class MainWindow(QMainWindow):
         self.message.emit(text)
 
     def _on_hover(self, view: ImageView, x: int, y: int) -> None:
+        if view is not self._pointer_view:
+            self._pointer_view = view
+            self._show_zoom(view)
         img = view.image
         if x < 0 or img is None:
             self.pixel_label.setText("")
@@ -490,11 +495,27 @@ class MainWindow(QMainWindow):
         value = f"{float(v):.3f}" if np.ndim(v) == 0 else " ".join(f"{float(c):.3f}" for c in v)
         self.pixel_label.setText(f"{view.title}  x {x}  y {y}  {value}")
 
-    def _focused_view(self) -> ImageView:
+    def _zoom_view(self) -> ImageView:
+        """The view the zoom shortcuts act on: the one under the mouse (the last it moved over),
+        else the focused one, else the result."""
+        view = self._pointer_view
+        if view is not None and view.isVisible():
+            return view
         for view in [self.result_view, *self.views.values()]:
             if view.hasFocus():
                 return view
         return self.result_view
+
+    def _on_zoomed(self, view: ImageView, scale: float) -> None:
+        if view is self._zoom_view():
+            self._show_zoom(view)
+
+    def _show_zoom(self, view: ImageView) -> None:
+        """The % label: the zoom of the view the shortcuts act on, named."""
+        if view.image is None:
+            self.zoom_label.setText("")
+            return
+        self.zoom_label.setText(f"{view.title.replace('_', ' ')} {view.scale_factor() * 100:.0f}%")
 
     def open_variations(self) -> None:
         from .variations import VariationsDialog

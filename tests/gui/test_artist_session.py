@@ -77,3 +77,26 @@ def test_every_dock_is_in_the_view_menu_and_reset_layout_restores_it(window, qtb
     qtbot.waitUntil(lambda: all(d.isVisible() and not d.isFloating() for d in docks), timeout=5000)
     assert window.dockWidgetArea(method) == Qt.DockWidgetArea.RightDockWidgetArea
     assert window.dockWidgetArea(window.examples_dock) == Qt.DockWidgetArea.LeftDockWidgetArea
+
+
+def test_zoom_shortcuts_act_on_the_view_under_the_mouse_and_the_label_shows_its_zoom(window, qtbot):
+    from .helpers import mouse
+
+    result, canvas = window.result_view, window.canvas_view
+    canvas.setFocus()  # the keyboard focus is on the canvas ...
+    qtbot.waitUntil(canvas.hasFocus, timeout=5000)
+    canvas_scale = canvas.scale_factor()
+    assert abs(result.scale_factor() - 1.0) > 0.01  # the result is fitted, not at 100%
+    w, h = result.image_size()
+    mouse(result, "move", (w / 2, h / 2))  # ... the mouse over the result
+    qtbot.keyClick(window, Qt.Key.Key_1, Qt.KeyboardModifier.ControlModifier)  # Actual Size
+    qtbot.waitUntil(lambda: abs(result.scale_factor() - 1.0) < 1e-6, timeout=5000)
+    assert canvas.scale_factor() == canvas_scale
+    assert window.zoom_label.text() == "result 100%"
+    cw, ch = canvas.image_size()
+    mouse(canvas, "move", (cw / 2, ch / 2))
+    assert window.zoom_label.text() == f"{canvas.title} {canvas_scale * 100:.0f}%"
+    qtbot.keyClick(window, Qt.Key.Key_Plus, Qt.KeyboardModifier.ControlModifier)  # Zoom In
+    qtbot.waitUntil(lambda: abs(canvas.scale_factor() - canvas_scale * 1.25) < 1e-6, timeout=5000)
+    assert abs(result.scale_factor() - 1.0) < 1e-6
+    assert window.zoom_label.text() == f"{canvas.title} {canvas_scale * 125:.0f}%"
