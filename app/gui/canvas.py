@@ -16,7 +16,17 @@ Contract
 from __future__ import annotations
 
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import QLabel, QSizePolicy, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QHBoxLayout,
+    QLabel,
+    QSizePolicy,
+    QSplitter,
+    QStackedWidget,
+    QTabWidget,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
 
 from weft.core.studio import LINES, SQUARE
 
@@ -31,13 +41,25 @@ def titled(view: QWidget, title: str) -> QWidget:
     lay = QVBoxLayout(box)
     lay.setContentsMargins(0, 0, 0, 0)
     lay.setSpacing(0)
+    header = QWidget()
+    header.setStyleSheet("background:#2b2b2b; color:#ddd;")
+    row = QHBoxLayout(header)
+    row.setContentsMargins(0, 0, 2, 0)
+    row.setSpacing(2)
     label = QLabel(f"  {title}")
-    label.setStyleSheet("background:#2b2b2b; color:#ddd; padding:2px;")
+    label.setStyleSheet("padding:2px;")
     label.setToolTip(title)
     label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
-    lay.addWidget(label)
+    row.addWidget(label, 1)
+    clear = QToolButton()  # shown for an optional input (InputsPane.rebuild)
+    clear.setText("Clear")
+    clear.setAutoRaise(True)
+    clear.hide()
+    row.addWidget(clear)
+    lay.addWidget(header)
     lay.addWidget(view)
     box.label = label
+    box.clear_button = clear
     return box
 
 
@@ -49,6 +71,7 @@ class InputsPane(QSplitter):
     hovered = Signal(object, int, int)  # view, x, y
     zoomed = Signal(object, float)  # view, scale
     open_requested = Signal(str, str)
+    clear_requested = Signal(str)  # an optional input's "Clear" button
 
     def __init__(self, doc, parent=None):
         super().__init__(Qt.Orientation.Vertical, parent)
@@ -73,6 +96,7 @@ class InputsPane(QSplitter):
             view.file_dropped.connect(lambda path, n=name: self.open_requested.emit(n, path))
             self.views[name] = view
             self._boxes[name] = titled(view, name)
+            self._boxes[name].clear_button.clicked.connect(lambda _=False, n=name: self.clear_requested.emit(n))
         return view
 
     @property
@@ -113,6 +137,7 @@ class InputsPane(QSplitter):
         for inp in method.inputs:
             view = self.view(inp.name)
             view.set_image(self.doc.image(inp.name))
+            self._show_clear(inp.name, optional=not inp.required)
             if inp.name == studio.canvas:
                 continue
             label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")
@@ -151,9 +176,21 @@ class InputsPane(QSplitter):
 
     def input_changed(self, name: str) -> None:
         self.view(name).set_image(self.doc.image(name), fit=True)
+        spec = next((i for i in self.doc.current.inputs if i.name == name), None)
+        self._show_clear(name, optional=spec is not None and not spec.required)
         self.sync_tools()
         if self.lines_panel is not None and name == self.lines_panel.input_name:
             self.lines_panel.photo_changed()
+
+    def _show_clear(self, name: str, *, optional: bool) -> None:
+        """An optional input's title bar has a "Clear" button, enabled while the input is open."""
+        button = self._boxes[name].clear_button
+        button.setVisible(optional)
+        is_open = self.doc.image(name) is not None
+        button.setEnabled(is_open)
+        pretty = name.replace("_", " ")
+        button.setToolTip(f"remove the {pretty} (the method runs without it; Ctrl+Z brings it back)" if is_open
+                          else f"no {pretty} is open (optional)")
 
     def geometry_changed(self) -> None:
         self.sync_tools()

@@ -186,6 +186,11 @@ class Document(QObject):
     def set_input(self, name: str, path: str | None, image: np.ndarray) -> None:
         self.push(SetInput(self, name, InputImage(path, image)))
 
+    def clear_input(self, name: str) -> None:
+        """Undoable removal of an open input (the method then runs without it)."""
+        if name in self.inputs:
+            self.push(SetInput(self, name, None))
+
     def set_method(self, method: str) -> None:
         if method != self.method:
             self.push(SetMethod(self, method))
@@ -316,9 +321,12 @@ class SetParams(QUndoCommand):
 
 
 class SetInput(QUndoCommand):
-    def __init__(self, doc: Document, name: str, item: InputImage):
-        label = Path(item.path).name if item.path else "image"
-        super().__init__(f"Open {name} {label}")
+    def __init__(self, doc: Document, name: str, item: InputImage | None):
+        if item is None:
+            super().__init__(f"Clear {name.replace('_', ' ')}")
+        else:
+            label = Path(item.path).name if item.path else "image"
+            super().__init__(f"Open {name} {label}")
         self.doc, self.name, self.new = doc, name, item
         self.old = doc.inputs.get(name)
 

@@ -88,6 +88,7 @@ class MainWindow(QMainWindow):
         self.inputs_pane.zoomed.connect(self._on_zoomed)
         self._pointer_view: ImageView | None = None  # the view the mouse last moved over
         self.inputs_pane.open_requested.connect(self.open_input)
+        self.inputs_pane.clear_requested.connect(self.doc.clear_input)
         self.splitter = QSplitter(Qt.Orientation.Horizontal)
         self.splitter.addWidget(self.inputs_pane)
         self.splitter.addWidget(titled(self.result_view, "result"))
@@ -263,6 +264,7 @@ class MainWindow(QMainWindow):
         self.open_second_action = self._action(m, "Open &Second Input…", lambda: self._open_nth(1), "Ctrl+Shift+O")
         self.open_other_menu = m.addMenu("Open Input")
         self.recent_menu = m.addMenu("Open &Recent")
+        self.clear_input_menu = m.addMenu("&Clear Input")  # the current method's optional inputs
         m.addSeparator()
         self._action(m, "Open &Session…", self.files.open_session_dialog, "Ctrl+Shift+L")
         self._action(m, "&Save Session…", self.files.save_session_dialog, QKeySequence.StandardKey.Save)
@@ -382,6 +384,7 @@ class MainWindow(QMainWindow):
     def _on_doc_changed(self, what: str) -> None:
         if what.startswith("input:"):
             self.inputs_pane.input_changed(what.split(":", 1)[1])
+            self._refresh_clear_inputs()
             self.method_panel.show_square()
             self.method_panel.show_params()
             self.renderer.final()
@@ -419,7 +422,18 @@ class MainWindow(QMainWindow):
             act = self.open_other_menu.addAction(f"{inp.name.replace('_', ' ')}…")
             act.triggered.connect(lambda _=False, n=inp.name: self.open_input_dialog(n))
         self._refresh_recent()
+        self._refresh_clear_inputs()
         self._update_title()
+
+    def _refresh_clear_inputs(self) -> None:
+        """File > Clear Input: one entry per optional input of the current method, enabled while open."""
+        self.clear_input_menu.clear()
+        optional = [i.name for i in self.doc.current.inputs if not i.required]
+        for name in optional:
+            act = self.clear_input_menu.addAction(f"{name.replace('_', ' ')}")
+            act.setEnabled(self.doc.image(name) is not None)
+            act.triggered.connect(lambda _=False, n=name: self.doc.clear_input(n))
+        self.clear_input_menu.setEnabled(any(self.doc.image(n) is not None for n in optional))
 
     def _geometry_dragged(self, key: str, value) -> None:
         self.method_panel.show_square(value)

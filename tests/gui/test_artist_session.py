@@ -100,3 +100,25 @@ def test_zoom_shortcuts_act_on_the_view_under_the_mouse_and_the_label_shows_its_
     qtbot.waitUntil(lambda: abs(canvas.scale_factor() - canvas_scale * 1.25) < 1e-6, timeout=5000)
     assert abs(result.scale_factor() - 1.0) < 1e-6
     assert window.zoom_label.text() == f"{canvas.title} {canvas_scale * 125:.0f}%"
+
+
+def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(window, qtbot):
+    doc = window.doc
+    target = doc.image("target")
+    assert window.renderer.last.image.shape[:2] == target.shape[:2]  # a transfer onto the target
+    box = window.inputs_pane._boxes["target"]
+    window.input_tabs.setCurrentWidget(box)
+    qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
+    assert not window.inputs_pane._boxes["texture"].clear_button.isVisible()  # required: no Clear
+    with qtbot.waitSignal(window.renderer.shown, timeout=20000,
+                          check_params_cb=lambda shown: shown.final and "target" not in shown.recipe.inputs):
+        qtbot.mouseClick(box.clear_button, Qt.MouseButton.LeftButton)
+    assert doc.image("target") is None and not box.clear_button.isEnabled()
+    assert window.renderer.last.image.shape[:2] != target.shape[:2]  # plain synthesis now
+    assert [a.text() for a in window.clear_input_menu.actions()] == ["target", "mask"]  # File > Clear Input
+    assert not window.clear_input_menu.isEnabled()  # neither is open now
+    with qtbot.waitSignal(window.renderer.shown, timeout=20000,
+                          check_params_cb=lambda shown: shown.final and "target" in shown.recipe.inputs):
+        qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # Undo
+    assert doc.image("target") is target and box.clear_button.isEnabled()
+    assert window.renderer.last.image.shape[:2] == target.shape[:2]
