@@ -143,10 +143,10 @@ class FileActions(QObject):
             return False
         return True
 
-    def save_session_dialog(self) -> None:
+    def save_session_dialog(self) -> bool:
+        """Ask where, then save; True if the session was saved."""
         path, _ = QFileDialog.getSaveFileName(self.window, "Save session", "", "weft session (*.weft.json *.json)")
-        if path:
-            self.save_session(path)
+        return bool(path) and self.save_session(path)
 
     def save_session(self, path: str) -> bool:
         try:
@@ -166,9 +166,9 @@ class FileActions(QObject):
     def open_session(self, path: str) -> bool:
         """Replace the document with a saved session (inputs re-read from their files).
 
-        Unsaved edits are discarded only if the user agrees (:meth:`_confirm`).
+        Unsaved edits are saved or discarded as the user chooses first (``window.may_drop_edits``).
         """
-        if not self.doc.undo_stack.isClean() and not self._confirm("Discard your unsaved edits and open the session?"):
+        if not self.window.may_drop_edits("open another session"):
             return False
         try:
             data, images = self._read_session_files(path)

@@ -208,6 +208,28 @@ class MainWindow(QMainWindow):
                                       QMessageBox.StandardButton.No)
         return answer == QMessageBox.StandardButton.Yes
 
+    def _ask_unsaved(self, doing: str) -> str:
+        """The document has unsaved edits and the user is about to ``doing`` (e.g. "quit"): ask
+        Save / Discard / Cancel in a modal box; returns "save", "discard" or "cancel"."""
+        box = QMessageBox(QMessageBox.Icon.Question, "weft",
+                          f"Save your unsaved edits as a session before you {doing}?",
+                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self)
+        box.setDefaultButton(QMessageBox.StandardButton.Save)
+        box.setEscapeButton(QMessageBox.StandardButton.Cancel)
+        answer = box.exec()
+        return {QMessageBox.StandardButton.Save: "save",
+                QMessageBox.StandardButton.Discard: "discard"}.get(QMessageBox.StandardButton(answer), "cancel")
+
+    def may_drop_edits(self, doing: str) -> bool:
+        """True when there is nothing unsaved, or the user saved (a session) or discarded it."""
+        if self.doc.undo_stack.isClean():
+            return True
+        answer = self._ask_unsaved(doing)
+        if answer == "save":
+            return self.files.save_session_dialog()
+        return answer == "discard"
+
     # --- construction --------------------------------------------------------------------------
     def _build_examples(self) -> None:
         self.example_list = _ExampleList()
@@ -276,7 +298,7 @@ class MainWindow(QMainWindow):
         self.load_lines_action = self._action(m, "Load Feature &Lines…", lambda: self.lines_panel.load_lines_dialog())
         self.save_lines_action = self._action(m, "Save Feature Li&nes…", lambda: self.lines_panel.save_lines_dialog())
         m.addSeparator()
-        self._action(m, "&Quit", self.close, QKeySequence.StandardKey.Quit)
+        self._action(m, "&Quit", self.close, "Ctrl+Q")  # StandardKey.Quit is empty on some desktops
         e = self.menuBar().addMenu("&Edit")
         undo = self.doc.undo_stack.createUndoAction(self, "&Undo")
         undo.setShortcut(QKeySequence.StandardKey.Undo)
@@ -564,7 +586,7 @@ class MainWindow(QMainWindow):
             self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
 
     def closeEvent(self, event):  # noqa: N802
-        if not self.doc.undo_stack.isClean() and not self._confirm("Discard your unsaved edits and quit?"):
+        if not self.may_drop_edits("quit"):
             event.ignore()
             return
         self.files._autosave_timer.stop()

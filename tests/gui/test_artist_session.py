@@ -122,3 +122,45 @@ def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(wind
         qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # Undo
     assert doc.image("target") is target and box.clear_button.isEnabled()
     assert window.renderer.last.image.shape[:2] == target.shape[:2]
+
+
+def _click_in_box_when_shown(qtbot, button):
+    """Once a modal message box is up, click its ``button`` with the mouse; returns the box's text."""
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication, QMessageBox
+
+    seen = []
+
+    def poll():
+        box = QApplication.activeModalWidget()
+        if not isinstance(box, QMessageBox):
+            QTimer.singleShot(20, poll)
+            return
+        seen.append((box.text(), sorted(b.text().replace("&", "") for b in box.buttons())))
+        qtbot.mouseClick(box.button(button), Qt.MouseButton.LeftButton)
+
+    QTimer.singleShot(0, poll)
+    return seen
+
+
+def test_quitting_with_unsaved_edits_offers_save_discard_cancel(window, qtbot, monkeypatch, tmp_path):
+    from PySide6.QtWidgets import QFileDialog, QMessageBox
+
+    from weft.app.gui.main_window import MainWindow
+
+    monkeypatch.undo()  # the real question, not the conftest's answer ...
+    monkeypatch.setenv("WEFT_RECOVERY_DIR", str(tmp_path / "recovery"))  # ... with a private autosave
+    monkeypatch.setattr(MainWindow, "_confirm", lambda self, question: True)
+    window.doc.set_param("p", 0.5)
+    seen = _click_in_box_when_shown(qtbot, QMessageBox.StandardButton.Cancel)
+    qtbot.keyClick(window, Qt.Key.Key_Q, Qt.KeyboardModifier.ControlModifier)  # File > Quit
+    assert seen and seen[0][1] == ["Cancel", "Discard", "Save"] and "quit" in seen[0][0]
+    assert window.isVisible()  # Cancel: the window stays, edits kept
+    session = tmp_path / "kept.weft.json"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(session), ""))
+    window.activateWindow()  # the box has gone: the window is active again
+    qtbot.waitUntil(window.isActiveWindow, timeout=5000)
+    seen = _click_in_box_when_shown(qtbot, QMessageBox.StandardButton.Save)
+    qtbot.keyClick(window, Qt.Key.Key_Q, Qt.KeyboardModifier.ControlModifier)
+    assert seen and not window.isVisible()  # Save: the session is written, then the studio quits
+    assert session.exists() and '"p": 0.5' in session.read_text(encoding="utf-8")

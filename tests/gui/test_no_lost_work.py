@@ -50,28 +50,42 @@ def test_export_to_a_new_file_does_not_ask(window, tmp_path, monkeypatch):
     assert asked == []
 
 
+def answer_unsaved(monkeypatch, reply: str) -> list[str]:
+    """Make the Save / Discard / Cancel question about unsaved edits answer ``reply``; returns what
+    the user was about to do, per question."""
+    asked = []
+
+    def ask(self, doing):
+        asked.append(doing)
+        return reply
+
+    monkeypatch.setattr(MainWindow, "_ask_unsaved", ask)
+    return asked
+
+
 def test_close_with_unsaved_edits_asks(window, monkeypatch):
     window.doc.set_param("p", 0.5)
-    asked = answer(monkeypatch, False)
+    asked = answer_unsaved(monkeypatch, "cancel")
     assert window.close() is False  # refused: the window stays
-    assert window.isVisible() and len(asked) == 1
-    answer(monkeypatch, True)
+    assert window.isVisible() and asked == ["quit"]
+    answer_unsaved(monkeypatch, "discard")
     assert window.close() is True
 
 
 def test_close_when_clean_does_not_ask(window, monkeypatch):
     asked = answer(monkeypatch, False)
-    assert window.close() is True and asked == []
+    asked_unsaved = answer_unsaved(monkeypatch, "cancel")
+    assert window.close() is True and asked == [] and asked_unsaved == []
 
 
 def test_open_session_with_unsaved_edits_asks(window, tmp_path, monkeypatch):
     session = tmp_path / "s.weft.json"
     assert window.save_session(str(session))
     window.doc.set_param("p", 0.5)
-    asked = answer(monkeypatch, False)
+    asked = answer_unsaved(monkeypatch, "cancel")
     assert window.open_session(str(session)) is False
     assert len(asked) == 1 and window.doc.current_params.p == 0.5
-    answer(monkeypatch, True)
+    answer_unsaved(monkeypatch, "discard")
     assert window.open_session(str(session)) is True
     assert window.doc.current_params.p != 0.5
 
