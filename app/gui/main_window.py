@@ -261,6 +261,7 @@ class MainWindow(QMainWindow):
         self.progress_bar.setRange(0, 1000)
         self.cancel_button = QPushButton("Cancel")
         self.cancel_button.clicked.connect(self.renderer.cancel)
+        self.cancel_button.setToolTip("cancel the render (Esc); the previous result is kept")
         for w in (self.pixel_label, self.zoom_label, self.progress_bar, self.cancel_button):
             self.statusBar().addPermanentWidget(w)
         self.progress_bar.hide()
@@ -577,6 +578,15 @@ class MainWindow(QMainWindow):
         dialog = getattr(self, "_variations", None)
         if dialog is not None:
             dialog.shutdown()
+
+    def keyPressEvent(self, event):  # noqa: N802
+        # Esc cancels a running render. Not a shortcut: a view's tool that uses Esc (a square drag,
+        # Quad… clicks) accepts it first; only an Esc nothing used reaches the window.
+        if event.key() == Qt.Key.Key_Escape and self.renderer.running():
+            self.renderer.cancel()
+            event.accept()
+            return
+        super().keyPressEvent(event)
 
     def showEvent(self, event):  # noqa: N802
         super().showEvent(event)

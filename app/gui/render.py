@@ -172,6 +172,11 @@ class Renderer(QObject):
         self.busy.emit(False)
         self.cancelled.emit()
 
+    def running(self) -> bool:
+        """A preview or final render is running or about to start."""
+        return (self._final_running or self._preview_running is not None
+                or self._final_timer.isActive() or self._preview_timer.isActive())
+
     def shutdown(self) -> None:
         self._warm_up_timer.stop()
         self._warm_up_wanted = False  # a result still queued must not start it on a closed runner

@@ -164,3 +164,24 @@ def test_quitting_with_unsaved_edits_offers_save_discard_cancel(window, qtbot, m
     qtbot.keyClick(window, Qt.Key.Key_Q, Qt.KeyboardModifier.ControlModifier)
     assert seen and not window.isVisible()  # Save: the session is written, then the studio quits
     assert session.exists() and '"p": 0.5' in session.read_text(encoding="utf-8")
+
+
+def test_esc_cancels_a_running_render_and_keeps_the_previous_result(window, qtbot, monkeypatch):
+    import threading
+
+    shown = window.renderer.last
+    started = threading.Event()
+
+    def run(inputs, params, *, rng=None, progress=None, cancel=None):
+        started.set()
+        while True:
+            cancel.raise_if_cancelled()
+            threading.Event().wait(0.01)
+
+    monkeypatch.setitem(window.doc.methods, "fast", dataclasses.replace(window.doc.methods["fast"], run=run))
+    qtbot.keyClick(window, Qt.Key.Key_F5)
+    qtbot.waitUntil(started.is_set, timeout=5000)
+    with qtbot.waitSignal(window.renderer.cancelled, timeout=5000):
+        qtbot.keyClick(window.result_view, Qt.Key.Key_Escape)  # the view has no use for it: the window's
+    qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
+    assert window.renderer.last is shown and window.result_view.image is shown.image
