@@ -25,6 +25,18 @@ from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsLineItem, QGraphics
 from weft.core.geometry import Square
 
 HANDLE_PX = 8  # grab distance of handles and end points, in screen pixels
+
+
+def _screen_sized(item, x: float, y: float):
+    """``item`` (drawn around its origin in screen pixels) placed at image point (x, y), keeping its
+    size on screen at any zoom (a handle must not cover a corner when zoomed out, nor vanish when
+    zoomed in)."""
+    item.setFlag(item.GraphicsItemFlag.ItemIgnoresTransformations, True)
+    item.setPos(x, y)
+    return item
+
+
+_HALF = HANDLE_PX / 2
 PALETTE = [QColor(c) for c in ("#ff5252", "#40c4ff", "#ffd740", "#69f0ae", "#e040fb", "#ff9100", "#b2ff59", "#f8bbd0")]
 
 
@@ -101,9 +113,9 @@ class PatchTool(Tool):
             return
         x, y, s = rect
         self.rect_item.setRect(QRectF(x, y, s, s))
-        r = self.view.screen_to_image_distance(HANDLE_PX / 2)
         for h, (cx, cy) in zip(self.handles, self._corners(rect)):
-            h.setRect(QRectF(cx - r, cy - r, 2 * r, 2 * r))
+            h.setRect(QRectF(-_HALF, -_HALF, HANDLE_PX, HANDLE_PX))
+            _screen_sized(h, cx, cy)
 
     def refresh(self) -> None:
         self._show(self.square)
@@ -213,7 +225,6 @@ class LineTool(Tool):
             scene.removeItem(it)
         self.items = []
         lines = self.lines() if lines is None else lines
-        r = self.view.screen_to_image_distance(HANDLE_PX / 2)
         font = QFont()
         font.setPointSize(9)
         font.setBold(True)
@@ -224,7 +235,7 @@ class LineTool(Tool):
             seg.setPen(_cosmetic(colour, width))
             items = [seg]
             for x, y in ((x1, y1), (x2, y2)):
-                dot = QGraphicsEllipseItem(x - r, y - r, 2 * r, 2 * r)
+                dot = _screen_sized(QGraphicsEllipseItem(-_HALF, -_HALF, HANDLE_PX, HANDLE_PX), x, y)
                 dot.setPen(_cosmetic(QColor("black"), 1))
                 dot.setBrush(QBrush(colour))
                 items.append(dot)
@@ -350,9 +361,8 @@ class QuadTool(Tool):
         for it in self.items:
             scene.removeItem(it)
         self.items = []
-        r = self.view.screen_to_image_distance(HANDLE_PX / 2)
         for i, (x, y) in enumerate(self.points):
-            dot = QGraphicsEllipseItem(x - r, y - r, 2 * r, 2 * r)
+            dot = _screen_sized(QGraphicsEllipseItem(-_HALF, -_HALF, HANDLE_PX, HANDLE_PX), x, y)
             dot.setBrush(QBrush(line_colour(i)))
             dot.setZValue(21)
             scene.addItem(dot)

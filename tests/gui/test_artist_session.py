@@ -185,3 +185,33 @@ def test_esc_cancels_a_running_render_and_keeps_the_previous_result(window, qtbo
         qtbot.keyClick(window.result_view, Qt.Key.Key_Escape)  # the view has no use for it: the window's
     qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
     assert window.renderer.last is shown and window.result_view.image is shown.image
+
+
+def test_square_handles_keep_their_size_on_screen_through_zooming(window, qtbot):
+    from weft.app.gui.tools import HANDLE_PX
+
+    from .helpers import drag, mouse
+
+    view = window.canvas_view
+    drag(view, (20, 20), (60, 60))  # a source square on the texture
+    qtbot.waitUntil(lambda: window.doc.square is not None, timeout=5000)
+    tool = view.tool
+
+    def on_screen():
+        sizes = []
+        for h in tool.handles:
+            r = h.deviceTransform(view.viewportTransform()).mapRect(h.boundingRect())
+            sizes.append(round(r.width()))
+        return sizes
+
+    first = on_screen()
+    assert all(abs(s - HANDLE_PX) <= 2 for s in first), first
+    w, h = view.image_size()
+    mouse(view, "move", (w / 2, h / 2))
+    before = view.scale_factor()
+    for _ in range(3):
+        qtbot.keyClick(window, Qt.Key.Key_Plus, Qt.KeyboardModifier.ControlModifier)
+    qtbot.waitUntil(lambda: abs(view.scale_factor() - before * 1.25 ** 3) < 1e-6, timeout=5000)
+    assert on_screen() == first
+    qtbot.keyClick(window, Qt.Key.Key_0, Qt.KeyboardModifier.ControlModifier)
+    assert on_screen() == first
