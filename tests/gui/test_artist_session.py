@@ -215,3 +215,32 @@ def test_square_handles_keep_their_size_on_screen_through_zooming(window, qtbot)
     assert on_screen() == first
     qtbot.keyClick(window, Qt.Key.Key_0, Qt.KeyboardModifier.ControlModifier)
     assert on_screen() == first
+
+
+def _fills_view(view) -> bool:
+    w, h = view.image_size()
+    shown = view.mapFromScene(0, 0, w, h).boundingRect()
+    vp = view.viewport().rect()
+    return (abs(shown.width() - vp.width()) <= 3 or abs(shown.height() - vp.height()) <= 3) \
+        and shown.width() <= vp.width() + 3 and shown.height() <= vp.height() + 3
+
+
+def test_a_result_of_another_size_refits_unless_the_user_zoomed(window, qtbot):
+    """Bug 2 (fixed by issue 13): a new result size refits the result view; a hand zoom is kept."""
+    from .helpers import mouse
+
+    view = window.result_view
+    old = view.image_size()
+    assert _fills_view(view)
+    box = window.inputs_pane._boxes["target"]
+    window.input_tabs.setCurrentWidget(box)
+    qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
+    qtbot.mouseClick(box.clear_button, Qt.MouseButton.LeftButton)  # synthesis: twice the texture
+    qtbot.waitUntil(lambda: view.image_size() != old and window.renderer.last.final, timeout=20000)
+    assert _fills_view(view)
+    w, h = view.image_size()
+    mouse(view, "move", (w / 2, h / 2))
+    qtbot.keyClick(window, Qt.Key.Key_1, Qt.KeyboardModifier.ControlModifier)  # the user zooms: 100%
+    with qtbot.waitSignal(window.renderer.shown, timeout=20000, check_params_cb=lambda s: s.final):
+        qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # the target is back
+    assert view.image_size() == old and abs(view.scale_factor() - 1.0) < 1e-6
