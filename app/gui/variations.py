@@ -14,6 +14,7 @@ from PySide6.QtWidgets import (
     QComboBox,
     QDialog,
     QDoubleSpinBox,
+    QFileDialog,
     QGridLayout,
     QLabel,
     QPushButton,
@@ -23,6 +24,7 @@ from PySide6.QtWidgets import (
 )
 
 from weft.core.errors import WeftError
+from weft.core.image import save_image
 from weft.core.jobs import JobResult, JobRunner
 from weft.core.params import FLOAT, INT, specs
 from weft.core.studio import reduce_for_preview
@@ -88,11 +90,19 @@ class VariationsDialog(QDialog):
         self.render_button = QPushButton("Render grid")
         self.render_button.clicked.connect(self.render_grid)
         controls.addWidget(self.render_button, 2, 5)
+        self.export_button = QPushButton("Export grid…")
+        self.export_button.setToolTip("save the rendered cells as one PNG")
+        self.export_button.setEnabled(False)
+        self.export_button.clicked.connect(lambda: self.export_grid())
+        controls.addWidget(self.export_button, 2, 3)
+        self.images: dict[tuple[int, int], np.ndarray] = {}
+        self.side = THUMB_SIDE
         lay.addLayout(controls)
         self.grid_widget = QWidget()
         self.grid = QGridLayout(self.grid_widget)
         lay.addWidget(self.grid_widget, 1)
         self.status = QLabel("pick two parameters and their ranges, then Render grid; click a cell to adopt it")
+        self.status.setWordWrap(True)  # a long message must not widen the dialog
         lay.addWidget(self.status)
         for r in (0, 1):
             self._reset_range(r)
@@ -104,18 +114,39 @@ class VariationsDialog(QDialog):
         return self.numeric[self.combo[row].currentIndex()]
 
     def _reset_range(self, row: int) -> None:
+        """A range around the current value (what "auto" resolves to when it is ticked): half to
+        one and a half times it, or a quarter of the parameter's range where that is narrower — so
+        a block of 9 on a small texture gives 5..13, not 2..257."""
         if not self.numeric:
             return
         spec = self._spec(row)
         for box in (self.lo[row], self.hi[row]):
             box.setRange(spec.lo, spec.hi)
+            box.setDecimals(0 if spec.kind == INT else 3)
             box.setSingleStep(1 if spec.kind == INT else (spec.step or (spec.hi - spec.lo) / 20))
-        current = getattr(self.doc.params[self.method], spec.name)
+        params = self.doc.params[self.method]
+        current = getattr(params, spec.name)
+        if current is None:
+            current = self.doc.studio.resolved(params, self.doc.inputs).get(spec.name)
         if current is None:
             current = spec.default if spec.default is not None else spec.lo
         span = (spec.hi - spec.lo) / 4
+        if current:
+            span = min(span, abs(current) / 2)
+        if spec.kind == INT:
+            span = max(1, int(span))  # whole steps: the middle of the grid is the current value
         self.lo[row].setValue(max(spec.lo, current - span))
         self.hi[row].setValue(min(spec.hi, current + span))
+
+    def thumb_side(self, n: int) -> int:
+        """Thumbnail side so that an n x n grid (with its labels and the controls) fits the screen."""
+        screen = self.screen() or (self.parentWidget().screen() if self.parentWidget() else None)
+        if screen is None:
+            return THUMB_SIDE
+        free = screen.availableGeometry()
+        by_height = (free.height() - 220) // n - 40  # controls, status, title bar; a label per cell
+        by_width = (free.width() - 80) // n - 16
+        return int(max(48, min(THUMB_SIDE, by_height, by_width)))
 
     def render_grid(self) -> None:
         """Submit one thumbnail job per cell (replacing any grid being rendered)."""
@@ -124,7 +155,8 @@ class VariationsDialog(QDialog):
             item = self.grid.takeAt(0)
             if item.widget():
                 item.widget().deleteLater()
-        self.cells, self.values = {}, {}
+        self.cells, self.values, self.images = {}, {}, {}
+        self.export_button.setEnabled(False)
         n = 3 if self.size_box.currentIndex() == 0 else 4
         a, b = self._spec(0), self._spec(1)
         if a.name == b.name:
@@ -138,10 +170,12 @@ class VariationsDialog(QDialog):
             return
         inputs, base = built
         method, seed = self.doc.current, self.doc.seed
+        self.side = side = self.thumb_side(n)
         for i, va in enumerate(rows):
             for j, vb in enumerate(cols):
                 button = QToolButton()
-                button.setIconSize(QSize(THUMB_SIDE, THUMB_SIDE))
+                button.setIconSize(QSize(side, side))
+                button.setFixedWidth(side + 16)  # an error's text must not widen the dialog
                 button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextUnderIcon)
                 button.setText(f"{a.name}={va}  {b.name}={vb}")
                 button.clicked.connect(lambda _=False, key=(i, j): self.adopt(*key))
@@ -150,9 +184,8 @@ class VariationsDialog(QDialog):
                 self.values[(i, j)] = ((a.name, va), (b.name, vb))
                 try:
                     params = base.replace(**{a.name: va, b.name: vb})
-                except WeftError as e:
-                    button.setText(str(e))
-                    button.setEnabled(False)
+                except WeftError as e:  # refused before any work: not run
+                    self._cell_error(button, str(e))
                     continue
 
                 def job(*, progress=None, cancel=None, params=params):
@@ -168,14 +201,54 @@ class VariationsDialog(QDialog):
         if button is None:
             return
         if result.error is not None:
-            button.setText(str(result.error))
-            button.setEnabled(False)
+            self._cell_error(button, str(result.error))
         else:
             pix = QPixmap.fromImage(to_qimage(result.value))
-            button.setIcon(QIcon(pix.scaled(THUMB_SIDE, THUMB_SIDE, Qt.AspectRatioMode.KeepAspectRatio)))
+            button.setIcon(QIcon(pix.scaled(self.side, self.side, Qt.AspectRatioMode.KeepAspectRatio)))
+            self.images[key] = result.value
+            self.export_button.setEnabled(True)
         self.cell_done.emit(*key)
         if not self.runner.busy():
             self.status.setText("click a cell to adopt its values")
+
+    def _cell_error(self, button: QToolButton, text: str) -> None:
+        """A refused cell: the start of the reason on the cell (elided to its width), all of it in its tooltip."""
+        label = button.fontMetrics().elidedText(text, Qt.TextElideMode.ElideRight, button.maximumWidth() - 12)
+        button.setText(label)
+        button.setToolTip(text)
+        button.setEnabled(False)
+
+    def grid_image(self) -> np.ndarray | None:
+        """The rendered cells as one image (rows and columns as on screen, refused cells grey), or None."""
+        if not self.images:
+            return None
+        n = max(i for i, _ in self.cells) + 1
+        h = max(im.shape[0] for im in self.images.values())
+        w = max(im.shape[1] for im in self.images.values())
+        gap = 4
+        out = np.full((n * h + (n - 1) * gap, n * w + (n - 1) * gap, 3), 0.2, np.float32)
+        for (i, j), im in self.images.items():
+            rgb = im if im.ndim == 3 else np.repeat(im[..., None], 3, axis=2)
+            y, x = i * (h + gap), j * (w + gap)
+            out[y:y + rgb.shape[0], x:x + rgb.shape[1]] = rgb[..., :3]
+        return out
+
+    def export_grid(self, path: str | None = None) -> bool:
+        """Write the grid as one PNG (asks where when no path is given)."""
+        image = self.grid_image()
+        if image is None:
+            return False
+        if path is None:
+            path, _ = QFileDialog.getSaveFileName(self, "Export grid", "variations.png", "PNG (*.png)")
+            if not path:
+                return False
+        try:
+            save_image(path, image)
+        except WeftError as e:
+            self.status.setText(str(e))
+            return False
+        self.status.setText(f"grid saved to {path}")
+        return True
 
     def adopt(self, i: int, j: int) -> None:
         """Make cell (i, j)'s two values the document's (one undo step)."""

@@ -244,3 +244,36 @@ def test_a_result_of_another_size_refits_unless_the_user_zoomed(window, qtbot):
     with qtbot.waitSignal(window.renderer.shown, timeout=20000, check_params_cb=lambda s: s.final):
         qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # the target is back
     assert view.image_size() == old and abs(view.scale_factor() - 1.0) < 1e-6
+
+
+def test_variations_default_to_ranges_near_the_resolved_values_fit_the_screen_and_export(window, qtbot, tmp_path):
+    from weft.core.image import load_image
+
+    window.doc.set_method("quilt")  # a transfer: block resolves to 9, overlap to 3 (texture 112x128)
+    qtbot.mouseClick(window.method_panel.variations_button, Qt.MouseButton.LeftButton)
+    dialog = window._variations
+    qtbot.waitUntil(dialog.isVisible, timeout=5000)
+    assert [dialog._spec(0).name, dialog._spec(1).name] == ["block", "overlap"]
+    assert (dialog.lo[0].value(), dialog.hi[0].value()) == (5, 13) and dialog.lo[0].decimals() == 0
+    assert (dialog.lo[1].value(), dialog.hi[1].value()) == (2, 4)
+    dialog.hi[1].lineEdit().selectAll()
+    qtbot.keyClicks(dialog.hi[1], "6")  # overlap 2, 4, 6: 6 is not smaller than block 5
+    qtbot.keyClick(dialog.hi[1], Qt.Key.Key_Return)
+    assert dialog.hi[1].value() == 6
+    done = set()
+    dialog.cell_done.connect(lambda i, j: done.add((i, j)))
+    qtbot.mouseClick(dialog.render_button, Qt.MouseButton.LeftButton)
+    run = {k for k, b in dialog.cells.items() if b.isEnabled()}
+    refused = set(dialog.cells) - run  # overlap >= block: refused up front, never run
+    assert refused == {(0, 2)} and "smaller than block" in dialog.cells[(0, 2)].toolTip()
+    qtbot.waitUntil(lambda: done == run, timeout=60000)
+    assert all(not dialog.cells[k].icon().isNull() for k in run)  # every cell that ran is valid
+    free = dialog.screen().availableGeometry()
+    assert dialog.sizeHint().width() <= free.width() and dialog.sizeHint().height() <= free.height()
+    assert dialog.cells[(0, 2)].width() == dialog.cells[(0, 0)].width()  # the error did not widen its cell
+    out = tmp_path / "grid.png"
+    assert dialog.export_button.isEnabled() and dialog.export_grid(str(out))
+    grid = load_image(out).image
+    cell = dialog.images[(1, 1)]
+    assert grid.shape[0] >= 3 * cell.shape[0] and grid.shape[1] >= 3 * cell.shape[1]
+    dialog.close()
