@@ -8,7 +8,7 @@ window's renders are not held up; a cell whose values the method refuses says wh
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QSize, Qt, Signal
+from PySide6.QtCore import QSize, Qt, QTimer, Signal
 from PySide6.QtGui import QIcon, QPixmap
 from PySide6.QtWidgets import (
     QComboBox,
@@ -175,7 +175,8 @@ class VariationsDialog(QDialog):
             for j, vb in enumerate(cols):
                 button = QToolButton()
                 button.setIconSize(QSize(side, side))
-                button.setFixedWidth(side + 16)  # an error's text must not widen the dialog
+                # a fixed cell: an error's text must not widen the dialog, nor a thumbnail's arrival grow it
+                button.setFixedSize(side + 16, side + button.fontMetrics().height() + 20)
                 button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextUnderIcon)
                 button.setText(f"{a.name}={va}  {b.name}={vb}")
                 button.clicked.connect(lambda _=False, key=(i, j): self.adopt(*key))
@@ -193,6 +194,20 @@ class VariationsDialog(QDialog):
 
                 self.runner.submit(f"cell-{i}-{j}", job)
         self.status.setText("rendering…")
+        # the new cells are shown by their layout on the next turn of the event loop: fit then
+        QTimer.singleShot(0, self._fit_on_screen)
+
+    def _fit_on_screen(self) -> None:
+        """Grow to the new grid, then move (not past the screen's edges) so all of it is visible."""
+        self.adjustSize()
+        screen = self.screen()
+        if screen is None:
+            return
+        free = screen.availableGeometry()
+        frame = self.frameGeometry()
+        x = min(max(frame.x(), free.x()), free.right() - frame.width())
+        y = min(max(frame.y(), free.y()), free.bottom() - frame.height())
+        self.move(max(x, free.x()), max(y, free.y()))
 
     def _on_result(self, result: JobResult) -> None:
         _, i, j = result.slot.split("-")
