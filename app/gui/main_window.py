@@ -22,6 +22,7 @@ from PIL import Image as PILImage
 from PySide6.QtCore import QMimeData, QSettings, QSize, Qt, QUrl, Signal
 from PySide6.QtGui import QAction, QIcon, QKeySequence
 from PySide6.QtWidgets import (
+    QApplication,
     QDockWidget,
     QFileDialog,
     QLabel,
@@ -40,6 +41,7 @@ from weft.core.image import load_image
 from weft.core.jobs import JobRunner
 
 from .canvas import InputsPane, titled
+from .convert import to_qimage
 from .document import Document, DocumentState, InputImage
 from .files import FileActions
 from .method_panel import MethodPanel
@@ -309,6 +311,8 @@ class MainWindow(QMainWindow):
         e.addAction(redo)
         self.undo_action, self.redo_action = undo, redo
         e.addSeparator()
+        self.copy_result_action = self._action(e, "&Copy Result", self.copy_result, "Ctrl+Shift+C",
+                                               tip="copy the full-size result shown to the clipboard")
         self._action(e, "New &Seed", self.method_panel.new_seed, "Ctrl+R")
         self.clear_square_action = self._action(e, "Clear S&quare", lambda: self.doc.set_square(None))
         v = self.menuBar().addMenu("&View")
@@ -514,6 +518,17 @@ class MainWindow(QMainWindow):
         if self.renderer.last is not None:
             self.result_view.set_image(self.renderer.last.image)
         self.statusBar().showMessage("cancelled; the previous result is kept", 4000)
+
+    def copy_result(self) -> bool:
+        """Put the shown full-size result (not a preview) on the clipboard as an image."""
+        shown = self.renderer.last
+        if shown is None or not shown.final:
+            self.show_message("no full-size result to copy yet")
+            return False
+        QApplication.clipboard().setImage(to_qimage(shown.image))
+        h, w = shown.image.shape[:2]
+        self.statusBar().showMessage(f"result {w}x{h} copied to the clipboard", 4000)
+        return True
 
     def show_message(self, text: str) -> None:
         """A one-line message in the status bar (errors never open a blocking dialog mid-drag)."""

@@ -278,3 +278,18 @@ def test_variations_default_to_ranges_near_the_resolved_values_fit_the_screen_an
     cell = dialog.images[(1, 1)]
     assert grid.shape[0] >= 3 * cell.shape[0] and grid.shape[1] >= 3 * cell.shape[1]
     dialog.close()
+
+
+def test_ctrl_shift_c_copies_the_full_size_result_to_the_clipboard(window, qtbot):
+    import numpy as np
+    from PySide6.QtWidgets import QApplication
+
+    clipboard = QApplication.clipboard()
+    clipboard.clear()
+    with qtbot.waitSignal(clipboard.dataChanged, timeout=5000):
+        qtbot.keyClick(window, Qt.Key.Key_C, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
+    image = clipboard.image()
+    shown = window.renderer.last.image
+    assert (image.width(), image.height()) == (shown.shape[1], shown.shape[0])
+    pixel = image.pixelColor(10, 20)
+    assert np.allclose([pixel.redF(), pixel.greenF(), pixel.blueF()], shown[20, 10, :3], atol=1 / 255 + 1e-6)
