@@ -170,6 +170,7 @@ def test_kill_9_then_restart_offers_to_restore(qtbot, tmp_path, private_recovery
     assert [list(x) for x in lines.frontal_lines] == EDITS["frontal_lines"]
     assert doc.seed == EDITS["seed"] and w.seed_box.value() == EDITS["seed"]
     assert not doc.undo_stack.isClean()  # still unsaved: the recovery file stays until saved or discarded
+    assert w.windowTitle().endswith(" *")  # and the title says so
     assert recovery.exists()
     w.close()
     assert not recovery.exists()
