@@ -90,11 +90,26 @@ class FileActions(QObject):
         return self.window._confirm(question)
 
     # --- export, sessions ------------------------------------------------------------------------
+    def _start(self, suffix: str) -> str:
+        """Where a save dialog starts: the last folder used (else the home folder, never the
+        install's bundled examples), with a name made from the canvas input and the method, e.g.
+        ``wood-grain-fast.png``."""
+        canvas = self.doc.inputs.get(self.doc.studio.canvas)
+        folder = str(self.settings.value("last_dir", "") or "")
+        stem = Path(canvas.path).stem if canvas is not None and canvas.path else "weft"
+        return str(Path(folder or Path.home()) / f"{stem}-{self.doc.method}{suffix}")
+
+    def _ask_save(self, caption: str, suffix: str, filters: str) -> str:
+        path, _ = QFileDialog.getSaveFileName(self.window, caption, self._start(suffix), filters)
+        if path:
+            self.settings.setValue("last_dir", str(Path(path).parent))
+        return path
+
     def save_result_dialog(self) -> None:
         if self.renderer.last is None or not self.renderer.last.final:
             self.show_message("nothing to export yet: wait for the full-size result")
             return
-        path, _ = QFileDialog.getSaveFileName(self.window, "Export result", str(self.settings.value("last_dir", "")), SAVE_FILTER)
+        path = self._ask_save("Export result", ".png", SAVE_FILTER)
         if path:
             self.export_result(path)
 
@@ -126,7 +141,7 @@ class FileActions(QObject):
         return True
 
     def export_recipe_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self.window, "Export recipe", "", "Recipe (*.json)")
+        path = self._ask_save("Export recipe", ".json", "Recipe (*.json)")
         if path:
             self.export_recipe(path)
 
@@ -145,7 +160,7 @@ class FileActions(QObject):
 
     def save_session_dialog(self) -> bool:
         """Ask where, then save; True if the session was saved."""
-        path, _ = QFileDialog.getSaveFileName(self.window, "Save session", "", "weft session (*.weft.json *.json)")
+        path = self._ask_save("Save session", ".weft.json", "weft session (*.weft.json *.json)")
         return bool(path) and self.save_session(path)
 
     def save_session(self, path: str) -> bool:
@@ -159,7 +174,8 @@ class FileActions(QObject):
         return True
 
     def open_session_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self.window, "Open session", "", "weft session (*.json)")
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open session", str(self.settings.value("last_dir", "") or ""),
+                                              "weft session (*.json)")
         if path:
             self.open_session(path)
 

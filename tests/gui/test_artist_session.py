@@ -293,3 +293,21 @@ def test_ctrl_shift_c_copies_the_full_size_result_to_the_clipboard(window, qtbot
     assert (image.width(), image.height()) == (shown.shape[1], shown.shape[0])
     pixel = image.pixelColor(10, 20)
     assert np.allclose([pixel.redF(), pixel.greenF(), pixel.blueF()], shown[20, 10, :3], atol=1 / 255 + 1e-6)
+
+
+def test_save_dialogs_start_in_the_last_folder_with_a_suggested_name(window, qtbot, monkeypatch, tmp_path):
+    from PySide6.QtWidgets import QFileDialog
+
+    asked = []
+    out = tmp_path / "renders" / "mine.png"
+    out.parent.mkdir()
+    replies = iter([str(out), ""])
+    monkeypatch.setattr(QFileDialog, "getSaveFileName",
+                        lambda parent, caption, start, filters: asked.append(start) or (next(replies), ""))
+    qtbot.keyClick(window, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier)  # Export Result…
+    assert out.exists()
+    canvas = window.doc.inputs[window.doc.studio.canvas].path
+    from pathlib import Path
+    assert asked[0] == str(Path.home() / f"{Path(canvas).stem}-fast.png")  # no folder used yet: home
+    qtbot.keyClick(window, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
+    assert asked[1] == str(out.parent / f"{Path(canvas).stem}-fast.json")  # the folder used last
