@@ -99,8 +99,16 @@ class FeatureLinesPanel(QWidget):
             self.doc.set_lines(self.doc.image_lines, self.doc.frontal_lines, text="Frontal size", frontal_size=size)
 
     def _quad_mode(self, on: bool) -> None:
-        self.photo_view.tool = QuadTool(self.photo_view, self.doc, on_done=lambda: self.quad_button.setChecked(False)) \
-            if on else self.photo_lines
+        if on:
+            self.photo_view.tool = QuadTool(self.photo_view, self.doc, on_done=lambda: self.quad_button.setChecked(False),
+                                            on_prompt=self.rectify_status.setText)
+        else:
+            self.photo_view.tool = self.photo_lines
+            self._update_rectified()  # the status says the rectification again
+
+    def _status(self, text: str) -> None:
+        if not self.quad_button.isChecked():  # Quad… says which corner to click there meanwhile
+            self.rectify_status.setText(text)
 
     def _lines_dragged(self, image_lines, frontal_lines) -> None:
         self._update_rectified(image_lines, frontal_lines)
@@ -117,7 +125,7 @@ class FeatureLinesPanel(QWidget):
         if photo is None or n == 0:
             self.frontal_view.set_image(np.full((h, w), 0.25, np.float32))
             self.frontal_lines.refresh()
-            self.rectify_status.setText("draw line pairs: line i on the photo, line i here")
+            self._status("draw line pairs: line i on the photo, line i here")
             return
         if self._rectifier is None:
             from weft.core.rectify import Rectifier
@@ -133,12 +141,12 @@ class FeatureLinesPanel(QWidget):
 
     def _on_rectified(self, result: JobResult) -> None:
         if result.error is not None:
-            self.rectify_status.setText(str(result.error))
+            self._status(str(result.error))
             return
         first = self.frontal_view.image is None or self.frontal_view.image.shape[:2] != result.value.shape[:2]
         self.frontal_view.set_image(result.value, fit=first)
         self.frontal_lines.refresh()
-        self.rectify_status.setText("rectified")
+        self._status("rectified")
 
     def load_lines_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Load feature lines", "", "Feature lines (*.json)")

@@ -351,10 +351,21 @@ class LineTool(Tool):
 class QuadTool(Tool):
     """Four clicks on the plane's corners, clockwise from top-left -> four line pairs (the frontal rectangle's edges)."""
 
-    def __init__(self, view, doc, on_done: Callable[[], None] | None = None):
-        self.view, self.doc, self.on_done = view, doc, on_done
+    CORNERS = ("top-left", "top-right", "bottom-right", "bottom-left")
+
+    def __init__(self, view, doc, on_done: Callable[[], None] | None = None,
+                 on_prompt: Callable[[str], None] | None = None):
+        self.view, self.doc, self.on_done, self.on_prompt = view, doc, on_done, on_prompt
         self.points: list[tuple[float, float]] = []
         self.items: list = []
+        self._prompt()
+
+    def _prompt(self) -> None:
+        """Say which corner to click next (on screen, through ``on_prompt``)."""
+        if self.on_prompt is not None and len(self.points) < 4:
+            k = len(self.points)
+            self.on_prompt(f"Quad: click the plane's {self.CORNERS[k]} corner on the photo ({k + 1} of 4"
+                           f"{'' if k == 0 else '; Esc starts again'})")
 
     def _draw(self) -> None:
         scene = self.view.scene()
@@ -372,6 +383,7 @@ class QuadTool(Tool):
         w, h = view.image_size()
         self.points.append((min(max(pos.x(), 0.0), w), min(max(pos.y(), 0.0), h)))
         self._draw()
+        self._prompt()
         if len(self.points) == 4:
             pts = self.points
             self.points = []
@@ -388,5 +400,6 @@ class QuadTool(Tool):
         if event.key() == Qt.Key.Key_Escape and self.points:
             self.points = []
             self._draw()
+            self._prompt()
             return True
         return False

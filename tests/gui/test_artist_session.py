@@ -311,3 +311,22 @@ def test_save_dialogs_start_in_the_last_folder_with_a_suggested_name(window, qtb
     assert asked[0] == str(Path.home() / f"{Path(canvas).stem}-fast.png")  # no folder used yet: home
     qtbot.keyClick(window, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
     assert asked[1] == str(out.parent / f"{Path(canvas).stem}-fast.json")  # the folder used last
+
+
+def test_quad_says_on_screen_which_corner_to_click(window, qtbot):
+    from .helpers import mouse
+
+    window.doc.set_method("nfpt")
+    qtbot.waitUntil(lambda: window.lines_panel is not None and window.lines_panel.active, timeout=5000)
+    panel = window.lines_panel
+    window.input_tabs.setCurrentWidget(panel)
+    qtbot.mouseClick(panel.quad_button, Qt.MouseButton.LeftButton)
+    assert "top-left corner" in panel.rectify_status.text() and "1 of 4" in panel.rectify_status.text()
+    view = panel.photo_view
+    for k, (x, y) in enumerate([(10, 10), (100, 12), (98, 90)]):
+        mouse(view, "press", (x, y))
+        mouse(view, "release", (x, y))
+        assert f"{k + 2} of 4" in panel.rectify_status.text()
+    assert "bottom-left corner" in panel.rectify_status.text()
+    qtbot.keyClick(view, Qt.Key.Key_Escape)  # start again
+    assert "top-left corner" in panel.rectify_status.text()
