@@ -86,7 +86,15 @@ class MethodPanel(QWidget):
         new_seed.setToolTip("a new random seed")
         new_seed.clicked.connect(self.new_seed)
         seed_row.addWidget(new_seed)
-        seed_row.addWidget(self.square_label)
+        square_box = QVBoxLayout()
+        square_box.setSpacing(2)
+        square_box.addWidget(self.square_label)
+        self.square_caption = QLabel("")  # what the thumbnail is: the method's square, named
+        self.square_caption.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.square_caption.setFixedWidth(THUMB)
+        self.square_caption.setWordWrap(True)
+        square_box.addWidget(self.square_caption)
+        seed_row.addLayout(square_box)
         lay.addLayout(seed_row)
         buttons = QHBoxLayout()
         self.render_button = QPushButton("Render")
@@ -155,6 +163,11 @@ class MethodPanel(QWidget):
         if g is not None and square is None:
             square = doc.value(g.key)
         image = None if g is None else doc.image(g.input_for(doc.inputs))
+        self.square_label.setVisible(g is not None)
+        self.square_caption.setVisible(g is not None)
+        if g is not None:
+            what = g.param.replace("_", " ") if g.param is not None else "source region"
+            self.square_caption.setText(f"{what}: none drawn" if square is None else f"{what} {square[2]} px")
         if square is None or image is None:
             self.square_label.clear()
             return

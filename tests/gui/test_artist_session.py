@@ -330,3 +330,15 @@ def test_quad_says_on_screen_which_corner_to_click(window, qtbot):
     assert "bottom-left corner" in panel.rectify_status.text()
     qtbot.keyClick(view, Qt.Key.Key_Escape)  # start again
     assert "top-left corner" in panel.rectify_status.text()
+
+
+def test_the_square_thumbnail_is_labelled(window, qtbot):
+    from .helpers import drag
+
+    caption = window.method_panel.square_caption
+    assert caption.isVisible() and caption.text() == "source region: none drawn"
+    drag(window.canvas_view, (20, 20), (60, 60))
+    qtbot.waitUntil(lambda: window.doc.square is not None, timeout=5000)
+    assert caption.text() == f"source region {window.doc.square[2]} px"
+    window.doc.set_method("affine")
+    qtbot.waitUntil(lambda: caption.text().startswith("prototype"), timeout=5000)
