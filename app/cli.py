@@ -1,6 +1,6 @@
 """The ``weft`` command.
 
-``weft`` with no arguments opens the desktop studio; ``weft METHOD INPUT... -o OUT [options]`` runs a
+``weft`` with no arguments opens the desktop studio (``weft IMAGE [TARGET]``: on those images); ``weft METHOD INPUT... -o OUT [options]`` runs a
 method headless; ``weft run RECIPE -o OUT`` reproduces a recipe (a ``.json`` file, or a PNG exported
 by weft, which carries its recipe); ``weft batch RECIPE --over INPUT FILES -o PATTERN`` applies it to
 many files (:mod:`weft.app.batch_cli`). Method options are generated from the method's ``Params`` specs,
@@ -156,7 +156,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     from weft.core import registry
 
     parser = _Parser(prog="weft", description="Example-based texture synthesis and transfer. "
-                     "Without arguments, opens the desktop studio.")
+                     "Without arguments, opens the desktop studio; 'weft IMAGE [TARGET]' opens it "
+                     "on those images.")
     parser.add_argument("--version", action="version", version=f"weft {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     chosen = [registry.get(only)] if only is not None else list(registry.methods().values())
@@ -352,6 +353,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         from weft.app.gui import run_gui
 
         return run_gui()
+    if len(argv) <= 2 and all(not a.startswith("-") and Path(a).is_file() for a in argv):
+        # weft IMAGE [TARGET]: the studio on those images (the current method's first inputs)
+        from weft.app.gui import run_gui
+
+        return run_gui(images=argv)
     try:
         from weft.core import registry
 

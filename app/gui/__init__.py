@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 
-def run_gui(argv: list[str] | None = None) -> int:
-    """Open the main window on the bundled examples and run the Qt event loop."""
+def run_gui(argv: list[str] | None = None, *, images: list[str] | None = None) -> int:
+    """Open the main window on the bundled examples (then on ``images``, given as the current
+    method's first inputs in order) and run the Qt event loop."""
     import sys
 
     from PySide6.QtWidgets import QApplication
@@ -16,6 +17,8 @@ def run_gui(argv: list[str] | None = None) -> int:
     app.setOrganizationName("weft")
     window = MainWindow()
     window.show()
+    if images:
+        window.open_images(images)
     try:
         return app.exec()
     finally:

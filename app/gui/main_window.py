@@ -359,6 +359,11 @@ class MainWindow(QMainWindow):
         self.doc.restore(DocumentState(inputs=inputs, method=self.doc.method, seed=self.doc.seed))
         self.renderer.final(now=True)
 
+    def open_images(self, paths: list[str]) -> None:
+        """Open ``paths`` as the current method's inputs in order (``weft IMAGE [TARGET]``)."""
+        for spec, path in zip(self.doc.current.inputs, paths):
+            self.open_input(spec.name, path)
+
     def _open_nth(self, i: int) -> None:
         inputs = self.doc.current.inputs
         if i < len(inputs):

@@ -342,3 +342,22 @@ def test_the_square_thumbnail_is_labelled(window, qtbot):
     assert caption.text() == f"source region {window.doc.square[2]} px"
     window.doc.set_method("affine")
     qtbot.waitUntil(lambda: caption.text().startswith("prototype"), timeout=5000)
+
+
+def test_weft_image_target_opens_the_studio_on_those_images(window, qtbot, monkeypatch, tmp_path):
+    import numpy as np
+
+    from weft.app import cli
+    from weft.app import gui as gui_package
+    from weft.core.image import save_image
+
+    tex, tgt = tmp_path / "tex.png", tmp_path / "tgt.png"
+    save_image(tex, np.full((40, 30, 3), 0.25, np.float32))
+    save_image(tgt, np.full((50, 60, 3), 0.75, np.float32))
+    opened = []
+    monkeypatch.setattr(gui_package, "run_gui", lambda argv=None, *, images=None: opened.append(images) or 0)
+    assert cli.main([str(tex), str(tgt)]) == 0 and opened == [[str(tex), str(tgt)]]
+    window.open_images(opened[0])  # what run_gui does with them once the window is up
+    qtbot.waitUntil(lambda: window.doc.inputs["texture"].path == str(tex)
+                    and window.doc.inputs["target"].path == str(tgt), timeout=10000)
+    assert window.doc.image("target").shape == (50, 60, 3)
