@@ -15,6 +15,7 @@ menus. Everything method-specific comes from the methods' studio descriptions (`
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import numpy as np
@@ -259,7 +260,9 @@ class MainWindow(QMainWindow):
         self.pixel_label = QLabel("")
         self.zoom_label = QLabel("")
         self.progress_bar = QProgressBar()
-        self.progress_bar.setMaximumWidth(220)
+        self.progress_bar.setMaximumWidth(320)
+        self._work_started: float | None = None  # when the running render's counted work began
+        self._last_fraction = 0.0
         self.progress_bar.setRange(0, 1000)
         self.cancel_button = QPushButton("Cancel")
         self.cancel_button.clicked.connect(self.renderer.cancel)
@@ -485,8 +488,13 @@ class MainWindow(QMainWindow):
 
     def _on_progress(self, fraction: float, stage: str) -> None:
         self._end_preparing()
+        now = time.monotonic()
+        if self._work_started is None or fraction < self._last_fraction:  # a new render (or stage)
+            self._work_started = now
+        self._last_fraction = fraction
         self.progress_bar.setValue(int(fraction * 1000))
-        self.progress_bar.setFormat(f"{stage} %p%")
+        left = _time_left(now - self._work_started, fraction)
+        self.progress_bar.setFormat(f"{stage} %p%" + (f" — about {left} left" if left else ""))
 
     def _on_preparing(self, words: str) -> None:
         """A first run: the method's kernels compile before any work can be counted — say so in
@@ -503,6 +511,7 @@ class MainWindow(QMainWindow):
         self.progress_bar.setToolTip("")
 
     def _on_busy(self, busy: bool) -> None:
+        self._work_started, self._last_fraction = None, 0.0
         self.progress_bar.setVisible(busy)
         self.cancel_button.setVisible(busy)
         if busy:
@@ -626,6 +635,17 @@ class MainWindow(QMainWindow):
         self.settings.setValue("state", self.saveState())
         self.shutdown()
         super().closeEvent(event)
+
+
+def _time_left(elapsed: float, fraction: float) -> str:
+    """The time a render still needs at this pace, in words ("12 s", "3 min 5 s"); "" while too
+    early to tell (under a second of work or 5 % done)."""
+    if elapsed < 1.0 or fraction < 0.05 or fraction >= 1.0:
+        return ""
+    left = round(elapsed * (1.0 - fraction) / fraction)
+    if left < 60:
+        return f"{max(left, 1)} s"
+    return f"{left // 60} min {left % 60} s"
 
 
 def _load_job(name: str, path: str, *, progress=None, cancel=None):

@@ -361,3 +361,25 @@ def test_weft_image_target_opens_the_studio_on_those_images(window, qtbot, monke
     qtbot.waitUntil(lambda: window.doc.inputs["texture"].path == str(tex)
                     and window.doc.inputs["target"].path == str(tgt), timeout=10000)
     assert window.doc.image("target").shape == (50, 60, 3)
+
+
+def test_a_long_render_shows_an_estimate_of_the_time_left(window, qtbot, monkeypatch):
+    import threading
+
+    from weft.core.jobs import Progress
+
+    def run(inputs, params, *, rng=None, progress=None, cancel=None):
+        for k in range(1, 1000):
+            cancel.raise_if_cancelled()
+            threading.Event().wait(0.02)
+            progress(Progress("quilting", k, 1000))  # 0.1 % every 0.02 s: about 20 s in all
+
+    monkeypatch.setitem(window.doc.methods, "fast", dataclasses.replace(window.doc.methods["fast"], run=run))
+    qtbot.keyClick(window, Qt.Key.Key_F5)
+    bar = window.progress_bar
+    qtbot.waitUntil(lambda: bar.isVisible() and "left" in bar.format(), timeout=15000)
+    import re
+
+    assert re.fullmatch(r"quilting %p% — about (\d+ min )?\d+ s left", bar.format()), bar.format()
+    qtbot.keyClick(window.result_view, Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
