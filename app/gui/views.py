@@ -91,6 +91,7 @@ class ImageView(QGraphicsView):
         super().resizeEvent(event)
         if self.auto_fit and self.image is not None:
             self.fitInView(self._item, Qt.AspectRatioMode.KeepAspectRatio)
+            self.zoomed.emit(self.scale_factor())  # the % label follows a refit on resize
 
     def zoom_by(self, factor: float, at=None) -> None:
         """Zoom by ``factor`` keeping the image point under view position ``at`` (default: centre) fixed."""

@@ -383,3 +383,18 @@ def test_a_long_render_shows_an_estimate_of_the_time_left(window, qtbot, monkeyp
     assert re.fullmatch(r"quilting %p% — about (\d+ min )?\d+ s left", bar.format()), bar.format()
     qtbot.keyClick(window.result_view, Qt.Key.Key_Escape)
     qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
+
+
+def test_the_zoom_label_follows_a_refit_when_the_window_is_resized(window, qtbot):
+    """A fitted view refits when its pane changes size; the % label must show the new zoom (it kept
+    the zoom of the first, tiny layout: 'result 9%' over a result shown at 143%)."""
+    from .helpers import mouse
+
+    result = window.result_view
+    w, h = result.image_size()
+    mouse(result, "move", (w / 2, h / 2))
+    window.result_view.fit()
+    before = result.scale_factor()
+    window.resize(window.width() + 300, window.height() + 200)
+    qtbot.waitUntil(lambda: abs(result.scale_factor() - before) > 0.01, timeout=5000)
+    qtbot.waitUntil(lambda: window.zoom_label.text() == f"result {result.scale_factor() * 100:.0f}%", timeout=5000)
