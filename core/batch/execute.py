@@ -31,8 +31,6 @@ CONNECT_TIMEOUT = "10s"
 # --------------------------------------------------------------------------------------------------
 # One item, on a worker
 
-_warm_lock = threading.Lock()
-_warm: set[str] = set()
 _cancel_event = None  # set in local pool workers by _init_local_worker
 
 
@@ -70,13 +68,7 @@ def warm_up(method_name: str) -> None:
     """Load the method's kernels once per process (every worker calls it before its first item)."""
     from .. import registry
 
-    with _warm_lock:
-        if method_name in _warm:
-            return
-        method = registry.get(method_name)
-        if method.warm_up is not None:
-            method.warm_up()
-        _warm.add(method_name)
+    registry.warm_up(method_name)
 
 
 def _one_line(e: BaseException) -> str:
