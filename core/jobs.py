@@ -75,8 +75,9 @@ class CancelToken:
 
     __slots__ = ("_event",)
 
-    def __init__(self) -> None:
-        self._event = threading.Event()
+    def __init__(self, event=None) -> None:
+        # any object with set()/is_set(): a multiprocessing.Event lets another process cancel (batches)
+        self._event = threading.Event() if event is None else event
 
     def cancel(self) -> None:
         """Ask the job to stop. Idempotent; never blocks."""

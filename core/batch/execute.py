@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ..errors import Cancelled, WeftError
+from ..jobs import CancelToken
 from ..limits import LimitError, _bytes
 from .prepare import BatchProgress, Item, Outcome, Plan, Summary, check_memory, item_memory
 
@@ -32,21 +33,6 @@ CONNECT_TIMEOUT = "10s"
 # One item, on a worker
 
 _cancel_event = None  # set in local pool workers by _init_local_worker
-
-
-class _EventToken:
-    """A cancel token over a ``multiprocessing.Event`` shared with the client process."""
-
-    def __init__(self, event):
-        self.event = event
-
-    @property
-    def cancelled(self) -> bool:
-        return self.event.is_set()
-
-    def raise_if_cancelled(self) -> None:
-        if self.event.is_set():
-            raise Cancelled("batch cancelled")
 
 
 def set_threads(n: int | None) -> None:
@@ -101,7 +87,7 @@ def run_item(item: Item) -> Outcome:
                 copy.parent.mkdir()
                 copy.write_bytes(data)
                 paths[name] = str(copy)
-        cancel = _EventToken(_cancel_event) if _cancel_event is not None else None
+        cancel = CancelToken(_cancel_event) if _cancel_event is not None else None
         try:
             result, seconds = render(method, params, paths, item.seed, item.region, cancel=cancel,
                                      warm_up=False, shown_paths=item.inputs)
