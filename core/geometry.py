@@ -1,4 +1,4 @@
-"""Typed geometry: a square, feature lines, and how each is read and written at the edges.
+"""Typed geometry: a square, feature lines, a mask, margins, and how each is read and written at the edges.
 
 A geometry value is parsed once where it enters weft -- command-line text (:meth:`parse`), the JSON
 of a recipe or session (:meth:`from_json`), a Python caller's value (:meth:`coerce`) -- and is held
@@ -31,12 +31,14 @@ from .jsonio import MAX_FILE_BYTES
 
 MAX_SIDE = 16384
 
-__all__ = ["Square", "FeatureLines", "LineDraft", "read_json_or_file", "SQUARE", "LINES", "KINDS"]
+__all__ = ["Square", "FeatureLines", "LineDraft", "Mask", "Margins", "read_json_or_file",
+           "SQUARE", "LINES", "MASK", "MARGINS", "KINDS"]
 
-#: The kinds of geometry the studio has a tool for (a method's studio description names them per input).
-#: DESIGN.md's third kind, a mask painted with a brush, comes with the method that needs it (fill).
-SQUARE, LINES = "square", "lines"
-KINDS = (SQUARE, LINES)
+#: The kinds of geometry the studio has a tool for (a method's studio description names them per input):
+#: a square (dragged), feature lines (drawn in pairs), a mask (painted with a brush, eraser or lasso)
+#: and margins (the canvas's edges dragged outward: an uncrop).
+SQUARE, LINES, MASK, MARGINS = "square", "lines", "mask", "margins"
+KINDS = (SQUARE, LINES, MASK, MARGINS)
 
 
 class Square(NamedTuple):
@@ -358,3 +360,228 @@ class LineDraft:
     def of(cls, lines: FeatureLines) -> "LineDraft":
         return cls(tuple(map(tuple, lines.image_lines.tolist())), tuple(map(tuple, lines.frontal_lines.tolist())),
                    lines.frontal_size)
+
+
+# --- masks ----------------------------------------------------------------------------------------
+
+
+class Mask:
+    """A region of an image: ``bits`` is a bool (H, W) array, True = the region (to fill, to copy from).
+
+    DESIGN.md: a mask is an image file the size of the image it belongs to; white (> 50 %) is the
+    region, black is not. It enters weft as an *input image* (``--mask MASK``; a recipe names its
+    PNG), is read with :meth:`from_image` and written with :meth:`to_image` / :meth:`save` (a 1-bit
+    PNG). The studio paints one with :meth:`painted_line` and :meth:`painted_polygon` (Qt-free, so
+    the brush's pixels are tested here). Immutable; equal when the bits are.
+    """
+
+    __slots__ = ("bits",)
+
+    def __init__(self, bits) -> None:
+        arr = np.asarray(bits)
+        if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
+            raise GeometryError(f"a mask must be a 2-D array of at least 1x1, not shape {arr.shape}")
+        if max(arr.shape) > MAX_SIDE:
+            raise GeometryError(f"a mask of {arr.shape[1]}x{arr.shape[0]} has a side over {MAX_SIDE}")
+        arr = np.array(arr, dtype=bool)  # a private copy
+        arr.flags.writeable = False
+        object.__setattr__(self, "bits", arr)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("Mask is immutable")
+
+    @classmethod
+    def empty(cls, width: int, height: int) -> "Mask":
+        return cls(np.zeros((height, width), dtype=bool))
+
+    @classmethod
+    def from_image(cls, image, what: str = "mask") -> "Mask":
+        """White (> 0.5) pixels of a float image in [0, 1]: grey (H, W), colour (H, W, 3) by its mean,
+        or with alpha (H, W, 2|4), where a transparent pixel is black."""
+        arr = np.asarray(image, dtype=np.float32)
+        if arr.ndim == 2:
+            value = arr
+        elif arr.ndim == 3 and arr.shape[2] in (1, 2, 3, 4):
+            colour = arr[..., : 1 if arr.shape[2] <= 2 else 3].mean(axis=2)
+            value = colour * arr[..., -1] if arr.shape[2] in (2, 4) else colour
+        else:
+            raise GeometryError(f"the {what} has shape {arr.shape}; a mask is a grey or colour image")
+        return cls(value > 0.5)
+
+    @classmethod
+    def from_alpha(cls, alpha, threshold: float = 0.5) -> "Mask":
+        """The transparent pixels (alpha below ``threshold``) of an alpha channel in [0, 1]: the hole
+        a fill closes when it is given no mask."""
+        return cls(np.asarray(alpha, dtype=np.float32) < threshold)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.bits.shape
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """``(width, height)``."""
+        return self.bits.shape[1], self.bits.shape[0]
+
+    @property
+    def area(self) -> int:
+        """The region's pixel count."""
+        return int(np.count_nonzero(self.bits))
+
+    @property
+    def fraction(self) -> float:
+        return self.area / self.bits.size
+
+    def __bool__(self) -> bool:
+        return self.area > 0
+
+    def bbox(self) -> tuple[int, int, int, int] | None:
+        """``(x0, y0, x1, y1)`` (exclusive ends) of the region, or None when it is empty."""
+        rows = np.flatnonzero(self.bits.any(axis=1))
+        if not len(rows):
+            return None
+        cols = np.flatnonzero(self.bits.any(axis=0))
+        return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
+
+    def check_size(self, shape, what: str = "image", name: str = "mask") -> "Mask":
+        """Raise ``GeometryError`` naming both sizes unless the mask is the size of ``shape``'s image."""
+        h, w = int(shape[0]), int(shape[1])
+        if self.bits.shape != (h, w):
+            raise GeometryError(f"the {name} is {self.size[0]}x{self.size[1]} but the {what} is {w}x{h}; "
+                                f"a {name} must be the size of its image")
+        return self
+
+    def to_image(self) -> np.ndarray:
+        """float32 (H, W): 1.0 in the region, 0.0 elsewhere (what a method is given as its input)."""
+        return self.bits.astype(np.float32)
+
+    def to_png(self) -> bytes:
+        """A 1-bit PNG of the mask (white = the region)."""
+        import io
+
+        from PIL import Image
+
+        buf = io.BytesIO()
+        Image.fromarray(self.bits).convert("1").save(buf, format="PNG", optimize=True)
+        return buf.getvalue()
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write :meth:`to_png` to ``path`` atomically (a temporary file renamed into place)."""
+        target = Path(path)
+        tmp = target.with_name(f".{target.name}.tmp")
+        tmp.write_bytes(self.to_png())
+        os.replace(tmp, target)
+
+    @classmethod
+    def read(cls, path: str | os.PathLike, what: str = "mask") -> "Mask":
+        """A mask image file (any format weft reads); errors are weft's one-line image errors."""
+        from .image import load_image
+
+        return cls.from_image(load_image(path).image, what)
+
+    def painted_line(self, p0, p1, radius: float, value: bool = True) -> "Mask":
+        """The mask with a round brush stroke from ``p0`` to ``p1`` (pixel coordinates ``(x, y)``,
+        pixel centres at whole numbers) set to ``value`` (True paints, False erases): every pixel whose
+        centre lies within ``radius`` of the segment. A zero-length stroke is a dot; radius 0 is a
+        one-pixel-wide line."""
+        h, w = self.bits.shape
+        (x0, y0), (x1, y1) = (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))
+        r = max(0.0, float(radius)) + 0.5  # a pixel is hit when its centre is within radius (+ half a pixel)
+        left, right = max(0, int(math.floor(min(x0, x1) - r))), min(w, int(math.ceil(max(x0, x1) + r)) + 1)
+        top, bottom = max(0, int(math.floor(min(y0, y1) - r))), min(h, int(math.ceil(max(y0, y1) + r)) + 1)
+        if left >= right or top >= bottom:
+            return self
+        yy, xx = np.mgrid[top:bottom, left:right].astype(np.float64)
+        dx, dy = x1 - x0, y1 - y0
+        length2 = dx * dx + dy * dy
+        t = np.zeros_like(xx) if length2 == 0 else np.clip(((xx - x0) * dx + (yy - y0) * dy) / length2, 0.0, 1.0)
+        hit = (xx - x0 - t * dx) ** 2 + (yy - y0 - t * dy) ** 2 < r * r
+        out = self.bits.copy()
+        out[top:bottom, left:right][hit] = value
+        return Mask(out)
+
+    def painted_polygon(self, points, value: bool = True) -> "Mask":
+        """The mask with the polygon ``points`` [(x, y), ...] (a lasso, closed) set to ``value``."""
+        import cv2
+
+        pts = np.round(np.asarray(points, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
+        if len(pts) < 3:
+            return self
+        layer = np.zeros(self.bits.shape, dtype=np.uint8)
+        cv2.fillPoly(layer, [pts], 1, lineType=cv2.LINE_8)
+        out = self.bits.copy()
+        out[layer > 0] = value
+        return Mask(out)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Mask) and self.bits.shape == other.bits.shape and bool(np.array_equal(self.bits, other.bits))
+
+    def __hash__(self) -> int:
+        return hash((self.bits.shape, np.packbits(self.bits).tobytes()))
+
+    def __repr__(self) -> str:
+        return f"Mask({self.size[0]}x{self.size[1]}, {self.area} px)"
+
+
+# --- margins --------------------------------------------------------------------------------------
+
+
+class Margins(NamedTuple):
+    """Pixels added on each side of an image: ``left, top, right, bottom`` (an uncrop's new border).
+
+    Text form ``L,T,R,B`` (``--extend``); JSON ``[l, t, r, b]``. Each is a whole number from 0 to
+    :data:`MAX_SIDE`; whether the grown canvas is allowed is the pixel limit's business.
+    """
+
+    left: int
+    top: int
+    right: int
+    bottom: int
+
+    METAVAR = "L,T,R,B"
+
+    @classmethod
+    def parse(cls, text: Any, name: str = "extend") -> "Margins":
+        shown = text if isinstance(text, str) else ",".join(map(str, text)) if isinstance(text, (list, tuple)) else repr(text)
+        values: tuple = ()
+        try:
+            if isinstance(text, str):
+                values = tuple(int(p) for p in text.replace(" ", "").split(","))
+            elif not any(isinstance(v, (bool, np.bool_)) for v in text):
+                values = tuple(int(v) for v in text)
+                if any(v != w for v, w in zip(values, text)):
+                    values = ()
+        except (TypeError, ValueError, OverflowError):
+            values = ()
+        if len(values) != 4:
+            raise InvalidParameter(f"parameter '{name}' = {shown!r} must be L,T,R,B (pixels added on the left, "
+                                   f"top, right and bottom, e.g. 0,0,128,0)", name=name, value=text)
+        for side, v in zip(("left", "top", "right", "bottom"), values):
+            if not 0 <= v <= MAX_SIDE:
+                raise InvalidParameter(f"parameter '{name}' = {shown}: the {side} margin {v} is outside 0..{MAX_SIDE}",
+                                       name=name, value=text)
+        return cls(*values)
+
+    @classmethod
+    def coerce(cls, value: Any, name: str = "extend") -> "Margins":
+        return value if isinstance(value, Margins) else cls.parse(value, name)
+
+    @classmethod
+    def from_json(cls, data: Any, name: str = "extend", base: str | os.PathLike | None = None) -> "Margins":
+        if not isinstance(data, (list, str)):
+            raise InvalidParameter(f"parameter '{name}' = {data!r} must be [left, top, right, bottom] in pixels",
+                                   name=name, value=data)
+        return cls.parse(data, name)
+
+    def to_json(self) -> list[int]:
+        return [int(v) for v in self]
+
+    def to_text(self) -> str:
+        return ",".join(str(int(v)) for v in self)
+
+    def __bool__(self) -> bool:
+        return any(self)
+
+    def grown(self, width: int, height: int) -> tuple[int, int]:
+        """The canvas size ``(width, height)`` once the margins are added."""
+        return width + self.left + self.right, height + self.top + self.bottom

@@ -20,9 +20,9 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from .errors import WeftError
-from .geometry import KINDS, LINES, SQUARE  # noqa: F401 (the kinds are re-exported)
+from .geometry import KINDS, LINES, MARGINS, MASK, SQUARE  # noqa: F401 (the kinds are re-exported)
 
-__all__ = ["Studio", "Geometry", "reduce_for_preview", "SQUARE", "LINES", "REGION"]
+__all__ = ["Studio", "Geometry", "reduce_for_preview", "SQUARE", "LINES", "MASK", "MARGINS", "REGION"]
 
 #: The key of a square that fills no parameter: the recipe's source ``region`` (the input is cropped to it).
 REGION = "region"
@@ -34,12 +34,17 @@ class Geometry:
 
     Attributes
     ----------
-    kind : ``"square"`` or ``"lines"`` (:data:`weft.core.geometry.KINDS`): which tool edits it.
+    kind : ``"square"``, ``"lines"``, ``"mask"`` or ``"margins"`` (:data:`weft.core.geometry.KINDS`):
+        which tool edits it.
     on : the inputs it is drawn on, in order of preference: the first one that is open is used (the
         affine prototype lies on the prototype image when one is open, else on the texture).
     param : the ``Params`` field it fills (typed: a :class:`~weft.core.geometry.Square`,
         :class:`~weft.core.geometry.FeatureLines`); ``None`` for a square means the recipe's source
         ``region``: the first input of ``on`` is cropped to it before the method runs.
+    input : for a mask only: the method's (optional) input image it *is* -- the studio paints a
+        :class:`~weft.core.geometry.Mask` the size of the ``on`` image and gives it to the method as
+        that input (``mask.to_image()``); a recipe names it as a PNG written beside the export, a
+        session beside the session file. A mask has no ``param``.
     help : what the user does, shown as the view's title.
     live : ``live(params) -> bool``: re-render a preview while the geometry is being dragged.
     """
@@ -49,16 +54,24 @@ class Geometry:
     param: str | None = None
     help: str = ""
     live: Callable[[Any], bool] | None = None
+    input: str | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"unknown geometry kind {self.kind!r} (known: {', '.join(KINDS)})")
-        if self.param is None and self.kind != SQUARE:
+        if self.kind == MASK:
+            if self.input is None or self.param is not None:
+                raise ValueError("a mask geometry names the input it is (input=...), not a parameter")
+        elif self.input is not None:
+            raise ValueError("only a mask geometry is an input (input=...)")
+        elif self.param is None and self.kind != SQUARE:
             raise ValueError("only a square may stand for the source region (param None)")
 
     @property
     def key(self) -> str:
-        """Its name in the document and in sessions: the parameter, or :data:`REGION`."""
+        """Its name in the document and in sessions: the parameter, the input (a mask), or :data:`REGION`."""
+        if self.input is not None:
+            return self.input
         return self.param if self.param is not None else REGION
 
     def input_for(self, open_inputs) -> str:
