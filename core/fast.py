@@ -41,7 +41,7 @@ from .image import luminance, resize, validate_image
 from .jobs import CancelToken, Progress, ProgressReporter
 from .params import Params, as_rng, out_of_range, param
 from .registry import InputSpec, Method, Result
-from .studio import SQUARE, Geometry, Studio
+from .studio import SQUARE, Figure, Geometry, Studio
 
 MODES = ("auto", "transfer", "synthesis", "superres", "novel")
 # Metric codes of the kernel (weft.core._kernels.fast), which is imported on first use: importing numba
@@ -377,5 +377,9 @@ METHOD = Method(
         geometry=(Geometry(SQUARE, on=("texture",),
                            help="drag a square: the source region (the method copies only from it)"),),
         preview_inputs=("target",), preview_params=("size",), auto=_auto, compare=("target", "texture"),
-        examples={"texture": "wood-grain", "target": "astronaut"}, rank=0),
+        examples={"texture": "wood-grain", "target": "astronaut"}, rank=0,
+        figures={"mode": Figure("mode"), "metric": Figure("metric"),
+                 "p": Figure("random candidates", "%", digits=2),
+                 "p_l": Figure("location candidates", "%", digits=2),
+                 "coherent_fraction": Figure("coherent pixels", "%", digits=2)}),
 )

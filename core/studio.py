@@ -22,7 +22,8 @@ import numpy as np
 from .errors import WeftError
 from .geometry import KINDS, LINES, MARGINS, MASK, SQUARE  # noqa: F401 (the kinds are re-exported)
 
-__all__ = ["Studio", "Geometry", "reduce_for_preview", "SQUARE", "LINES", "MASK", "MARGINS", "REGION"]
+__all__ = ["Studio", "Geometry", "Figure", "describe_figures", "reduce_for_preview", "SQUARE", "LINES", "MASK",
+           "MARGINS", "REGION"]
 
 #: The key of a square that fills no parameter: the recipe's source ``region`` (the input is cropped to it).
 REGION = "region"
@@ -83,6 +84,60 @@ class Geometry:
 
 
 @dataclass(frozen=True)
+class Figure:
+    """How people read one of a method's ``Result.figures`` (the report JSON keeps its key and value).
+
+    Attributes
+    ----------
+    label : words before the value, e.g. ``"largest verbatim copy"``.
+    unit : ``"%"`` (the value is a fraction, shown times 100), ``"px"``, ``"dB"``, ``"s"`` or ``""``.
+    after : words after the value and unit, e.g. ``"of the sample"``.
+    digits : significant digits of a number.
+
+    ``Figure("largest verbatim copy", "%", "of the sample", digits=2).render(0.0532)`` is
+    ``"largest verbatim copy 5.3 % of the sample"``.
+    """
+
+    label: str
+    unit: str = ""
+    after: str = ""
+    digits: int = 3
+
+    def render(self, value: Any) -> str:
+        if isinstance(value, bool):
+            text = "yes" if value else "no"
+        elif isinstance(value, (int, np.integer)) and self.unit != "%":
+            text = str(int(value))
+        elif isinstance(value, (int, float, np.integer, np.floating)):
+            v = float(value) * (100.0 if self.unit == "%" else 1.0)
+            text = f"{v:.{self.digits}g}"
+        else:
+            text = str(value)
+        if self.unit:
+            text += f" {self.unit}"
+        return " ".join(part for part in (self.label, text, self.after) if part)
+
+    def prefixed(self, words: str) -> "Figure":
+        """The same figure with ``words`` before its label (a figure of a step, e.g. the rectification)."""
+        return Figure(f"{words} {self.label}".strip(), self.unit, self.after, self.digits)
+
+
+def describe_figures(figures: Mapping[str, Any], known: Mapping[str, Figure]) -> list[str]:
+    """``figures`` (a ``Result.figures``) in words: each scalar by its :class:`Figure` in ``known``,
+    in the order of ``figures``; lists, tables and missing values (``None``) are left to the report.
+    A key no table describes reads as its words (``"some_count"`` -> ``"some count"``)."""
+    out = []
+    for key, value in figures.items():
+        if value is None or isinstance(value, (list, tuple, dict, np.ndarray)):
+            continue
+        figure = known.get(key)
+        if figure is None:
+            figure = Figure(key.replace("_", " "))
+        out.append(figure.render(value))
+    return out
+
+
+@dataclass(frozen=True)
 class Studio:
     """A method's studio description (see the module docstring).
 
@@ -99,6 +154,8 @@ class Studio:
     compare : the "before" image of Compare: the first of these inputs that is open (default the canvas).
     examples : a bundled example (``weft.core.examples``) per input, opened when the studio starts.
     rank : position in the method list (lowest first; the first is the studio's starting method).
+    figures : how people read each key of the method's ``Result.figures`` (:class:`Figure`); the
+        status bar shows them in words and units (:meth:`describe`), the CLI's ``--report`` keeps the keys.
     """
 
     title: str
@@ -110,6 +167,11 @@ class Studio:
     compare: tuple[str, ...] = ()
     examples: Mapping[str, str] = field(default_factory=dict)
     rank: int = 100
+    figures: Mapping[str, Figure] = field(default_factory=dict)
+
+    def describe(self, figures: Mapping[str, Any]) -> list[str]:
+        """A result's figures in words and units (see :func:`describe_figures`)."""
+        return describe_figures(figures, self.figures)
 
     def geometry_on(self, input_name: str, open_inputs) -> tuple[Geometry, ...]:
         """The geometry drawn on ``input_name`` given the open inputs."""

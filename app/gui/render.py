@@ -27,7 +27,8 @@ from PySide6.QtCore import QObject, QTimer, Signal
 from weft.core import registry
 from weft.core.jobs import JobResult, JobRunner, Progress
 from weft.core.params import Params, Recipe
-from weft.core.studio import reduce_for_preview
+from weft.core.errors import WeftError
+from weft.core.studio import describe_figures, reduce_for_preview
 
 PREVIEW_SIDE = 400
 PROGRESS_DELAY_MS = 300
@@ -314,11 +315,23 @@ def describe(shown: Shown) -> str:
     """Status-bar text for a shown result."""
     h, w = shown.image.shape[:2]
     kind = "result" if shown.final else "preview"
-    figs = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in shown.figures.items()
-                     if not isinstance(v, (list, dict)))
+    figs = ", ".join(_figure_words(shown))
     prepared = ""
     if shown.compiled:
         prepared = f" (after preparing its kernels for {shown.prepared:.1f} s, first run only)"
     elif shown.prepared >= 0.05:
         prepared = f" (after loading its kernels for {shown.prepared:.1f} s)"
     return f"{kind} {w}x{h} in {shown.seconds * 1000:.0f} ms{prepared}" + (f" — {figs}" if figs else "")
+
+
+def _figure_words(shown: Shown) -> list[str]:
+    """The result's figures in words and units, as its method's studio description reads them."""
+    studio = None
+    if shown.recipe is not None:
+        try:
+            studio = registry.get(shown.recipe.method).studio
+        except WeftError:
+            studio = None
+    if studio is None:
+        return describe_figures(shown.figures, {})
+    return studio.describe(shown.figures)

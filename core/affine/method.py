@@ -15,7 +15,7 @@ from ..jobs import CancelToken, Progress
 from ..limits import check_output_size
 from ..metrics import snr_db
 from ..registry import InputSpec, Method, Result
-from ..studio import SQUARE, Geometry, Studio
+from ..studio import SQUARE, Figure, Geometry, Studio
 from .boundary import BoundaryReport, match_boundaries
 from .fields import field_model
 from .params import MIN_SIDE, AffineParams, check_rect, default_rect
@@ -228,5 +228,9 @@ METHOD = Method(
                            help="drag a square: the prototype patch (on the prototype image when one is open); "
                                 "with reuse transforms the result follows it live",
                            live=lambda params: params.reuse_transforms),),
-        preview_params=("size",), compare=("texture",), examples={"texture": "wood-grain"}, rank=2),
+        preview_params=("size",), compare=("texture",), examples={"texture": "wood-grain"}, rank=2,
+        figures={"patches": Figure("patches"), "snr_db": Figure("SNR against the texture", "dB"),
+                 "snr_lowpass_db": Figure("SNR of its lowpass alone", "dB"),
+                 "rms_median": Figure("median transform fit error"), "boundary": Figure("boundary matching"),
+                 "shaker_iterations": Figure("shaker iterations")}),
 )

@@ -11,9 +11,9 @@ from ..errors import GeometryError, InvalidParameter
 from ..image import validate_image
 from ..jobs import CancelToken, Progress
 from ..params import out_of_range, param
-from ..rectify import FeatureLines, View, WarpParams
+from ..rectify import FIGURES as RECTIFY_FIGURES, FeatureLines, View, WarpParams
 from ..registry import InputSpec, Method, Result
-from ..studio import LINES, Geometry, Studio
+from ..studio import LINES, Figure, Geometry, Studio
 from .synthesis import SMOOTH_SIGMA, Synthesis, distance_weights, synthesize_patches
 
 DEFAULT_BLOCK = 48
@@ -345,5 +345,10 @@ METHOD = Method(
                            help="drag to draw feature lines; drag an end to move it; click a line + "
                                 "Delete to remove it"),),
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
-        auto=lambda params, open_inputs: {"sigma_d": params.overlap / 2.0}, rank=3),
+        auto=lambda params, open_inputs: {"sigma_d": params.overlap / 2.0}, rank=3,
+        figures={**{f"rectify_{k}": f.prefixed("rectification") for k, f in RECTIFY_FIGURES.items()},
+                 "patches": Figure("patches"), "repaired_pixels": Figure("repaired pixels"),
+                 "repaired_fraction": Figure("repaired", "%", digits=2),
+                 "view_coverage": Figure("view coverage", "%"),
+                 "photo_replaced_fraction": Figure("photo replaced", "%")}),
 )

@@ -8,7 +8,7 @@ import numpy as np
 from ..errors import InvalidParameter
 from ..params import out_of_range
 from ..registry import InputSpec, Method, Result
-from ..studio import SQUARE, Geometry, Studio
+from ..studio import SQUARE, Figure, Geometry, Studio
 from .checks import _blocks, _transfer_passes, memory_estimate
 from .params import SYNTH_BLOCK, QuiltParams
 from .synthesis import _synthesize, synthesize
@@ -103,5 +103,8 @@ METHOD = Method(
                            help="drag a square: the source region (blocks come only from it)"),),
         preview_inputs=("target", "target_map"), preview_params=("size",), auto=_auto,
         compare=("target", "texture"),
-        examples={"texture": "wood-grain", "target": "astronaut"}, rank=1),
+        examples={"texture": "wood-grain", "target": "astronaut"}, rank=1,
+        figures={"blocks": Figure("blocks"),
+                 "verbatim_fraction": Figure("largest verbatim copy", "%", "of the sample", digits=2),
+                 "iterations": Figure("passes")}),
 )

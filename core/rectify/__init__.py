@@ -27,7 +27,7 @@ in :mod:`weft.core.rectify.view` and is driven by :mod:`weft.core.nfpt`.
 
 from .homography import HomographyFit, apply_homography, fit_homography
 from .lines import FeatureLines, line_correspondences, load_feature_lines, parse_feature_lines
-from .method import (INTERPOLATIONS, METHOD, Rectified, Rectifier, RectifyParams, WarpParams, homography_figure,
+from .method import (FIGURES, INTERPOLATIONS, METHOD, Rectified, Rectifier, RectifyParams, WarpParams, homography_figure,
                      rectify, rectify_feature_lines, scale_lines, warm_up)
 from .view import View, load_view
 from .warps import PLANAR_TOL_PX, WARPS, WarpPlan, homography_plan, plan_warp

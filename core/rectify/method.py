@@ -12,6 +12,7 @@ from ..image import validate_image
 from ..jobs import ProgressReporter
 from ..params import Params, param
 from ..registry import InputSpec, Method, Result
+from ..studio import Figure
 from .lines import FeatureLines, load_feature_lines
 from .warps import WARPS, WarpPlan, homography_plan, plan_warp
 
@@ -230,6 +231,16 @@ def _run(inputs: Mapping[str, np.ndarray], params: RectifyParams, *, rng=None, p
     if out.homography is not None:
         figures["homography"] = homography_figure(out.homography)
     return Result(out.image, figures)
+
+
+#: How people read the rectification's figures (a method that rectifies, e.g. NFPT, shows them in its
+#: status line through its studio description; the report keeps the keys).
+FIGURES = {
+    "points": Figure("points"), "inliers": Figure("inliers"), "rms_points_px": Figure("error", "px", digits=2),
+    "rms_lines_px": Figure("line error", "px", digits=2), "lines": Figure("lines"),
+    "plane_rms_px": Figure("plane error", "px", digits=2), "warp": Figure("warp"), "view": Figure("view"),
+    "coverage": Figure("coverage", "%"),
+}
 
 
 def homography_figure(h: np.ndarray) -> list[list[float]]:

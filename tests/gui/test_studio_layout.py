@@ -1,0 +1,53 @@
+"""Issue 14 (friction): figures in words, a status line that never runs into the pixel read-out,
+tab titles that fit, the square typed, a usable result view in a small window."""
+
+import json
+import re
+
+import pytest
+from PySide6.QtCore import QRect, Qt
+
+from weft.core import registry
+from weft.core.examples import RESOURCES
+from weft.app.gui.main_window import MainWindow
+
+from .helpers import drag, mouse
+
+SNAKE = re.compile(r"\b[a-z0-9]+(?:_[a-z0-9]+)+\b")
+
+
+def _window(qtbot, settings, size):
+    w = MainWindow(settings=settings)
+    qtbot.addWidget(w)
+    w.resize(*size)
+    w.show()
+    qtbot.waitExposed(w)
+    qtbot.waitUntil(lambda: w.renderer.last is not None and w.renderer.last.final, timeout=20000)
+    return w
+
+
+def _final_of(window, method):
+    last = window.renderer.last
+    return last is not None and last.final and last.recipe is not None and last.recipe.method == method
+
+
+@pytest.mark.parametrize("method", list(registry.studio_methods()))
+def test_the_status_line_gives_a_results_figures_in_words_and_units(window, qtbot, method):
+    if method != window.doc.method:
+        window.doc.set_method(method)
+    if method == "nfpt":  # with feature lines, so the rectification's figures are there too
+        data = json.loads((RESOURCES / "perspective-lines.json").read_text())
+        window.doc.set_lines(data["image_lines"], data["frontal_lines"], frontal_size=data["frontal_size"])
+        window.doc.set_param("size", (256, 192))
+    qtbot.waitUntil(lambda: _final_of(window, method) and not window.renderer.running(), timeout=60000)
+    shown = window.renderer.last
+    text = window.statusBar().currentMessage()
+    assert text.startswith("result ") and " — " in text
+    assert not SNAKE.findall(text), text
+    assert not [k for k in shown.figures if "_" in k and k in text], text
+    words = registry.get(method).studio.describe(shown.figures)
+    assert words and text.endswith(", ".join(words))
+    if method == "nfpt":
+        assert re.search(r"rectification error [0-9.e-]+ px", text), text
+    if method == "fast":
+        assert re.search(r"coherent pixels \d+(\.\d+)? %", text), text
