@@ -33,6 +33,7 @@ from PySide6.QtWidgets import (
     QMessageBox,
     QProgressBar,
     QPushButton,
+    QSizePolicy,
     QSplitter,
 )
 
@@ -62,6 +63,33 @@ class _ExampleList(QListWidget):
         return data
 
 
+class ElidedLabel(QLabel):
+    """A one-line label that shows as much of its text as fits (elided at the right) and the whole
+    text in its tooltip; it takes whatever width its layout gives it."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._full = ""
+        self.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.setMinimumWidth(0)
+
+    def full_text(self) -> str:
+        return self._full
+
+    def set_full_text(self, text: str) -> None:
+        self._full = text
+        self.setToolTip(text)
+        self._elide()
+
+    def resizeEvent(self, event):  # noqa: N802
+        super().resizeEvent(event)
+        self._elide()
+
+    def _elide(self) -> None:
+        width = self.contentsRect().width()
+        super().setText(self.fontMetrics().elidedText(self._full, Qt.TextElideMode.ElideRight, max(width, 0)))
+
+
 class MainWindow(QMainWindow):
     """The studio window (see the module docstring)."""
 
@@ -75,7 +103,10 @@ class MainWindow(QMainWindow):
         # kernels' compilation on another worker crashed the process (seen in the test suite).
         PILImage.init()
         self.setWindowTitle("weft")
-        self.resize(1280, 800)
+        # 1280x800, within the screen with room for the window manager's frame (a 1280x800 window on
+        # a 1280x800 screen had its status bar below the screen's edge, seen under Xvfb)
+        room = self.screen().availableGeometry() if self.screen() is not None else None
+        self.resize(min(1280, room.width()) if room else 1280, min(800, room.height() - 48) if room else 800)
         self.settings = settings if settings is not None else QSettings("weft", "weft")
         self.doc = Document(self)
         self.renderer = Renderer(self.doc, self)
@@ -257,7 +288,17 @@ class MainWindow(QMainWindow):
         self.examples_dock = dock
 
     def _build_status(self) -> None:
+        # The status bar's message is shown by status_label, the first permanent widget (stretching,
+        # elided, the whole text in its tooltip), so it never runs under the pixel read-out: QStatusBar
+        # paints its own message only left of its first permanent widget, i.e. nowhere.
+        self.status_label = ElidedLabel()
+        self.statusBar().messageChanged.connect(self.status_label.set_full_text)
+        self.statusBar().addPermanentWidget(self.status_label, 1)
         self.pixel_label = QLabel("")
+        # the read-out keeps its own room (a typical read-out's width), so moving the mouse does not
+        # shift the message, and a longer read-out is elided rather than pushed into it
+        self.pixel_label.setFixedWidth(self.pixel_label.fontMetrics().horizontalAdvance(
+            "texture  x 0000  y 0000  0.000 0.000 0.000") + 8)
         self.zoom_label = QLabel("")
         self.progress_bar = QProgressBar()
         self.progress_bar.setMaximumWidth(320)
@@ -559,7 +600,10 @@ class MainWindow(QMainWindow):
             return
         v = img[y, x]
         value = f"{float(v):.3f}" if np.ndim(v) == 0 else " ".join(f"{float(c):.3f}" for c in v)
-        self.pixel_label.setText(f"{view.title}  x {x}  y {y}  {value}")
+        text = f"{view.title}  x {x}  y {y}  {value}"
+        metrics = self.pixel_label.fontMetrics()
+        self.pixel_label.setText(metrics.elidedText(text, Qt.TextElideMode.ElideMiddle, self.pixel_label.width()))
+        self.pixel_label.setToolTip(text)
 
     def _zoom_view(self) -> ImageView:
         """The view the zoom shortcuts act on: the one under the mouse (the last it moved over),

@@ -51,3 +51,27 @@ def test_the_status_line_gives_a_results_figures_in_words_and_units(window, qtbo
         assert re.search(r"rectification error [0-9.e-]+ px", text), text
     if method == "fast":
         assert re.search(r"coherent pixels \d+(\.\d+)? %", text), text
+
+
+def test_the_status_text_never_runs_into_the_pixel_read_out(qtbot, settings):
+    w = _window(qtbot, settings, (760, 560))
+    long = "result 1500x1000 in 4321 ms — " + ", ".join(f"rectification figure {i} 0.123 px" for i in range(30))
+    w.statusBar().showMessage(long)
+    view = w.result_view
+    view.actual_size()
+    view.centerOn(10.5, 12.5)
+    mouse(view, "move", (10.5, 12.5), buttons=Qt.MouseButton.NoButton)
+    assert re.match(r"result  x \d+  y \d+  [0-9.]+ ", w.pixel_label.text()), w.pixel_label.text()
+    status, pixel, zoom = w.status_label, w.pixel_label, w.zoom_label
+    assert status.isVisible() and pixel.isVisible()
+    assert not status.geometry().intersects(pixel.geometry())
+    assert not status.geometry().intersects(zoom.geometry())
+    # the message shown is cut to its room (with an ellipsis); the whole of it is the tooltip
+    assert status.text() != long and status.text().endswith("…")
+    assert status.fontMetrics().horizontalAdvance(status.text()) <= status.contentsRect().width()
+    assert status.toolTip() == long
+    assert pixel.fontMetrics().horizontalAdvance(pixel.text()) <= pixel.contentsRect().width()
+    # a short message is shown whole
+    w.statusBar().showMessage("cancelled; the previous result is kept")
+    assert status.text() == "cancelled; the previous result is kept"
+    w.shutdown()
