@@ -140,12 +140,17 @@ class InputsPane(QSplitter):
             self._show_clear(inp.name, optional=not inp.required)
             if inp.name == studio.canvas:
                 continue
-            label = inp.name.replace("_", " ") + ("" if inp.required else " (optional)")
-            self.tabs.addTab(self._boxes[inp.name], label)
+            # short tab titles (the input's name; "optional" is in its title bar and tooltip) so the
+            # tabs fit a narrow pane instead of being cut or scrolled away
+            pretty = inp.name.replace("_", " ")
+            i = self.tabs.addTab(self._boxes[inp.name], pretty)
+            self.tabs.setTabToolTip(i, f"{pretty}{'' if inp.required else ' (optional)'}: {inp.help}")
         lines = next((g for g in studio.geometry if g.kind == LINES), None)
         if lines is not None:
             self.tool(lines, lines.input_for(self.doc.inputs))
-            self.tabs.insertTab(0, self.lines_panel, "frontal frame (live rectification)")
+            self.tabs.insertTab(0, self.lines_panel, "frontal frame")
+            self.tabs.setTabToolTip(0, "the frontal frame: the photo rectified live from the feature lines; "
+                                       "draw each line's partner here")
             self.lines_panel.set_active(True)
         self.tabs.setCurrentIndex(0)
         self.tabs.setVisible(self.tabs.count() > 0)
@@ -158,7 +163,8 @@ class InputsPane(QSplitter):
         for inp in self.doc.current.inputs:
             help_ = " — ".join(g.help for g in studio.geometry if g.input_for(self.doc.inputs) == inp.name)
             self.view(inp.name)
-            self._boxes[inp.name].label.setText(f"  {inp.name.replace('_', ' ')} — {help_ or inp.help}")
+            optional = "" if inp.required else " (optional)"
+            self._boxes[inp.name].label.setText(f"  {inp.name.replace('_', ' ')}{optional} — {help_ or inp.help}")
         wanted = {}
         for g in studio.geometry:
             name = g.input_for(self.doc.inputs)

@@ -52,6 +52,8 @@ from .views import ImageView, ResultView, is_image_path
 
 OPEN_FILTER = "Images (*.png *.jpg *.jpeg *.tif *.tiff *.bmp *.webp);;All files (*)"
 MAX_RECENT = 8
+NARROW = 1200  # a window narrower than this (px) gets the Examples panel as a tab behind the Method panel
+EXAMPLES_WIDTH = 170  # the Examples panel's width in a wider window: two columns of thumbnails
 
 
 class _ExampleList(QListWidget):
@@ -141,7 +143,6 @@ class MainWindow(QMainWindow):
         dock = QDockWidget("Method", self)
         dock.setObjectName("method")
         dock.setWidget(self.method_panel)
-        dock.setMinimumWidth(390)
         self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
         self.method_dock = dock
         self.files = FileActions(self, self.doc, self.renderer)
@@ -162,7 +163,8 @@ class MainWindow(QMainWindow):
         self._rebuild_method()
         self._default_layout = self.saveState()  # View > Reset Layout returns to it
         self.restoreGeometry(self.settings.value("geometry", b""))
-        self.restoreState(self.settings.value("state", b""))
+        # a layout the user left last time is kept; else the first show lays the docks out for the window's size
+        self._restored_layout = bool(self.restoreState(self.settings.value("state", b"")))
         # The method on screen loads (or compiles) its kernels in its own first render; the other
         # methods' are loaded off the GUI thread once that first result is shown.
         self.renderer.warm_up_soon()
@@ -268,7 +270,7 @@ class MainWindow(QMainWindow):
     def _build_examples(self) -> None:
         self.example_list = _ExampleList()
         self.example_list.setViewMode(QListWidget.ViewMode.IconMode)
-        self.example_list.setIconSize(QSize(72, 72))
+        self.example_list.setIconSize(QSize(64, 64))
         self.example_list.setResizeMode(QListWidget.ResizeMode.Adjust)
         self.example_list.setMovement(QListWidget.Movement.Static)
         self.example_list.setDragEnabled(True)
@@ -384,7 +386,24 @@ class MainWindow(QMainWindow):
         for dock in (self.method_dock, self.examples_dock):
             dock.setFloating(False)
             dock.show()
-        total = max(self.splitter.width(), 400)
+        self._lay_out_for_width()
+
+    def _lay_out_for_width(self) -> None:
+        """Dock widths for the window's width, so the result view keeps a usable share: below
+        NARROW px the Examples panel becomes a tab behind the Method panel (the result view is
+        ~200 px wide at 1024 px otherwise), and the Method panel takes at most 30 % of the width
+        (its parameters scroll); the splitter gives the result 55 % of the rest."""
+        width = self.width()
+        method_width = max(self.method_panel.minimumSizeHint().width(), min(390, int(width * 0.3)))
+        if width < NARROW:
+            if self.dockWidgetArea(self.examples_dock) != self.dockWidgetArea(self.method_dock):
+                self.tabifyDockWidget(self.method_dock, self.examples_dock)
+            self.method_dock.raise_()
+            self.resizeDocks([self.method_dock], [method_width], Qt.Orientation.Horizontal)
+        else:
+            self.resizeDocks([self.examples_dock, self.method_dock], [EXAMPLES_WIDTH, method_width],
+                             Qt.Orientation.Horizontal)
+        total = max(self.width() - method_width - (0 if width < NARROW else EXAMPLES_WIDTH) - 24, 400)
         self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
 
     # --- inputs ----------------------------------------------------------------------------------
@@ -665,8 +684,11 @@ class MainWindow(QMainWindow):
         super().showEvent(event)
         if not getattr(self, "_sized", False):  # first show: give the result the larger share
             self._sized = True
-            total = max(self.splitter.width(), 400)
-            self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
+            if self._restored_layout:
+                total = max(self.splitter.width(), 400)
+                self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
+            else:
+                self._lay_out_for_width()
 
     def closeEvent(self, event):  # noqa: N802
         if not self.may_drop_edits("quit"):

@@ -75,3 +75,71 @@ def test_the_status_text_never_runs_into_the_pixel_read_out(qtbot, settings):
     w.statusBar().showMessage("cancelled; the previous result is kept")
     assert status.text() == "cancelled; the previous result is kept"
     w.shutdown()
+
+
+@pytest.mark.parametrize("size", [(1280, 800), (1024, 700)])
+def test_tab_titles_are_not_clipped(qtbot, settings, size):
+    w = _window(qtbot, settings, size)
+    for method in registry.studio_methods():
+        w.doc.set_method(method)
+        qtbot.waitUntil(lambda: w.doc.method == method, timeout=5000)
+        bar = w.input_tabs.tabBar()
+        if not w.input_tabs.isVisible():
+            continue
+        qtbot.waitUntil(lambda: bar.width() > 0, timeout=5000)
+        for i in range(bar.count()):
+            rect = bar.tabRect(i)
+            text = bar.tabText(i)
+            assert bar.rect().contains(rect), (method, text, rect, bar.rect())  # not scrolled out of sight
+            assert bar.fontMetrics().horizontalAdvance(text) < rect.width(), (method, text, rect)
+            assert bar.tabToolTip(i)
+    w.shutdown()
+
+
+def test_the_result_view_keeps_a_usable_share_of_a_1024x700_window(qtbot, settings):
+    w = _window(qtbot, settings, (1024, 700))
+    for method in registry.studio_methods():
+        w.doc.set_method(method)
+        qtbot.waitUntil(lambda: w.result_view.width() >= 350, timeout=5000)
+        assert w.result_view.height() >= 350
+    # the Examples panel is a tab behind the Method panel, a click away
+    assert w.tabifiedDockWidgets(w.method_dock) == [w.examples_dock]
+    assert not w.method_dock.visibleRegion().isEmpty()
+    w.shutdown()
+
+
+def _widgets_over_the_examples_title(w):
+    """Visible widgets of the window, not the Examples dock's own, that overlap its title bar."""
+    from PySide6.QtCore import QPoint
+    from PySide6.QtWidgets import QWidget
+
+    dock = w.examples_dock
+    top_left = dock.mapTo(w, QPoint(0, 0))
+    title = QRect(top_left.x(), top_left.y(), dock.width(), dock.widget().geometry().top())
+    assert title.height() > 0
+    over = []
+    for child in w.findChildren(QWidget):
+        if (not child.isVisible() or child.isWindow() or child is dock or child.isAncestorOf(dock)
+                or dock.isAncestorOf(child)):
+            continue
+        if QRect(child.mapTo(w, QPoint(0, 0)), child.size()).intersects(title):
+            over.append(child)
+    return over
+
+
+def test_no_widget_is_painted_over_the_examples_dock_title(qtbot, settings):
+    """Seen under Xvfb: a view made for an input no method had shown yet (parented to the window and
+    never laid out) was painted over the Examples title; every input's view now lives in its pane."""
+    w = _window(qtbot, settings, (1280, 800))
+    assert not _widgets_over_the_examples_title(w)
+    for method in registry.studio_methods():
+        w.doc.set_method(method)
+        qtbot.waitUntil(lambda: w.doc.method == method, timeout=5000)
+        assert not _widgets_over_the_examples_title(w), method
+    from weft.app.gui.views import ImageView
+
+    stray = ImageView(w)  # the old way a view was made: the check sees it
+    stray.show()
+    assert stray in _widgets_over_the_examples_title(w)
+    stray.deleteLater()
+    w.shutdown()
