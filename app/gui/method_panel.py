@@ -31,6 +31,7 @@ from PySide6.QtWidgets import (
 )
 
 from weft.core.errors import WeftError
+from weft.core.geometry import Square
 from weft.core.studio import SQUARE
 
 from .convert import to_qimage
@@ -96,6 +97,24 @@ class MethodPanel(QWidget):
         square_box.addWidget(self.square_caption)
         seed_row.addLayout(square_box)
         lay.addLayout(seed_row)
+        # the square typed: its corner and side (the same undoable edit as a drag on its view)
+        self.square_row = QWidget()
+        sq = QHBoxLayout(self.square_row)
+        sq.setContentsMargins(0, 0, 0, 0)
+        self.square_boxes: list[QSpinBox] = []
+        for text, tip in (("X", "left edge of the square, pixels from the image's left"),
+                          ("Y", "top edge of the square, pixels from the image's top"),
+                          ("side", "side of the square, pixels")):
+            label = QLabel(text)
+            box = QSpinBox()
+            box.setKeyboardTracking(False)  # a typed number counts on Enter (or leaving the box)
+            box.setToolTip(tip + "; Enter applies (Ctrl+Z undoes)")
+            box.valueChanged.connect(self._square_typed)
+            label.setBuddy(box)
+            sq.addWidget(label)
+            sq.addWidget(box, 1)
+            self.square_boxes.append(box)
+        lay.addWidget(self.square_row)
         buttons = QHBoxLayout()
         self.render_button = QPushButton("Render")
         self.render_button.setToolTip("render the full-size result (F5)")
@@ -130,6 +149,32 @@ class MethodPanel(QWidget):
             self.preview_requested.emit()
         else:
             self.final_requested.emit()  # a release on an unchanged value still asks for the full size
+
+    def _square_typed(self, _value=None) -> None:
+        """X, Y or side typed: the square they give, checked as the CLI checks ``--region X,Y,S`` /
+        ``--prototype`` (the corner, the side, inside the image, the method's own rules), becomes
+        the document's square; a refused one is said in one line and the boxes show the square there is."""
+        doc = self.doc
+        g = doc.geometry_of(SQUARE)
+        if g is None:
+            return
+        where = g.input_for(doc.inputs)
+        image = doc.image(where)
+        if image is None:
+            return
+        values = [b.value() for b in self.square_boxes]
+        if doc.value(g.key) is None:  # none drawn: the boxes left blank take the corner and a default side
+            values = [d if v == b.minimum() else v for v, b, d in zip(values, self.square_boxes, _default_square(image))]
+        try:
+            square = Square.parse(values, g.key)
+            square.crop(image, where.replace("_", " "), g.key)
+            if g.param is not None:
+                doc.current_params.replace(**{g.param: square})  # the method's rules (e.g. an even side)
+        except WeftError as e:
+            self.message.emit(str(e))
+            self.show_square()
+            return
+        doc.set_geometry(g.key, square, "Square")
 
     def new_seed(self) -> None:
         self.seed_box.setValue(int(np.random.default_rng().integers(0, 2**31 - 1)))
@@ -168,6 +213,7 @@ class MethodPanel(QWidget):
         if g is not None:
             what = g.param.replace("_", " ") if g.param is not None else "source region"
             self.square_caption.setText(f"{what}: none drawn" if square is None else f"{what} {square[2]} px")
+        self._show_square_boxes(g, square, image)
         if square is None or image is None:
             self.square_label.clear()
             return
@@ -176,3 +222,31 @@ class MethodPanel(QWidget):
         if patch.size:
             pix = QPixmap.fromImage(to_qimage(patch)).scaled(THUMB, THUMB, Qt.AspectRatioMode.KeepAspectRatio)
             self.square_label.setPixmap(pix)
+
+    def _show_square_boxes(self, g, square, image) -> None:
+        """The X, Y and side boxes: the square's values (blank when none is drawn), ranged to the
+        image; hidden for a method with no square."""
+        self.square_row.setVisible(g is not None)
+        self.square_row.setEnabled(image is not None)
+        if g is None or image is None:
+            return
+        h, w = image.shape[:2]
+        limits = ((0, max(w - Square.MIN_SIDE, 0)), (0, max(h - Square.MIN_SIDE, 0)), (Square.MIN_SIDE, min(w, h)))
+        for i, (box, (lo, hi)) in enumerate(zip(self.square_boxes, limits)):
+            box.blockSignals(True)
+            if square is None:  # blank (the minimum shows "–") until a number is typed
+                box.setRange(lo - 1, max(lo, hi))
+                box.setSpecialValueText("–")
+                box.setValue(lo - 1)
+            else:
+                box.setSpecialValueText("")
+                box.setRange(lo, max(lo, hi))
+                box.setValue(int(square[i]))
+            box.blockSignals(False)
+
+
+def _default_square(image) -> tuple[int, int, int]:
+    """What a typed square takes for the numbers left blank: the top-left corner and an even side of
+    half the image's shorter side."""
+    side = max(Square.MIN_SIDE, min(image.shape[:2]) // 2)
+    return 0, 0, side - side % 2

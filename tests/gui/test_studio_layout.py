@@ -143,3 +143,47 @@ def test_no_widget_is_painted_over_the_examples_dock_title(qtbot, settings):
     assert stray in _widgets_over_the_examples_title(w)
     stray.deleteLater()
     w.shutdown()
+
+
+def test_the_square_can_be_typed_and_the_edit_undone(window, qtbot):
+    panel = window.method_panel
+    x_box, y_box, side_box = panel.square_boxes
+    assert panel.square_row.isVisible()
+    drag(window.canvas_view, (20, 20), (60, 60))
+    qtbot.waitUntil(lambda: window.doc.square is not None, timeout=5000)
+    before = window.doc.square
+    assert (x_box.value(), y_box.value(), side_box.value()) == tuple(before)
+    for box, text in ((x_box, "30"), (side_box, "24")):
+        box.lineEdit().selectAll()
+        qtbot.keyClicks(box.lineEdit(), text)
+        qtbot.keyClick(box.lineEdit(), Qt.Key.Key_Return)
+    assert tuple(window.doc.square) == (30, before[1], 24)
+    assert window.undo_action.text().endswith("Square")
+    qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # the side's edit
+    qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # the corner's
+    assert window.doc.square == before
+    assert (x_box.value(), y_box.value(), side_box.value()) == tuple(before)
+    # a square that leaves the image is refused with the CLI's words, and the boxes go back
+    w = window.doc.image(window.doc.studio.canvas).shape[1]
+    messages = []
+    window.message.connect(messages.append)
+    x_box.lineEdit().selectAll()
+    qtbot.keyClicks(x_box.lineEdit(), str(w - 4))
+    qtbot.keyClick(x_box.lineEdit(), Qt.Key.Key_Return)
+    assert window.doc.square == before
+    assert messages and messages[-1].startswith(f"parameter 'region' = {w - 4},{before[1]},{before[2]} leaves the texture")
+    assert x_box.value() == before[0]
+
+
+def test_a_square_can_be_typed_when_none_is_drawn(window, qtbot):
+    panel = window.method_panel
+    x_box, y_box, side_box = panel.square_boxes
+    assert window.doc.square is None
+    assert [b.text() for b in panel.square_boxes] == ["–", "–", "–"]  # blank: nothing drawn
+    side_box.lineEdit().selectAll()
+    qtbot.keyClicks(side_box.lineEdit(), "40")
+    qtbot.keyClick(side_box.lineEdit(), Qt.Key.Key_Return)
+    assert tuple(window.doc.square) == (0, 0, 40)  # at the corner
+    assert [b.text() for b in panel.square_boxes] == ["0", "0", "40"]
+    qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert window.doc.square is None and side_box.text() == "–"
