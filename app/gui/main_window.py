@@ -401,6 +401,9 @@ class MainWindow(QMainWindow):
             self.method_dock.raise_()
             self.resizeDocks([self.method_dock], [method_width], Qt.Orientation.Horizontal)
         else:
+            if (self.dockWidgetArea(self.examples_dock) != Qt.DockWidgetArea.LeftDockWidgetArea
+                    and not self.examples_dock.isFloating()):
+                self.addDockWidget(Qt.DockWidgetArea.LeftDockWidgetArea, self.examples_dock)
             self.resizeDocks([self.examples_dock, self.method_dock], [EXAMPLES_WIDTH, method_width],
                              Qt.Orientation.Horizontal)
         total = max(self.width() - method_width - (0 if width < NARROW else EXAMPLES_WIDTH) - 24, 400)
@@ -689,6 +692,12 @@ class MainWindow(QMainWindow):
                 self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
             else:
                 self._lay_out_for_width()
+
+    def resizeEvent(self, event):  # noqa: N802
+        super().resizeEvent(event)
+        old = event.oldSize().width()
+        if getattr(self, "_sized", False) and old > 0 and (old < NARROW) != (self.width() < NARROW):
+            self._lay_out_for_width()  # made narrow (or wide again): the result view keeps its share
 
     def closeEvent(self, event):  # noqa: N802
         if not self.may_drop_edits("quit"):

@@ -105,6 +105,11 @@ def test_the_result_view_keeps_a_usable_share_of_a_1024x700_window(qtbot, settin
     # the Examples panel is a tab behind the Method panel, a click away
     assert w.tabifiedDockWidgets(w.method_dock) == [w.examples_dock]
     assert not w.method_dock.visibleRegion().isEmpty()
+    # made wide, Examples goes back to the left; made narrow again, the result keeps its share
+    w.resize(1400, 800)
+    qtbot.waitUntil(lambda: w.dockWidgetArea(w.examples_dock) == Qt.DockWidgetArea.LeftDockWidgetArea, timeout=5000)
+    w.resize(1024, 700)
+    qtbot.waitUntil(lambda: w.result_view.width() >= 350, timeout=5000)
     w.shutdown()
 
 
