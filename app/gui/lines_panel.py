@@ -80,10 +80,14 @@ class FeatureLinesPanel(QWidget):
             box_.setKeyboardTracking(False)
             box_.valueChanged.connect(self._frontal_size_edited)
             row.addWidget(box_)
+        row.addStretch(1)
+        lay.addLayout(row)
+        # on a line of its own, wrapped: Quad…'s "click the top-left corner" was cut off beside the boxes
         self.rectify_status = QLabel("")
         self.rectify_status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
-        row.addWidget(self.rectify_status, 1)
-        lay.addLayout(row)
+        self.rectify_status.setWordWrap(True)
+        self.rectify_status.setContentsMargins(4, 0, 4, 0)
+        lay.addWidget(self.rectify_status)
         lay.addWidget(self.frontal_view, 1)
         self._sync_frontal_size()
 

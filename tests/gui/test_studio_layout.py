@@ -192,3 +192,24 @@ def test_a_square_can_be_typed_when_none_is_drawn(window, qtbot):
     assert [b.text() for b in panel.square_boxes] == ["0", "0", "40"]
     qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
     assert window.doc.square is None and side_box.text() == "–"
+
+
+def test_quads_prompt_is_not_cut_off_in_a_narrow_pane(qtbot, settings):
+    w = _window(qtbot, settings, (1024, 700))
+    w.doc.set_method("nfpt")
+    qtbot.waitUntil(lambda: w.lines_panel is not None and w.lines_panel.active, timeout=5000)
+    panel = w.lines_panel
+    w.input_tabs.setCurrentWidget(panel)
+    qtbot.mouseClick(panel.quad_button, Qt.MouseButton.LeftButton)
+    status = panel.rectify_status
+    qtbot.waitUntil(lambda: status.isVisible() and "top-left corner" in status.text(), timeout=5000)
+    # every word is inside the label (it wraps) and the label inside the panel
+    def fits():
+        room = status.contentsRect()
+        need = status.fontMetrics().boundingRect(QRect(0, 0, room.width(), 10**4), Qt.TextFlag.TextWordWrap,
+                                                 status.text())
+        return need.width() <= room.width() and need.height() <= room.height()
+
+    qtbot.waitUntil(fits, timeout=5000)
+    assert panel.rect().contains(status.geometry())
+    w.shutdown()
