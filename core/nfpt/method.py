@@ -346,7 +346,8 @@ METHOD = Method(
                                 "Delete to remove it"),),
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
         auto=lambda params, open_inputs: {"sigma_d": params.overlap / 2.0}, rank=3,
-        figures={**{f"rectify_{k}": f.prefixed("rectification") for k, f in RECTIFY_FIGURES.items()},
+        figures={**{f"rectify_{k}": f.prefixed("rectification") if f.unit == "px" else f
+                    for k, f in RECTIFY_FIGURES.items()},
                  "patches": Figure("patches"), "repaired_pixels": Figure("repaired pixels"),
                  "repaired_fraction": Figure("repaired", "%", digits=2),
                  "view_coverage": Figure("view coverage", "%"),
