@@ -104,7 +104,7 @@ class Figure:
     digits: int = 3
 
     def render(self, value: Any) -> str:
-        if isinstance(value, bool):
+        if isinstance(value, (bool, np.bool_)):
             text = "yes" if value else "no"
         elif isinstance(value, (int, np.integer)) and self.unit != "%":
             text = str(int(value))

@@ -55,8 +55,9 @@ def test_every_scalar_figure_of_a_studio_method_has_a_human_reading(name, inputs
     json.dumps(dict(result.figures))  # the report keeps keys and values as they are
 
 
-def test_every_studio_method_covers_the_keys_it_was_tested_for():
-    assert {c[0] for c in CASES} == set(registry.studio_methods())
+def test_every_studio_method_has_a_case_above():
+    untested = set(registry.studio_methods()) - {c[0] for c in CASES}
+    assert not untested, f"add a case to CASES for {sorted(untested)}: every figure it reports needs a Figure"
 
 
 def test_a_figure_renders_its_value_in_words_and_units():
@@ -65,7 +66,7 @@ def test_a_figure_renders_its_value_in_words_and_units():
     assert Figure("coherent pixels", "%", digits=2).render(0.83) == "coherent pixels 83 %"
     assert Figure("error", "px", digits=2).prefixed("rectification").render(1.2) == "rectification error 1.2 px"
     assert Figure("blocks").render(np.int64(36)) == "blocks 36"
-    assert Figure("repair").render(True) == "repair yes"
+    assert Figure("repair").render(True) == "repair yes" and Figure("repair").render(np.False_) == "repair no"
     assert Figure("warp").render("homography") == "warp homography"
     # lists and missing values are left to the report; a key no table names reads as its words
     assert describe_figures({"homography": [[1, 0], [0, 1]], "prototype": None, "odd_count": 3}, {}) == \
