@@ -396,7 +396,8 @@ class MainWindow(QMainWindow):
         width = self.width()
         method_width = max(self.method_panel.minimumSizeHint().width(), min(390, int(width * 0.3)))
         if width < NARROW:
-            if self.dockWidgetArea(self.examples_dock) != self.dockWidgetArea(self.method_dock):
+            if (self.dockWidgetArea(self.examples_dock) != self.dockWidgetArea(self.method_dock)
+                    and not self.examples_dock.isFloating() and not self.method_dock.isFloating()):
                 self.tabifyDockWidget(self.method_dock, self.examples_dock)
             self.method_dock.raise_()
             self.resizeDocks([self.method_dock], [method_width], Qt.Orientation.Horizontal)
