@@ -143,7 +143,8 @@ def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("-o", "--output", required=True, metavar="OUT",
                    help="output image (.png, .jpg, .tif); PNGs carry the recipe")
     p.add_argument("--seed", metavar="N", help="random seed (default: a fresh one, recorded in the recipe)")
-    p.add_argument("--bit-depth", metavar="BITS", default="8", help="8 or 16 bits per channel (16: PNG, TIFF)")
+    p.add_argument("--bit-depth", metavar="BITS",
+                   help="8 or 16 bits per channel (16: PNG, TIFF); default 8 (fill: the image's own)")
     p.add_argument("--region", metavar="X,Y,S",
                    help="use only this square of the texture (top-left corner and side, pixels) as the source")
     p.add_argument("--report", action="store_true", help="print one JSON line with the compute time and figures")
@@ -230,7 +231,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     method = registry.get(method_name)
     # typed parameters (a method's own command line) or their JSON form (a recipe's, read at its edge)
     params = params_dict if isinstance(params_dict, Params) else method.params.from_dict(params_dict)
-    bit_depth = _parse_bit_depth(args)
+    bit_depth = _parse_bit_depth(args) if args.bit_depth is not None else None  # None: see below
     out = _check_output(args.output, list(input_paths.values()))
     if bit_depth == 16 and out.suffix.lower() in (".jpg", ".jpeg"):
         raise WeftError(f"{args.output}: JPEG cannot hold 16 bits per channel (use .png or .tif)")
@@ -239,19 +240,24 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
 
     bar = _TerminalProgress(not args.quiet)
     preparing = _PreparingLine(method.name, bar)
+    infos: dict = {}
     try:
         with registry.watch_compiles(on_start=preparing):  # a kernel compiling: say so on the terminal
             # Loading every kernel up front only keeps --report's "seconds" free of cache loads; without
             # --report a run loads (or, first time, compiles) just the kernels it uses: a cold
             # `weft affine` 3.8 -> 3.0 s, `weft nfpt` 4.7 -> 3.9 s.
             result, seconds = render(method, params, input_paths, seed, region, progress=bar,
-                                     warm_up=args.report)
+                                     warm_up=args.report, infos=infos)
     finally:
         preparing.stop()
         bar.close()
     notice = registry.kernel_cache_notice()
     if notice is not None and not args.quiet:
         print(f"weft: {notice}", file=sys.stderr)
+    if bit_depth is None:  # not asked for: 8, or the bit depth of the input the method names (fill: the image)
+        info = infos.get(method.depth_from) if method.depth_from else None
+        jpeg = out.suffix.lower() in (".jpg", ".jpeg")
+        bit_depth = info.bit_depth if info is not None and not jpeg else 8
     recipe = output_recipe(method, params, input_paths, seed, region, out)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if args.report:

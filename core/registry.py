@@ -31,6 +31,7 @@ _MODULES = {
     "rectify": "weft.core.rectify",
     "nfpt": "weft.core.nfpt",
     "affine": "weft.core.affine",
+    "fill": "weft.core.fill",
 }
 
 
@@ -50,6 +51,10 @@ class InputSpec:
     #: The smallest width and height the method can use at all (with its most permissive
     #: parameters); front ends refuse a smaller image up front, naming its file.
     min_side: int = 1
+    #: Keep an alpha channel when the file has one (``load_image(..., alpha=True)``): the method then
+    #: gets (H, W, 2) grey+alpha or (H, W, 4) RGBA. Off for every method but ``fill`` (a transparent
+    #: region is its hole); the others get alpha dropped, as before.
+    alpha: bool = False
 
     @property
     def is_positional(self) -> bool:
@@ -89,6 +94,9 @@ class Method:
     #: a batch multiplies it by its workers to refuse up front (:mod:`weft.core.batch`). None: no estimate.
     memory: Callable[[Mapping[str, tuple[int, ...]], Params], float] | None = None
     studio: Studio | None = None
+    #: The input whose bit depth (8 or 16) the command line's output keeps when ``--bit-depth`` is not
+    #: given (``fill``: a 16-bit photo stays 16-bit; its known pixels come back unchanged). None: 8.
+    depth_from: str | None = None
 
 
 _loaded: dict[str, Method] = {}

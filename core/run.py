@@ -82,7 +82,7 @@ def output_recipe(method, params: Params, input_paths: Mapping[str, str], seed: 
 
 def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
            region: tuple[int, int, int] | None = None, *, progress=None, cancel=None, warm_up: bool = True,
-           shown_paths: Mapping[str, str] | None = None):
+           shown_paths: Mapping[str, str] | None = None, infos: dict | None = None):
     """Load the inputs, run ``method`` and return ``(Result, seconds)`` (compute time only).
 
     The first input is cropped to ``region`` when given; an input smaller than its ``min_side`` is
@@ -90,12 +90,17 @@ def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
     ``warm_up`` loads the method's kernels first (when the method asks for that on the command line),
     so ``seconds`` is the compute alone; a kernel compiled during the run (this thread's numba
     compiles) is left out of it too. ``shown_paths`` are the names to use in messages when the
-    files read are copies (a batch's shipped inputs).
+    files read are copies (a batch's shipped inputs). An input whose ``InputSpec.alpha`` is set keeps
+    its alpha channel. ``infos``, when given, receives each input's :class:`~weft.core.image.ImageInfo`.
     """
     from .image import load_image
 
     shown = dict(shown_paths or input_paths)
-    images = {name: load_image(path).image for name, path in input_paths.items()}
+    keep_alpha = {spec.name for spec in method.inputs if spec.alpha}
+    loaded = {name: load_image(path, alpha=name in keep_alpha) for name, path in input_paths.items()}
+    images = {name: item.image for name, item in loaded.items()}
+    if infos is not None:
+        infos.update({name: item.info for name, item in loaded.items()})
     if region is not None:
         first = method.inputs[0].name
         images[first] = Square(*region).crop(images[first], what=first)

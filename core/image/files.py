@@ -232,7 +232,8 @@ def _damaged(name: str, reason: str) -> str | None:
     return None
 
 
-def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: str | None = None) -> Loaded:
+def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: str | None = None,
+               alpha: bool = False) -> Loaded:
     """Load PNG, JPEG, TIFF, BMP, WebP or GIF (8 or 16 bits per sample) as float32 in [0, 1].
 
     Parameters
@@ -245,6 +246,11 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
     mode : {None, "rgb", "grey"}, default None
         None keeps grey (H, W) and colour (H, W, 3); "rgb" always gives (H, W, 3); "grey" gives the
         Rec. 601 :func:`luminance`.
+    alpha : bool, default False
+        Keep an alpha channel (``weft fill``: a transparent region is a hole): an image that has one
+        comes back as (H, W, 2) grey+alpha or (H, W, 4) RGBA (a palette's transparency as RGBA), in
+        the same bit depth; ``mode`` then applies to the colour channels. An image without alpha is
+        returned as without this flag.
 
     Returns
     -------
@@ -291,6 +297,11 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
 
     try:
         arr = None
+        if alpha and had_alpha:
+            grey = src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] == 4)
+            kept = _decode_alpha(data, grey, orientation)
+            if kept is not None:
+                return _loaded_alpha(kept, name, fmt, orientation, src_mode, animated, mode)
         with contextlib.suppress(cv2.error):
             arr = cv2.imdecode(data, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)  # applies EXIF orientation
         if arr is None:  # OpenCV could not: truncated, corrupt, or a variant only Pillow reads
@@ -329,6 +340,42 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
         notes.append("converted to grey (Rec. 601 luminance)")
     info = ImageInfo(path=name, format=fmt, width=image.shape[1], height=image.shape[0],
                      channels=1 if image.ndim == 2 else 3, bit_depth=8 * arr.itemsize, had_alpha=had_alpha,
+                     orientation=orientation, notes=tuple(notes))
+    return Loaded(image, info)
+
+
+def _decode_alpha(data: np.ndarray, grey: bool, orientation: int) -> np.ndarray | None:
+    """Decode keeping alpha: uint8/uint16 (H, W, 2) grey+alpha or (H, W, 4) RGBA, upright; None when
+    the file turns out to have no alpha channel after all (a palette without transparency)."""
+    arr = None
+    with contextlib.suppress(cv2.error):
+        arr = cv2.imdecode(data, cv2.IMREAD_UNCHANGED)  # unlike IMREAD_ANYCOLOR, no EXIF orientation: ours
+    if arr is not None and arr.ndim == 3 and arr.shape[2] == 4 and arr.dtype in (np.uint8, np.uint16):
+        rgba = arr[..., [2, 1, 0, 3]]
+        out = np.stack([rgba[..., 0], rgba[..., 3]], axis=2) if grey else rgba
+        return np.ascontiguousarray(_ORIENT[orientation](out))
+    with _pil_open(io.BytesIO(data.tobytes()))[0] as im:  # palettes with transparency, odd layouts
+        im.load()
+        if not (im.mode in _ALPHA_MODES or "transparency" in im.info):
+            return None
+        out = np.asarray(im.convert("LA" if grey else "RGBA"))
+        return np.ascontiguousarray(_ORIENT[_exif_orientation(im)](out))
+
+
+def _loaded_alpha(arr: np.ndarray, name: str, fmt: str, orientation: int, src_mode: str, animated: bool,
+                  mode: str | None) -> Loaded:
+    image = arr.astype(np.float32, order="C") / np.float32(np.iinfo(arr.dtype).max)
+    notes = [text for cond, text in [
+        (orientation != 1, f"EXIF orientation {orientation} applied"), (True, "alpha channel kept"),
+        (src_mode in ("P", "PA"), "palette expanded to RGB"), (animated, "first frame of an animation used")] if cond]
+    if mode == "rgb" and image.shape[2] == 2:
+        image = np.ascontiguousarray(image[..., [0, 0, 0, 1]])
+        notes.append("grey expanded to RGB")
+    elif mode == "grey" and image.shape[2] == 4:
+        image = np.ascontiguousarray(np.stack([luminance(image[..., :3]), image[..., 3]], axis=2))
+        notes.append("converted to grey (Rec. 601 luminance)")
+    info = ImageInfo(path=name, format=fmt, width=image.shape[1], height=image.shape[0],
+                     channels=image.shape[2], bit_depth=8 * arr.itemsize, had_alpha=True,
                      orientation=orientation, notes=tuple(notes))
     return Loaded(image, info)
 
@@ -402,7 +449,9 @@ def encode_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | No
     path : str or PathLike
         ``.png``, ``.jpg``/``.jpeg`` or ``.tif``/``.tiff`` (any case), in an existing folder.
     image : ndarray
-        Anything :func:`validate_image` accepts; grey is saved grey.
+        Anything :func:`validate_image` accepts; grey is saved grey. (H, W, 4) RGBA and (H, W, 2)
+        grey+alpha keep their alpha (grey+alpha as RGBA: OpenCV writes no grey+alpha), except in a
+        JPEG, which gets the colour alone.
     recipe : str, optional
         Text embedded in a PNG as a ``weft-recipe`` ``tEXt`` chunk (``iTXt``, UTF-8, when not
         Latin-1) right after IHDR, for :func:`read_recipe`. JPEG and TIFF files do not carry it.
@@ -431,9 +480,20 @@ def encode_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | No
     if recipe is not None and (not isinstance(recipe, str) or "\0" in recipe):
         raise InvalidParameter("parameter 'recipe' must be text without NUL characters", name="recipe")
     top = 65535.0 if bit_depth == 16 else 255.0
-    arr = np.clip(np.rint(validate_image(image) * top), 0, top).astype(np.uint16 if bit_depth == 16 else np.uint8)
+    dtype = np.uint16 if bit_depth == 16 else np.uint8
+    alpha = None
+    shape = np.shape(image)
+    if len(shape) == 3 and shape[2] in (2, 4):  # with alpha (load_image(..., alpha=True), weft fill)
+        image = np.asarray(image)
+        alpha = np.clip(np.rint(validate_image(np.ascontiguousarray(image[..., -1]), "alpha") * top), 0, top)
+        image = np.ascontiguousarray(image[..., 0] if shape[2] == 2 else image[..., :3])
+    arr = np.clip(np.rint(validate_image(image) * top), 0, top).astype(dtype)
     if arr.ndim == 3:
         arr = np.ascontiguousarray(arr[..., ::-1])  # RGB -> BGR for OpenCV
+    if alpha is not None and _SAVE_FORMATS[ext] != "JPEG":  # JPEG has no alpha: the colour alone
+        # OpenCV writes no grey+alpha: grey with alpha is written as RGBA with three equal channels
+        colour = arr if arr.ndim == 3 else np.repeat(arr[..., None], 3, axis=2)
+        arr = np.ascontiguousarray(np.concatenate([colour, alpha.astype(dtype)[..., None]], axis=2))
     try:
         params = [cv2.IMWRITE_JPEG_QUALITY, int(quality)] if _SAVE_FORMATS[ext] == "JPEG" else []
         ok, encoded = cv2.imencode(ext, arr, params)

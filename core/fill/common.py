@@ -1,0 +1,74 @@
+"""What every fill engine shares: checking its arguments (the common signature of
+``fill_patchmatch``, ``fill_quilt`` and ``fill_pixel``), the fill-front order and the progress count."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from ..errors import ImageError, InvalidParameter, WeftError
+
+
+def as_channels(image: np.ndarray) -> np.ndarray:
+    """float32 (H, W, C), C-contiguous, from (H, W) or (H, W, C)."""
+    img = np.asarray(image, dtype=np.float32)
+    if img.ndim == 2:
+        img = img[..., None]
+    if img.ndim != 3 or not 1 <= img.shape[2] <= 4:
+        raise ImageError(f"image must be (H, W) or (H, W, C) with C = 1..4, not shape {img.shape}")
+    return np.ascontiguousarray(img)
+
+
+def check_engine_args(image, hole, source, patch: int, name: str):
+    """``(image (H, W, C) float32, hole bool, source bool)`` or a one-line ``WeftError``."""
+    img = as_channels(image)
+    h, w = img.shape[:2]
+    hole = np.asarray(hole, dtype=bool)
+    if hole.shape != (h, w):
+        raise ImageError(f"the hole is {hole.shape[1]}x{hole.shape[0]} but the image is {w}x{h}")
+    src = ~hole if source is None else (np.asarray(source, dtype=bool) & ~hole)
+    if src.shape != (h, w):
+        raise ImageError(f"the source is {src.shape[1]}x{src.shape[0]} but the image is {w}x{h}")
+    if isinstance(patch, bool) or not isinstance(patch, (int, np.integer)) or patch < 3:
+        raise InvalidParameter(f"parameter 'patch' = {patch!r} must be an integer of at least 3", name="patch")
+    if patch > min(h, w):
+        raise InvalidParameter(f"parameter 'patch' = {patch} is larger than the {w}x{h} image", name="patch")
+    if not whole_patches(src, patch).any():
+        raise WeftError(f"the {name} engine needs at least one whole {patch}x{patch} patch of known pixels to copy "
+                        f"from; the source has none")
+    return img, hole, src
+
+
+def whole_patches(region: np.ndarray, patch: int) -> np.ndarray:
+    """bool (H - patch + 1, W - patch + 1): the patch with this top-left corner lies inside ``region``."""
+    h, w = region.shape
+    if patch > h or patch > w:
+        return np.zeros((max(0, h - patch + 1), max(0, w - patch + 1)), dtype=bool)
+    ii = cv2.integral(region.astype(np.uint8), sdepth=cv2.CV_32S)
+    n = ii[patch:, patch:] - ii[:-patch, patch:] - ii[patch:, :-patch] + ii[:-patch, :-patch]
+    return n == patch * patch
+
+
+def onion_order(hole: np.ndarray) -> np.ndarray:
+    """The hole's pixels from its edge inwards ((N, 2) int64 rows of (y, x)): by distance to the
+    nearest known pixel (the fill front), ties in scan order."""
+    dist = cv2.distanceTransform((hole).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    ys, xs = np.nonzero(hole)
+    order = np.lexsort((xs, ys, dist[ys, xs]))
+    return np.stack([ys[order], xs[order]], axis=1).astype(np.int64)
+
+
+class Progress:
+    """Calls ``progress(done, total)`` when the percentage changes, and checks ``cancel``."""
+
+    def __init__(self, progress, cancel, total: int):
+        self.progress, self.cancel, self.total = progress, cancel, max(1, int(total))
+        self.last = -1
+
+    def __call__(self, done: int) -> None:
+        if self.cancel is not None:
+            self.cancel.raise_if_cancelled()
+        pct = int(100 * min(done, self.total) / self.total)
+        if self.progress is not None and pct != self.last:
+            self.last = pct
+            self.progress(min(done, self.total), self.total)

@@ -1,0 +1,267 @@
+"""``weft fill``: the method the registry, the command line and the studio run (see the package)."""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import cv2
+import numpy as np
+
+from ..errors import ImageError, InvalidParameter, WeftError
+from ..geometry import MARGINS, MASK, Margins, Mask
+from ..image import validate_image
+from ..jobs import ProgressReporter
+from ..limits import check_output_size
+from ..registry import InputSpec, Method, Result
+from ..studio import Geometry, Studio
+from .band import blend_band
+from .common import whole_patches
+from .params import ANCHORS, ENGINES, FillParams
+
+
+def _engine(name: str):
+    if name == "quilt":
+        from .quilt import fill_quilt
+
+        return fill_quilt
+    if name == "pixel":
+        from .pixel import fill_pixel
+
+        return fill_pixel
+    from .patchmatch import fill_patchmatch
+
+    return fill_patchmatch
+
+
+def _error(cls, message: str, input: str | None = None, **kw):
+    e = cls(message, **kw)
+    e.input = input  # the CLI puts that input's file name in front
+    return e
+
+
+def _split_alpha(image: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray | None]:
+    """``(colour (H, W) or (H, W, 3) float32, alpha (H, W) or None)`` of a validated image."""
+    arr = np.asarray(image)
+    if arr.ndim == 3 and arr.shape[2] in (2, 4):
+        alpha = validate_image(np.ascontiguousarray(arr[..., -1]), f"{what}'s alpha")
+        colour = validate_image(np.ascontiguousarray(arr[..., 0] if arr.shape[2] == 2 else arr[..., :3]), what)
+        return colour, alpha
+    if arr.ndim == 3 and arr.shape[2] == 1:
+        arr = arr[..., 0]
+    return validate_image(arr, what), None
+
+
+def _mask_bits(mask, shape: tuple[int, int], what: str, against: str) -> np.ndarray:
+    m = np.asarray(mask)
+    if m.dtype != bool:
+        m = np.asarray(validate_image(m if m.ndim != 3 or m.shape[2] not in (2, 4) else m[..., 0], what))
+    if m.shape[:2] != tuple(shape):
+        raise _error(ImageError, f"the {what.replace('_', ' ')} is {m.shape[1]}x{m.shape[0]} but the {against} is "
+                     f"{shape[1]}x{shape[0]}; they must be the same size", what)
+    return Mask.from_image(m.astype(np.float32), what).bits if m.dtype != bool else m
+
+
+def _margins(params: FillParams, w: int, h: int) -> Margins | None:
+    if params.extend:
+        return params.extend
+    if params.size is None:
+        return None
+    sw, sh = params.size
+    if sw < w or sh < h:
+        raise _error(InvalidParameter, f"parameter 'size' = {sw}x{sh} is smaller than the {w}x{h} image "
+                     "(an uncrop only grows the canvas)", None, name="size", value=params.size)
+    dx, dy = sw - w, sh - h
+    col = {"left": 0, "right": 2}.get(params.anchor.split("-")[-1], 1)
+    row = {"top": 0, "bottom": 2}.get(params.anchor.split("-")[0], 1)
+    left = (0, dx // 2, dx)[col]
+    top = (0, dy // 2, dy)[row]
+    return Margins(left, top, dx - left, dy - top)
+
+
+def _largest_square(region: np.ndarray) -> int:
+    """The side of the largest square inside ``region`` (0 if empty), from a chessboard distance."""
+    if not region.any():
+        return 0
+    d = cv2.distanceTransform(np.pad(region, 1).astype(np.uint8), cv2.DIST_C, 3)
+    r = int(d.max())
+    return 2 * r if whole_patches(region, 2 * r).any() else 2 * r - 1
+
+
+def _as_like(image: np.ndarray, colour: bool) -> np.ndarray:
+    if colour and image.ndim == 2:
+        return np.repeat(image[..., None], 3, axis=2)
+    if not colour and image.ndim == 3:
+        from ..image import luminance
+
+        return luminance(image)
+    return image
+
+
+def fill_image(image, mask=None, *, params: FillParams, source_mask=None, texture=None, rng=0,
+               progress=None, cancel=None) -> tuple[np.ndarray, dict]:
+    """The whole method: ``(filled image, figures)``. See :func:`weft.core.fill.fill`."""
+    colour, alpha = _split_alpha(image, "image")
+    h, w = colour.shape[:2]
+    patch = params.resolved_patch()
+    hole = np.zeros((h, w), dtype=bool)
+    named = None  # what made the hole, for messages
+    if mask is not None:
+        hole = _mask_bits(mask, (h, w), "mask", "image")
+        named = "mask"
+    transparent = alpha < 0.5 if alpha is not None else np.zeros((h, w), dtype=bool)
+    if mask is None and alpha is not None:
+        hole = transparent.copy()
+        named = "alpha"
+    margins = _margins(params, w, h)
+    if margins is None and named is None:
+        raise WeftError("nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size "
+                        "(--size WxH), or an image with transparent pixels")
+    if margins is None and not hole.any():
+        if named == "mask":
+            raise _error(WeftError, "nothing to fill: the mask has no white pixel", "mask")
+        raise _error(WeftError, "nothing to fill: the image has no transparent pixel and no mask, --extend or --size "
+                     "was given", "image")
+    # the canvas: the image, grown by the margins (their pixels are part of the hole)
+    if margins:
+        cw, ch = margins.grown(w, h)
+        check_output_size(cw, ch, "parameter 'size'" if params.size is not None else "parameter 'extend'")
+        pad = ((margins.top, margins.bottom), (margins.left, margins.right))
+        colour = np.pad(colour, pad + (((0, 0),) if colour.ndim == 3 else ()))
+        hole = np.pad(hole, pad, constant_values=True)
+        transparent = np.pad(transparent, pad, constant_values=False)
+        if alpha is not None:
+            alpha = np.pad(alpha, pad, constant_values=1.0)
+    ch, cw = hole.shape
+    if patch > min(ch, cw):
+        raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the "
+                     f"canvas is {cw}x{ch})", "image", name="patch", value=patch)
+    # the source: where blocks are copied from
+    if texture is not None:
+        tex, _talpha = _split_alpha(texture, "texture")
+        tex = _as_like(tex, colour.ndim == 3)
+        src_region = np.ones(tex.shape[:2], dtype=bool) if _talpha is None else _talpha >= 0.5
+        if source_mask is not None:
+            src_region &= _mask_bits(source_mask, tex.shape[:2], "source_mask", "texture")
+        src_name, src_input = "texture", "texture"
+    else:
+        src_region = ~hole & ~transparent
+        if source_mask is not None:
+            src_region &= _mask_bits(source_mask, (h, w), "source_mask", "image") if not margins else np.pad(
+                _mask_bits(source_mask, (h, w), "source_mask", "image"),
+                ((margins.top, margins.bottom), (margins.left, margins.right)))
+        src_name, src_input = "image", "image"
+        if not src_region.any():
+            if source_mask is not None:
+                raise _error(WeftError, "the source mask has no white pixel outside the hole: nothing to copy from",
+                             "source_mask")
+            raise _error(WeftError, f"the {'mask' if named == 'mask' else 'hole'} covers the whole image: nothing is "
+                         f"left to copy from (needs at least one whole {patch}x{patch} patch of known pixels)",
+                         "mask" if named == "mask" else "image")
+    if not whole_patches(src_region, patch).any():
+        side = _largest_square(src_region)
+        raise _error(WeftError, f"too little to copy from: the {engine_text(params)} needs at least one whole "
+                     f"{patch}x{patch} patch of known pixels in the {src_name}, whose largest is {side}x{side} "
+                     f"(a smaller --patch, a smaller hole or a larger source)", src_input)
+    # the engine's canvas: the image, or the image above the texture with a filled gap between them
+    if texture is not None:
+        gap = patch
+        th, tw = tex.shape[:2]
+        cw2 = max(cw, tw)
+        big = np.zeros((ch + gap + th, cw2) + colour.shape[2:], dtype=np.float32)
+        big[:ch, :cw] = colour
+        big[ch + gap:, :tw] = tex
+        big_hole = np.zeros(big.shape[:2], dtype=bool)
+        big_hole[:ch, :cw] = hole
+        big_hole[ch:ch + gap] = True
+        big_hole[:ch, cw:cw + gap] = True  # beside a narrower image: filled, so its edge has texture beside it
+        big_src = np.zeros(big.shape[:2], dtype=bool)
+        big_src[ch + gap:, :tw] = src_region
+        work, work_hole, work_src = big, big_hole, big_src
+    else:
+        work, work_hole, work_src = colour, hole, src_region
+    reporter = ProgressReporter(progress, f"fill ({params.engine})", 100)
+
+    def engine_progress(done: int, total: int) -> None:
+        reporter.update(int(100 * done // max(1, total)))
+
+    filled = _engine(params.engine)(work, work_hole, work_src, patch=patch, rng=rng, progress=engine_progress,
+                                    cancel=cancel)
+    filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
+    out3 = filled if filled.ndim == 3 else filled[..., None]
+    out3 = blend_band(np.ascontiguousarray(out3), hole, params.band, exclude=transparent)
+    out = out3 if colour.ndim == 3 else out3[..., 0]
+    if alpha is not None:
+        alpha = alpha.copy()
+        alpha[hole] = 1.0  # filled pixels are opaque
+        out = np.concatenate([out if out.ndim == 3 else out[..., None], alpha[..., None]], axis=2)
+    figures = {"engine": params.engine, "patch": patch, "hole_pixels": int(hole.sum()),
+               "hole_fraction": round(float(hole.mean()), 4), "canvas": [int(cw), int(ch)],
+               "source_pixels": int(src_region.sum())}
+    if margins:
+        figures["extend"] = margins.to_json()
+    return np.ascontiguousarray(out, dtype=np.float32), figures
+
+
+def engine_text(params: FillParams) -> str:
+    return f"{params.engine} engine"
+
+
+def _run(inputs: Mapping[str, np.ndarray], params: FillParams, *, rng=None, progress=None, cancel=None) -> Result:
+    image, figures = fill_image(inputs["image"], inputs.get("mask"), params=params,
+                                source_mask=inputs.get("source_mask"), texture=inputs.get("texture"), rng=rng,
+                                progress=progress, cancel=cancel)
+    return Result(image, figures)
+
+
+def warm_up() -> None:
+    """Load (or compile) every kernel a fill can use on tiny inputs: the min-cut of the quilting
+    engine, the pixel engine's kernel, the Poisson band's solver (and the PatchMatch engine's
+    kernels when this build has them), so that no run compiles."""
+    rng = np.random.default_rng(0)
+    img = rng.random((24, 24), dtype=np.float32)
+    hole = np.zeros((24, 24), dtype=bool)
+    hole[8:16, 8:16] = True
+    for engine in ENGINES:
+        fill_image(img, hole, params=FillParams(engine=engine, patch=5), rng=0)
+    fill_image(np.repeat(img[..., None], 3, axis=2), hole, params=FillParams(engine="quilt", patch=5), rng=0)
+    fill_image(np.repeat(img[..., None], 3, axis=2), hole, params=FillParams(engine="pixel", patch=5), rng=0)
+
+
+def _memory(shapes: Mapping[str, tuple[int, ...]], params: FillParams) -> float:
+    h, w = shapes["image"][:2]
+    if params.extend:
+        w, h = params.extend.grown(w, h)
+    elif params.size is not None:
+        w, h = max(w, params.size[0]), max(h, params.size[1])
+    if "texture" in shapes:
+        th, tw = shapes["texture"][:2]
+        h, w = h + th + 64, max(w, tw)
+    return float(h * w * 120)  # canvas, masks, costs, positions (float32/float64 copies), measured order
+
+
+METHOD = Method(
+    name="fill",
+    summary="fill a hole (the white of --mask, or transparent pixels) or extend the canvas (--extend, --size) "
+            "with texture from the rest of the image",
+    params=FillParams,
+    inputs=(
+        InputSpec("image", "the image to fill (a transparent region is the hole when no mask is given)", alpha=True),
+        InputSpec("mask", "white = the pixels to fill; the image's size", required=False),
+        InputSpec("source_mask", "white = the only pixels to copy from (the image's size, or the texture's)",
+                  required=False),
+        InputSpec("texture", "copy from this image instead of the rest of the image", required=False),
+    ),
+    run=_run,
+    warm_up=warm_up,
+    memory=_memory,
+    depth_from="image",
+    studio=Studio(
+        title="Fill and extend",
+        canvas="image",
+        geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)"),
+                  Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas")),
+        preview_inputs=("image", "mask", "source_mask", "texture"),
+        examples={"image": "brick"}, rank=7),
+)
+
+__all__ = ["ANCHORS", "METHOD", "fill_image", "warm_up"]

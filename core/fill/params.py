@@ -1,0 +1,56 @@
+"""Parameters of ``weft fill`` (:class:`FillParams`) and the engines it can run."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import InvalidParameter
+from ..geometry import MAX_SIDE, Margins
+from ..params import Params, param
+
+#: Where the image goes on a larger ``--size`` canvas.
+ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-left", "bottom", "bottom-right")
+
+
+def _engines() -> tuple[str, ...]:
+    try:  # ENGINE's multi-scale PatchMatch, when this build has it
+        from .patchmatch import fill_patchmatch  # noqa: F401
+    except ImportError:
+        return ("quilt", "pixel")
+    return ("patchmatch", "quilt", "pixel")
+
+
+ENGINES = _engines()
+#: The default engine: the one that measures best on issue 15's cases (see the package docstring).
+DEFAULT_ENGINE = "quilt"
+#: Each engine's patch side when ``patch`` is not given.
+DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7}
+
+
+@dataclass(frozen=True)
+class FillParams(Params):
+    """Parameters of ``weft fill``."""
+
+    engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
+                        help="quilt: blocks in fill-front order with min-cut seams (Efros & Freeman); "
+                             "pixel: coherent pixel synthesis (Ashikhmin)"
+                             + ("; patchmatch: multi-scale patch search with voting" if "patchmatch" in ENGINES else ""))
+    patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
+                       help="patch side in pixels (quilt: the block; pixel: the neighbourhood); default per engine: "
+                            + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items() if k in ENGINES))
+    extend: Margins = param(None, kind="geometry", type=Margins, optional=True,
+                            help="uncrop: pixels added on the left, top, right and bottom, filled like the hole")
+    size: tuple = param(None, kind="size", lo=1, hi=MAX_SIDE, optional=True,
+                        help="uncrop to this canvas size (at least the image's), the image placed by --anchor")
+    anchor: str = param("center", choices=ANCHORS, help="where the image sits on a --size canvas")
+    band: int = param(2, lo=0, hi=32,
+                      help="blend band: known pixels up to this many px from the hole may change (Poisson "
+                           "seam band); 0 = they never change")
+
+    def check(self) -> None:
+        if self.extend is not None and self.size is not None:
+            raise InvalidParameter("parameters 'extend' and 'size' cannot be given together (both set the canvas)",
+                                   name="size", value=self.size)
+
+    def resolved_patch(self) -> int:
+        return self.patch if self.patch is not None else DEFAULT_PATCH[self.engine]

@@ -1,0 +1,120 @@
+"""The quilting hole filler (Efros & Freeman 2001, §2 applied to a hole, as the quilting write-up in
+``papers/`` suggests): blocks in fill-front order, SSD over known pixels only, minimum-error cut.
+
+One block at a time, until no pixel of the hole is left:
+
+1. **Fill-front order.** Among the unknown pixels next to a known (or already filled) one, the next
+   block is centred on the one whose ``B x B`` window holds the most known or filled pixels (a box
+   filter of the known mask; ties: the first in scan order). Concave corners of the hole, where the
+   most context is, are filled first; the front moves inwards.
+2. **SSD over known pixels only.** The window's known and filled pixels are the template; the cost
+   of every source position is the masked sum of squared differences over them (``cv2.matchTemplate``
+   ``TM_SQDIFF`` with the known mask as weights, all colour channels), over positions whose whole
+   ``B x B`` block lies in the source region (the known pixels, or ``source``). A block is picked at
+   random among those within ``(1 + EPSILON)`` times the best cost (E&F §2.1's rule).
+3. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
+   overlap strip of ``B // 3`` pixels), the dynamic-programming cut of :func:`weft.core.seams.min_cut_mask`
+   runs over the squared difference between those pixels and the new block; unknown pixels and
+   the original known pixels cost a large constant there, so the cut goes through the filled ones.
+   The new block replaces the unknown pixels and the filled pixels on its side of the cut; the
+   original known pixels are never written (the method's blend band handles the hole's own edge).
+
+Blocks are copied only from the original known pixels (never from filled ones), so errors cannot
+feed on themselves.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from ..params import as_rng
+from ..seams import min_cut_mask
+from .common import Progress, check_engine_args, whole_patches
+
+#: E&F's tolerance: a block within (1 + EPSILON) of the best cost may be chosen.
+EPSILON = 0.1
+#: Default block side (pixels) of the quilting engine.
+BLOCK = 24
+_BIG = 1e6
+
+
+def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None) -> np.ndarray:
+    """Fill ``hole`` of ``image`` with blocks quilted from ``source`` (default: the known pixels).
+
+    Parameters
+    ----------
+    image : float32 (H, W) or (H, W, C), C = 1..4, in [0, 1]; values in the hole are ignored.
+    hole : bool (H, W), True = pixels to fill.
+    source : bool (H, W), optional: the pixels whose blocks may be copied (default ``~hole``).
+    patch : int >= 3, the block side ``B`` (at most the image's smaller side).
+    rng : seed or ``np.random.Generator``: same seed, same output.
+    progress : ``progress(done, total)`` in filled pixels, called when the percentage changes.
+    cancel : a ``CancelToken``, checked before every block.
+
+    Returns
+    -------
+    float32, the shape of ``image``; every pixel outside ``hole`` equals the input exactly.
+    """
+    img, hole, src = check_engine_args(image, hole, source, patch, "quilt")
+    shape = np.shape(image)
+    gen = as_rng(rng)
+    h, w, c = img.shape
+    b = int(patch)
+    ov = max(2, b // 3)
+    canvas = img.copy()
+    canvas[hole] = 0.0
+    known = ~hole  # original known pixels: never written
+    have = known.copy()  # known or filled
+    filled = np.zeros((h, w), dtype=bool)
+    # the search image: the bounding box of the source, its non-source pixels never inside a chosen block
+    ys, xs = np.nonzero(src)
+    sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
+    search = np.ascontiguousarray(canvas[sy0:sy1, sx0:sx1])
+    valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
+    total = int(hole.sum())
+    report = Progress(progress, cancel, total)
+    report(0)
+    kernel = np.ones((3, 3), np.uint8)
+    while True:
+        unknown = ~have
+        left = int(unknown.sum())
+        if left == 0:
+            break
+        front = unknown & (cv2.dilate(have.astype(np.uint8), kernel) > 0)
+        if not front.any():  # an unknown region not touching anything known (cannot happen, kept safe)
+            front = unknown
+        count = cv2.boxFilter(have.astype(np.float32), -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
+        count[~front] = -1.0
+        py, px = np.unravel_index(int(np.argmax(count)), count.shape)
+        y0 = int(min(max(py - b // 2, 0), h - b))
+        x0 = int(min(max(px - b // 2, 0), w - b))
+        win = (slice(y0, y0 + b), slice(x0, x0 + b))
+        weight = have[win].astype(np.float32)
+        template = np.ascontiguousarray(canvas[win])
+        if weight.any():
+            cost = cv2.matchTemplate(search, template, cv2.TM_SQDIFF, mask=weight)
+            cost = np.where(valid, cost, np.inf)
+        else:
+            cost = np.where(valid, 0.0, np.inf)
+        best = float(cost.min())
+        cand = np.flatnonzero(cost.ravel() <= best * (1.0 + EPSILON) + 1e-9)
+        pick = int(cand[gen.integers(len(cand))])
+        cy, cx = divmod(pick, cost.shape[1])
+        block = search[cy:cy + b, cx:cx + b]
+        new_region = unknown[win].copy()
+        soft = filled[win]
+        if soft.any():
+            err = ((canvas[win] - block) ** 2).sum(axis=2).astype(np.float64)
+            err[~soft] = _BIG
+            sides = dict(left=soft[:, :ov].any(), top=soft[:ov, :].any(), right=soft[:, b - ov:].any(),
+                         bottom=soft[b - ov:, :].any())
+            cut = min_cut_mask(np.ascontiguousarray(err), **{k: (ov if v else 0) for k, v in sides.items()})
+            new_region |= soft & cut
+        canvas[win][new_region] = block[new_region]
+        filled[win] |= new_region
+        have[win] |= new_region
+        report(total - int((~have).sum()))
+    out = img.copy()
+    out[hole] = canvas[hole]
+    return out.reshape(shape)
