@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 LINES = json.dumps({"image_lines": [[4, 4, 34, 6], [34, 6, 36, 35], [36, 35, 5, 33], [5, 33, 4, 4]],
                     "frontal_lines": [[0, 0, 31, 0], [31, 0, 31, 31], [31, 31, 0, 31], [0, 31, 0, 0]],
                     "frontal_size": [32, 32]})
-SUBCOMMANDS = ("quilt", "fast", "affine", "nfpt", "rectify", "blend")
+SUBCOMMANDS = ("quilt", "fast", "affine", "nfpt", "rectify", "blend", "fill")
 
 
 def argv(method: str, image: str, out: str) -> list[str]:
@@ -38,6 +38,7 @@ def argv(method: str, image: str, out: str) -> list[str]:
         "nfpt": ["nfpt", image, "--size", "24x24", "--block", "8", "--overlap", "2"],
         "rectify": ["rectify", image, "--lines", LINES],
         "blend": ["blend", image, image, "--mask", image],
+        "fill": ["fill", image, "--extend", "0,0,4,0", "--patch", "3"],
     }[method] + tail
 
 

@@ -133,8 +133,9 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
     if patch > min(ch, cw):
-        raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the "
-                     f"canvas is {cw}x{ch})", "image", name="patch", value=patch)
+        grown = f", {cw}x{ch} once extended" if margins else ""
+        raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
+                     f"is {w}x{h}{grown})", "image", name="patch", value=patch)
     # the source: where blocks are copied from
     if texture is not None:
         tex, _talpha = _split_alpha(texture, "texture")
@@ -142,14 +143,14 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         src_region = np.ones(tex.shape[:2], dtype=bool) if _talpha is None else _talpha >= 0.5
         if source_mask is not None:
             src_region &= _mask_bits(source_mask, tex.shape[:2], "source_mask", "texture")
-        src_name, src_input = "texture", "texture"
+        src_name, src_input = f"texture ({tex.shape[1]}x{tex.shape[0]})", "texture"
     else:
         src_region = ~hole & ~transparent
         if source_mask is not None:
             src_region &= _mask_bits(source_mask, (h, w), "source_mask", "image") if not margins else np.pad(
                 _mask_bits(source_mask, (h, w), "source_mask", "image"),
                 ((margins.top, margins.bottom), (margins.left, margins.right)))
-        src_name, src_input = "image", "image"
+        src_name, src_input = f"{w}x{h} image", "image"
         if not src_region.any():
             if source_mask is not None:
                 raise _error(WeftError, "the source mask has no white pixel outside the hole: nothing to copy from",
@@ -245,7 +246,8 @@ METHOD = Method(
             "with texture from the rest of the image",
     params=FillParams,
     inputs=(
-        InputSpec("image", "the image to fill (a transparent region is the hole when no mask is given)", alpha=True),
+        InputSpec("image", "the image to fill (a transparent region is the hole when no mask is given)", alpha=True,
+                  min_side=3),
         InputSpec("mask", "white = the pixels to fill; the image's size", required=False),
         InputSpec("source_mask", "white = the only pixels to copy from (the image's size, or the texture's)",
                   required=False),

@@ -94,7 +94,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         template = np.ascontiguousarray(canvas[win])
         if weight.any():
             cost = cv2.matchTemplate(search, template, cv2.TM_SQDIFF, mask=weight)
-            cost = np.where(valid, cost, np.inf)
+            cost = np.where(valid & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
         else:
             cost = np.where(valid, 0.0, np.inf)
         best = float(cost.min())

@@ -1,0 +1,165 @@
+"""weft.core.fill: the engines (known pixels untouched, seeds deterministic, quality bounds from
+weft.core.metrics on small cases), the blend band, alpha, uncrop geometry and the Python API."""
+
+import numpy as np
+import pytest
+
+from weft.core import metrics
+from weft.core.errors import InvalidParameter, WeftError
+from weft.core.examples import example
+from weft.core.fill import ENGINES, FillParams, fill, fill_pixel, fill_quilt
+from weft.core.fill.band import band_region, blend_band
+from weft.core.image import load_image
+
+ENGINE_FUNCS = {"quilt": fill_quilt, "pixel": fill_pixel}
+
+
+@pytest.fixture(scope="module")
+def gravel():
+    return load_image(example("gravel")).image[:96, :96]
+
+
+@pytest.fixture(scope="module")
+def brick():
+    return load_image(example("brick")).image[:96, :96]
+
+
+def square_hole(shape, y0=32, y1=60, x0=30, x1=66):
+    hole = np.zeros(shape[:2], dtype=bool)
+    hole[y0:y1, x0:x1] = True
+    return hole
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))
+def test_engine_leaves_known_pixels_and_is_deterministic(engine, gravel):
+    hole = square_hole(gravel.shape)
+    garbage = gravel.copy()
+    garbage[hole] = 1.0  # values in the hole are ignored
+    f = ENGINE_FUNCS[engine]
+    a = f(garbage, hole, patch=9 if engine == "quilt" else 5, rng=3)
+    b = f(gravel, hole, patch=9 if engine == "quilt" else 5, rng=3)
+    c = f(gravel, hole, patch=9 if engine == "quilt" else 5, rng=4)
+    assert a.dtype == np.float32 and a.shape == gravel.shape
+    assert np.array_equal(a[~hole], gravel[~hole])
+    assert np.array_equal(a, b)  # same seed, same pixels; the hole's old values play no part
+    assert not np.array_equal(a[hole], c[hole])
+    assert not np.any(a[hole] == 1.0) or np.mean(a[hole] == 1.0) < 0.01
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))
+@pytest.mark.parametrize("case", ["gravel", "brick"])
+def test_engine_quality_bounds(engine, case, gravel, brick):
+    """On a 96x96 crop with a 36x28 hole: coherence no worse than 1.5x the ground truth's (the
+    truth itself is far from the nearest known patch), detail within 0.6..1.4 of the truth's,
+    seam within 0.5 of the truth's after the blend band."""
+    img = gravel if case == "gravel" else brick
+    hole = square_hole(img.shape)
+    out = fill(img, hole, engine=engine, seed=1)
+    truth_coh = metrics.fill_coherence(img, hole)
+    assert metrics.fill_coherence(out, hole) <= 1.5 * truth_coh
+    truth_detail = metrics.fill_detail(img, hole)
+    assert 0.6 * truth_detail <= metrics.fill_detail(out, hole) <= 1.4 * truth_detail
+    assert abs(metrics.fill_seam(out, hole) - metrics.fill_seam(img, hole)) <= 0.5
+
+
+def test_a_smear_fails_the_detail_bound(gravel):
+    """The bounds above can fail: a diffusion fill is far below them."""
+    import cv2
+
+    hole = square_hole(gravel.shape)
+    smeared = cv2.inpaint((gravel * 255).astype(np.uint8), hole.astype(np.uint8), 3, cv2.INPAINT_TELEA) / 255.0
+    assert metrics.fill_detail(smeared.astype(np.float32), hole) < 0.6 * metrics.fill_detail(gravel, hole)
+
+
+def test_engine_copies_only_from_the_source(brick):
+    hole = square_hole(brick.shape)
+    source = np.zeros(brick.shape, dtype=bool)
+    source[64:, :] = True  # only the bottom rows
+    marked = brick.copy()
+    marked[:64] = 0.0  # nothing black exists below row 64 in the brick crop
+    assert marked[64:].min() > 0.0
+    out = fill_quilt(marked, hole, source, patch=12, rng=0)
+    assert out[hole].min() > 0.0  # no pixel came from the blackened, non-source rows
+    out = fill_pixel(marked, hole, source, patch=5, rng=0)
+    assert out[hole].min() > 0.0
+
+
+def test_engine_refuses_a_source_without_a_whole_patch(gravel):
+    hole = np.ones(gravel.shape, dtype=bool)
+    hole[:, :5] = False  # a 5-pixel strip: no 9x9 patch
+    with pytest.raises(WeftError, match="needs at least one whole 9x9 patch"):
+        fill_quilt(gravel, hole, patch=9)
+
+
+def test_band_changes_only_pixels_within_band(brick):
+    hole = square_hole(brick.shape)
+    raw = fill(brick, hole, band=0, seed=2)
+    assert np.array_equal(raw[~hole], brick[~hole])  # band 0: no known pixel changes
+    blended = fill(brick, hole, band=3, seed=2)
+    ring = band_region(hole, 3)
+    assert np.array_equal(blended[~ring], raw[~ring])  # beyond the band, bit-identical
+    assert not np.array_equal(blended[ring], raw[ring])
+    # the ring is exactly the pixels within 3 px (8-connected) of the hole's edge, on both sides
+    assert ring[29, 40] and ring[34, 40] and not ring[28, 40] and not ring[35, 40]  # hole rows 32..59
+
+
+def test_band_spreads_a_step_at_the_seam():
+    img = np.zeros((32, 32, 1), dtype=np.float32)
+    hole = np.zeros((32, 32), dtype=bool)
+    hole[:, 16:] = True
+    img[:, 16:] = 0.5  # a step of 0.5 exactly at the hole's edge
+    out = blend_band(img, hole, 4)[..., 0]
+    assert np.abs(np.diff(out[10])).max() < 0.2  # spread over the band (0.5 / 8 px ~ 0.07 a step)
+    assert np.array_equal(out[:, :12], img[:, :12, 0]) and np.array_equal(out[:, 20:], img[:, 20:, 0])
+
+
+def test_alpha_hole_and_opaque_output(gravel):
+    rgba = np.dstack([np.repeat(gravel[..., None], 3, axis=2), np.ones(gravel.shape, np.float32)])
+    hole = square_hole(gravel.shape)
+    rgba[hole, 3] = 0.0
+    rgba[hole, :3] = 1.0
+    out = fill(rgba, seed=0)
+    assert out.shape == rgba.shape
+    assert np.all(out[..., 3] == 1.0)
+    ring = band_region(hole, 2)
+    assert np.array_equal(out[~hole & ~ring], rgba[~hole & ~ring])
+    assert out[hole, :3].mean() < 0.9  # filled with gravel, not the transparent pixels' white
+
+
+def test_extend_and_size_grow_the_canvas(gravel):
+    out = fill(gravel, extend=(8, 0, 16, 4), seed=0)
+    assert out.shape == (100, 120)
+    assert np.array_equal(out[:94, 10:102], gravel[:94, 2:94])  # the image, away from the band, is intact
+    anchored = fill(gravel, size=(128, 112), anchor="bottom-right", seed=0)
+    assert anchored.shape == (112, 128)
+    assert np.array_equal(anchored[18:, 34:], gravel[2:, 2:])
+    top_left = fill(gravel, size=(128, 112), anchor="top-left", seed=0, band=0)
+    assert np.array_equal(top_left[:96, :96], gravel)
+
+
+def test_texture_is_the_source(gravel, brick):
+    hole = square_hole(gravel.shape)
+    out = fill(gravel, hole, texture=np.full((64, 64), 0.25, np.float32) + 0 * brick[:64, :64], seed=0, band=0)
+    assert np.allclose(out[hole], 0.25)
+    assert np.array_equal(out[~hole], gravel[~hole])
+
+
+def test_python_api_refusals(gravel):
+    with pytest.raises(WeftError, match="nothing to fill: give a mask"):
+        fill(gravel)
+    with pytest.raises(WeftError, match="nothing to fill: the mask has no white pixel"):
+        fill(gravel, np.zeros(gravel.shape, bool))
+    with pytest.raises(WeftError, match="the mask is 10x10 but the image is 96x96"):
+        fill(gravel, np.ones((10, 10), bool))
+    with pytest.raises(WeftError, match="covers the whole image: nothing is left to copy from"):
+        fill(gravel, np.ones(gravel.shape, bool))
+    with pytest.raises(InvalidParameter, match="parameter 'size' = 64x64 is smaller than the 96x96 image"):
+        fill(gravel, size=(64, 64))
+    with pytest.raises(InvalidParameter, match="cannot be given together"):
+        FillParams(extend=(1, 1, 1, 1), size=(200, 200))
+    with pytest.raises(InvalidParameter, match="the left margin -1 is outside"):
+        fill(gravel, extend=(-1, 0, 0, 0))
+
+
+def test_engines_listed():
+    assert {"quilt", "pixel"} <= set(ENGINES)
