@@ -8,8 +8,9 @@ One block at a time, until no pixel of the hole is left:
    filter of the known mask; ties: the first in scan order). Concave corners of the hole, where the
    most context is, are filled first; the front moves inwards.
 2. **SSD over known pixels only.** The window's known and filled pixels are the template; the cost
-   of every source position is the masked sum of squared differences over them (``cv2.matchTemplate``
-   ``TM_SQDIFF`` with the known mask as weights, all colour channels), over positions whose whole
+   of every source position is the masked sum of squared differences over them, all colour channels
+   (``sum M I^2 - 2 sum M T I + sum M T^2``: two ``cv2.matchTemplate`` correlations, the source's
+   squares summed over its channels once), over positions whose whole
    ``B x B`` block lies in the source region (the known pixels, or ``source``). A block is picked at
    random among those within ``(1 + EPSILON)`` times the best cost (E&F §2.1's rule).
 3. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
@@ -37,6 +38,8 @@ EPSILON = 0.1
 #: Default block side (pixels) of the quilting engine.
 BLOCK = 24
 _BIG = 1e6
+#: How far a block moves away from its known pixels, as a fraction of their centroid's offset.
+SHIFT = 2.0 / 3.0
 
 
 def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None) -> np.ndarray:
@@ -72,6 +75,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
     search = np.ascontiguousarray(canvas[sy0:sy1, sx0:sx1])
     valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
+    search_sq = np.ascontiguousarray((search * search).sum(axis=2))
     total = int(hole.sum())
     report = Progress(progress, cancel, total)
     report(0)
@@ -87,13 +91,23 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         count = cv2.boxFilter(have.astype(np.float32), -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
         count[~front] = -1.0
         py, px = np.unravel_index(int(np.argmax(count)), count.shape)
+        # the window centred there, moved away from its known pixels so that they fill about an
+        # overlap's width of it (a straight front: B/2 known -> B/3) and the block fills more
         y0 = int(min(max(py - b // 2, 0), h - b))
         x0 = int(min(max(px - b // 2, 0), w - b))
+        sub = have[y0:y0 + b, x0:x0 + b]
+        if sub.any() and not sub.all():
+            ky, kx = np.nonzero(sub)
+            y0 = int(min(max(y0 - round(SHIFT * (ky.mean() - (b - 1) / 2)), 0), h - b))
+            x0 = int(min(max(x0 - round(SHIFT * (kx.mean() - (b - 1) / 2)), 0), w - b))
         win = (slice(y0, y0 + b), slice(x0, x0 + b))
         weight = have[win].astype(np.float32)
         template = np.ascontiguousarray(canvas[win])
         if weight.any():
-            cost = cv2.matchTemplate(search, template, cv2.TM_SQDIFF, mask=weight)
+            # masked SSD = sum M I^2 - 2 sum M T I + sum M T^2 (the squares summed over channels first)
+            cost = cv2.matchTemplate(search_sq, weight, cv2.TM_CCORR)
+            cost -= 2.0 * cv2.matchTemplate(search, np.ascontiguousarray(template * weight[..., None]), cv2.TM_CCORR)
+            cost += float((weight[..., None] * template * template).sum())
             cost = np.where(valid & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
         else:
             cost = np.where(valid, 0.0, np.inf)

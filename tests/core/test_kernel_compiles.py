@@ -46,6 +46,13 @@ RUNS = {
               {"metric": "artistic", "p": 0.2}),
              ({"texture": image("cat-fur", 64, 64)}, {"size": [80, 80]})],
     "rectify": [({"photo": image("perspective")}, {"lines": LINES, "warp": "lines"})],
+    "fill": [({"image": image("gravel", 64, 64), "mask": np.pad(np.ones((20, 24), np.float32), ((20, 24), (16, 24)))},
+              {}),
+             ({"image": image("chelsea", 48, 48)}, {"extend": [8, 0, 8, 4], "engine": "pixel"}),
+             ({"image": np.dstack([image("brick", 48, 48), np.pad(np.zeros((16, 16), np.float32), 16,
+                                                                  constant_values=1)])}, {"patch": 9, "band": 3}),
+             ({"image": image("gravel", 48, 48), "mask": np.pad(np.ones((16, 16), np.float32), 16),
+               "texture": image("brick", 40, 40)}, {"engine": "pixel", "patch": 5})],
     "blend": [({"foreground": image("gravel", 64, 64), "background": image("camera", 64, 64),
                 "mask": np.pad(np.ones((32, 32), np.float32), 16)}, {"mode": "poisson"})],
 }
@@ -78,7 +85,7 @@ def _signatures(method: str) -> tuple[dict, dict]:
     return out["before"], out["after"]
 
 
-@pytest.mark.parametrize("method", ["quilt", "nfpt", "affine", "fast", "rectify", "blend"])
+@pytest.mark.parametrize("method", ["quilt", "nfpt", "affine", "fast", "rectify", "blend", "fill"])
 def test_a_run_after_warm_up_compiles_nothing_and_each_kernel_once(method):
     before, after = _signatures(method)
     assert before, "warm_up() loaded no kernel"
