@@ -26,7 +26,8 @@ examples, a 96x64 hole, seed 1, patch defaults, band 2::
     brick   pixel
 
 **Known pixels** are never changed except within the blend band (``--band``, default 2 px): the
-pixels within ``band`` px (8-connected) of the hole's edge, on both sides, are re-solved by a Poisson
+quilting engine's minimum-error cut may run through the known pixels within ``band`` px of the hole,
+and then the pixels within ``band`` px (8-connected) of the hole's edge, on both sides, are re-solved by a Poisson
 equation whose guidance is the image's own gradients except across the hole's edge, where the
 step is replaced by the continued slope of both sides (:mod:`weft.core.fill.band`); every pixel
 further away is bit-identical to the input. ``--band 0``: no known pixel changes.

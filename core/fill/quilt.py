@@ -17,8 +17,10 @@ One block at a time, until no pixel of the hole is left:
    overlap strip of ``B // 3`` pixels), the dynamic-programming cut of :func:`weft.core.seams.min_cut_mask`
    runs over the squared difference between those pixels and the new block; unknown pixels and
    the original known pixels cost a large constant there, so the cut goes through the filled ones.
-   The new block replaces the unknown pixels and the filled pixels on its side of the cut; the
-   original known pixels are never written (the method's blend band handles the hole's own edge).
+   The new block replaces the unknown pixels and the filled pixels on its side of the cut. With
+   ``band`` > 0 (``weft fill`` passes its ``--band``), the known pixels within ``band`` px of the
+   hole count as filled ones: the cut may run through them, so a block can meet the known texture
+   a little outside the hole where they agree best; every other known pixel is never written.
 
 Blocks are copied only from the original known pixels (never from filled ones), so errors cannot
 feed on themselves.
@@ -42,7 +44,7 @@ _BIG = 1e6
 SHIFT = 2.0 / 3.0
 
 
-def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None) -> np.ndarray:
+def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0) -> np.ndarray:
     """Fill ``hole`` of ``image`` with blocks quilted from ``source`` (default: the known pixels).
 
     Parameters
@@ -54,10 +56,12 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     rng : seed or ``np.random.Generator``: same seed, same output.
     progress : ``progress(done, total)`` in filled pixels, called when the percentage changes.
     cancel : a ``CancelToken``, checked before every block.
+    band : int >= 0, default 0: known pixels within this many px of the hole may be cut into (above).
 
     Returns
     -------
-    float32, the shape of ``image``; every pixel outside ``hole`` equals the input exactly.
+    float32, the shape of ``image``; every pixel outside ``hole`` (and, with ``band``, outside the
+    band around it: :func:`weft.core.fill.band.band_region`) equals the input exactly.
     """
     img, hole, src = check_engine_args(image, hole, source, patch, "quilt")
     shape = np.shape(image)
@@ -70,10 +74,15 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     known = ~hole  # original known pixels: never written
     have = known.copy()  # known or filled
     filled = np.zeros((h, w), dtype=bool)
+    if band > 0:  # known pixels within the band may be cut into: they count as filled ones
+        from .band import band_region
+
+        cuttable = band_region(hole, band) & ~hole
+        filled |= cuttable
     # the search image: the bounding box of the source, its non-source pixels never inside a chosen block
     ys, xs = np.nonzero(src)
     sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
-    search = np.ascontiguousarray(canvas[sy0:sy1, sx0:sx1])
+    search = canvas[sy0:sy1, sx0:sx1].copy()  # never a view: the canvas is written
     valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
     search_sq = np.ascontiguousarray((search * search).sum(axis=2))
     total = int(hole.sum())
@@ -130,5 +139,6 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         have[win] |= new_region
         report(total - int((~have).sum()))
     out = img.copy()
-    out[hole] = canvas[hole]
+    changed = hole if band <= 0 else (hole | cuttable)
+    out[changed] = canvas[changed]
     return out.reshape(shape)
