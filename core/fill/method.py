@@ -192,7 +192,10 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         reporter.update(int(100 * done // max(1, total)))
 
     extra = {"band": params.band} if params.engine == "quilt" and CUT_INTO_BAND else {}
-    filled = _engine(params.engine)(work, work_hole, work_src, patch=patch, rng=rng, progress=engine_progress,
+    # quilt and pixel report progress(done, total); the PatchMatch engine reports weft.core.jobs.Progress
+    # itself (its ProgressReporter), so it gets the method's callback as it is
+    engine_report = progress if params.engine == "patchmatch" else engine_progress
+    filled = _engine(params.engine)(work, work_hole, work_src, patch=patch, rng=rng, progress=engine_report,
                                     cancel=cancel, **extra)
     filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
     out3 = filled if filled.ndim == 3 else filled[..., None]
@@ -229,7 +232,11 @@ def warm_up() -> None:
     img = rng.random((24, 24), dtype=np.float32)
     hole = np.zeros((24, 24), dtype=bool)
     hole[8:16, 8:16] = True
-    for engine in ENGINES:
+    if "patchmatch" in ENGINES:
+        from . import patchmatch
+
+        patchmatch.warm_up()
+    for engine in ("quilt", "pixel"):
         fill_image(img, hole, params=FillParams(engine=engine, patch=5), rng=0)
     fill_image(np.repeat(img[..., None], 3, axis=2), hole, params=FillParams(engine="quilt", patch=5), rng=0)
     fill_image(np.repeat(img[..., None], 3, axis=2), hole, params=FillParams(engine="pixel", patch=5), rng=0)

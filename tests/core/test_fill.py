@@ -164,3 +164,18 @@ def test_python_api_refusals(gravel):
 
 def test_engines_listed():
     assert {"quilt", "pixel"} <= set(ENGINES)
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))
+def test_progress_reaches_the_end_and_cancel_stops(engine, gravel):
+    from weft.core.errors import Cancelled
+    from weft.core.jobs import CancelToken
+
+    hole = square_hole(gravel.shape)
+    seen = []
+    fill(gravel, hole, engine=engine, seed=0, progress=seen.append)
+    assert seen and seen[-1].fraction == 1.0 and all(a.done <= b.done for a, b in zip(seen, seen[1:]))
+    token = CancelToken()
+    token.cancel()
+    with pytest.raises(Cancelled):
+        fill(gravel, hole, engine=engine, seed=0, cancel=token)
