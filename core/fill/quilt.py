@@ -11,8 +11,15 @@ One block at a time, until no pixel of the hole is left:
    of every source position is the masked sum of squared differences over them, all colour channels
    (``sum M I^2 - 2 sum M T I + sum M T^2``: two ``cv2.matchTemplate`` correlations, the source's
    squares summed over its channels once), over positions whose whole
-   ``B x B`` block lies in the source region (the known pixels, or ``source``). A block is picked at
-   random among those within ``(1 + EPSILON)`` times the best cost (E&F §2.1's rule).
+   ``B x B`` block lies in the source region (the known pixels, or ``source``). The SSD alone prefers
+   flat blocks (a flat block of the right mean costs half as much as a textured one half a period
+   off), which smeared a photo's hole; so ``DETAIL * n * (sigma_block - sigma_template)^2`` is added,
+   ``sigma`` the standard deviation over the template's known pixels (two more correlations). On
+   two holes each of gravel, brick and the cat photo (seeds 1-2) it moved detail from 0.95/0.85,
+   0.83/0.94, 0.70/0.60 to 1.13/0.95, 0.78/0.99, 0.71/0.77 of the truth's and the seam excess from
+   -0.09/-0.38, +0.11/+0.16, -0.18/-0.36 to -0.04/-0.22, +0.05/+0.01, -0.16/-0.17, for coherence
+   0.50-0.62 -> 0.42-0.62 of the truth's. A block is picked at random among those within
+   ``(1 + EPSILON)`` times the best cost (E&F §2.1's rule).
 3. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
    overlap strip of ``B // 3`` pixels), the dynamic-programming cut of :func:`weft.core.seams.min_cut_mask`
    runs over the squared difference between those pixels and the new block; unknown pixels and
@@ -40,6 +47,8 @@ EPSILON = 0.1
 #: Default block side (pixels) of the quilting engine.
 BLOCK = 24
 _BIG = 1e6
+#: Weight of the contrast term added to the SSD (step 2 of the module docstring); 0 = E&F's SSD alone.
+DETAIL = 3.0
 #: How far a block moves away from its known pixels, as a fraction of their centroid's offset.
 SHIFT = 2.0 / 3.0
 
@@ -85,6 +94,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     search = canvas[sy0:sy1, sx0:sx1].copy()  # never a view: the canvas is written
     valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
     search_sq = np.ascontiguousarray((search * search).sum(axis=2))
+    search_sum = np.ascontiguousarray(search.sum(axis=2))
     total = int(hole.sum())
     report = Progress(progress, cancel, total)
     report(0)
@@ -117,6 +127,13 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
             cost = cv2.matchTemplate(search_sq, weight, cv2.TM_CCORR)
             cost -= 2.0 * cv2.matchTemplate(search, np.ascontiguousarray(template * weight[..., None]), cv2.TM_CCORR)
             cost += float((weight[..., None] * template * template).sum())
+            if DETAIL > 0:  # the contrast term: the block's and the template's standard deviations
+                n = float(weight.sum()) * c
+                s1 = cv2.matchTemplate(search_sum, weight, cv2.TM_CCORR) / n
+                sq = np.maximum(cv2.matchTemplate(search_sq, weight, cv2.TM_CCORR) / n - s1 * s1, 0)
+                tm = float((weight[..., None] * template).sum()) / n
+                tv = max(float((weight[..., None] * template * template).sum()) / n - tm * tm, 0.0)
+                cost += DETAIL * n * (np.sqrt(sq) - np.sqrt(tv)) ** 2
             cost = np.where(valid & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
         else:
             cost = np.where(valid, 0.0, np.inf)
