@@ -13,7 +13,7 @@ from ..image import validate_image
 from ..jobs import ProgressReporter
 from ..limits import check_output_size
 from ..registry import InputSpec, Method, Result
-from ..studio import Geometry, Studio
+from ..studio import Figure, Geometry, Studio
 from .band import blend_band
 from .common import whole_patches
 from .params import ANCHORS, ENGINES, FillParams
@@ -277,7 +277,10 @@ METHOD = Method(
         geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)"),
                   Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas")),
         preview_inputs=("image", "mask", "source_mask", "texture"),
-        examples={"image": "brick"}, rank=7),
+        examples={"image": "brick"}, rank=7,
+        figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
+                 "hole_fraction": Figure("filled", "%", "of the image", digits=2),
+                 "source_pixels": Figure("copied from", "px")}),
 )
 
 __all__ = ["ANCHORS", "METHOD", "fill_image", "warm_up"]
