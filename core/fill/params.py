@@ -21,7 +21,7 @@ def _engines() -> tuple[str, ...]:
 
 
 ENGINES = _engines()
-#: The default engine: the one that measures best on issue 15's cases (see the package docstring).
+#: The default engine: the one that measures best on issue 15's cases (see the package docstring for the figures).
 DEFAULT_ENGINE = "quilt"
 #: Each engine's patch side when ``patch`` is not given.
 DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7}
