@@ -52,7 +52,9 @@ RUNS = {
              ({"image": np.dstack([image("brick", 48, 48), np.pad(np.zeros((16, 16), np.float32), 16,
                                                                   constant_values=1)])}, {"patch": 9, "band": 3}),
              ({"image": image("gravel", 48, 48), "mask": np.pad(np.ones((16, 16), np.float32), 16),
-               "texture": image("brick", 40, 40)}, {"engine": "pixel", "patch": 5})],
+               "texture": image("brick", 40, 40)}, {"engine": "pixel", "patch": 5}),
+             ({"image": image("chelsea", 64, 64), "mask": np.pad(np.ones((16, 20), np.float32), ((20, 28), (20, 24)))},
+              {"engine": "patchmatch"})],
     "blend": [({"foreground": image("gravel", 64, 64), "background": image("camera", 64, 64),
                 "mask": np.pad(np.ones((32, 32), np.float32), 16)}, {"mode": "poisson"})],
 }
