@@ -35,9 +35,6 @@ CASES = [
     ("quilt", lambda: {"texture": _small("brick", 64)}, {"size": (64, 64), "mode": "mincut"}),
     ("quilt", lambda: {"texture": _small("brick", 64), "target": _small("astronaut", 48)}, {}),
     ("affine", lambda: {"texture": _small("cat-fur", 96)}, {"block": 16, "boundary": "shaker"}),
-    ("fill", lambda: {"image": _small("brick", 64), "mask": np.pad(np.ones((16, 20), np.float32), ((20, 28), (20, 24)))},
-     {"patch": 9}),
-    ("fill", lambda: {"image": _small("gravel", 48)}, {"extend": (8, 0, 8, 4), "engine": "pixel"}),
     ("nfpt", lambda: {"photo": load_image(example("perspective")).image},
      {"lines": _lines(), "size": (64, 64), "block": 32, "overlap": 8, "into_photo": True}),
 ]

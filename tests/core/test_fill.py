@@ -179,3 +179,27 @@ def test_progress_reaches_the_end_and_cancel_stops(engine, gravel):
     token.cancel()
     with pytest.raises(Cancelled):
         fill(gravel, hole, engine=engine, seed=0, cancel=token)
+
+
+@pytest.mark.parametrize("case", ["hole", "uncrop"])
+def test_every_scalar_figure_has_a_human_reading_in_the_studio_description(case, brick):
+    """As tests/core/test_figures.py does for the studio's methods (fill joins them once the studio draws masks)."""
+    import json
+    import re
+
+    from weft.core import registry
+    from weft.core.fill.method import STUDIO
+
+    method = registry.get("fill")
+    inputs = {"image": brick[:64, :64]}
+    params = {"extend": (8, 0, 8, 4)} if case == "uncrop" else {"patch": 9}
+    if case == "hole":
+        inputs["mask"] = square_hole((64, 64), 20, 36, 20, 40).astype(np.float32)
+    result = method.run(inputs, method.params(**params), rng=0)
+    scalars = {k for k, v in result.figures.items() if v is not None and not isinstance(v, (list, tuple, dict))}
+    assert scalars >= {"engine", "hole_pixels"} and not scalars - set(STUDIO.figures)
+    words = STUDIO.describe(result.figures)
+    assert len(words) == len(scalars) and not any(re.search(r"\b[a-z0-9]+(?:_[a-z0-9]+)+\b", t) for t in words)
+    json.dumps(dict(result.figures))
+    assert STUDIO.canvas == "image" and [g.kind for g in STUDIO.geometry] == ["mask", "margins"]
+    assert STUDIO.geometry[0].input == "mask" and STUDIO.geometry[1].param == "extend"
