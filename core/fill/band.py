@@ -3,8 +3,8 @@
 The only place where known pixels may change. The band is every pixel within ``band`` pixels
 (8-connected steps, i.e. a ``(2 band + 1)``-square neighbourhood) of the hole's edge, on both sides:
 known pixels up to ``band`` px outside the hole and filled pixels up to ``band`` px inside it. On
-the band, the image is re-solved (Pérez et al.'s Poisson equation, the solver of
-:func:`weft.core.blending.poisson_blend`, ``weft.core._kernels.poisson.poisson_cg``) with the pixels
+the band, the image is re-solved (Pérez et al.'s Poisson equation, the system of
+:func:`weft.core.blending.poisson_blend`, solved by conjugate gradient in numpy, :func:`weft.core.fill.cut.poisson_cg`) with the pixels
 around the band as fixed (Dirichlet) values and, as the guidance field, the image's own gradients
 -- except across the hole's edge, where the difference between a known and a filled pixel (the
 seam) is replaced by the mean of the differences one step further on either side (the local slope
@@ -78,9 +78,9 @@ def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarr
         outside = i[~inside]
         rhs[outside] += f[qyc[outside], qxc[outside]]
     x = f[ys, xs].copy()
-    from .._kernels import poisson as _k  # numba loads on first use
+    from .cut import poisson_cg  # numpy: a band is small, and a fill then loads no numba
 
-    _k.poisson_cg(nbr, ndeg, rhs, x, 1e-6, int(20 * np.sqrt(n)) + 200)
+    poisson_cg(nbr, ndeg, rhs, x, 1e-6, int(20 * np.sqrt(n)) + 200)
     out = image.copy()
     out[ys, xs] = np.clip(x, 0.0, 1.0).astype(np.float32)
     return out

@@ -21,8 +21,9 @@ One block at a time, until no pixel of the hole is left:
    0.50-0.62 -> 0.42-0.62 of the truth's. A block is picked at random among those within
    ``(1 + EPSILON)`` times the best cost (E&F §2.1's rule).
 3. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
-   overlap strip of ``B // 3`` pixels), the dynamic-programming cut of :func:`weft.core.seams.min_cut_mask`
-   runs over the squared difference between those pixels and the new block; unknown pixels and
+   overlap strip of ``B // 3`` pixels), E&F's dynamic-programming cut
+   runs over the squared difference between those pixels and the new block (one path per side, in
+   numpy: :func:`weft.core.fill.cut.min_cut`, so a fill loads no numba); unknown pixels and
    the original known pixels cost a large constant there, so the cut goes through the filled ones.
    The new block replaces the unknown pixels and the filled pixels on its side of the cut. With
    ``band`` > 0 (``weft fill`` passes its ``--band``), the known pixels within ``band`` px of the
@@ -39,7 +40,7 @@ import cv2
 import numpy as np
 
 from ..params import as_rng
-from ..seams import min_cut_mask
+from .cut import min_cut
 from .common import Progress, check_engine_args, whole_patches
 
 #: E&F's tolerance: a block within (1 + EPSILON) of the best cost may be chosen.
@@ -161,7 +162,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
             err[~soft] = _BIG
             sides = dict(left=soft[:, :ov].any(), top=soft[:ov, :].any(), right=soft[:, b - ov:].any(),
                          bottom=soft[b - ov:, :].any())
-            cut = min_cut_mask(np.ascontiguousarray(err), **{k: (ov if v else 0) for k, v in sides.items()})
+            cut = min_cut(err, **{k: (ov if v else 0) for k, v in sides.items()})
             new_region |= soft & cut
         left -= int(np.count_nonzero(new_region & ~have[win]))
         canvas[win][new_region] = block[new_region]

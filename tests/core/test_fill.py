@@ -203,3 +203,38 @@ def test_every_scalar_figure_has_a_human_reading_in_the_studio_description(case,
     json.dumps(dict(result.figures))
     assert STUDIO.canvas == "image" and [g.kind for g in STUDIO.geometry] == ["mask", "margins"]
     assert STUDIO.geometry[0].input == "mask" and STUDIO.geometry[1].param == "extend"
+
+
+def test_numpy_cut_and_solver_agree_with_the_kernels():
+    """weft.core.fill.cut (numpy) against weft.core.seams / weft.core._kernels.poisson (numba)."""
+    from weft.core._kernels.poisson import poisson_cg as kernel_cg
+    from weft.core.fill.cut import min_cut, poisson_cg
+    from weft.core.seams import min_cut_mask, min_error_path
+    from weft.core.fill.cut import _vertical_path
+
+    rng = np.random.default_rng(5)
+    err = rng.random((20, 9))
+    assert np.array_equal(_vertical_path(err), min_error_path(err))  # the same path (ties aside: random costs)
+    assert np.array_equal(min_cut(err, left=9), min_cut_mask(err, left=9))
+    e2 = rng.random((16, 16))
+    both = min_cut(e2, right=5, bottom=4)
+    assert np.array_equal(both, min_cut_mask(e2, right=5, bottom=4))
+    img = rng.random((12, 12, 2))
+    hole = np.zeros((12, 12), bool)
+    hole[3:9, 4:10] = True
+    ys, xs = np.nonzero(hole)
+    index = -np.ones((12, 12), int)
+    index[ys, xs] = np.arange(len(ys))
+    nbr = np.full((len(ys), 4), -1)
+    ndeg = np.zeros(len(ys))
+    rhs = np.zeros((len(ys), 2))
+    for k, (dy, dx) in enumerate(((1, 0), (-1, 0), (0, 1), (0, -1))):
+        qy, qx = ys + dy, xs + dx
+        ndeg += 1
+        j = index[qy, qx]
+        nbr[:, k] = j
+        rhs[j < 0] += img[qy[j < 0], qx[j < 0]]
+    a = poisson_cg(nbr, ndeg, rhs, np.zeros_like(rhs), 1e-10, 500)
+    b = np.zeros_like(rhs)
+    kernel_cg(nbr, ndeg, rhs, b, 1e-10, 500)
+    assert np.allclose(a, b, atol=1e-7)

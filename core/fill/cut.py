@@ -1,0 +1,88 @@
+"""The quilting engine's minimum-error cut and the blend band's Poisson solve in numpy: a fill with
+the default engine then never loads numba (its import and cache loads were ~0.5 s of a 0.7 s
+``weft fill`` on a quiet machine, more under load), and the blocks and bands are small enough for
+vectorised numpy.
+
+* :func:`min_cut` -- E&F's dynamic-programming cut through each overlap strip of a block, one path
+  per side (the new region is the intersection of the sides' new halves), as
+  :func:`weft.core.seams.min_cut_mask` with its separate right and bottom paths; path pixels are new.
+* :func:`poisson_cg` -- conjugate gradient on the Poisson system of a pixel set, all channels at
+  once, the same system as ``weft.core._kernels.poisson.poisson_cg``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _vertical_path(err: np.ndarray) -> np.ndarray:
+    """Column of the least-error 8-connected top-to-bottom path in every row of ``err`` (h, w)."""
+    h, w = err.shape
+    acc = err.astype(np.float64).copy()
+    for y in range(h - 2, -1, -1):
+        below = acc[y + 1]
+        m = below.copy()
+        if w > 1:
+            m[1:] = np.minimum(m[1:], below[:-1])
+            m[:-1] = np.minimum(m[:-1], below[1:])
+        acc[y] += m
+    path = np.empty(h, dtype=np.int64)
+    x = int(np.argmin(acc[0]))
+    path[0] = x
+    for y in range(1, h):
+        lo, hi = max(0, x - 1), min(w, x + 2)
+        x = lo + int(np.argmin(acc[y, lo:hi]))
+        path[y] = x
+    return path
+
+
+def min_cut(err: np.ndarray, *, left: int = 0, top: int = 0, right: int = 0, bottom: int = 0) -> np.ndarray:
+    """bool (h, w): where the new block shows after the cut through the given overlap strips."""
+    h, w = err.shape
+    new = np.ones((h, w), dtype=bool)
+    cols = np.arange(w)[None, :]
+    rows = np.arange(h)[:, None]
+    if left > 0:
+        path = _vertical_path(err[:, :left])
+        new &= cols >= path[:, None]
+    if right > 0:
+        path = _vertical_path(err[:, w - right:]) + (w - right)
+        new &= cols <= path[:, None]
+    if top > 0:
+        path = _vertical_path(np.ascontiguousarray(err[:top, :].T))
+        new &= rows >= path[None, :]
+    if bottom > 0:
+        path = _vertical_path(np.ascontiguousarray(err[h - bottom:, :].T)) + (h - bottom)
+        new &= rows <= path[None, :]
+    return new
+
+
+def poisson_cg(nbr: np.ndarray, ndeg: np.ndarray, rhs: np.ndarray, x: np.ndarray, tol: float,
+               max_iter: int) -> np.ndarray:
+    """Solve ``ndeg_p x_p - sum_{q in nbr_p} x_q = rhs_p`` (``nbr`` (n, 4), -1: none) for every
+    channel of ``rhs`` (n, C), starting from ``x`` (overwritten); stops at ``||r|| <= tol ||rhs||``."""
+    n, c = rhs.shape
+    idx = np.where(nbr >= 0, nbr, n)  # row n is a zero row
+
+    def apply(v: np.ndarray) -> np.ndarray:
+        ext = np.vstack([v, np.zeros((1, c))])
+        return ndeg[:, None] * v - ext[idx].sum(axis=1)
+
+    bnorm = np.sqrt((rhs * rhs).sum(axis=0))
+    bnorm[bnorm == 0] = 1.0
+    r = rhs - apply(x)
+    p = r.copy()
+    rr = (r * r).sum(axis=0)
+    for _ in range(max_iter):
+        if np.all(np.sqrt(rr) <= tol * bnorm):
+            break
+        ap = apply(p)
+        pap = (p * ap).sum(axis=0)
+        a = np.where(pap > 0, rr / np.where(pap > 0, pap, 1.0), 0.0)
+        x += a * p
+        r -= a * ap
+        rr_new = (r * r).sum(axis=0)
+        beta = np.where(rr > 0, rr_new / np.where(rr > 0, rr, 1.0), 0.0)
+        rr = rr_new
+        p = r + beta * p
+    return x
