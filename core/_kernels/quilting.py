@@ -2,6 +2,8 @@
 
 * :func:`choose_best`, :func:`choose_tol`, :func:`choose_epsilon`, :func:`choose_sampled` -- the
   source position of one block from the SSD map of every position, one kernel per selection rule.
+* :func:`best_k`, :func:`seam_error` -- the seam rule of synthesis: the tol rule's candidates, and
+  the error along the cut of each.
 * :func:`block_error` -- the error surface of one block's overlap, which the engine cuts with
   ``weft.core._kernels.seams.cut_mask``; :func:`place_block` -- paste the block where the cut says.
 * :func:`poisson_band` -- Poisson-blend a band around the seam of the block just placed
@@ -187,6 +189,43 @@ def choose_tol(cross, sq, const, cost, tol, u):
     cost = _cost_map(cross, sq, const, cost)
     k = min(tol, cost.size)
     return _ranked(cost, k, min(int(u * k), k - 1))
+
+
+@njit(cache=True, nogil=True)
+def best_k(cross, sq, const, cost, k, out):
+    """The ``k`` best positions (the tol rule's candidates, in its order: those strictly better
+    than the k-th, then the ties with it, each in index order) written into ``out``; returns how
+    many (``min(k, positions)``). The seam rule of synthesis cuts each of them."""
+    cost = _cost_map(cross, sq, const, cost)
+    k = min(k, cost.size)
+    kth = _kth_smallest(cost, k)
+    m = 0
+    for i in range(cost.size):
+        if cost[i] < kth:
+            out[m] = i
+            m += 1
+    for i in range(cost.size):
+        if m >= k:
+            break
+        if cost[i] == kth:
+            out[m] = i
+            m += 1
+    return m
+
+
+@njit(cache=True, nogil=True)
+def seam_error(err, mask):
+    """The error along a block's cut: the sum of ``err`` over the pixels of the new block
+    (``mask`` 1) with a 4-neighbour inside the block that keeps the old pixel (``mask`` 0), in
+    row-major order."""
+    h, w = err.shape
+    total = 0.0
+    for y in range(h):
+        for x in range(w):
+            if mask[y, x] and ((y > 0 and not mask[y - 1, x]) or (y < h - 1 and not mask[y + 1, x])
+                               or (x > 0 and not mask[y, x - 1]) or (x < w - 1 and not mask[y, x + 1])):
+                total += err[y, x]
+    return total
 
 
 @njit(cache=True, nogil=True)

@@ -29,6 +29,13 @@ NUMPY_ENGINE_MAX_BLOCKS = 1024
 #: Synthesis never takes a source position within this many pixels of the continuation of a
 #: neighbouring block's piece of the sample, across the seam (see ``_forbid_continuations``); -1: off.
 AVOID_RADIUS = 4
+#: Synthesis adds to every position's cost ``USAGE_WEIGHT`` x a random match's error over the
+#: block's overlap x how often the sample pixels under the block were pasted already, relative to
+#: the average sample pixel (see ``_penalise_usage``); 0: off.
+USAGE_WEIGHT = 0.04
+#: The seam rule of min-cut synthesis with rule tol: the ``SEAM_POOL`` x tol lowest-cost positions
+#: are cut, and the one whose cut runs through the least error is taken; 0: the plain tol rule.
+SEAM_POOL = 4
 #: The cross-correlation written at a forbidden position: its SSD becomes ~2e30, so every rule ranks
 #: it behind every allowed position (and still picks among them when nothing else is left).
 _FORBIDDEN_CROSS = np.float32(-1e30)
@@ -50,6 +57,8 @@ class _Pass:
     w_corr: float = 0.0
     engine: str = "auto"  # "auto", "numba" or "numpy" (tests compare the two)
     avoid: int | None = None  # radius of _forbid_continuations, -1 off; None: AVOID_RADIUS for synthesis, off for transfer
+    usage: float | None = None  # weight of _penalise_usage, 0 off; None: USAGE_WEIGHT for synthesis, off for transfer
+    seam_pool: int | None = None  # candidates per tol of the seam rule, 0 off; None: SEAM_POOL for synthesis, off for transfer
 
 
 
@@ -88,6 +97,27 @@ def _forbid_continuations(cross: np.ndarray, ph: int, pw: int, y0: int, x0: int,
             xa, xb = 0, pw
         if ya < yb and xa < xb:
             cross[ya:yb, xa:xb] = _FORBIDDEN_CROSS
+
+
+def _penalise_usage(cross: np.ndarray, usage: np.ndarray, ph: int, pw: int, b: int, weight: float) -> None:
+    """Add ``weight`` x (how often the sample pixels under a block at each position were pasted,
+    relative to the average sample pixel) to every position's cost, through ``cross``.
+
+    ``usage`` (h, w) counts, for every sample pixel, the output pixels copied from it so far (after
+    the cut). Without it the tol rule keeps drawing from the parts of the sample that match well
+    most often and leaves others out of the output (on brick_128, T1: the top rows and left columns
+    of the sample, completeness 0.021); with it the output covers the whole sample. ``weight`` is in
+    the units of the cost (the caller scales it by a random match's error over the overlap), and the
+    cost is ``sq - 2 cross + const``, so the penalty goes into ``cross`` halved and negated.
+    """
+    import cv2
+
+    mean = float(usage.mean())
+    if mean <= 0.0:
+        return
+    under = cv2.boxFilter(usage, cv2.CV_32F, (b, b), normalize=False, anchor=(0, 0),
+                          borderType=cv2.BORDER_CONSTANT)[:ph, :pw]
+    cross[:ph, :pw] -= np.float32(0.5 * weight / (b * b * mean)) * under
 
 
 def _neighbours(chosen: np.ndarray, i: int, j: int, ys: list[int], xs: list[int], hc: int, wc: int,
@@ -246,12 +276,15 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
         place, template, blend, error, cut = _place_block_numpy, _make_template_numpy, None, None, None
         by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,
                                                _choose_sampled_numpy)
+        best_k, seam_error, seam_cut = _best_k_numpy, _seam_error_numpy, _cut_mask_into_numpy
+        block_error = _block_error_numpy
     else:
         from .._kernels import quilting as _k  # numba loads on first use, not with the CLI
         from .._kernels import seams as _seams
 
         place, template, blend = _k.place_block, _k.make_template, _k.poisson_band
         error, cut = _k.block_error, _seams.cut_mask
+        best_k, seam_error, seam_cut, block_error = _k.best_k, _k.seam_error, _seams.cut_mask, _k.block_error
         by_best, by_tol, by_eps, by_sampled = _k.choose_best, _k.choose_tol, _k.choose_epsilon, _k.choose_sampled
     # one kernel per rule (a run compiles only the one it uses); all take (cross, sq, const, cost, u, seed)
     if p.rule == "sampled":
@@ -279,7 +312,15 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     us = rng.random((rows, cols))
     seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
     first = (int(rng.integers(0, src.ph)), int(rng.integers(0, src.pw)))
-    avoid = p.avoid if p.avoid is not None else (AVOID_RADIUS if prev is None and corr is None else -1)
+    synthesis = prev is None and corr is None
+    avoid = p.avoid if p.avoid is not None else (AVOID_RADIUS if synthesis else -1)
+    usage_weight = p.usage if p.usage is not None else (USAGE_WEIGHT if synthesis else 0.0)
+    usage = np.zeros((th, tw), dtype=np.float32) if usage_weight > 0 else None
+    # a random match's expected squared error per overlap pixel: 2 x the variance, per channel
+    random_error = 2.0 * float(tex.astype(np.float64).var()) * nc
+    pool = p.seam_pool if p.seam_pool is not None else (SEAM_POOL if synthesis else 0)
+    pool = pool * p.tol if p.mode == "mincut" and p.rule == "tol" and pool > 0 else 0
+    candidates = np.empty(max(pool, 1), dtype=np.int64)
     chosen = np.full((rows, cols, 2), -1, dtype=np.int64)  # each block's source position
     ip = np.zeros(_K.N_IPARAMS, dtype=np.int64)
     ip[_K.P_B] = b
@@ -354,12 +395,19 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                                 cv2.mulSpectrums(spectra[c], fwd, 0, c=part, conjB=True)
                                 spec = np.add(spec, part, out=acc)
                     cross = cv2.idft(spec, dst=cross_buf, flags=flags)
+                    if usage is not None and overlaps:
+                        n_overlap = b * b - (b - top - bottom) * (b - left - right)
+                        _penalise_usage(cross, usage, src.ph, src.pw, b, usage_weight * random_error * n_overlap)
                     if avoid >= 0:
                         _forbid_continuations(cross, src.ph, src.pw, y0, x0,
                                               _neighbours(chosen, i, j, ys, xs, hc, wc, wrap), avoid)
                     sq = src.sq((top, left, right, bottom), p)
-                    ip[_K.P_SY], ip[_K.P_SX] = divmod(int(choose(cross, sq, float(const), cost_buf, us[i, j],
-                                                                 seeds[i, j])), src.pw)
+                    if pool and overlaps:
+                        pick = _by_seam(cross, sq, float(const), cost_buf, pool, candidates, canvas, filled, tex,
+                                        ip, err, mask, best_k, block_error, seam_cut, seam_error, src.pw)
+                    else:
+                        pick = int(choose(cross, sq, float(const), cost_buf, us[i, j], seeds[i, j]))
+                    ip[_K.P_SY], ip[_K.P_SX] = divmod(pick, src.pw)
                 else:  # synthesis, first block: a random position
                     ip[_K.P_SY], ip[_K.P_SX] = first
                 if mincut and overlaps and cut is not None:
@@ -367,6 +415,9 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                     cut(err, top, left, right, bottom, mask)
                 place(canvas, filled, tex, ip, mask, win, label, old)
                 chosen[i, j] = ip[_K.P_SY], ip[_K.P_SX]
+                if usage is not None:
+                    sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
+                    usage[sy:sy + b, sx:sx + b] += mask if mincut and overlaps else np.float32(1.0)
                 if sources is not None:
                     _record(sources, y0, x0, int(ip[_K.P_SY]), int(ip[_K.P_SX]), b,
                             mask if mincut and overlaps else None)
@@ -380,6 +431,25 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     if record is not None:
         record["sources"] = sources[:out_h, :out_w].copy()
     return canvas[:out_h, :out_w], rows * cols
+
+
+def _by_seam(cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, ip, err, mask,
+             best_k, block_error, cut, seam_error, pw) -> int:
+    """The seam rule: of the ``pool`` lowest-cost positions (the tol rule's candidates), the one
+    whose minimum-error cut runs through the least error (``seam_error``; ties: the earlier
+    candidate). The overlap SSD ranks a block by its whole overlap, but what shows is the error
+    along the cut; on brick_128 (T1) cutting 8 candidates instead of drawing one of the best 2
+    lowers coherence (fewer broken mortar joints at the seams)."""
+    n = int(best_k(cross, sq, const, cost_buf, pool, candidates))
+    best, best_err = int(candidates[0]), np.inf
+    for c in candidates[:n]:
+        ip[_K.P_SY], ip[_K.P_SX] = divmod(int(c), pw)
+        block_error(canvas, filled, tex, ip, err)
+        cut(err, int(ip[_K.P_TOP]), int(ip[_K.P_LEFT]), int(ip[_K.P_RIGHT]), int(ip[_K.P_BOTTOM]), mask)
+        e = float(seam_error(err, mask))
+        if e < best_err:
+            best, best_err = int(c), e
+    return best
 
 
 # --------------------------------------------------------------------------------------------
@@ -412,6 +482,27 @@ def _choose_tol_numpy(cross, sq, const, cost_buf, tol: int, u: float) -> int:
     kth = np.partition(cost, k - 1)[k - 1]
     order = np.concatenate([np.flatnonzero(cost < kth), np.flatnonzero(cost == kth)])
     return int(order[min(int(u * k), k - 1)])
+
+
+def _best_k_numpy(cross, sq, const, cost_buf, k: int, out: np.ndarray) -> int:
+    cost = _cost_numpy(cross, sq, const)
+    k = min(k, cost.size)
+    kth = np.partition(cost, k - 1)[k - 1]
+    order = np.concatenate([np.flatnonzero(cost < kth), np.flatnonzero(cost == kth)])[:k]
+    out[:k] = order
+    return k
+
+
+def _seam_error_numpy(err: np.ndarray, mask: np.ndarray) -> float:
+    """The kernel's ``seam_error`` (summed in the same order)."""
+    m = mask.astype(bool)
+    off = np.zeros_like(m)  # a 4-neighbour inside the block keeps the old pixel
+    off[1:] |= ~m[:-1]
+    off[:-1] |= ~m[1:]
+    off[:, 1:] |= ~m[:, :-1]
+    off[:, :-1] |= ~m[:, 1:]
+    vals = err[m & off]
+    return float(np.cumsum(vals)[-1]) if vals.size else 0.0
 
 
 def _choose_epsilon_numpy(cross, sq, const, cost_buf, eps: float, u: float) -> int:
@@ -516,6 +607,30 @@ def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bott
     return float(np.cumsum(terms.ravel())[-1]) if terms.size else 0.0
 
 
+def _block_error_numpy(canvas, filled, tex, ip, err: np.ndarray) -> None:
+    """The kernel's ``block_error`` in numpy, into ``err``."""
+    hc, wc, nc = canvas.shape
+    b = int(ip[_K.P_B])
+    y0, x0 = int(ip[_K.P_Y0]), int(ip[_K.P_X0])
+    top, left, right, bottom = (int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM))
+    sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
+    iy = (y0 + np.arange(b)) % hc
+    ix = (x0 + np.arange(b)) % wc
+    d = canvas[np.ix_(iy, ix)] - tex[sy:sy + b, sx:sx + b]
+    e = (d * d).astype(np.float64).sum(axis=2)
+    strips = np.zeros((b, b), dtype=bool)
+    strips[:top] = strips[:, :left] = True
+    strips[:, b - right:] = True
+    strips[b - bottom:] = True
+    e[~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
+    err[...] = e
+
+
+def _cut_mask_into_numpy(err, top, left, right, bottom, mask) -> None:
+    """:func:`_cut_mask_numpy` written into ``mask``, as the kernel's ``cut_mask``."""
+    mask[...] = _cut_mask_numpy(err, top, left, right, bottom)
+
+
 def _place_block_numpy(canvas, filled, tex, ip, *work):
     """The kernels' ``block_error``, ``cut_mask`` and ``place_block`` (no Poisson band), in numpy
     (same pixels).
@@ -534,13 +649,8 @@ def _place_block_numpy(canvas, filled, tex, ip, *work):
     block = tex[sy:sy + b, sx:sx + b]
     if ip[_K.P_MODE] == _K.MODE_MINCUT and (top or left or right or bottom):
         old = canvas[np.ix_(iy, ix)]
-        d = old - block
-        err = (d * d).astype(np.float64).sum(axis=2)
-        strips = np.zeros((b, b), dtype=bool)
-        strips[:top] = strips[:, :left] = True
-        strips[:, b - right:] = True
-        strips[b - bottom:] = True
-        err[~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
+        err = np.empty((b, b))
+        _block_error_numpy(canvas, filled, tex, ip, err)
         mask = _cut_mask_numpy(err, top, left, right, bottom)
         if work:
             work[0][...] = mask

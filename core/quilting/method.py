@@ -64,8 +64,8 @@ def _auto(params: QuiltParams, open_inputs: frozenset) -> dict:
 
 def warm_up() -> None:
     """Load (or compile) every numba kernel a run can use, on tiny inputs, so that no run compiles:
-    the four selection kernels (tol, tol 1, epsilon, sampled), the cut and paste, the Poisson band
-    and the templates of a transfer.
+    the four selection kernels (tol, tol 1, epsilon, sampled), the seam rule's (candidates and the
+    error along a cut), the cut and paste, the Poisson band and the templates of a transfer.
 
     For the GUI's background start-up; ``METHOD.warm_up_in_cli`` is False: a small synthesis on the
     command line (the numpy engine, see ``NUMPY_ENGINE_MAX_BLOCKS``) would otherwise pay numba's
@@ -78,6 +78,7 @@ def warm_up() -> None:
     synthesize(tex, size=(16, 16), block=6, overlap=2, mode="mincut", poisson=True, rng=0)
     for rule in ("epsilon", "sampled"):
         synthesize(tex, size=(16, 16), block=6, overlap=2, mode="mincut", rule=rule, rng=0)
+    synthesize(tex, size=(16, 16), block=6, overlap=2, mode="overlap", rng=0)  # the tol rule itself
     transfer(tex, tex, block=6, overlap=2, rng=0)
 
 

@@ -45,7 +45,8 @@ class QuiltParams(Params):
         help="output size WIDTHxHEIGHT; default twice the texture's size (transfer: the target's)",
     )
     tol: int = param(None, kind="int", lo=1, hi=100000, optional=True,
-                     help="rule tol: pick at random among the tol best positions (default 2; transfer 1)")
+                     help="rule tol: pick at random among the tol best positions (default 2; transfer 1); "
+                          "min-cut synthesis: of the 4 x tol best, the one with the least error along its cut")
     rule: str = param("tol", choices=RULES,
                       help="how a position is picked: tol best; epsilon: within (1+epsilon) x the best; "
                            "sampled: best 10% of a random 10%")

@@ -55,8 +55,9 @@ def synthesize(
         on its side of the minimum-error boundary cut through the overlap (Fig. 2c, :mod:`weft.core.seams`).
     tol : int, optional
         Default (None) 2. Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD positions (Ngo's ``tol``; 1 =
-        always the best). 2 keeps seams nearly invisible yet uses the whole sample (brick 128² ->
-        512², block 32/6, mincut: coherence 0.024, completeness 0.011; a pure best match repeats).
+        always the best). In ``mincut`` mode the seam rule takes its place: of the ``4 x tol``
+        lowest-cost positions, the one whose minimum-error cut runs through the least error
+        (``weft.core.quilting.engine.SEAM_POOL``).
     rule : {"tol", "epsilon", "sampled"}, default "tol"
         ``epsilon``: pick uniformly among positions with SSD <= (1 + epsilon) x the least (E&F
         §2.1, "within 0.1 times the error of the best"). ``sampled``: draw a random 10% of the
@@ -90,6 +91,11 @@ def synthesize(
 
     Notes
     -----
+    Beyond the paper, a block's cost has two more terms in synthesis (``weft.core.quilting.engine``):
+    no block continues a neighbour's piece of the sample (``AVOID_RADIUS``), and positions whose
+    sample pixels were pasted more often than the average cost more (``USAGE_WEIGHT``), so the
+    output covers the whole sample.
+
     Ambiguities resolved: the first block of ``overlap``/``mincut`` is a random position; the
     overlap region of ``overlap`` mode is overwritten by the new block (Ngo: "will overwrite a
     portion of T_prev"); the output is quilted on a canvas of whole blocks and cropped; SSDs are

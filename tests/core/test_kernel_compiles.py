@@ -36,6 +36,7 @@ RUNS = {
         ({"texture": image("brick", 80, 80)}, {"size": [96, 96], "block": 16, "poisson": True, "rule": "epsilon"}),
         ({"texture": image("brick", 80, 80)}, {"size": [96, 96], "block": 16, "poisson": True, "rule": "sampled"}),
         ({"texture": image("chelsea", 80, 80)}, {"size": [96, 96], "block": 16, "poisson": True, "tol": 40}),
+        ({"texture": image("brick", 80, 80)}, {"size": [96, 96], "block": 16, "mode": "overlap", "tol": 3}),
     ],
     "nfpt": [({"photo": image("perspective")}, {"lines": LINES, "size": [160, 120]}),
              ({"photo": image("perspective")}, {"lines": LINES, "size": [96, 96], "warp": "lines"})],
