@@ -270,8 +270,12 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
 
     import sys
 
-    use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and prev is None and corr is None
-                 and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "weft.core._kernels.quilting" not in sys.modules)
+    synthesis = prev is None and corr is None
+    pool = p.seam_pool if p.seam_pool is not None else (SEAM_POOL if synthesis else 0)
+    pool = pool * p.tol if p.mode == "mincut" and p.rule == "tol" and pool > 0 else 0
+    # the seam rule cuts ``pool`` candidates a block, each about two blocks' numpy step (0.9 ms)
+    use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and synthesis
+                 and rows * cols * (1 + 2 * pool) <= NUMPY_ENGINE_MAX_BLOCKS and "weft.core._kernels.quilting" not in sys.modules)
     if use_numpy:
         place, template, blend, error, cut = _place_block_numpy, _make_template_numpy, None, None, None
         by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,
@@ -312,14 +316,11 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     us = rng.random((rows, cols))
     seeds = rng.integers(0, 2**63 - 1, size=(rows, cols), dtype=np.int64)
     first = (int(rng.integers(0, src.ph)), int(rng.integers(0, src.pw)))
-    synthesis = prev is None and corr is None
     avoid = p.avoid if p.avoid is not None else (AVOID_RADIUS if synthesis else -1)
     usage_weight = p.usage if p.usage is not None else (USAGE_WEIGHT if synthesis else 0.0)
     usage = np.zeros((th, tw), dtype=np.float32) if usage_weight > 0 else None
     # a random match's expected squared error per overlap pixel: 2 x the variance, per channel
     random_error = 2.0 * float(tex.astype(np.float64).var()) * nc
-    pool = p.seam_pool if p.seam_pool is not None else (SEAM_POOL if synthesis else 0)
-    pool = pool * p.tol if p.mode == "mincut" and p.rule == "tol" and pool > 0 else 0
     candidates = np.empty(max(pool, 1), dtype=np.int64)
     chosen = np.full((rows, cols, 2), -1, dtype=np.int64)  # each block's source position
     ip = np.zeros(_K.N_IPARAMS, dtype=np.int64)
