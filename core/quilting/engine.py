@@ -273,22 +273,21 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     synthesis = prev is None and corr is None
     pool = p.seam_pool if p.seam_pool is not None else (SEAM_POOL if synthesis else 0)
     pool = pool * p.tol if p.mode == "mincut" and p.rule == "tol" and pool > 0 else 0
-    # the seam rule cuts ``pool`` candidates a block, each about two blocks' numpy step (0.9 ms)
     use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and synthesis
-                 and rows * cols * (1 + 2 * pool) <= NUMPY_ENGINE_MAX_BLOCKS and "weft.core._kernels.quilting" not in sys.modules)
+                 and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "weft.core._kernels.quilting" not in sys.modules)
     if use_numpy:
         place, template, blend, error, cut = _place_block_numpy, _make_template_numpy, None, None, None
         by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,
                                                _choose_sampled_numpy)
-        best_k, seam_error, seam_cut = _best_k_numpy, _seam_error_numpy, _cut_mask_into_numpy
-        block_error = _block_error_numpy
+        by_seam, best_k, seam_error, seam_cut, block_error = _by_seam_numpy, None, None, None, None
     else:
         from .._kernels import quilting as _k  # numba loads on first use, not with the CLI
         from .._kernels import seams as _seams
 
         place, template, blend = _k.place_block, _k.make_template, _k.poisson_band
         error, cut = _k.block_error, _seams.cut_mask
-        best_k, seam_error, seam_cut, block_error = _k.best_k, _k.seam_error, _seams.cut_mask, _k.block_error
+        by_seam, best_k, seam_error, seam_cut, block_error = (_by_seam, _k.best_k, _k.seam_error, _seams.cut_mask,
+                                                              _k.block_error)
         by_best, by_tol, by_eps, by_sampled = _k.choose_best, _k.choose_tol, _k.choose_epsilon, _k.choose_sampled
     # one kernel per rule (a run compiles only the one it uses); all take (cross, sq, const, cost, u, seed)
     if p.rule == "sampled":
@@ -404,7 +403,7 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                                               _neighbours(chosen, i, j, ys, xs, hc, wc, wrap), avoid)
                     sq = src.sq((top, left, right, bottom), p)
                     if pool and overlaps:
-                        pick = _by_seam(cross, sq, float(const), cost_buf, pool, candidates, canvas, filled, tex,
+                        pick = by_seam(cross, sq, float(const), cost_buf, pool, candidates, canvas, filled, tex,
                                         ip, err, mask, best_k, block_error, seam_cut, seam_error, src.pw)
                     else:
                         pick = int(choose(cross, sq, float(const), cost_buf, us[i, j], seeds[i, j]))
@@ -527,65 +526,72 @@ def _choose_sampled_numpy(cross, sq, const, cost_buf, u: float, seed: int) -> in
 
 
 def _vertical_acc_numpy(err: np.ndarray) -> np.ndarray:
-    h, w = err.shape
-    acc = np.empty((h, w))
-    acc[h - 1] = err[h - 1]
-    pad = np.full(w + 2, np.inf)
+    """The kernel's ``_vertical_acc`` for a stack of error surfaces (K, h, w)."""
+    k, h, w = err.shape
+    acc = np.empty((k, h, w))
+    acc[:, h - 1] = err[:, h - 1]
+    pad = np.full((k, w + 2), np.inf)
     for y in range(h - 2, -1, -1):
-        pad[1:-1] = acc[y + 1]
-        acc[y] = err[y] + np.minimum(np.minimum(pad[1:-1], pad[:-2]), pad[2:])
+        pad[:, 1:-1] = acc[:, y + 1]
+        acc[:, y] = err[:, y] + np.minimum(np.minimum(pad[:, 1:-1], pad[:, :-2]), pad[:, 2:])
     return acc
 
 
-def _trace_numpy(acc: np.ndarray, y_start: int, x_start: int) -> np.ndarray:
-    h, w = acc.shape
-    path = np.empty(h, dtype=np.int64)
-    x = x_start
-    path[y_start] = x
-    for y in range(y_start + 1, h):
-        best, m = x, acc[y, x]
-        if x > 0 and acc[y, x - 1] < m:
-            m, best = acc[y, x - 1], x - 1
-        if x < w - 1 and acc[y, x + 1] < m:
-            best = x + 1
-        x = best
-        path[y] = x
+def _trace_numpy(acc: np.ndarray, y_start: np.ndarray, x_start: np.ndarray) -> np.ndarray:
+    """The kernel's ``_trace_down`` for a stack (K, h, w), each from its own (y_start, x_start);
+    the path is 0 above its start."""
+    k, h, w = acc.shape
+    ar = np.arange(k)
+    path = np.zeros((k, h), dtype=np.int64)
+    x = np.asarray(x_start, dtype=np.int64).copy()
+    path[ar, y_start] = x
+    for y in range(1, h):
+        m = acc[ar, y, x]
+        best = x
+        left = acc[ar, y, np.maximum(x - 1, 0)]
+        go_left = (x > 0) & (left < m)
+        m = np.where(go_left, left, m)
+        best = np.where(go_left, x - 1, best)
+        right = acc[ar, y, np.minimum(x + 1, w - 1)]
+        best = np.where((x < w - 1) & (right < m), x + 1, best)
+        active = y > y_start
+        x = np.where(active, best, x)
+        path[:, y] = np.where(active, x, path[:, y])
     return path
 
 
 def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: int) -> np.ndarray:
-    """The kernel's ``cut_mask`` in numpy (horizontal cuts by transposition)."""
-    h, w = err.shape
-    mask = np.ones((h, w), dtype=bool)
+    """The kernel's ``cut_mask`` in numpy (horizontal cuts by transposition), for one error surface
+    (h, w) or a stack of them (K, h, w) (the seam rule's candidates, cut together)."""
+    if err.ndim == 2:
+        return _cut_mask_numpy(err[None], top, left, right, bottom)[0]
+    k, h, w = err.shape
+    mask = np.ones((k, h, w), dtype=bool)
     yy, xx = np.mgrid[0:h, 0:w]
+    zero = np.zeros(k, dtype=np.int64)
     if left > 0 and top > 0:
-        ev = _vertical_acc_numpy(err[:, :left])
-        eh = _vertical_acc_numpy(err[:top, :].T)  # (w, top): rows = columns from the right
-        corner = ev[:top, :left] + eh[:left, :top].T - err[:top, :left]
-        r, c = divmod(int(np.argmin(corner)), left)
-        vpath = np.zeros(h, dtype=np.int64)
-        vpath[r:] = _trace_numpy(ev, r, c)[r:]
-        hpath = np.zeros(w, dtype=np.int64)
-        hpath[c:] = _trace_numpy(eh, c, r)[c:]
-        a = np.where(yy >= r, xx >= vpath[:, None], xx >= c)
-        b = np.where(xx >= c, yy >= hpath[None, :], yy >= r)
+        ev = _vertical_acc_numpy(err[:, :, :left])
+        eh = _vertical_acc_numpy(err[:, :top, :].transpose(0, 2, 1))  # (K, w, top): rows = columns
+        corner = ev[:, :top, :left] + eh[:, :left, :top].transpose(0, 2, 1) - err[:, :top, :left]
+        r, c = np.divmod(corner.reshape(k, -1).argmin(axis=1), left)
+        vpath = _trace_numpy(ev, r, c)
+        hpath = _trace_numpy(eh, c, r)
+        r3, c3 = r[:, None, None], c[:, None, None]
+        a = np.where(yy >= r3, xx >= vpath[:, :, None], xx >= c3)
+        b = np.where(xx >= c3, yy >= hpath[:, None, :], yy >= r3)
         mask &= a & b
     elif left > 0:
-        ev = _vertical_acc_numpy(err[:, :left])
-        vpath = _trace_numpy(ev, 0, int(np.argmin(ev[0])))
-        mask &= xx >= vpath[:, None]
+        ev = _vertical_acc_numpy(err[:, :, :left])
+        mask &= xx >= _trace_numpy(ev, zero, ev[:, 0].argmin(axis=1))[:, :, None]
     elif top > 0:
-        eh = _vertical_acc_numpy(err[:top, :].T)
-        hpath = _trace_numpy(eh, 0, int(np.argmin(eh[0])))
-        mask &= yy >= hpath[None, :]
+        eh = _vertical_acc_numpy(err[:, :top, :].transpose(0, 2, 1))
+        mask &= yy >= _trace_numpy(eh, zero, eh[:, 0].argmin(axis=1))[:, None, :]
     if right > 0:
-        ev = _vertical_acc_numpy(err[:, w - right:])
-        vpath = _trace_numpy(ev, 0, int(np.argmin(ev[0]))) + (w - right)
-        mask &= xx <= vpath[:, None]
+        ev = _vertical_acc_numpy(err[:, :, w - right:])
+        mask &= xx <= (_trace_numpy(ev, zero, ev[:, 0].argmin(axis=1)) + (w - right))[:, :, None]
     if bottom > 0:
-        eh = _vertical_acc_numpy(err[h - bottom:, :].T)
-        hpath = _trace_numpy(eh, 0, int(np.argmin(eh[0]))) + (h - bottom)
-        mask &= yy <= hpath[None, :]
+        eh = _vertical_acc_numpy(err[:, h - bottom:, :].transpose(0, 2, 1))
+        mask &= yy <= (_trace_numpy(eh, zero, eh[:, 0].argmin(axis=1)) + (h - bottom))[:, None, :]
     return mask
 
 
@@ -608,28 +614,41 @@ def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bott
     return float(np.cumsum(terms.ravel())[-1]) if terms.size else 0.0
 
 
-def _block_error_numpy(canvas, filled, tex, ip, err: np.ndarray) -> None:
-    """The kernel's ``block_error`` in numpy, into ``err``."""
+def _block_errors_numpy(canvas, filled, tex, ip, positions) -> np.ndarray:
+    """The kernel's ``block_error`` in numpy for the block of ``ip`` taken from each source
+    position ``(sy, sx)`` of ``positions``: a (K, B, B) stack."""
     hc, wc, nc = canvas.shape
     b = int(ip[_K.P_B])
     y0, x0 = int(ip[_K.P_Y0]), int(ip[_K.P_X0])
     top, left, right, bottom = (int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM))
-    sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
     iy = (y0 + np.arange(b)) % hc
     ix = (x0 + np.arange(b)) % wc
-    d = canvas[np.ix_(iy, ix)] - tex[sy:sy + b, sx:sx + b]
-    e = (d * d).astype(np.float64).sum(axis=2)
+    blocks = np.stack([tex[sy:sy + b, sx:sx + b] for sy, sx in positions])
+    d = canvas[np.ix_(iy, ix)][None] - blocks
+    e = (d * d).astype(np.float64).sum(axis=3)
     strips = np.zeros((b, b), dtype=bool)
     strips[:top] = strips[:, :left] = True
     strips[:, b - right:] = True
     strips[b - bottom:] = True
-    e[~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
-    err[...] = e
+    e[:, ~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
+    return e
 
 
-def _cut_mask_into_numpy(err, top, left, right, bottom, mask) -> None:
-    """:func:`_cut_mask_numpy` written into ``mask``, as the kernel's ``cut_mask``."""
-    mask[...] = _cut_mask_numpy(err, top, left, right, bottom)
+def _block_error_numpy(canvas, filled, tex, ip, err: np.ndarray) -> None:
+    """The kernel's ``block_error`` in numpy, into ``err``."""
+    err[...] = _block_errors_numpy(canvas, filled, tex, ip, [(int(ip[_K.P_SY]), int(ip[_K.P_SX]))])[0]
+
+
+def _by_seam_numpy(cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, ip, err, mask,
+                   *kernels_and_pw) -> int:
+    """:func:`_by_seam` in numpy, the candidates' cuts computed together (same choice)."""
+    pw = kernels_and_pw[-1]
+    n = _best_k_numpy(cross, sq, const, cost_buf, pool, candidates)
+    cands = [int(c) for c in candidates[:n]]
+    errs = _block_errors_numpy(canvas, filled, tex, ip, [divmod(c, pw) for c in cands])
+    masks = _cut_mask_numpy(errs, *(int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM)))
+    seam = [_seam_error_numpy(e, m) for e, m in zip(errs, masks)]
+    return cands[int(np.argmin(seam))]
 
 
 def _place_block_numpy(canvas, filled, tex, ip, *work):
