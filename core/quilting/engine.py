@@ -537,27 +537,28 @@ def _vertical_acc_numpy(err: np.ndarray) -> np.ndarray:
     return acc
 
 
-def _trace_numpy(acc: np.ndarray, y_start: np.ndarray, x_start: np.ndarray) -> np.ndarray:
+def _trace_numpy(acc: np.ndarray, y_start, x_start) -> np.ndarray:
     """The kernel's ``_trace_down`` for a stack (K, h, w), each from its own (y_start, x_start);
-    the path is 0 above its start."""
+    the path is 0 above its start. (Scalar steps on Python floats: per-row numpy calls on arrays
+    this small cost ~40x more.)"""
     k, h, w = acc.shape
-    ar = np.arange(k)
-    path = np.zeros((k, h), dtype=np.int64)
-    x = np.asarray(x_start, dtype=np.int64).copy()
-    path[ar, y_start] = x
-    for y in range(1, h):
-        m = acc[ar, y, x]
-        best = x
-        left = acc[ar, y, np.maximum(x - 1, 0)]
-        go_left = (x > 0) & (left < m)
-        m = np.where(go_left, left, m)
-        best = np.where(go_left, x - 1, best)
-        right = acc[ar, y, np.minimum(x + 1, w - 1)]
-        best = np.where((x < w - 1) & (right < m), x + 1, best)
-        active = y > y_start
-        x = np.where(active, best, x)
-        path[:, y] = np.where(active, x, path[:, y])
-    return path
+    rows_k = acc.tolist()
+    out = []
+    for i in range(k):
+        rows, x, y0 = rows_k[i], int(x_start[i]), int(y_start[i])
+        path = [0] * h
+        path[y0] = x
+        for y in range(y0 + 1, h):
+            r = rows[y]
+            best, m = x, r[x]
+            if x > 0 and r[x - 1] < m:
+                m, best = r[x - 1], x - 1
+            if x < w - 1 and r[x + 1] < m:
+                best = x + 1
+            x = best
+            path[y] = x
+        out.append(path)
+    return np.array(out, dtype=np.int64).reshape(k, h)
 
 
 def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: int) -> np.ndarray:
