@@ -5,7 +5,10 @@ A session is the whole document as JSON::
     {"weft_session": 1, "method": "fast", "params": {"fast": {...}, ...}, "inputs": {"texture": "a.png"},
      "geometry": {"fast": {"region": [x, y, side]}, "nfpt": {"lines": {...}}}, "seed": 7}
 
-``geometry`` holds each method's own geometry (its studio description's keys). Files written before
+``geometry`` holds each method's own geometry (its studio description's keys): a square ``[x, y, side]``,
+feature lines ``{...}``, margins ``[left, top, right, bottom]``, and a mask as the name of its 1-bit PNG
+written beside the session (relative to the session's folder), e.g. ``"mask": "s.weft.fill.mask.png"``.
+Files written before
 geometry was per method have one ``"prototype": [x, y, side]`` and one ``"lines": {...}`` instead;
 each is given to every method with a geometry of that kind.
 """
@@ -18,7 +21,7 @@ from typing import Any
 
 from . import registry
 from .errors import WeftError
-from .geometry import LINES, SQUARE, LineDraft, Square
+from .geometry import LINES, MARGINS, MASK, SQUARE, LineDraft, Margins, Mask, Square
 from .jsonio import read_json_file
 from .studio import Geometry
 
@@ -98,15 +101,30 @@ def _session_from_data(data: Any, base: Path) -> dict:
             if g is None:
                 raise WeftError(f"{name}: unknown geometry {key!r} (known: {', '.join(known) or 'none'})")
             try:
-                geometry[name][key] = _geometry_from_json(g, value)
+                geometry[name][key] = _geometry_from_json(g, value, base)
             except WeftError as e:
                 raise WeftError(f"{name}: {e}") from None
     return {"method": data["method"], "params": params, "inputs": inputs, "geometry": geometry, "seed": seed}
 
 
-def _geometry_from_json(g: Geometry, value: Any):
+def mask_file(session: str | Path, method: str, key: str) -> Path:
+    """Where a session at ``session`` keeps the mask ``key`` of ``method``: a 1-bit PNG beside it
+    (``s.weft.json`` -> ``s.weft.fill.mask.png``)."""
+    session = Path(session)
+    stem = session.name[:-5] if session.name.lower().endswith(".json") else session.name
+    return session.with_name(f"{stem}.{method}.{key}.png")
+
+
+def _geometry_from_json(g: Geometry, value: Any, base: Path):
     if value is None:
         return None
+    if g.kind == MASK:
+        if not isinstance(value, str) or not value or "\0" in value:
+            raise WeftError(f"{g.key} = {value!r} must be the name of a mask PNG beside the session")
+        path = Path(value) if os.path.isabs(value) else base / value
+        return Mask.read(path, g.key)
+    if g.kind == MARGINS:
+        return Margins.from_json(value, g.key)
     if g.kind == SQUARE:
         try:
             return Square.from_json(value, g.key)

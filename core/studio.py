@@ -22,8 +22,8 @@ import numpy as np
 from .errors import WeftError
 from .geometry import KINDS, LINES, MARGINS, MASK, SQUARE  # noqa: F401 (the kinds are re-exported)
 
-__all__ = ["Studio", "Geometry", "Figure", "describe_figures", "reduce_for_preview", "SQUARE", "LINES", "MASK",
-           "MARGINS", "REGION"]
+__all__ = ["Studio", "Geometry", "Figure", "describe_figures", "reduce_for_preview", "crop_around", "Around",
+           "SQUARE", "LINES", "MASK", "MARGINS", "REGION"]
 
 #: The key of a square that fills no parameter: the recipe's source ``region`` (the input is cropped to it).
 REGION = "region"
@@ -156,6 +156,10 @@ class Studio:
     rank : position in the method list (lowest first; the first is the studio's starting method).
     figures : how people read each key of the method's ``Result.figures`` (:class:`Figure`); the
         status bar shows them in words and units (:meth:`describe`), the CLI's ``--report`` keeps the keys.
+    preview_around : the input of a mask geometry whose painting previews *around the stroke*: while a
+        stroke is drawn, the method runs on a crop of its inputs around the painted region
+        (:func:`crop_around`) and the crop's result is pasted into the last full result; None: a
+        stroke previews nothing until it is released.
     """
 
     title: str
@@ -168,6 +172,7 @@ class Studio:
     examples: Mapping[str, str] = field(default_factory=dict)
     rank: int = 100
     figures: Mapping[str, Figure] = field(default_factory=dict)
+    preview_around: str | None = None
 
     def describe(self, figures: Mapping[str, Any]) -> list[str]:
         """A result's figures in words and units (see :func:`describe_figures`)."""
@@ -223,3 +228,115 @@ def reduce_for_preview(studio: Studio, inputs: Mapping[str, np.ndarray], params,
         except WeftError:  # a size the method refuses at preview scale: render at full size
             pass
     return dict(inputs), params
+
+
+#: The longest side of a preview around a stroke (:func:`crop_around`): larger crops are scaled down.
+AROUND_SIDE = 160
+
+
+@dataclass(frozen=True)
+class Around:
+    """A render of the region around a stroke (see :func:`crop_around`).
+
+    Attributes
+    ----------
+    inputs, params : what the method runs on (cropped, perhaps scaled; margins parameters off).
+    box : ``(x0, y0, x1, y1)`` of the crop in the painted image's pixels (exclusive ends).
+    offset : ``(dx, dy)`` of the painted image in a full result (the left and top margins of an
+        uncrop; (0, 0) without them).
+    """
+
+    inputs: dict
+    params: Any
+    box: tuple[int, int, int, int]
+    offset: tuple[int, int]
+
+    def paste(self, base: np.ndarray, part: np.ndarray) -> np.ndarray | None:
+        """``base`` (a full result) with ``part`` (the crop's result, scaled back to the box) pasted
+        at the box; None when they do not fit together (another size or channel count)."""
+        from .image import resize
+
+        x0, y0, x1, y1 = self.box
+        dx, dy = self.offset
+        w, h = x1 - x0, y1 - y0
+        if part.shape[:2] != (h, w):
+            if part.ndim != base.ndim or min(part.shape[:2]) < 1:
+                return None
+            part = resize(part, (w, h), interpolation="linear")
+        if (part.ndim != base.ndim or (part.ndim == 3 and part.shape[2] != base.shape[2])
+                or y0 + dy < 0 or x0 + dx < 0 or y1 + dy > base.shape[0] or x1 + dx > base.shape[1]):
+            return None
+        out = base.copy()
+        out[y0 + dy:y1 + dy, x0 + dx:x1 + dx] = part
+        return out
+
+
+def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke: tuple[float, float, float, float],
+                *, side: int = AROUND_SIDE, context: int = 16) -> Around | None:
+    """What to render while a stroke paints the mask input ``studio.preview_around``: the inputs
+    cropped around the painted region near the stroke, so the preview costs a fraction of a full
+    render.
+
+    ``stroke`` is the stroke's ``(x0, y0, x1, y1)`` in the painted image's pixels (brush radius
+    included). The crop is the bounding box of the mask's pixels within the stroke's box grown by
+    ``context`` px, grown again by ``context`` px and by a quarter of its side (known pixels around
+    the hole to copy from), clipped to the image. Every input the size of the painted image (the
+    image, its masks) is cropped alike; others (a second texture) are kept. A crop longer than
+    ``side`` is scaled down to it (``area``, a mask thresholded back to 0/1). Parameters filled by a
+    margins geometry on that image are reset to their defaults (the crop is not uncropped) and their
+    left/top margins give :attr:`Around.offset`. None when the studio previews no mask that way,
+    the mask is not open, or there is nothing painted near the stroke (nothing to fill).
+    """
+    from .geometry import Margins
+    from .image import resize
+    from .params import specs
+
+    name = studio.preview_around
+    g = next((g for g in studio.geometry if g.kind == MASK and g.input == name), None)
+    if g is None or name not in inputs:
+        return None
+    on = g.input_for(inputs)
+    if on not in inputs:
+        return None
+    mask = np.asarray(inputs[name])
+    h, w = inputs[on].shape[:2]
+    if mask.shape[:2] != (h, w):
+        return None
+    bits = (mask if mask.ndim == 2 else mask[..., 0]) > 0.5
+    sx0, sy0, sx1, sy1 = stroke
+    wx0, wy0 = max(0, int(np.floor(sx0)) - context), max(0, int(np.floor(sy0)) - context)
+    wx1, wy1 = min(w, int(np.ceil(sx1)) + 1 + context), min(h, int(np.ceil(sy1)) + 1 + context)
+    if wx0 >= wx1 or wy0 >= wy1:
+        return None
+    near = bits[wy0:wy1, wx0:wx1]
+    rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
+    if not len(rows):
+        return None
+    bx0, bx1 = wx0 + int(cols[0]), wx0 + int(cols[-1]) + 1
+    by0, by1 = wy0 + int(rows[0]), wy0 + int(rows[-1]) + 1
+    grow = context + max(bx1 - bx0, by1 - by0) // 4
+    x0, y0, x1, y1 = max(0, bx0 - grow), max(0, by0 - grow), min(w, bx1 + grow), min(h, by1 + grow)
+    k = min(1.0, side / max(x1 - x0, y1 - y0))
+    size = (max(8, round((x1 - x0) * k)), max(8, round((y1 - y0) * k)))
+    small = dict(inputs)
+    for n, img in inputs.items():
+        if img.shape[:2] != (h, w):
+            continue
+        part = np.ascontiguousarray(img[y0:y1, x0:x1])
+        if k < 1.0:
+            part = resize(part, size, interpolation="area")
+            if n == name:
+                part = (part > 0.5).astype(np.float32)
+        small[n] = part
+    changes, offset = {}, (0, 0)
+    defaults = {s.name: s.default for s in specs(type(params))}
+    for m in studio.geometry:
+        if m.kind == MARGINS and m.param is not None and m.input_for(inputs) == on:
+            value = getattr(params, m.param, None)
+            if value:
+                margins = Margins.coerce(value, m.param)
+                offset = (margins.left, margins.top)
+                changes[m.param] = defaults.get(m.param)
+    if changes:
+        params = params.replace(**changes)
+    return Around(small, params, (x0, y0, x1, y1), offset)

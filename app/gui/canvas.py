@@ -9,8 +9,13 @@ Contract
   ``set_lines`` on release). :meth:`rebuild` after a method change, :meth:`input_changed` after an
   input changed, :meth:`geometry_changed` after a geometry changed.
 * Signals: ``message(text)`` a one-line problem; ``dragging(key, value)`` a square is being dragged
-  (the window renders a live preview when the geometry asks for one); ``open_requested(input, path)``
-  a file was dropped on an input's view.
+  (the window renders a live preview when the geometry asks for one); ``painting(key, mask, box)`` a
+  mask stroke is being drawn (``box`` around its latest dab; ``mask`` None: the stroke was cancelled);
+  ``open_requested(input, path)`` a file was dropped on an input's view.
+* A view with several geometries (a mask and an uncrop's margins) gets a ``ToolSet`` of their tools;
+  a view with a mask or margins tool gets a ``GeometryBar`` (brush, eraser, lasso, Clear, Invert,
+  Fill transparent, Extend canvas…) over it. An input that is a mask geometry has no view of its own:
+  it is painted over its image.
 """
 
 from __future__ import annotations
@@ -28,9 +33,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from weft.core.studio import LINES, SQUARE
+from weft.core.studio import LINES, MARGINS, MASK, SQUARE
 
 from .lines_panel import FeatureLinesPanel
+from .mask_tools import GeometryBar, MarginsTool, MaskTool, ToolSet
 from .tools import PatchTool, QuadTool, Tool
 from .views import ImageView
 
@@ -68,6 +74,7 @@ class InputsPane(QSplitter):
 
     message = Signal(str)
     dragging = Signal(str, object)
+    painting = Signal(str, object, object)  # key, mask so far (None: cancelled), box of the latest dab
     hovered = Signal(object, int, int)  # view, x, y
     zoomed = Signal(object, float)  # view, scale
     open_requested = Signal(str, str)
@@ -79,6 +86,8 @@ class InputsPane(QSplitter):
         self.views: dict[str, ImageView] = {}
         self._boxes: dict[str, QWidget] = {}
         self._tools: dict[tuple, Tool] = {}
+        self._toolsets: dict[tuple, ToolSet] = {}
+        self._bars: dict[str, GeometryBar] = {}
         self.lines_panel: FeatureLinesPanel | None = None
         self.canvas = QStackedWidget()
         self.tabs = QTabWidget()
@@ -112,6 +121,12 @@ class InputsPane(QSplitter):
             if geometry.kind == SQUARE:
                 tool = PatchTool(view, self.doc, geometry.key,
                                  on_drag=lambda square, k=geometry.key: self.dragging.emit(k, square))
+            elif geometry.kind == MASK:
+                tool = MaskTool(view, self.doc, geometry,
+                                on_stroke=lambda mask, box, k=geometry.key: self.painting.emit(k, mask, box))
+            elif geometry.kind == MARGINS:
+                tool = MarginsTool(view, self.doc, geometry,
+                                   on_drag=lambda m, k=geometry.key: self.dragging.emit(k, m))
             elif geometry.kind == LINES:
                 # one lines panel (with the frontal frame), on the view of the first lines geometry met
                 if self.lines_panel is None:
@@ -135,6 +150,8 @@ class InputsPane(QSplitter):
         if self.lines_panel is not None:
             self.lines_panel.set_active(False)
         for inp in method.inputs:
+            if self.doc.mask_geometry(inp.name) is not None:
+                continue  # painted over its image, not a view of its own
             view = self.view(inp.name)
             view.set_image(self.doc.image(inp.name))
             self._show_clear(inp.name, optional=not inp.required)
@@ -161,17 +178,31 @@ class InputsPane(QSplitter):
         title each view with its input and what to draw on it."""
         studio = self.doc.studio
         for inp in self.doc.current.inputs:
+            if self.doc.mask_geometry(inp.name) is not None:
+                continue
             help_ = " — ".join(g.help for g in studio.geometry if g.input_for(self.doc.inputs) == inp.name)
             self.view(inp.name)
             optional = "" if inp.required else " (optional)"
             self._boxes[inp.name].label.setText(f"  {inp.name.replace('_', ' ')}{optional} — {help_ or inp.help}")
-        wanted = {}
+        per_view: dict[str, list[Tool]] = {}
         for g in studio.geometry:
             name = g.input_for(self.doc.inputs)
-            wanted[name] = self.tool(g, name)
+            per_view.setdefault(name, []).append(self.tool(g, name))
+        active = {t for tools in per_view.values() for t in tools}
         for tool in self._tools.values():
-            if tool not in wanted.values():
+            if tool not in active:
                 tool.hide()
+        wanted: dict[str, Tool] = {}
+        for name, tools in per_view.items():
+            if len(tools) == 1:
+                wanted[name] = tools[0]
+            else:
+                wanted[name] = self._toolsets.setdefault(tuple(tools), ToolSet(tools))
+            self._bar(name).attach(next((t for t in tools if isinstance(t, MaskTool)), None),
+                                   next((t for t in tools if isinstance(t, MarginsTool)), None))
+        for name, bar in self._bars.items():
+            if name not in per_view:
+                bar.attach(None, None)
         for name, view in self.views.items():
             tool = wanted.get(name)
             if isinstance(view.tool, QuadTool) and tool is not None and tool.view is view:
@@ -179,6 +210,30 @@ class InputsPane(QSplitter):
             view.tool = tool
             if tool is not None:
                 tool.refresh()
+
+    def _bar(self, name: str) -> GeometryBar:
+        """The mask and margins buttons over the view of input ``name`` (made on first use)."""
+        bar = self._bars.get(name)
+        if bar is None:
+            bar = GeometryBar(self.doc)
+            bar.message.connect(self.message)
+            self._boxes[name].layout().insertWidget(1, bar)
+            self._bars[name] = bar
+        return bar
+
+    def mask_tool(self) -> MaskTool | None:
+        """The current method's mask tool (its first mask geometry), or None."""
+        g = self.doc.geometry_of(MASK)
+        return None if g is None else self._tools.get((g.kind, g.key, g.input_for(self.doc.inputs)))
+
+    def margins_tool(self) -> MarginsTool | None:
+        g = self.doc.geometry_of(MARGINS)
+        return None if g is None else self._tools.get((g.kind, g.key, g.input_for(self.doc.inputs)))
+
+    def bar(self) -> GeometryBar | None:
+        """The bar of the current method's mask or margins tool, or None."""
+        tool = self.mask_tool() or self.margins_tool()
+        return None if tool is None else self._bars.get(next(n for n, v in self.views.items() if v is tool.view))
 
     def input_changed(self, name: str) -> None:
         self.view(name).set_image(self.doc.image(name), fit=True)
@@ -200,6 +255,8 @@ class InputsPane(QSplitter):
 
     def geometry_changed(self) -> None:
         self.sync_tools()
+        for bar in self._bars.values():
+            bar.refresh()
         if self.lines_panel is not None and self.lines_panel.active:
             self.lines_panel.lines_changed()
 

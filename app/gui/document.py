@@ -2,10 +2,16 @@
 
 Contract: views listen to ``Document.changed(name)`` and never own state; they read the document's
 public attributes and change it only through its setters (``set_param``, ``set_params``,
-``set_input``, ``set_method``, ``set_seed``, ``set_geometry``/``set_square``/``set_lines``) or
+``set_input``, ``set_method``, ``set_seed``, ``set_geometry``/``set_square``/``set_lines``/``set_mask``) or
 :meth:`Document.restore`. Every setter pushes one ``QUndoCommand`` onto one ``QUndoStack`` (consecutive
 changes of one parameter merge: a slider drag is one step). Names emitted: ``"input:<name>"``,
 ``"method"``, ``"params"``, ``"geometry"``, ``"seed"``, ``"restored"`` (everything changed).
+``message(text)`` says what an edit did on the side (a mask of another size dropped).
+
+A mask geometry (``Geometry(MASK, input=...)``) is an input of its method that the user paints: its
+:class:`~weft.core.geometry.Mask` is held as geometry (undoable, per method) and given to the method
+as that input (``mask.to_image()``) when it is the size of the image it is painted on; opening an
+image file as that input makes it the mask. A session keeps it as a 1-bit PNG beside the session file.
 """
 
 from __future__ import annotations
@@ -21,9 +27,9 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 
 from weft.core import registry
 from weft.core.errors import WeftError
-from weft.core.geometry import LINES, SQUARE, LineDraft, Square
+from weft.core.geometry import LINES, MARGINS, MASK, SQUARE, LineDraft, Margins, Mask, Square
 from weft.core.params import Params, Recipe, relative_path
-from weft.core.session import SESSION_VERSION, read_session  # noqa: F401 (read_session: the studio reads sessions)
+from weft.core.session import SESSION_VERSION, mask_file, read_session  # noqa: F401 (read_session: the studio reads sessions)
 from weft.core.studio import Geometry, Studio
 
 _MERGE_PARAM = 1001
@@ -31,10 +37,42 @@ _MERGE_PARAM = 1001
 
 @dataclass(frozen=True)
 class InputImage:
-    """An input picture: where it came from and its pixels (float32, as ``weft.core.image.load_image``)."""
+    """An input picture: where it came from, its pixels (float32, as ``weft.core.image.load_image``)
+    and its alpha channel (float32 (H, W) in [0, 1]) when the file had one (the image itself has none:
+    every method gets what ``weft run`` gives it); "Fill transparent" paints a mask from it."""
 
     path: str | None
     image: np.ndarray
+    alpha: np.ndarray | None = None
+
+
+def read_input(path: str | Path) -> InputImage:
+    """Decode an image file as an input (its pixels as ``load_image`` gives them, and its alpha).
+    Slow for a large file: call it off the GUI thread. ``WeftError`` naming the file."""
+    from weft.core.image import load_image
+
+    loaded = load_image(path)
+    alpha = _read_alpha(path, loaded.image.shape[:2]) if loaded.info.had_alpha else None
+    return InputImage(str(path), loaded.image, alpha)
+
+
+def _read_alpha(path, shape) -> np.ndarray | None:
+    """The alpha channel of an image file (upright, as ``load_image`` turns the pixels), or None."""
+    from PIL import Image, ImageOps
+
+    try:
+        with Image.open(path) as im:
+            im = ImageOps.exif_transpose(im)
+            if im.mode in ("I;16", "I;16B", "I", "F") or "A" not in im.getbands():
+                im = im.convert("RGBA") if "transparency" in im.info else None
+            if im is None:
+                return None
+            band = im.getchannel("A")
+            top = 65535.0 if band.mode.startswith("I") else 255.0
+            alpha = np.asarray(band, dtype=np.float32) / top
+    except (OSError, ValueError):
+        return None
+    return alpha if alpha.shape == tuple(shape) else None
 
 
 @dataclass(frozen=True)
@@ -61,6 +99,7 @@ class Document(QObject):
     """
 
     changed = Signal(str)
+    message = Signal(str)
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -131,14 +170,38 @@ class Document(QObject):
     def region(self, method: str | None = None) -> Square | None:
         """The source region of a method (a square that fills no parameter), or None."""
         method = method or self.method
-        g = next((g for g in self.methods[method].studio.geometry if g.param is None), None)
+        g = next((g for g in self.methods[method].studio.geometry if g.param is None and g.kind == SQUARE), None)
         return None if g is None else self.value(g.key, method)
 
-    def method_inputs(self) -> dict[str, np.ndarray]:
-        """The current method's loaded inputs; the canvas cropped to the source region if there is one."""
-        out = {i.name: self.inputs[i.name].image for i in self.current.inputs if i.name in self.inputs}
+    def mask_geometry(self, input_name: str, method: str | None = None) -> Geometry | None:
+        """The mask geometry of a method (default the current one) that *is* input ``input_name``."""
+        method = method or self.method
+        return next((g for g in self.methods[method].studio.geometry if g.kind == MASK and g.input == input_name), None)
+
+    def masks(self, *, live: bool = False) -> dict[str, Mask]:
+        """The current method's painted masks that it gets as inputs (input name -> mask): those not
+        empty and the size of the image they are painted on (with ``live``, the stroke being drawn)."""
+        out = {}
+        for g in self.studio.geometry:
+            if g.kind != MASK:
+                continue
+            mask = self.value(g.key)
+            if live and self.live is not None and self.live[0] == g.key:
+                mask = self.live[1]
+            on = self.image(g.input_for(self.inputs))
+            if mask is not None and mask and on is not None and mask.shape == on.shape[:2]:
+                out[g.input] = mask
+        return out
+
+    def method_inputs(self, *, live: bool = False) -> dict[str, np.ndarray]:
+        """The current method's loaded inputs (its painted masks among them, as images; with
+        ``live`` the stroke being drawn); the canvas cropped to the source region if there is one."""
+        painted = {g.input for g in self.studio.geometry if g.kind == MASK}
+        out = {i.name: self.inputs[i.name].image for i in self.current.inputs
+               if i.name in self.inputs and i.name not in painted}
+        out.update({name: mask.to_image() for name, mask in self.masks(live=live).items()})
         region = self.region()
-        g = next((g for g in self.studio.geometry if g.param is None), None)
+        g = next((g for g in self.studio.geometry if g.param is None and g.kind == SQUARE), None)
         if region is not None and g is not None and g.on[0] in out:
             out[g.on[0]] = region.crop(out[g.on[0]], what=g.on[0].replace("_", " "))
         return out
@@ -150,7 +213,7 @@ class Document(QObject):
         changes = {}
         for g in self.studio.geometry:
             if g.param is None:
-                continue
+                continue  # the source region (a crop) or a mask (an input)
             value = self.value(g.key)
             if live and self.live is not None and self.live[0] == g.key:
                 value = self.live[1]
@@ -183,8 +246,24 @@ class Document(QObject):
         if params != self.current_params:
             self.push(SetParams(self, self.method, params, text))
 
-    def set_input(self, name: str, path: str | None, image: np.ndarray) -> None:
-        self.push(SetInput(self, name, InputImage(path, image)))
+    def set_input(self, name: str, path: str | None, image: np.ndarray, alpha: np.ndarray | None = None) -> None:
+        """Undoable opening of an input image. An input the current method paints (a mask geometry)
+        becomes that mask (refused in one line if it is not the size of its image). Masks painted on
+        this input that do not fit the new image are dropped (said in ``message``; undo brings them back)."""
+        g = self.mask_geometry(name)
+        if g is not None:
+            on = g.input_for(self.inputs)
+            try:
+                mask = Mask.from_image(image, name.replace("_", " "))
+                if self.image(on) is not None:
+                    mask.check_size(self.image(on).shape, what=on.replace("_", " "), name=name.replace("_", " "))
+            except WeftError as e:
+                shown = Path(path).name if path else name
+                self.message.emit(f"{shown}: {e}")
+                return
+            self.set_mask(g.key, mask, f"Open {name.replace('_', ' ')} {Path(path).name if path else ''}".strip())
+            return
+        self.push(SetInput(self, name, InputImage(path, image, alpha)))
 
     def clear_input(self, name: str) -> None:
         """Undoable removal of an open input (the method then runs without it)."""
@@ -205,6 +284,14 @@ class Document(QObject):
         """Undoable change of one geometry of the current method."""
         if value != self.value(key):
             self.push(SetGeometry(self, self.method, key, value, text))
+
+    def set_mask(self, key: str, mask: Mask | None, text: str) -> None:
+        """Undoable change of a mask geometry of the current method (an empty mask clears it)."""
+        self.set_geometry(key, mask if mask is not None and mask else None, text)
+
+    def set_margins(self, key: str, margins: Margins | None, text: str = "Extend canvas") -> None:
+        """Undoable change of a margins geometry of the current method (no margins clears it)."""
+        self.set_geometry(key, margins if margins else None, text)
 
     def set_square(self, rect) -> None:
         """Set (or with None clear) the current method's square; nothing if it has none."""
@@ -269,25 +356,44 @@ class Document(QObject):
         self.changed.emit("seed")
 
     # --- sessions ------------------------------------------------------------------------------
-    def session_dict(self, relative_to: str | Path | None = None) -> dict:
+    def session_dict(self, relative_to: str | Path | None = None, *, session: str | Path | None = None) -> dict:
+        """The session JSON object. A mask is the name of its PNG beside ``session`` (the file the
+        JSON goes to; :meth:`session_masks` says what to write there); without ``session`` masks are
+        left out."""
         def path(p):
             return p if relative_to is None else relative_path(p, relative_to)
+
+        def geometry(method, key, value):
+            if isinstance(value, Mask):
+                return None if session is None else path(str(mask_file(session, method, key)))
+            return value.to_json()
 
         return {
             "weft_session": SESSION_VERSION,
             "method": self.method,
             "params": {name: p.to_dict() for name, p in self.params.items()},
             "inputs": {name: path(item.path) for name, item in self.inputs.items() if item.path},
-            "geometry": {name: {key: value.to_json() for key, value in values.items()}
+            "geometry": {name: {key: geometry(name, key, value) for key, value in values.items()}
                          for name, values in self.geometry.items() if values},
             "seed": self.seed,
         }
 
+    def session_masks(self, session: str | Path) -> dict[Path, Mask]:
+        """The mask PNGs a session at ``session`` keeps beside it: file -> mask."""
+        return {mask_file(session, name, key): value for name, values in self.geometry.items()
+                for key, value in values.items() if isinstance(value, Mask)}
+
     def save_session(self, path: str | Path) -> None:
+        """Write the session (its masks first, as 1-bit PNGs beside it), each file atomically."""
         from weft.core.image import atomic_write_bytes
 
         path = Path(path)
-        text = json.dumps(self.session_dict(relative_to=path.resolve().parent), indent=1)
+        for file, mask in self.session_masks(path).items():
+            try:
+                mask.save(file)
+            except OSError as e:
+                raise WeftError(f"{file}: cannot write the mask ({e.strerror or e})") from None
+        text = json.dumps(self.session_dict(relative_to=path.resolve().parent, session=path), indent=1)
         atomic_write_bytes(path, (text + "\n").encode("utf-8"))
 
 
@@ -321,6 +427,8 @@ class SetParams(QUndoCommand):
 
 
 class SetInput(QUndoCommand):
+    """Open (or clear) an input; masks painted on it that do not fit the new image go with the same step."""
+
     def __init__(self, doc: Document, name: str, item: InputImage | None):
         if item is None:
             super().__init__(f"Clear {name.replace('_', ' ')}")
@@ -329,12 +437,33 @@ class SetInput(QUndoCommand):
             super().__init__(f"Open {name} {label}")
         self.doc, self.name, self.new = doc, name, item
         self.old = doc.inputs.get(name)
+        after = {**doc.inputs, name: item} if item is not None else {k: v for k, v in doc.inputs.items() if k != name}
+        self.dropped = []  # (method, key, mask) that no longer fit
+        for method, m in doc.methods.items():
+            for g in m.studio.geometry:
+                mask = doc.geometry[method].get(g.key)
+                if g.kind != MASK or mask is None or g.input_for(after) != name or item is None:
+                    continue
+                if mask.shape != item.image.shape[:2]:
+                    self.dropped.append((method, g.key, mask))
 
     def redo(self):
+        for method, key, _mask in self.dropped:
+            self.doc.geometry[method].pop(key, None)
         self.doc._put_input(self.name, self.new)
+        for method, key, mask in self.dropped:
+            h, w = self.new.image.shape[:2]
+            self.doc.message.emit(f"the {key.replace('_', ' ')} of {method} ({mask.size[0]}x{mask.size[1]}) does not "
+                                  f"fit the new {self.name.replace('_', ' ')} ({w}x{h}): dropped (Ctrl+Z brings it back)")
+        if self.dropped:
+            self.doc.changed.emit("geometry")
 
     def undo(self):
+        for method, key, mask in self.dropped:
+            self.doc.geometry[method][key] = mask
         self.doc._put_input(self.name, self.old)
+        if self.dropped:
+            self.doc.changed.emit("geometry")
 
 
 class SetMethod(QUndoCommand):

@@ -1,5 +1,10 @@
 """The studio's files: export, recipes, sessions, and never losing work (ask, autosave, recover).
 
+A result rendered with a painted mask (a mask geometry is an input of its method) is exported with
+that mask as a 1-bit PNG beside it, ``OUT.<input>.png`` (``out.png`` -> ``out.mask.png``), which its
+recipe names as that input, so ``weft run OUT.png`` reproduces it; a recipe exported alone gets its
+mask beside it alike. Sessions keep masks beside the session file (``Document.save_session``).
+
 Contract: :class:`FileActions` is given the window (a parent for dialogs, with ``show_message(text)``,
 ``statusBar()``, ``settings`` and ``_confirm(question) -> bool``, the one place the studio asks), the
 document and the renderer. It exports the *shown result* with that result's own recipe (never the
@@ -9,6 +14,7 @@ of the window.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import threading
@@ -20,10 +26,10 @@ from PySide6.QtWidgets import QFileDialog
 
 from weft.core import registry
 from weft.core.errors import WeftError
-from weft.core.studio import SQUARE
-from weft.core.image import atomic_write_bytes, load_image, save_image
+from weft.core.studio import MASK, SQUARE
+from weft.core.image import atomic_write_bytes, save_image
 
-from .document import DocumentState, InputImage, read_session
+from .document import DocumentState, InputImage, read_input, read_session
 
 T = TypeVar("T")
 
@@ -129,7 +135,11 @@ class FileActions(QObject):
         if p.exists() and not self._confirm(f"{p.name} exists. Replace it?"):
             self.show_message(f"{p.name}: not exported (the existing file is kept)")
             return False
-        recipe = shown.recipe.to_json(relative_to=p.resolve().parent)
+        try:
+            recipe = self._with_masks(shown, p).to_json(relative_to=p.resolve().parent)
+        except WeftError as e:
+            self.show_message(str(e))
+            return False
         depth = 16 if p.suffix.lower() in (".tif", ".tiff") else 8
         self.statusBar().showMessage(f"exporting {p.name}…")
         try:  # encoding a large PNG takes a second: off the GUI thread
@@ -152,11 +162,29 @@ class FileActions(QObject):
             self.show_message("no recipe to export yet: wait for the full-size result")
             return False
         try:
-            shown.recipe.save(path)
+            self._with_masks(shown, Path(path)).save(path)
         except WeftError as e:
             self.show_message(str(e))
             return False
         return True
+
+    def _with_masks(self, shown, beside: Path):
+        """The recipe of ``shown`` with each painted mask it was rendered with written as a 1-bit PNG
+        beside ``beside`` (``out.png`` -> ``out.mask.png``) and named as that input."""
+        recipe = shown.recipe
+        if not shown.masks:
+            return recipe
+        inputs = dict(recipe.inputs)
+        for name, mask in shown.masks.items():
+            file = beside.with_name(f"{beside.stem}.{name}.png")
+            if any(item.path and Path(item.path).resolve() == file.resolve() for item in self.doc.inputs.values()):
+                raise WeftError(f"{file.name}: refusing to overwrite an input image with the {name.replace('_', ' ')}")
+            try:
+                mask.save(file)
+            except OSError as e:
+                raise WeftError(f"{file}: cannot write the {name.replace('_', ' ')} ({e.strerror or e})") from None
+            inputs[name] = str(file.resolve())
+        return dataclasses.replace(recipe, inputs=inputs)
 
     def save_session_dialog(self) -> bool:
         """Ask where, then save; True if the session was saved."""
@@ -209,7 +237,7 @@ class FileActions(QObject):
             images = {}
             for name, p in data["inputs"].items():
                 try:
-                    images[name] = InputImage(p, load_image(p).image)
+                    images[name] = read_input(p)
                 except WeftError as e:
                     raise WeftError(f"{path}: the {name.replace('_', ' ')} image: {e}") from None
             return images
@@ -218,12 +246,18 @@ class FileActions(QObject):
         images = off_gui_thread(decode)
         for method, values in data["geometry"].items():  # a square must lie inside its image
             for g in offered[method].studio.geometry:
-                square, on = values.get(g.key), g.input_for(images)
-                if g.kind == SQUARE and square is not None and on in images:
+                value, on = values.get(g.key), g.input_for(images)
+                if g.kind == SQUARE and value is not None and on in images:
                     try:
-                        square.crop(images[on].image, what=on.replace("_", " "), name=g.key)
+                        value.crop(images[on].image, what=on.replace("_", " "), name=g.key)
                     except WeftError as e:
                         raise WeftError(f"{path}: {method} {g.key}: {e}") from None
+                if g.kind == MASK and value is not None and on in images:  # a mask must fit its image
+                    try:
+                        value.check_size(images[on].image.shape, what=on.replace("_", " "), name=g.key)
+                    except WeftError as e:
+                        del values[g.key]
+                        self.show_message(f"{path}: {method}: {e}; dropped")
         return data, images
 
     def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
@@ -252,10 +286,12 @@ class FileActions(QObject):
         """
         if self.doc.undo_stack.isClean():
             return False
-        data = self.doc.session_dict()
+        data = self.doc.session_dict(session=self.recovery_file)
         data["inputs"] = {name: os.path.abspath(p) for name, p in data["inputs"].items()}
         try:
             self.recovery_file.parent.mkdir(parents=True, exist_ok=True)
+            for file, mask in self.doc.session_masks(self.recovery_file).items():
+                mask.save(file)
             atomic_write_bytes(self.recovery_file, (json.dumps(data, indent=1) + "\n").encode("utf-8"))
         except (OSError, WeftError) as e:
             self.show_message(f"{self.recovery_file}: autosave failed ({' '.join(str(e).split())})")

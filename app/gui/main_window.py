@@ -39,12 +39,11 @@ from PySide6.QtWidgets import (
 
 from weft.core.errors import WeftError
 from weft.core.examples import example, examples
-from weft.core.image import load_image
 from weft.core.jobs import JobRunner
 
 from .canvas import InputsPane, titled
 from .convert import to_qimage
-from .document import Document, DocumentState, InputImage
+from .document import Document, DocumentState, read_input
 from .files import FileActions
 from .method_panel import MethodPanel
 from .render import Renderer, describe
@@ -120,6 +119,8 @@ class MainWindow(QMainWindow):
         self.inputs_pane = InputsPane(self.doc, self)
         self.inputs_pane.message.connect(self.show_message)
         self.inputs_pane.dragging.connect(self._geometry_dragged)
+        self.inputs_pane.painting.connect(self._mask_painted)
+        self.doc.message.connect(self.show_message)
         self.inputs_pane.hovered.connect(self._on_hover)
         self.inputs_pane.zoomed.connect(self._on_zoomed)
         self._pointer_view: ImageView | None = None  # the view the mouse last moved over
@@ -154,6 +155,7 @@ class MainWindow(QMainWindow):
         self.doc.undo_stack.indexChanged.connect(self._update_title)
         self.doc.undo_stack.cleanChanged.connect(self._update_title)
         self.renderer.shown.connect(self._on_shown)
+        self.renderer.around_shown.connect(self._on_around_shown)
         self.renderer.partial.connect(lambda img: self.result_view.set_image(img))
         self.renderer.progress.connect(self._on_progress)
         self.renderer.preparing.connect(self._on_preparing)
@@ -422,7 +424,7 @@ class MainWindow(QMainWindow):
                     path = example(stem)
                 except WeftError:
                     continue
-                inputs[name] = InputImage(str(path), load_image(path).image)  # small files: milliseconds
+                inputs[name] = read_input(path)  # small files: milliseconds
         self.doc.restore(DocumentState(inputs=inputs, method=self.doc.method, seed=self.doc.seed))
         self.renderer.final(now=True)
 
@@ -456,10 +458,11 @@ class MainWindow(QMainWindow):
         if result.error is not None:
             self.show_message(f"could not open: {result.error}")
             return
-        name, path, image = result.value
+        name, path, item = result.value
+        image = item.image
         self.settings.setValue("last_dir", str(Path(path).parent))
         self._add_recent(path)
-        self.doc.set_input(name, path, image)
+        self.doc.set_input(name, path, image, item.alpha)
         self.statusBar().showMessage(f"{name}: {Path(path).name} {image.shape[1]}x{image.shape[0]}", 4000)
 
     def _add_recent(self, path: str) -> None:
@@ -542,7 +545,21 @@ class MainWindow(QMainWindow):
             self.doc.live = (key, value)
             self.renderer.preview()
 
+    def _mask_painted(self, key: str, mask, box) -> None:
+        """A mask stroke in progress: render the region around it (if the method previews strokes);
+        ``mask`` None: the stroke was cancelled."""
+        if mask is None:
+            self.doc.live = None
+            self.renderer.stroke_cancelled()
+            return
+        self.doc.live = (key, mask)
+        self.renderer.preview_around(box)
+
     # --- results ---------------------------------------------------------------------------------
+    def _on_around_shown(self, shown) -> None:
+        self.result_view.set_image(shown.image)
+        self.statusBar().showMessage(describe(shown) + " (around the stroke)")
+
     def _on_shown(self, shown) -> None:
         self.result_view.set_stale(None)  # a render succeeded: what is shown follows the panel
         self.result_view.set_image(shown.image)
@@ -725,5 +742,4 @@ def _time_left(elapsed: float, fraction: float) -> str:
 
 
 def _load_job(name: str, path: str, *, progress=None, cancel=None):
-    loaded = load_image(path)
-    return name, path, loaded.image
+    return name, path, read_input(path)

@@ -13,6 +13,11 @@
   completed job. A result carries the recipe of its pixels (method, parameters, inputs, seed, region)
   and its "before" image, captured when the job was made: export and Compare use those, never the
   panel's state at the time of the export. Workers never touch widgets: results and progress arrive through queued signals.
+* While a mask stroke is painted, ``preview_around(box)`` submits (in the same coalesced preview slot)
+  a render of the region around the stroke only, when the method's studio description asks for it
+  (``Studio.preview_around``; ``weft.core.studio.crop_around`` crops the inputs to at most
+  ``AROUND_SIDE`` px): its result is pasted into the last full result and shown; the release renders
+  full size. A preview around a stroke that fails says nothing (the release's render will).
 * A job running longer than ``PROGRESS_DELAY_MS`` shows its progress (with partial previews where the
   method gives them) and can be cancelled; after a cancel or an error the last good result stays.
 """
@@ -28,7 +33,7 @@ from weft.core import registry
 from weft.core.jobs import JobResult, JobRunner, Progress
 from weft.core.params import Params, Recipe
 from weft.core.errors import WeftError
-from weft.core.studio import describe_figures, reduce_for_preview
+from weft.core.studio import crop_around, describe_figures, reduce_for_preview
 
 PREVIEW_SIDE = 400
 PROGRESS_DELAY_MS = 300
@@ -64,6 +69,7 @@ class Shown:
     compiled: bool = False
     recipe: Recipe | None = None
     before: np.ndarray | None = None
+    masks: dict | None = None  # the painted masks it was rendered with (input name -> Mask): export writes them
 
 
 def _render(method, inputs, params, seed, report, cancel, *, final: bool):
@@ -109,6 +115,7 @@ class Renderer(QObject):
     """
 
     submitted = Signal(int, str)
+    around_shown = Signal(object)  # a preview around a stroke, pasted into the last full result
 
     shown = Signal(object)
     partial = Signal(object)
@@ -131,6 +138,9 @@ class Renderer(QObject):
         self._preview_finished.connect(self._on_preview_finished)
         self._preview_running: int | None = None
         self._preview_dirty = False
+        self._around_box: tuple[float, float, float, float] | None = None  # stroke region not previewed yet
+        self._around_jobs: set[int] = set()
+        self._around_image: np.ndarray | None = None  # the last full result with the stroke's previews pasted
         self.last: Shown | None = None
         self.latest_final: int | None = None
         self._final_running = False  # the latest final job has not delivered yet
@@ -151,6 +161,31 @@ class Renderer(QObject):
         """Ask for a reduced-size render soon (coalesced to one per frame)."""
         if not self._preview_timer.isActive():
             self._preview_timer.start()
+
+    def preview_around(self, box) -> bool:
+        """A mask stroke is being painted (``box`` the region of its latest dab, in the painted image's
+        pixels): preview the region around it soon (coalesced with the dabs that follow). False if
+        the method previews no stroke that way."""
+        if self.doc.studio.preview_around is None or self.last is None:
+            return False
+        if self._around_box is None:
+            self._around_box = tuple(box)
+        else:
+            a = self._around_box
+            self._around_box = (min(a[0], box[0]), min(a[1], box[1]), max(a[2], box[2]), max(a[3], box[3]))
+        if not self._preview_timer.isActive():
+            self._preview_timer.start()
+        return True
+
+    def stroke_cancelled(self) -> None:
+        """The stroke was cancelled: drop its previews and show the last full result again."""
+        self._preview_timer.stop()
+        self._around_box = None
+        self._around_image = None
+        self.runner.cancel("preview")
+        self._preview_running, self._preview_dirty = None, False
+        if self.last is not None:
+            self.shown.emit(self.last)
 
     def final(self, *, now: bool = False) -> None:
         """Ask for the full-size render (coalesced; ``now`` skips the short delay)."""
@@ -206,20 +241,32 @@ class Renderer(QObject):
             return None
         inputs, params = built
         doc = self.doc
+        around = None
+        if slot == "preview" and self._around_box is not None:
+            box, self._around_box = self._around_box, None
+            around = crop_around(doc.studio, doc.method_inputs(live=True), doc.run_params(), box)
+            if around is None:
+                return None  # nothing painted near the stroke: the release renders
+            inputs, params = around.inputs, around.params
         method, seed = doc.current, doc.seed
         recipe = None if preview else doc.recipe(params)
+        masks = None if preview else doc.masks()
         before = doc.image(doc.studio.compare_input(doc.inputs))
 
         def job(*, progress=None, cancel=None):
             # Previews report nothing; a final render's partial images are built at most every
             # PARTIAL_INTERVAL seconds (a fast render never pays for one).
             report = None if preview or progress is None else _Partial(progress)
-            return (*_render(method, inputs, params, seed, report, cancel, final=not preview), recipe, before)
+            return (*_render(method, inputs, params, seed, report, cancel, final=not preview), recipe, before,
+                    masks, around)
 
         if slot == "final":
             self.runner.cancel("preview")
             self._preview_running, self._preview_dirty = None, False
+            self._around_box = None
         handle = self.runner.submit(slot, job)
+        if around is not None:
+            self._around_jobs.add(handle.id)
         if slot == "preview":
             self._preview_running = handle.id
             handle.future.add_done_callback(lambda _f, jid=handle.id: self._preview_finished.emit(jid))
@@ -258,16 +305,35 @@ class Renderer(QObject):
             self._busy_timer.stop()
             self.busy.emit(False)
             self._start_warm_up()  # the first result (or error) is in: the other methods' turn
+        around = result.job_id in self._around_jobs
+        self._around_jobs.discard(result.job_id)
         if result.error is not None:
-            if self.last is None or result.job_id > self.last.job_id:
+            if not around and (self.last is None or result.job_id > self.last.job_id):
                 self.failed.emit(f"render failed: {result.error}")
             return
         if self.last is not None and result.job_id < self.last.job_id:
             return  # older than what is shown: stale
-        res, seconds, final, prepared, compiled, recipe, before = result.value
+        res, seconds, final, prepared, compiled, recipe, before, masks, crop = result.value
+        if crop is not None:
+            self._show_around(res, crop, result.job_id, seconds)
+            return
+        if final:
+            self._around_image = None
         self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared, compiled,
-                          recipe, before)
+                          recipe, before, masks)
         self.shown.emit(self.last)
+
+    def _show_around(self, res, crop, job_id: int, seconds: float) -> None:
+        """Paste a preview around a stroke into the full result (and the stroke's earlier ones)."""
+        if self.last is None:
+            return
+        base = self._around_image if self._around_image is not None else self.last.image
+        pasted = crop.paste(base if self._around_image is not None else base.copy(), res.image)
+        if pasted is None:
+            return  # the crop's result does not fit the full one (another size): the release renders
+        self._around_image = pasted
+        self.around_shown.emit(Shown(pasted, job_id, seconds, dict(res.figures), False, recipe=None,
+                                     before=self.last.before))
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
         if slot != "final" or job_id != self.latest_final:

@@ -42,6 +42,7 @@ class ImageView(QGraphicsView):
         self.image: np.ndarray | None = None
         self.tool = None
         self.auto_fit = True  # keep fitting the image to the window until the user zooms
+        self._frame: QRectF | None = None  # a tool's frame around the image (an uncrop's grown canvas)
         self._pan_from = None
         self._space = False
         self.setTransformationAnchor(QGraphicsView.ViewportAnchor.NoAnchor)
@@ -64,10 +65,30 @@ class ImageView(QGraphicsView):
             self._item.setPixmap(QPixmap())
             return
         self._item.setPixmap(QPixmap.fromImage(to_qimage(image)))
-        self.scene().setSceneRect(self._item.boundingRect())
+        self._set_scene_rect()
         if fit or first or (resized and self.auto_fit):
             self.fit()
         self.viewport().update()
+
+    def set_frame(self, rect: QRectF | None, *, fit: bool = True) -> None:
+        """A tool draws a frame around the image (the grown canvas of an uncrop): the scene keeps
+        room around the image and the frame, to drag its edges in; None: just the image."""
+        if rect == self._frame:
+            return
+        self._frame = rect
+        self._set_scene_rect()
+        if fit and self.auto_fit and self.image is not None:
+            self.fit()
+
+    def _set_scene_rect(self) -> None:
+        rect = self._item.boundingRect()
+        if self._frame is not None and not rect.isEmpty():
+            room = 0.12 * max(rect.width(), rect.height())
+            rect = rect.united(self._frame).adjusted(-room, -room, room, room)
+        self.scene().setSceneRect(rect)
+
+    def _fitted(self) -> QRectF:
+        return self.sceneRect() if self._frame is not None else self._item.sceneBoundingRect()
 
     def image_size(self) -> tuple[int, int]:
         return (0, 0) if self.image is None else (self.image.shape[1], self.image.shape[0])
@@ -79,7 +100,7 @@ class ImageView(QGraphicsView):
     def fit(self) -> None:
         self.auto_fit = True
         if self.image is not None:
-            self.fitInView(self._item, Qt.AspectRatioMode.KeepAspectRatio)
+            self.fitInView(self._fitted(), Qt.AspectRatioMode.KeepAspectRatio)
             self.zoomed.emit(self.scale_factor())
 
     def actual_size(self) -> None:
@@ -90,7 +111,7 @@ class ImageView(QGraphicsView):
     def resizeEvent(self, event):  # noqa: N802
         super().resizeEvent(event)
         if self.auto_fit and self.image is not None:
-            self.fitInView(self._item, Qt.AspectRatioMode.KeepAspectRatio)
+            self.fitInView(self._fitted(), Qt.AspectRatioMode.KeepAspectRatio)
             self.zoomed.emit(self.scale_factor())  # the % label follows a refit on resize
 
     def zoom_by(self, factor: float, at=None) -> None:

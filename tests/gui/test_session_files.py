@@ -183,7 +183,7 @@ def test_session_images_are_decoded_off_the_gui_thread_while_it_keeps_running(wi
     window.doc.set_input("texture", str(texture), load_image(texture).image)
     session = tmp_path / "s.weft.json"
     assert window.save_session(str(session))
-    flags = _runs_off_gui_thread(monkeypatch, files, "load_image", lambda: window.open_session(str(session)))
+    flags = _runs_off_gui_thread(monkeypatch, files, "read_input", lambda: window.open_session(str(session)))
     assert flags and not any(flags)  # every image of the session, none on the GUI thread
     assert window.doc.inputs["texture"].path == str(texture)
 

@@ -1,0 +1,545 @@
+"""The tools of a painted mask and of an uncrop's margins (DESIGN.md, Studio and Geometry).
+
+* ``MaskTool`` paints a mask geometry (``Geometry(MASK, input=...)``) of the document's current
+  method over its image: brush and eraser (round, size with ``[`` / ``]``, shown as a circle of the
+  brush's size on screen), lasso (add or subtract a polygon). The mask is drawn over the image in a
+  semi-transparent colour. A stroke is painted with the Qt-free ``Mask.painted_line`` /
+  ``painted_polygon`` and is one undo command, pushed on release; Esc cancels a stroke in progress.
+  While a brush stroke is drawn, ``on_stroke(mask, box)`` hears the mask so far and the box around
+  the latest dab (the window renders a preview around it).
+* ``MarginsTool`` edits a margins geometry (``Geometry(MARGINS, param=...)``): a press outside the
+  image drags the canvas edges on that side outward (the grown frame drawn as a dashed outline);
+  one undo command on release; Esc cancels.
+* ``ToolSet`` puts several tools on one view: a press goes to the first tool that wants it (the
+  margins tool wants presses outside the image), hover moves to all.
+* ``GeometryBar`` is the row of buttons over a view with such tools: brush, eraser, lasso +/-, brush
+  size, Clear mask, Invert, Fill transparent, Extend canvas…
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QBrush, QColor, QImage, QPainterPath, QPen, QPixmap
+from PySide6.QtWidgets import (
+    QButtonGroup,
+    QDialog,
+    QDialogButtonBox,
+    QFormLayout,
+    QGraphicsEllipseItem,
+    QGraphicsPathItem,
+    QGraphicsPixmapItem,
+    QGraphicsRectItem,
+    QHBoxLayout,
+    QLabel,
+    QSpinBox,
+    QToolButton,
+    QWidget,
+)
+
+from weft.core.geometry import MAX_SIDE, Margins, Mask
+
+from .tools import Tool, _cosmetic
+
+MASK_RGBA = (255, 48, 96, 120)  # the mask's colour over the image
+BRUSH_MIN, BRUSH_MAX, BRUSH_DEFAULT = 1, 512, 24
+BRUSH, ERASER, LASSO_ADD, LASSO_SUBTRACT = "brush", "eraser", "lasso add", "lasso subtract"
+MODES = (BRUSH, ERASER, LASSO_ADD, LASSO_SUBTRACT)
+
+
+def mask_overlay(mask: Mask | None) -> QPixmap:
+    """The mask as a pixmap: its colour where it is set, transparent elsewhere."""
+    if mask is None:
+        return QPixmap()
+    h, w = mask.shape
+    rgba = np.zeros((h, w, 4), dtype=np.uint8)
+    rgba[mask.bits] = MASK_RGBA
+    image = QImage(rgba.data, w, h, 4 * w, QImage.Format.Format_RGBA8888)
+    return QPixmap.fromImage(image.copy())  # a deep copy first: fromImage may share the numpy buffer, which goes
+
+
+class MaskTool(Tool):
+    """Paints the mask geometry ``geometry`` of the current method on ``view`` (module docstring)."""
+
+    def __init__(self, view, doc, geometry, on_stroke: Callable[[Mask | None, tuple | None], None] | None = None,
+                 on_size: Callable[[int], None] | None = None):
+        self.view, self.doc, self.geometry, self.on_stroke, self.on_size = view, doc, geometry, on_stroke, on_size
+        self.geometry_key = geometry.key
+        self.mode = BRUSH
+        self.size = BRUSH_DEFAULT  # brush diameter in image pixels
+        scene = view.scene()
+        self.overlay = QGraphicsPixmapItem()
+        self.overlay.setZValue(5)
+        scene.addItem(self.overlay)
+        self.cursor = QGraphicsEllipseItem()
+        self.cursor.setPen(_cosmetic(QColor(255, 255, 255, 230), 1.5))
+        self.cursor.setZValue(30)
+        self.cursor.hide()
+        scene.addItem(self.cursor)
+        self.lasso_item = QGraphicsPathItem()
+        self.lasso_item.setPen(_cosmetic(QColor("#ffd740"), 1.5, Qt.PenStyle.DashLine))
+        self.lasso_item.setBrush(QBrush(QColor(255, 215, 64, 50)))
+        self.lasso_item.setZValue(25)
+        scene.addItem(self.lasso_item)
+        self.live: Mask | None = None  # the mask with the stroke so far
+        self.last: tuple[float, float] | None = None
+        self.points: list[tuple[float, float]] = []
+        self.active = False
+        self.refresh()
+
+    # --- state ---------------------------------------------------------------------------------
+    @property
+    def stroking(self) -> bool:
+        return self.active
+
+    def mask(self) -> Mask | None:
+        """The document's mask if it fits the image shown (else None)."""
+        value = self.doc.value(self.geometry_key)
+        w, h = self.view.image_size()
+        return value if value is not None and value.shape == (h, w) else None
+
+    def base(self) -> Mask:
+        mask = self.mask()
+        w, h = self.view.image_size()
+        return mask if mask is not None else Mask.empty(max(w, 1), max(h, 1))
+
+    @property
+    def radius(self) -> float:
+        """The brush's radius for ``Mask.painted_line``: a diameter of ``size`` pixels."""
+        return (self.size - 1) / 2.0
+
+    def set_mode(self, mode: str) -> None:
+        if mode in MODES:
+            self.mode = mode
+            self._show_cursor(None)
+
+    def set_size(self, size: int) -> None:
+        size = int(min(max(size, BRUSH_MIN), BRUSH_MAX))
+        if size != self.size:
+            self.size = size
+            if self.cursor.isVisible():
+                self._show_cursor(self.cursor.rect().center())
+            if self.on_size is not None:
+                self.on_size(size)
+
+    def grow(self, steps: int) -> None:
+        """``]`` (+1) and ``[`` (-1): the brush size by a quarter (at least a pixel) per step."""
+        size = self.size
+        for _ in range(abs(steps)):
+            change = max(1, round(size * 0.25))
+            size = size + change if steps > 0 else max(BRUSH_MIN, size - max(1, round(size * 0.2)))
+        self.set_size(size)
+
+    # --- drawing -------------------------------------------------------------------------------
+    def refresh(self) -> None:
+        self._draw(self.live if self.active and self.live is not None else self.mask())
+
+    def hide(self) -> None:
+        self.active = False
+        self.live = None
+        self.points = []
+        self.lasso_item.setPath(QPainterPath())
+        self.overlay.setPixmap(QPixmap())
+        self.cursor.hide()
+
+    def _draw(self, mask: Mask | None) -> None:
+        self.overlay.setPixmap(mask_overlay(mask if mask is not None and mask else None))
+
+    def _show_cursor(self, pos) -> None:
+        if pos is None or self.mode not in (BRUSH, ERASER):
+            self.cursor.hide()
+            return
+        r = self.size / 2.0
+        self.cursor.setRect(QRectF(pos.x() - r, pos.y() - r, 2 * r, 2 * r))
+        self.cursor.show()
+
+    @staticmethod
+    def _pixel(pos) -> tuple[float, float]:
+        """Scene point -> the mask's pixel coordinates (pixel centres at whole numbers)."""
+        return pos.x() - 0.5, pos.y() - 0.5
+
+    def _dab(self, p0, p1) -> None:
+        value = self.mode == BRUSH
+        self.live = self.live.painted_line(p0, p1, self.radius, value)
+        self.last = p1
+        self._draw(self.live)
+        if self.on_stroke is not None and value:
+            r = self.radius + 1
+            box = (min(p0[0], p1[0]) - r, min(p0[1], p1[1]) - r, max(p0[0], p1[0]) + r, max(p0[1], p1[1]) + r)
+            self.on_stroke(self.live, box)
+
+    def press(self, view, pos, event):
+        self.active = True
+        self.live = self.base()
+        p = self._pixel(pos)
+        if self.mode in (BRUSH, ERASER):
+            self._dab(p, p)
+        else:
+            self.points = [p]
+            self._draw_lasso()
+
+    def move(self, view, pos, event):
+        inside = 0 <= pos.x() <= view.image_size()[0] and 0 <= pos.y() <= view.image_size()[1]
+        self._show_cursor(pos if inside or self.active else None)
+        if not self.active or not (event.buttons() & Qt.MouseButton.LeftButton):
+            return
+        p = self._pixel(pos)
+        if self.mode in (BRUSH, ERASER):
+            self._dab(self.last, p)
+        else:
+            self.points.append(p)
+            self._draw_lasso()
+
+    def _draw_lasso(self) -> None:
+        path = QPainterPath()
+        if self.points:
+            path.moveTo(QPointF(self.points[0][0] + 0.5, self.points[0][1] + 0.5))
+            for x, y in self.points[1:]:
+                path.lineTo(QPointF(x + 0.5, y + 0.5))
+            path.closeSubpath()
+        self.lasso_item.setPath(path)
+
+    def release(self, view, pos, event):
+        if not self.active:
+            return
+        if self.mode in (BRUSH, ERASER):
+            if self.last is not None and self._pixel(pos) != self.last:
+                self._dab(self.last, self._pixel(pos))
+            mask, text = self.live, "Brush stroke" if self.mode == BRUSH else "Erase"
+        else:
+            self.points.append(self._pixel(pos))
+            mask = self.live.painted_polygon(self.points, self.mode == LASSO_ADD)
+            text = "Lasso" if self.mode == LASSO_ADD else "Lasso subtract"
+        self._end()
+        if mask != self.base():
+            self.doc.set_mask(self.geometry_key, mask, text)
+        self.refresh()
+
+    def _end(self) -> None:
+        self.active = False
+        self.live = None
+        self.last = None
+        self.points = []
+        self.lasso_item.setPath(QPainterPath())
+
+    def cancel(self) -> bool:
+        """Esc: drop the stroke in progress (the mask stays as it was); False if there is none."""
+        if not self.active:
+            return False
+        self._end()
+        self.refresh()
+        if self.on_stroke is not None:
+            self.on_stroke(None, None)
+        return True
+
+    def key(self, view, event) -> bool:
+        if event.key() == Qt.Key.Key_Escape:
+            return self.cancel()
+        if event.key() == Qt.Key.Key_BracketRight:
+            self.grow(+1)
+            return True
+        if event.key() == Qt.Key.Key_BracketLeft:
+            self.grow(-1)
+            return True
+        return False
+
+
+class MarginsTool(Tool):
+    """Drags the canvas's edges outward: the margins geometry ``geometry`` (module docstring)."""
+
+    def __init__(self, view, doc, geometry, on_drag: Callable[[Margins], None] | None = None):
+        self.view, self.doc, self.geometry, self.on_drag = view, doc, geometry, on_drag
+        self.geometry_key = geometry.key
+        self.frame = QGraphicsRectItem()
+        self.frame.setPen(_cosmetic(QColor("#40c4ff"), 2, Qt.PenStyle.DashLine))
+        self.frame.setZValue(15)
+        view.scene().addItem(self.frame)
+        self.drag = None  # (sides, start point, start margins)
+        self.live: Margins | None = None
+        self.refresh()
+
+    def margins(self) -> Margins:
+        value = self.doc.value(self.geometry_key)
+        return value if value is not None else Margins(0, 0, 0, 0)
+
+    def wants(self, pos) -> bool:
+        """A press outside the image is an edge drag."""
+        w, h = self.view.image_size()
+        return pos.x() < 0 or pos.y() < 0 or pos.x() > w or pos.y() > h
+
+    def refresh(self) -> None:
+        self._show(self.live if self.live is not None else self.margins())
+
+    def hide(self) -> None:
+        self.drag = None
+        self.live = None
+        self.frame.hide()
+        self.view.set_frame(None)
+
+    def _show(self, m: Margins) -> None:
+        w, h = self.view.image_size()
+        rect = QRectF(-m.left, -m.top, w + m.left + m.right, h + m.top + m.bottom)
+        self.frame.setRect(rect)
+        self.frame.setVisible(bool(m))
+        self.view.set_frame(rect, fit=self.drag is None)  # no refit under the mouse mid-drag
+
+    def press(self, view, pos, event):
+        w, h = view.image_size()
+        sides = (pos.x() < 0, pos.y() < 0, pos.x() > w, pos.y() > h)  # left, top, right, bottom
+        self.drag = (sides, (pos.x(), pos.y()), self.margins())
+        self.live = self.margins()
+
+    def _dragged(self, pos) -> Margins:
+        sides, (x0, y0), m = self.drag
+        dx, dy = pos.x() - x0, pos.y() - y0
+        moves = (-dx, -dy, dx, dy)
+        return Margins(*(max(0, min(MAX_SIDE, int(round(v + d)))) if s else v
+                         for v, d, s in zip(m, moves, sides)))
+
+    def move(self, view, pos, event):
+        if self.drag is None or not (event.buttons() & Qt.MouseButton.LeftButton):
+            return
+        self.live = self._dragged(pos)
+        self._show(self.live)
+        if self.on_drag is not None:
+            self.on_drag(self.live)
+
+    def release(self, view, pos, event):
+        if self.drag is None:
+            return
+        margins = self._dragged(pos)
+        self.drag = None
+        self.live = None
+        if margins != self.margins():
+            self.doc.set_margins(self.geometry_key, margins, f"Extend canvas {margins.to_text()}")
+        self.refresh()
+
+    def key(self, view, event) -> bool:
+        if event.key() == Qt.Key.Key_Escape and self.drag is not None:
+            self.drag = None
+            self.live = None
+            self.refresh()
+            return True
+        return False
+
+
+class ToolSet(Tool):
+    """Several tools on one view: a press goes to the first that ``wants`` it (else the last), the
+    rest of that drag to it; hover moves to every tool; keys to the dragging tool first."""
+
+    def __init__(self, tools):
+        self.tools = list(tools)
+        self.view = self.tools[0].view
+        self.grabbed: Tool | None = None
+
+    def _pick(self, pos) -> Tool:
+        for tool in self.tools:
+            wants = getattr(tool, "wants", None)
+            if wants is not None and wants(pos):
+                return tool
+        return next((t for t in self.tools if getattr(t, "wants", None) is None), self.tools[-1])
+
+    def press(self, view, pos, event):
+        self.grabbed = self._pick(pos)
+        self.grabbed.press(view, pos, event)
+
+    def move(self, view, pos, event):
+        if self.grabbed is not None and event.buttons() & Qt.MouseButton.LeftButton:
+            self.grabbed.move(view, pos, event)
+            return
+        for tool in self.tools:
+            tool.move(view, pos, event)
+
+    def release(self, view, pos, event):
+        tool, self.grabbed = self.grabbed, None
+        if tool is not None:
+            tool.release(view, pos, event)
+
+    def key(self, view, event) -> bool:
+        order = ([self.grabbed] if self.grabbed is not None else []) + [t for t in self.tools if t is not self.grabbed]
+        return any(t.key(view, event) for t in order)
+
+    def refresh(self) -> None:
+        for tool in self.tools:
+            tool.refresh()
+
+    def hide(self) -> None:
+        for tool in self.tools:
+            tool.hide()
+
+
+class ExtendDialog(QDialog):
+    """"Extend canvas…": the four margins typed, in pixels."""
+
+    def __init__(self, margins: Margins, size: tuple[int, int], parent=None):
+        super().__init__(parent)
+        self.setWindowTitle("Extend canvas")
+        self.size_ = size
+        form = QFormLayout(self)
+        self.boxes = {}
+        for side, value in zip(("left", "top", "right", "bottom"), margins):
+            box = QSpinBox()
+            box.setRange(0, MAX_SIDE)
+            box.setSuffix(" px")
+            box.setValue(int(value))
+            box.setAccessibleName(f"{side} margin")
+            box.valueChanged.connect(self._say)
+            form.addRow(f"{side.capitalize()}:", box)
+            self.boxes[side] = box
+        self.result_label = QLabel()
+        form.addRow(self.result_label)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel)
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+        self._say()
+
+    def margins(self) -> Margins:
+        return Margins(*(self.boxes[s].value() for s in ("left", "top", "right", "bottom")))
+
+    def _say(self) -> None:
+        w, h = self.size_
+        gw, gh = self.margins().grown(w, h)
+        self.result_label.setText(f"canvas {w}x{h} → {gw}x{gh}")
+
+
+class GeometryBar(QWidget):
+    """The buttons of a view's mask and margins tools (module docstring). ``message(text)``: a
+    one-line note (why an action did nothing)."""
+
+    message = Signal(str)
+
+    def __init__(self, doc, parent=None):
+        super().__init__(parent)
+        self.doc = doc
+        self.mask_tool: MaskTool | None = None
+        self.margins_tool: MarginsTool | None = None
+        row = QHBoxLayout(self)
+        row.setContentsMargins(4, 1, 4, 1)
+        row.setSpacing(2)
+        self.mode_group = QButtonGroup(self)
+        self.mode_buttons = {}
+        tips = {BRUSH: "paint the mask (B; [ and ] size the brush)", ERASER: "erase the mask (E)",
+                LASSO_ADD: "draw a closed outline to add to the mask (L)",
+                LASSO_SUBTRACT: "draw a closed outline to take from the mask"}
+        labels = {BRUSH: "Brush", ERASER: "Eraser", LASSO_ADD: "Lasso +", LASSO_SUBTRACT: "Lasso −"}
+        for mode in MODES:
+            b = QToolButton()
+            b.setText(labels[mode])
+            b.setCheckable(True)
+            b.setToolTip(tips[mode])
+            b.setAutoRaise(True)
+            self.mode_group.addButton(b)
+            self.mode_buttons[mode] = b
+            b.toggled.connect(lambda on, m=mode: on and self.mask_tool is not None and self.mask_tool.set_mode(m))
+            row.addWidget(b)
+        self.size_box = QSpinBox()
+        self.size_box.setRange(BRUSH_MIN, BRUSH_MAX)
+        self.size_box.setSuffix(" px")
+        self.size_box.setToolTip("brush size in image pixels ([ smaller, ] larger)")
+        self.size_box.valueChanged.connect(lambda v: self.mask_tool is not None and self.mask_tool.set_size(v))
+        row.addWidget(self.size_box)
+        self.clear_button = self._button(row, "Clear mask", "remove the whole mask", self.clear_mask)
+        self.invert_button = self._button(row, "Invert", "swap what the mask covers and what it does not",
+                                          self.invert_mask)
+        self.transparent_button = self._button(row, "Fill transparent", "", self.fill_transparent)
+        self.extend_button = self._button(row, "Extend canvas…", "type the pixels to add on each side "
+                                          "(or drag outside the image)", self.extend_dialog)
+        row.addStretch(1)
+
+    def _button(self, row, text, tip, slot) -> QToolButton:
+        b = QToolButton()
+        b.setText(text)
+        b.setToolTip(tip)
+        b.setAutoRaise(True)
+        b.clicked.connect(slot)
+        row.addWidget(b)
+        return b
+
+    def attach(self, mask_tool: MaskTool | None, margins_tool: MarginsTool | None) -> None:
+        """Show the buttons of these tools (a view with neither hides the bar)."""
+        self.mask_tool, self.margins_tool = mask_tool, margins_tool
+        has_mask = mask_tool is not None
+        for b in [*self.mode_buttons.values(), self.size_box, self.clear_button, self.invert_button,
+                  self.transparent_button]:
+            b.setVisible(has_mask)
+        self.extend_button.setVisible(margins_tool is not None)
+        if has_mask:
+            mask_tool.on_size = self._show_size
+            self.mode_buttons[mask_tool.mode].setChecked(True)
+            self._show_size(mask_tool.size)
+        self.setVisible(has_mask or margins_tool is not None)
+        self.refresh()
+
+    def _show_size(self, size: int) -> None:
+        if self.size_box.value() != size:
+            self.size_box.blockSignals(True)
+            self.size_box.setValue(size)
+            self.size_box.blockSignals(False)
+
+    def _on_image(self) -> tuple[str, object | None]:
+        on = self.mask_tool.geometry.input_for(self.doc.inputs)
+        return on, self.doc.inputs.get(on)
+
+    def refresh(self) -> None:
+        """Enable the actions that can do something now (a disabled one says why in its tooltip)."""
+        if self.mask_tool is None:
+            return
+        on, item = self._on_image()
+        pretty = on.replace("_", " ")
+        mask = self.mask_tool.mask()
+        self.clear_button.setEnabled(mask is not None and bool(mask))
+        self.invert_button.setEnabled(item is not None)
+        alpha = None if item is None else item.alpha
+        if item is None:
+            why = f"no {pretty} is open"
+        elif alpha is None:
+            why = f"the {pretty} has no alpha channel: nothing is transparent"
+        elif not (alpha < 0.5).any():
+            why = f"the {pretty} has an alpha channel but no transparent pixel"
+        else:
+            why = ""
+        self.transparent_button.setEnabled(not why)
+        self.transparent_button.setToolTip(why or f"make the mask the transparent pixels of the {pretty}")
+
+    def _size(self) -> tuple[int, int]:
+        return self.mask_tool.view.image_size()
+
+    def clear_mask(self) -> None:
+        if self.mask_tool is not None and self.mask_tool.mask() is not None:
+            self.doc.set_mask(self.mask_tool.geometry_key, None, "Clear mask")
+
+    def invert_mask(self) -> None:
+        if self.mask_tool is None or self._on_image()[1] is None:
+            return
+        base = self.mask_tool.base()
+        self.doc.set_mask(self.mask_tool.geometry_key, Mask(~base.bits), "Invert mask")
+
+    def fill_transparent(self) -> None:
+        if self.mask_tool is None:
+            return
+        on, item = self._on_image()
+        if item is None or item.alpha is None:
+            self.message.emit(f"the {on.replace('_', ' ')} has no alpha channel: nothing is transparent")
+            return
+        self.doc.set_mask(self.mask_tool.geometry_key, Mask.from_alpha(item.alpha), "Fill transparent")
+
+    def extend_dialog(self) -> ExtendDialog | None:
+        """Open the "Extend canvas" dialog (window-modal); OK sets the margins (one undo step)."""
+        tool = self.margins_tool
+        if tool is None:
+            return None
+        dialog = ExtendDialog(tool.margins(), tool.view.image_size(), self.window())
+        dialog.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+
+        def apply() -> None:
+            margins = dialog.margins()
+            if margins != tool.margins():
+                self.doc.set_margins(tool.geometry_key, margins, f"Extend canvas {margins.to_text()}")
+
+        dialog.accepted.connect(apply)
+        self.dialog = dialog  # (the open one: tests reach it)
+        dialog.open()
+        return dialog

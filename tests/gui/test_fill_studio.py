@@ -1,0 +1,389 @@
+"""Issue 15, the studio side of fill and extend: the mask tool (brush, eraser, lasso, Clear, Invert,
+Fill transparent) and the margins tool (drag, Extend canvas…), driven with real mouse and key events.
+
+The studio is generic: these tests drive it with a method registered here (it fills its painted mask
+with the mean colour of the rest of the picture, and grows the canvas by its margins, filling the new
+border alike), so they test the studio, not any one method; nothing in app/gui knows it.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPointF, Qt
+from PySide6.QtGui import QImage
+
+from weft.app.cli import main as weft
+from weft.core import registry
+from weft.core.errors import WeftError
+from weft.core.geometry import Margins, Mask
+from weft.core.image import load_image, read_recipe, save_image
+from weft.core.params import Params, param
+from weft.core.registry import InputSpec, Method, Result
+from weft.core.studio import MARGINS, MASK, Geometry, Studio
+
+from .helpers import mouse
+
+W, H = 80, 64
+
+
+@dataclass(frozen=True)
+class MeanFillParams(Params):
+    grow: Margins = param(None, kind="geometry", type=Margins, optional=True, help="pixels added on each side")
+    amount: float = param(1.0, lo=0.0, hi=1.0, step=0.05, help="how far towards the mean")
+
+
+CALLS: list[tuple[int, int]] = []  # the picture sizes the method ran on (previews around a stroke are small)
+
+
+def _mean_fill(inputs, params, *, rng=None, progress=None, cancel=None):
+    picture = inputs["picture"]
+    CALLS.append(picture.shape[:2])
+    hole = inputs.get("hole")
+    bits = np.zeros(picture.shape[:2], bool) if hole is None else np.asarray(hole) > 0.5
+    if hole is not None and hole.shape[:2] != picture.shape[:2]:
+        raise WeftError("the hole is not the size of the picture")
+    if params.grow:
+        left, top, right, bottom = params.grow
+        picture = np.pad(picture, ((top, bottom), (left, right), (0, 0)))
+        bits = np.pad(bits, ((top, bottom), (left, right)), constant_values=True)
+    out = picture.copy()
+    if bits.any() and not bits.all():
+        mean = picture[~bits].mean(axis=0)
+        out[bits] = picture[bits] + params.amount * (mean - picture[bits])
+    return Result(out, {"hole_pixels": int(bits.sum())})
+
+
+MEAN_FILL = Method(
+    name="mean-fill", summary="fill a painted hole with the mean colour of the rest", params=MeanFillParams,
+    inputs=(InputSpec("picture", "the picture"), InputSpec("hole", "white = fill", required=False)),
+    run=_mean_fill,
+    studio=Studio(title="Mean fill", canvas="picture", preview_around="hole",
+                  geometry=(Geometry(MASK, on=("picture",), input="hole", help="paint the hole"),
+                            Geometry(MARGINS, on=("picture",), param="grow", help="drag an edge outward"))),
+)
+
+
+@pytest.fixture
+def plugin():
+    registry.register(MEAN_FILL)
+    yield MEAN_FILL
+    registry.unregister(MEAN_FILL.name)
+
+
+def _picture(path, seed=3, alpha=None):
+    pixels = np.random.default_rng(seed).random((H, W, 3)).astype(np.float32)
+    if alpha is None:
+        save_image(path, pixels)
+    else:  # an RGBA PNG: Qt writes it (weft's save_image writes colour only)
+        rgba = np.dstack([pixels, alpha]).clip(0, 1)
+        data = np.ascontiguousarray((rgba * 255 + 0.5).astype(np.uint8))
+        QImage(data.data, W, H, 4 * W, QImage.Format.Format_RGBA8888).save(str(path))
+    return path
+
+
+@pytest.fixture
+def studio(plugin, qtbot, settings, tmp_path):
+    """The window on the mean-fill method with a picture open, its first result shown, zoomed 4x."""
+    from weft.app.gui.main_window import MainWindow
+
+    CALLS.clear()
+    window = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(window)
+    window.resize(1300, 820)
+    window.show()
+    box = window.method_panel.method_box
+    box.setCurrentIndex(box.findData(plugin.name))
+    picture = _picture(tmp_path / "picture.png")
+    window.open_input("picture", str(picture))
+    qtbot.waitUntil(lambda: window.doc.image("picture") is not None, timeout=10000)
+    qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=10000)
+    view = window.canvas_view
+    view.actual_size()
+    view.zoom_by(4.0)
+    view.centerOn(W / 2, H / 2)
+    window.picture = picture
+    yield window
+    window.shutdown()
+
+
+def _mask(window) -> Mask | None:
+    return window.doc.value("hole")
+
+
+def _stroke(view, points, *, release=True):
+    mouse(view, "press", points[0])
+    for p in points[1:]:
+        mouse(view, "move", p)
+    if release:
+        mouse(view, "release", points[-1])
+
+
+def _final_after(window, qtbot, action):
+    """Do ``action`` and wait for the full-size result it causes."""
+    with qtbot.waitSignal(window.renderer.shown, timeout=10000,
+                          check_params_cb=lambda shown: shown.final):
+        action()
+    return window.renderer.last
+
+
+def test_the_mask_input_is_painted_over_its_image_not_a_view_of_its_own(studio):
+    assert "hole" not in studio.views
+    tabs = [studio.input_tabs.tabText(i) for i in range(studio.input_tabs.count())]
+    assert not any("hole" in t for t in tabs)
+    bar = studio.inputs_pane.bar()
+    assert bar is not None and bar.isVisible()
+    assert bar.mode_buttons["brush"].isChecked()
+    assert not bar.clear_button.isEnabled()  # nothing painted yet
+
+
+def test_a_brush_stroke_paints_the_pixels_under_it_and_is_one_undo_step(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    tool = studio.inputs_pane.mask_tool()
+    tool.set_size(5)  # radius 2
+    steps = doc.undo_stack.count()
+    result = _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 20.5), (20.5, 20.5), (30.5, 20.5)]))
+    mask = _mask(studio)
+    assert mask is not None and mask.shape == (H, W)
+    expected = Mask.empty(W, H).painted_line((10, 20), (20, 20), 2).painted_line((20, 20), (30, 20), 2)
+    assert mask == expected
+    assert mask.bits[20, 10:31].all() and mask.bits[18:23, 15].all() and not mask.bits[17, 15] and not mask.bits[23, 15]
+    # the method got the mask: the hole is the mean of the rest, the rest untouched
+    source = doc.image("picture")
+    assert result.figures["hole_pixels"] == mask.area
+    assert np.allclose(result.image[mask.bits], source[~mask.bits].mean(axis=0), atol=1e-5)
+    assert np.array_equal(result.image[~mask.bits], source[~mask.bits])
+    # the overlay shows the mask over the image: coloured where painted, clear elsewhere
+    overlay = tool.overlay.pixmap().toImage()
+    assert overlay.width() == W and overlay.pixelColor(20, 20).alpha() > 0 and overlay.pixelColor(20, 40).alpha() == 0
+    assert doc.undo_stack.count() == steps + 1 and doc.undo_stack.text(steps) == "Brush stroke"
+    # Ctrl+Z undoes the whole stroke
+    view.setFocus()
+    _final_after(studio, qtbot, lambda: qtbot.keyClick(studio, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier))
+    assert _mask(studio) is None
+    assert np.array_equal(studio.renderer.last.image, source)
+    assert tool.overlay.pixmap().isNull()
+
+
+def test_square_brackets_size_the_brush_and_its_circle_cursor(studio, qtbot):
+    view = studio.canvas_view
+    tool = studio.inputs_pane.mask_tool()
+    bar = studio.inputs_pane.bar()
+    tool.set_size(8)
+    mouse(view, "move", (40.5, 30.5), buttons=Qt.MouseButton.NoButton)
+    assert tool.cursor.isVisible()
+    on_screen = view.mapFromScene(tool.cursor.rect()).boundingRect().width()
+    assert abs(on_screen - 8 * view.scale_factor()) <= 2  # the brush's size on screen
+    view.setFocus()
+    qtbot.keyClick(view, Qt.Key.Key_BracketRight)
+    assert tool.size == 10 and bar.size_box.value() == 10
+    assert abs(tool.cursor.rect().width() - 10) < 1e-6
+    qtbot.keyClick(view, Qt.Key.Key_BracketRight)
+    qtbot.keyClick(view, Qt.Key.Key_BracketRight)
+    assert tool.size > 12
+    big = tool.size
+    qtbot.keyClick(view, Qt.Key.Key_BracketLeft)
+    assert tool.size < big
+    # a larger brush paints a wider stroke
+    tool.set_size(11)  # radius 5
+    _final_after(studio, qtbot, lambda: _stroke(view, [(40.5, 30.5), (41.5, 30.5)]))
+    column = _mask(studio).bits[:, 40]
+    assert column[25:36].all() and not column[24] and not column[36]
+
+
+def test_the_eraser_removes_and_esc_cancels_a_stroke_in_progress(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    tool = studio.inputs_pane.mask_tool()
+    bar = studio.inputs_pane.bar()
+    tool.set_size(9)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 30.5), (60.5, 30.5)]))
+    painted = _mask(studio)
+    assert painted.bits[30, 35]
+    qtbot.mouseClick(bar.mode_buttons["eraser"], Qt.MouseButton.LeftButton)
+    assert tool.mode == "eraser"
+    tool.set_size(3)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(35.5, 20.5), (35.5, 40.5)]))
+    erased = _mask(studio)
+    assert not erased.bits[25:36, 34:37].any() and erased.bits[30, 33] and erased.bits[30, 37]
+    assert erased.area < painted.area
+    assert doc.undo_stack.text(doc.undo_stack.index() - 1) == "Erase"
+    # Esc in the middle of a stroke: the mask stays as it was, no undo step
+    steps = doc.undo_stack.count()
+    _stroke(view, [(50.5, 25.5), (50.5, 35.5)], release=False)
+    assert tool.stroking
+    view.setFocus()
+    qtbot.keyClick(view, Qt.Key.Key_Escape)
+    mouse(view, "release", (50.5, 35.5))
+    assert not tool.stroking and _mask(studio) == erased and doc.undo_stack.count() == steps
+
+
+def test_the_lasso_adds_and_subtracts_a_polygon(studio, qtbot):
+    view = studio.canvas_view
+    bar = studio.inputs_pane.bar()
+    qtbot.mouseClick(bar.mode_buttons["lasso add"], Qt.MouseButton.LeftButton)
+    square = [(10.5, 10.5), (40.5, 10.5), (40.5, 40.5), (10.5, 40.5)]
+    _final_after(studio, qtbot, lambda: _stroke(view, square))
+    mask = _mask(studio)
+    assert mask.bits[11:40, 11:40].all() and not mask.bits[45:, :].any() and not mask.bits[:, 45:].any()
+    assert mask == Mask.empty(W, H).painted_polygon([(10, 10), (40, 10), (40, 40), (10, 40), (10, 40)])
+    qtbot.mouseClick(bar.mode_buttons["lasso subtract"], Qt.MouseButton.LeftButton)
+    inner = [(20.5, 20.5), (30.5, 20.5), (30.5, 30.5), (20.5, 30.5)]
+    _final_after(studio, qtbot, lambda: _stroke(view, inner))
+    mask = _mask(studio)
+    assert not mask.bits[21:30, 21:30].any() and mask.bits[12:18, 12:38].all()
+
+
+def test_clear_and_invert_are_undoable(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    bar = studio.inputs_pane.bar()
+    studio.inputs_pane.mask_tool().set_size(5)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
+    painted = _mask(studio)
+    assert bar.clear_button.isEnabled()
+    _final_after(studio, qtbot, lambda: qtbot.mouseClick(bar.invert_button, Qt.MouseButton.LeftButton))
+    assert np.array_equal(_mask(studio).bits, ~painted.bits)
+    _final_after(studio, qtbot, lambda: qtbot.mouseClick(bar.clear_button, Qt.MouseButton.LeftButton))
+    assert _mask(studio) is None and not bar.clear_button.isEnabled()
+    doc.undo_stack.undo()
+    doc.undo_stack.undo()
+    assert _mask(studio) == painted
+
+
+def test_fill_transparent_paints_the_images_transparent_pixels(studio, qtbot, tmp_path):
+    bar = studio.inputs_pane.bar()
+    assert not bar.transparent_button.isEnabled()
+    assert "no alpha channel" in bar.transparent_button.toolTip()
+    alpha = np.ones((H, W), np.float32)
+    alpha[:10, :] = 0.0  # a transparent band along the top
+    alpha[30:40, 50:60] = 0.0
+    rgba = _picture(tmp_path / "cutout.png", alpha=alpha)
+    studio.open_input("picture", str(rgba))
+    qtbot.waitUntil(lambda: studio.doc.inputs["picture"].path == str(rgba), timeout=10000)
+    assert studio.doc.inputs["picture"].alpha is not None
+    assert studio.doc.image("picture").shape == (H, W, 3)  # the method gets colour, as weft run gives it
+    qtbot.waitUntil(bar.transparent_button.isEnabled, timeout=5000)
+    result = _final_after(studio, qtbot, lambda: qtbot.mouseClick(bar.transparent_button, Qt.MouseButton.LeftButton))
+    assert _mask(studio) == Mask.from_alpha(alpha)
+    assert result.figures["hole_pixels"] == 10 * W + 100
+    assert studio.doc.undo_stack.text(studio.doc.undo_stack.index() - 1) == "Fill transparent"
+
+
+def test_a_mask_that_no_longer_fits_its_image_is_dropped_with_a_message(studio, qtbot, tmp_path):
+    view = studio.canvas_view
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
+    painted = _mask(studio)
+    other = tmp_path / "other.png"
+    save_image(other, np.random.default_rng(5).random((50, 70, 3)).astype(np.float32))
+    with qtbot.waitSignal(studio.message, timeout=10000) as said:
+        studio.open_input("picture", str(other))
+    assert "does not fit" in said.args[0] and "dropped" in said.args[0]
+    assert _mask(studio) is None
+    qtbot.waitUntil(lambda: studio.renderer.last.final and studio.renderer.last.image.shape[:2] == (50, 70),
+                    timeout=10000)
+    studio.doc.undo_stack.undo()  # the old picture and its mask come back together
+    assert studio.doc.inputs["picture"].path == str(studio.picture) and _mask(studio) == painted
+
+
+def test_session_save_and_open_restores_the_mask_and_margins(studio, qtbot, tmp_path):
+    view, doc = studio.canvas_view, studio.doc
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 25.5)]))
+    doc.set_margins("grow", Margins(4, 0, 8, 2))
+    painted = _mask(studio)
+    session = tmp_path / "s.weft.json"
+    assert studio.save_session(str(session))
+    png = tmp_path / "s.weft.mean-fill.hole.png"
+    assert png.is_file() and Mask.read(png) == painted
+    from PIL import Image
+
+    assert Image.open(png).mode == "1"  # a 1-bit PNG
+    doc.set_mask("hole", None, "Clear mask")
+    doc.set_margins("grow", None)
+    assert studio.open_session(str(session))
+    assert _mask(studio) == painted and doc.value("grow") == Margins(4, 0, 8, 2)
+    assert studio.inputs_pane.mask_tool().overlay.pixmap().width() == W
+
+
+def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(studio, qtbot, tmp_path, capsys):
+    view, doc = studio.canvas_view, studio.doc
+    _final_after(studio, qtbot, lambda: _stroke(view, [(15.5, 15.5), (35.5, 40.5)]))
+    _final_after(studio, qtbot, lambda: doc.set_margins("grow", Margins(6, 0, 0, 3)))
+    painted = _mask(studio)
+    out = tmp_path / "out.png"
+    assert studio.export_result(str(out))
+    beside = tmp_path / "out.hole.png"
+    assert beside.is_file() and Mask.read(beside) == painted
+    recipe = read_recipe(out)
+    assert '"hole": "out.hole.png"' in recipe and '"grow": [6, 0, 0, 3]' in recipe
+    again = tmp_path / "again.png"
+    assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
+    exported = load_image(out).image
+    assert exported.shape == (H + 3, W + 6, 3)
+    assert np.array_equal(exported, load_image(again).image)
+    # a recipe exported alone gets its mask beside it too
+    assert studio.export_recipe(str(tmp_path / "r.json"))
+    assert Mask.read(tmp_path / "r.hole.png") == painted
+
+
+def test_extend_canvas_by_dragging_an_edge_outward(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    view.fit()  # the whole image with room around it
+    tool = studio.inputs_pane.margins_tool()
+    assert view.sceneRect().left() < 0 and view.sceneRect().right() > W  # room to drag in
+    start = (W + 1.0, H / 2)  # just right of the image
+    mouse(view, "press", start)
+    mouse(view, "move", (W + 8.0, H / 2))
+    assert tool.frame.isVisible() and tool.frame.rect().width() == W + 7  # the grown frame, drawn
+    mouse(view, "move", (W + 21.0, H / 2))
+    result = _final_after(studio, qtbot, lambda: mouse(view, "release", (W + 21.0, H / 2)))
+    assert doc.value("grow") == Margins(0, 0, 20, 0)
+    assert doc.undo_stack.text(doc.undo_stack.index() - 1) == "Extend canvas 0,0,20,0"
+    assert result.image.shape == (H, W + 20, 3)
+    assert _mask(studio) is None  # the press outside the image painted nothing
+    # the top-left corner drags two edges
+    mouse(view, "press", (-1.0, -1.0))
+    mouse(view, "move", (-5.0, -1.0))
+    _final_after(studio, qtbot, lambda: mouse(view, "release", (-11.0, -7.0)))
+    assert doc.value("grow") == Margins(10, 6, 20, 0)
+    doc.undo_stack.undo()
+    assert doc.value("grow") == Margins(0, 0, 20, 0)
+
+
+def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
+    bar = studio.inputs_pane.bar()
+    assert bar.extend_button.isVisible()
+    qtbot.mouseClick(bar.extend_button, Qt.MouseButton.LeftButton)
+    dialog = bar.dialog
+    qtbot.waitUntil(dialog.isVisible, timeout=5000)
+    for side, value in zip(("left", "top", "right", "bottom"), (3, 5, 0, 12)):
+        box = dialog.boxes[side]
+        box.selectAll()
+        qtbot.keyClicks(box, str(value))
+    assert dialog.result_label.text().endswith(f"{W + 3}x{H + 17}")
+    result = _final_after(studio, qtbot, lambda: qtbot.keyClick(dialog, Qt.Key.Key_Return))
+    assert studio.doc.value("grow") == Margins(3, 5, 0, 12)
+    assert result.image.shape == (H + 17, W + 3, 3)
+    frame = studio.inputs_pane.margins_tool().frame
+    assert frame.isVisible() and frame.rect().topLeft() == QPointF(-3, -5)
+
+
+def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
+    from weft.core.studio import AROUND_SIDE
+
+    view = studio.canvas_view
+    studio.inputs_pane.mask_tool().set_size(5)
+    CALLS.clear()
+    around = []
+    studio.renderer.around_shown.connect(around.append)
+    _stroke(view, [(10.5, 10.5), (14.5, 12.5)], release=False)
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    shown = around[-1]
+    assert not shown.final and shown.image.shape == (H, W, 3)
+    assert CALLS and max(CALLS[0]) < max(H, W) and max(CALLS[0]) <= AROUND_SIDE  # a crop, not the whole picture
+    live = studio.doc.live[1]
+    # the stroke so far is filled in the preview; far from it the last full result is kept
+    source = studio.doc.image("picture")
+    assert not np.allclose(shown.image[live.bits], source[live.bits])
+    assert np.array_equal(shown.image[50:, 60:], studio.renderer.last.image[50:, 60:])
+    assert _mask(studio) is None  # nothing committed before the release
+    result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
+    assert result.image.shape == (H, W, 3) and _mask(studio) is not None
