@@ -1,0 +1,124 @@
+"""core.studio.crop_around (the preview around a mask stroke) and sessions' masks and margins (Qt-free)."""
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from weft.core import registry
+from weft.core.errors import WeftError
+from weft.core.geometry import Margins, Mask
+from weft.core.params import Params, param
+from weft.core.registry import InputSpec, Method, Result
+from weft.core.session import mask_file, read_session
+from weft.core.studio import AROUND_SIDE, MARGINS, MASK, Geometry, Studio, crop_around
+
+
+@dataclass(frozen=True)
+class HoleParams(Params):
+    grow: Margins = param(None, kind="geometry", type=Margins, optional=True, help="margins")
+
+
+STUDIO = Studio(title="t", canvas="picture", preview_around="hole",
+                geometry=(Geometry(MASK, on=("picture",), input="hole"),
+                          Geometry(MARGINS, on=("picture",), param="grow")))
+
+
+def _inputs(h=300, w=400, hole=None):
+    rng = np.random.default_rng(0)
+    picture = rng.random((h, w, 3)).astype(np.float32)
+    other = rng.random((50, 60, 3)).astype(np.float32)
+    mask = np.zeros((h, w), np.float32) if hole is None else hole
+    return {"picture": picture, "hole": mask, "texture": other}
+
+
+def test_the_crop_is_the_painted_region_near_the_stroke_with_context_around_it():
+    hole = np.zeros((300, 400), np.float32)
+    hole[100:120, 200:230] = 1.0  # painted near the stroke
+    hole[10:20, 10:20] = 1.0  # painted far away: not in this preview
+    inputs = _inputs(hole=hole)
+    around = crop_around(STUDIO, inputs, HoleParams(), (205, 105, 215, 115))
+    x0, y0, x1, y1 = around.box
+    assert x0 < 200 and y0 < 100 and x1 > 230 and y1 > 120  # the whole painted blob, and room around it
+    assert x0 > 20 and y0 > 20  # not the far one
+    assert max(x1 - x0, y1 - y0) <= AROUND_SIDE
+    assert np.array_equal(around.inputs["picture"], inputs["picture"][y0:y1, x0:x1])
+    assert np.array_equal(around.inputs["hole"], hole[y0:y1, x0:x1])
+    assert around.inputs["texture"] is inputs["texture"]  # another image's size: kept whole
+    assert around.offset == (0, 0)
+
+
+def test_a_large_crop_is_scaled_to_the_side_and_pasted_back_at_full_size():
+    hole = np.zeros((300, 400), np.float32)
+    hole[20:280, 30:370] = 1.0
+    inputs = _inputs(hole=hole)
+    around = crop_around(STUDIO, inputs, HoleParams(), (100, 100, 110, 110), side=64)
+    x0, y0, x1, y1 = around.box
+    small = around.inputs["picture"]
+    assert max(small.shape[:2]) == 64 and small.shape[:2] != (y1 - y0, x1 - x0)
+    assert set(np.unique(around.inputs["hole"])) <= {0.0, 1.0}  # the mask stays a mask
+    base = np.zeros((300, 400, 3), np.float32)
+    pasted = around.paste(base, np.ones_like(small))
+    assert pasted[y0:y1, x0:x1].min() == pytest.approx(1.0) and pasted.sum() == pytest.approx((y1 - y0) * (x1 - x0) * 3)
+    assert base.sum() == 0  # the base is not changed
+
+
+def test_margins_are_off_in_the_crop_and_offset_the_paste():
+    hole = np.zeros((300, 400), np.float32)
+    hole[150:160, 150:160] = 1.0
+    around = crop_around(STUDIO, _inputs(hole=hole), HoleParams(grow=Margins(7, 5, 0, 0)), (150, 150, 160, 160))
+    assert around.params.grow is None and around.offset == (7, 5)
+    x0, y0, x1, y1 = around.box
+    grown = np.zeros((305, 407, 3), np.float32)
+    part = np.ones((y1 - y0, x1 - x0, 3), np.float32)
+    pasted = around.paste(grown, part)
+    assert pasted[y0 + 5:y1 + 5, x0 + 7:x1 + 7].min() == 1.0 and pasted.sum() == part.sum()
+    assert around.paste(np.zeros((10, 10, 3), np.float32), part) is None  # does not fit: nothing
+
+
+def test_no_crop_without_anything_painted_near_the_stroke_or_without_the_field():
+    hole = np.zeros((300, 400), np.float32)
+    hole[10:20, 10:20] = 1.0
+    assert crop_around(STUDIO, _inputs(hole=hole), HoleParams(), (200, 200, 210, 210)) is None
+    plain = Studio(title="t", canvas="picture", geometry=STUDIO.geometry)
+    assert crop_around(plain, _inputs(hole=hole), HoleParams(), (10, 10, 20, 20)) is None
+    inputs = _inputs(hole=hole)
+    del inputs["hole"]
+    assert crop_around(STUDIO, inputs, HoleParams(), (10, 10, 20, 20)) is None
+
+
+HOLE = Method(name="hole-test", summary="t", params=HoleParams,
+              inputs=(InputSpec("picture", "p"), InputSpec("hole", "h", required=False)),
+              run=lambda inputs, params, **kw: Result(inputs["picture"]), studio=STUDIO)
+
+
+@pytest.fixture
+def hole_method():
+    registry.register(HOLE)
+    yield HOLE
+    registry.unregister(HOLE.name)
+
+
+def test_a_session_reads_its_mask_png_and_margins(hole_method, tmp_path):
+    session = tmp_path / "s.weft.json"
+    png = mask_file(session, HOLE.name, "hole")
+    assert png == tmp_path / "s.weft.hole-test.hole.png"
+    mask = Mask.empty(40, 30).painted_line((5, 5), (30, 20), 3)
+    mask.save(png)
+    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
+                                   "geometry": {HOLE.name: {"hole": png.name, "grow": [1, 2, 3, 4]}}}))
+    data = read_session(session)
+    assert data["geometry"][HOLE.name] == {"hole": mask, "grow": Margins(1, 2, 3, 4)}
+
+
+def test_a_session_naming_a_missing_mask_or_bad_margins_says_which(hole_method, tmp_path):
+    session = tmp_path / "s.weft.json"
+    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
+                                   "geometry": {HOLE.name: {"hole": "gone.png"}}}))
+    with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: .*gone\.png"):
+        read_session(session)
+    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
+                                   "geometry": {HOLE.name: {"grow": [1, -2, 3, 4]}}}))
+    with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: parameter 'grow' = 1,-2,3,4: the top margin -2"):
+        read_session(session)
