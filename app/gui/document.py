@@ -38,48 +38,56 @@ _MERGE_PARAM = 1001
 @dataclass(frozen=True)
 class InputImage:
     """An input picture: where it came from, its pixels (float32, as ``weft.core.image.load_image``)
-    and its alpha channel (float32 (H, W) in [0, 1]) when the file had one (the image itself has none:
-    every method gets what ``weft run`` gives it); "Fill transparent" paints a mask from it."""
+    and, when the file has an alpha channel, the pixels with it (``load_image(..., alpha=True)``:
+    (H, W, 2) or (H, W, 4)). A method gets what ``weft run`` gives it: the pixels with alpha for an
+    input whose ``InputSpec.alpha`` asks for them, the others without; "Fill transparent" paints a
+    mask from :attr:`alpha`."""
 
     path: str | None
     image: np.ndarray
-    alpha: np.ndarray | None = None
+    with_alpha: np.ndarray | None = None
+
+    @property
+    def alpha(self) -> np.ndarray | None:
+        """The alpha channel (H, W) in [0, 1], or None."""
+        return None if self.with_alpha is None else self.with_alpha[..., -1]
 
 
 def read_input(path: str | Path) -> InputImage:
-    """Decode an image file as an input (its pixels as ``load_image`` gives them, and its alpha).
-    Slow for a large file: call it off the GUI thread. ``WeftError`` naming the file."""
+    """Decode an image file as an input (its pixels as ``load_image`` gives them, and with its alpha
+    when it has one). Slow for a large file: call it off the GUI thread. ``WeftError`` naming the file."""
     from weft.core.image import load_image
 
     loaded = load_image(path)
-    alpha = _read_alpha(path, loaded.image.shape[:2]) if loaded.info.had_alpha else None
-    return InputImage(str(path), loaded.image, alpha)
+    with_alpha = None
+    if loaded.info.had_alpha:
+        try:
+            kept = load_image(path, alpha=True).image
+        except TypeError:  # a weft.core.image that drops alpha always
+            kept = _pillow_with_alpha(path, loaded.image)
+        if kept.ndim == 3 and kept.shape[2] in (2, 4) and kept.shape[:2] == loaded.image.shape[:2]:
+            with_alpha = kept
+    return InputImage(str(path), loaded.image, with_alpha)
 
 
-def _read_alpha(path, shape) -> np.ndarray | None:
-    """The alpha channel of an image file (upright, as ``load_image`` turns the pixels), or None."""
+def _pillow_with_alpha(path, image: np.ndarray) -> np.ndarray:
+    """``image`` with the file's alpha channel read by Pillow (8 or 16 bits) appended."""
     from PIL import Image, ImageOps
 
-    try:
-        with Image.open(path) as im:
-            im = ImageOps.exif_transpose(im)
-            if im.mode in ("I;16", "I;16B", "I", "F") or "A" not in im.getbands():
-                im = im.convert("RGBA") if "transparency" in im.info else None
-            if im is None:
-                return None
-            band = im.getchannel("A")
-            top = 65535.0 if band.mode.startswith("I") else 255.0
-            alpha = np.asarray(band, dtype=np.float32) / top
-    except (OSError, ValueError):
-        return None
-    return alpha if alpha.shape == tuple(shape) else None
+    with Image.open(path) as im:
+        im = ImageOps.exif_transpose(im)
+        band = (im if "A" in im.getbands() else im.convert("RGBA")).getchannel("A")
+        alpha = np.asarray(band, dtype=np.float32) / (65535.0 if band.mode.startswith("I") else 255.0)
+    colour = image if image.ndim == 3 else image[..., None]
+    return np.ascontiguousarray(np.concatenate([colour, alpha[..., None]], axis=2)) if alpha.shape == image.shape[:2] else image
 
 
 @dataclass(frozen=True)
 class DocumentState:
     """A whole document at once, for :meth:`Document.restore` (sessions, crash recovery, the bundled
     examples, screenshots, benchmarks). ``geometry`` maps method -> geometry key -> typed value
-    (:class:`~weft.core.geometry.Square`, :class:`~weft.core.geometry.LineDraft`); what is not given is empty
+    (:class:`~weft.core.geometry.Square`, :class:`~weft.core.geometry.LineDraft`, a
+    :class:`~weft.core.geometry.Mask`, :class:`~weft.core.geometry.Margins`); what is not given is empty
     or default."""
 
     inputs: dict[str, InputImage] = field(default_factory=dict)
@@ -197,8 +205,12 @@ class Document(QObject):
         """The current method's loaded inputs (its painted masks among them, as images; with
         ``live`` the stroke being drawn); the canvas cropped to the source region if there is one."""
         painted = {g.input for g in self.studio.geometry if g.kind == MASK}
-        out = {i.name: self.inputs[i.name].image for i in self.current.inputs
-               if i.name in self.inputs and i.name not in painted}
+        out = {}
+        for spec in self.current.inputs:
+            item = self.inputs.get(spec.name)
+            if item is not None and spec.name not in painted:
+                keep = getattr(spec, "alpha", False) and item.with_alpha is not None
+                out[spec.name] = item.with_alpha if keep else item.image
         out.update({name: mask.to_image() for name, mask in self.masks(live=live).items()})
         region = self.region()
         g = next((g for g in self.studio.geometry if g.param is None and g.kind == SQUARE), None)
@@ -246,7 +258,7 @@ class Document(QObject):
         if params != self.current_params:
             self.push(SetParams(self, self.method, params, text))
 
-    def set_input(self, name: str, path: str | None, image: np.ndarray, alpha: np.ndarray | None = None) -> None:
+    def set_input(self, name: str, path: str | None, image: np.ndarray, with_alpha: np.ndarray | None = None) -> None:
         """Undoable opening of an input image. An input the current method paints (a mask geometry)
         becomes that mask (refused in one line if it is not the size of its image). Masks painted on
         this input that do not fit the new image are dropped (said in ``message``; undo brings them back)."""
@@ -263,7 +275,7 @@ class Document(QObject):
                 return
             self.set_mask(g.key, mask, f"Open {name.replace('_', ' ')} {Path(path).name if path else ''}".strip())
             return
-        self.push(SetInput(self, name, InputImage(path, image, alpha)))
+        self.push(SetInput(self, name, InputImage(path, image, with_alpha)))
 
     def clear_input(self, name: str) -> None:
         """Undoable removal of an open input (the method then runs without it)."""

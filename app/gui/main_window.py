@@ -462,7 +462,7 @@ class MainWindow(QMainWindow):
         image = item.image
         self.settings.setValue("last_dir", str(Path(path).parent))
         self._add_recent(path)
-        self.doc.set_input(name, path, image, item.alpha)
+        self.doc.set_input(name, path, image, item.with_alpha)
         self.statusBar().showMessage(f"{name}: {Path(path).name} {image.shape[1]}x{image.shape[0]}", 4000)
 
     def _add_recent(self, path: str) -> None:
