@@ -1,4 +1,5 @@
-"""GUI latency: ``python -m benchmarks.gui_latency [--values 30] [--hz 60]``.
+"""GUI latency: ``python -m benchmarks.gui_latency [--values 30] [--hz 60]`` and, for painting a mask,
+``python -m benchmarks.gui_latency --paint [--method M] [--values 60] [--hz 60] [--side 512]``.
 
 The real main window, offscreen, the fast method on a 640x500 target (astronaut) with a 192 px
 gravel texture. The p slider is held down and moved through ``--values`` values at ``--hz``; for every
@@ -6,6 +7,12 @@ preview that reaches the screen, the latency is the time from the slider's value
 that preview was computed for) to the end of the result view's next paint. A 5 ms heartbeat timer on
 the GUI thread measures the longest stall. Prints one JSON line:
 ``{"median_ms", "p95_ms", "max_stall_ms", "previews", "values"}``.
+
+``--paint``: the first studio method whose description previews a stroke (``Studio.preview_around``;
+or ``--method``) on its bundled example (or gravel) resized to ``--side`` px; a brush stroke of
+``--values`` mouse moves at ``--hz`` is painted on the canvas with real mouse events. For every
+preview around the stroke that reaches the screen, the latency is the time from the mouse move of the
+latest dab it includes to the end of the result view's next paint. Same JSON line, plus ``"method"``.
 """
 
 from __future__ import annotations
@@ -111,6 +118,105 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
     }
 
 
+def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = None, side: int = 512) -> dict:
+    from PySide6.QtCore import QEvent, QPointF, Qt
+    from PySide6.QtGui import QMouseEvent
+
+    from weft.app.gui.document import DocumentState, InputImage
+    from weft.app.gui.main_window import MainWindow
+    from weft.core import registry
+    from weft.core.errors import WeftError
+    from weft.core.examples import example
+    from weft.core.image import load_image, resize
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    offered = registry.studio_methods()
+    if method is None:
+        method = next((n for n, m in offered.items() if m.studio.preview_around is not None), None)
+    if method not in offered or offered[method].studio.preview_around is None:
+        raise SystemExit(f"no studio method previews a painted stroke ({method or 'none registered'})")
+    studio = offered[method].studio
+    with tempfile.TemporaryDirectory() as tmp:
+        settings = QSettings(os.path.join(tmp, "weft.ini"), QSettings.Format.IniFormat)
+        os.environ["WEFT_RECOVERY_DIR"] = tmp
+        window = MainWindow(settings=settings, load_defaults=False)
+        window.resize(1400, 900)
+        window.show()
+        doc = window.doc
+        try:
+            picture = load_image(example(studio.examples.get(studio.canvas, "gravel"))).image
+        except WeftError:
+            picture = load_image(example("gravel")).image
+        picture = resize(picture, (side, side))
+        doc.restore(DocumentState(inputs={studio.canvas: InputImage(None, picture)}, method=method))
+        window.renderer.final(now=True)
+        _wait(app, lambda: window.renderer.last is not None, 60)
+        view = window.canvas_view
+        tool = window.inputs_pane.mask_tool()
+        tool.set_size(max(8, side // 24))
+
+        moved_at: list[float] = []
+        dab_of_job: dict[int, int] = {}
+        window.renderer.submitted.connect(
+            lambda job_id, slot: slot == "preview" and dab_of_job.__setitem__(job_id, len(moved_at) - 1))
+        latencies: list[float] = []
+        pending: list[int] = []
+        window.renderer.around_shown.connect(lambda s: pending.append(s.job_id))
+
+        def painted():
+            now = time.perf_counter()
+            while pending:
+                dab = dab_of_job.get(pending.pop(0))
+                if dab is not None and dab >= 0:
+                    latencies.append((now - moved_at[dab]) * 1000)
+
+        watch = _PaintWatch(painted)
+        window.result_view.viewport().installEventFilter(watch)
+        beats: list[float] = []
+        heartbeat = QTimer()
+        heartbeat.setInterval(5)
+        heartbeat.timeout.connect(lambda: beats.append(time.perf_counter()))
+        heartbeat.start()
+
+        def send(kind, x, y):
+            pos = view.mapFromScene(QPointF(x, y))
+            etype = {"press": QEvent.Type.MouseButtonPress, "move": QEvent.Type.MouseMove,
+                     "release": QEvent.Type.MouseButtonRelease}[kind]
+            button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
+            held = Qt.MouseButton.NoButton if kind == "release" else Qt.MouseButton.LeftButton
+            QApplication.sendEvent(view.viewport(), QMouseEvent(etype, QPointF(pos), QPointF(view.viewport().mapToGlobal(pos)),
+                                                                button, held, Qt.KeyboardModifier.NoModifier))
+
+        # a wavy stroke across the middle of the picture
+        points = [(side * (0.15 + 0.7 * i / (values - 1)), side * (0.5 + 0.15 * ((i // 10) % 2 * 2 - 1) * (i % 10) / 10))
+                  for i in range(values)]
+        step = 1.0 / hz
+        moved_at.append(time.perf_counter())
+        send("press", *points[0])
+        start = time.perf_counter()
+        for i, (x, y) in enumerate(points[1:], 1):
+            _wait(app, lambda: time.perf_counter() - start >= i * step, 5)
+            moved_at.append(time.perf_counter())
+            send("move", x, y)
+        _wait(app, lambda: time.perf_counter() - start >= values * step + 0.5, 5)
+        send("release", *points[-1])
+        _wait(app, lambda: window.renderer.last.final and doc.value(tool.geometry_key) is not None
+              and not window.renderer.running(), 120)
+        heartbeat.stop()
+        gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:])]
+        window.doc.undo_stack.setClean()
+        window.close()
+    latencies.sort()
+    return {
+        "method": method,
+        "median_ms": round(statistics.median(latencies), 1) if latencies else None,
+        "p95_ms": round(latencies[min(len(latencies) - 1, int(0.95 * len(latencies)))], 1) if latencies else None,
+        "max_stall_ms": round(max(gaps), 1) if gaps else None,
+        "previews": len(latencies),
+        "values": values,
+    }
+
+
 def _wait(app, condition, timeout: float) -> None:
     end = time.perf_counter() + timeout
     while not condition():
@@ -124,10 +230,16 @@ def _wait(app, condition, timeout: float) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks.gui_latency", description=__doc__)
-    ap.add_argument("--values", type=int, default=30)
+    ap.add_argument("--values", type=int, default=None, help="slider values (30) or mouse moves of the stroke (60)")
     ap.add_argument("--hz", type=float, default=60.0)
+    ap.add_argument("--paint", action="store_true", help="paint a mask stroke instead of moving a slider")
+    ap.add_argument("--method", default=None, help="with --paint: the method (default: the first that previews strokes)")
+    ap.add_argument("--side", type=int, default=512, help="with --paint: the picture's side in pixels")
     args = ap.parse_args(argv)
-    print(json.dumps(measure(args.values, args.hz)))
+    if args.paint:
+        print(json.dumps(measure_painting(args.values or 60, args.hz, args.method, args.side)))
+    else:
+        print(json.dumps(measure(args.values or 30, args.hz)))
     return 0
 
 

@@ -40,6 +40,7 @@ from PySide6.QtWidgets import (
 from weft.core.errors import WeftError
 from weft.core.examples import example, examples
 from weft.core.jobs import JobRunner
+from weft.core.studio import SQUARE
 
 from .canvas import InputsPane, titled
 from .convert import to_qimage
@@ -538,8 +539,9 @@ class MainWindow(QMainWindow):
         self.clear_input_menu.setEnabled(any(self.doc.image(n) is not None for n in optional))
 
     def _geometry_dragged(self, key: str, value) -> None:
-        self.method_panel.show_square(value)
         g = next((g for g in self.doc.studio.geometry if g.key == key), None)
+        if g is not None and g.kind == SQUARE:
+            self.method_panel.show_square(value)
         if g is not None and g.live is not None and g.live(self.doc.current_params):
             # the method asks for a live result while the square moves (affine's prototype swap)
             self.doc.live = (key, value)
