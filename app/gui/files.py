@@ -301,8 +301,11 @@ class FileActions(QObject):
 
     def discard_recovery(self) -> None:
         """Remove the recovery file (the document is saved, clean, or its edits were discarded)."""
+        stem = self.recovery_file.name[:-5] if self.recovery_file.name.endswith(".json") else self.recovery_file.name
         try:
             self.recovery_file.unlink(missing_ok=True)
+            for mask in self.recovery_file.parent.glob(f"{stem}.*.png"):  # its masks (Document.session_masks)
+                mask.unlink(missing_ok=True)
         except OSError:
             pass
         self._owns_recovery = False

@@ -387,3 +387,39 @@ def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
     assert _mask(studio) is None  # nothing committed before the release
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
     assert result.image.shape == (H, W, 3) and _mask(studio) is not None
+
+
+def test_a_session_whose_mask_no_longer_fits_its_image_opens_without_it_and_says_so(studio, qtbot, tmp_path):
+    view = studio.canvas_view
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
+    session = tmp_path / "s.weft.json"
+    assert studio.save_session(str(session))
+    save_image(studio.picture, np.random.default_rng(9).random((40, 40, 3)).astype(np.float32))  # the file changed
+    messages = []
+    studio.message.connect(messages.append)
+    assert studio.open_session(str(session))
+    assert _mask(studio) is None and studio.doc.image("picture").shape == (40, 40, 3)
+    assert any("must be the size of its image" in m and m.endswith("dropped") for m in messages)
+
+
+def test_unsaved_masks_and_margins_reach_the_recovery_file(studio, qtbot, settings, private_recovery):
+    from weft.app.gui.main_window import MainWindow
+
+    view, doc = studio.canvas_view, studio.doc
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 28.5)]))
+    doc.set_margins("grow", Margins(0, 2, 0, 0))
+    painted = _mask(studio)
+    assert studio.autosave()
+    assert (private_recovery / "recovery.weft.mean-fill.hole.png").is_file()
+    # a new window (the first one "crashed") offers the recovery and gets the mask back
+    again = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(again)
+    try:
+        assert again.doc.method == "mean-fill" and again.doc.value("hole") == painted
+        assert again.doc.value("grow") == Margins(0, 2, 0, 0)
+        again.doc.undo_stack.setClean()  # saved: the recovery file and its mask go
+        again.files._schedule_autosave()
+        assert not (private_recovery / "recovery.weft.json").exists()
+        assert not (private_recovery / "recovery.weft.mean-fill.hole.png").exists()
+    finally:
+        again.shutdown()
