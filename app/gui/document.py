@@ -30,7 +30,7 @@ from weft.core.errors import WeftError
 from weft.core.geometry import LINES, MARGINS, MASK, SQUARE, LineDraft, Margins, Mask, Square
 from weft.core.params import Params, Recipe, relative_path
 from weft.core.session import SESSION_VERSION, mask_file, read_session  # noqa: F401 (read_session: the studio reads sessions)
-from weft.core.studio import Geometry, Studio
+from weft.core.studio import Geometry, Studio, keeps_alpha
 
 _MERGE_PARAM = 1001
 
@@ -209,7 +209,7 @@ class Document(QObject):
         for spec in self.current.inputs:
             item = self.inputs.get(spec.name)
             if item is not None and spec.name not in painted:
-                keep = getattr(spec, "alpha", False) and item.with_alpha is not None
+                keep = keeps_alpha(spec) and item.with_alpha is not None
                 out[spec.name] = item.with_alpha if keep else item.image
         out.update({name: mask.to_image() for name, mask in self.masks(live=live).items()})
         region = self.region()

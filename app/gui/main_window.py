@@ -364,6 +364,8 @@ class MainWindow(QMainWindow):
                                                tip="copy the full-size result shown to the clipboard")
         self._action(e, "New &Seed", self.method_panel.new_seed, "Ctrl+R")
         self.clear_square_action = self._action(e, "Clear S&quare", lambda: self.doc.set_square(None))
+        self.geometry_menu = e.addMenu("&Mask and Canvas")  # the mask and margins tools' actions, if any
+        self.geometry_menu.setToolTipsVisible(True)  # a disabled action says why
         v = self.menuBar().addMenu("&View")
         self._action(v, "Zoom &In", lambda: self._zoom_view().zoom_by(1.25), QKeySequence.StandardKey.ZoomIn)
         self._action(v, "Zoom &Out", lambda: self._zoom_view().zoom_by(0.8), QKeySequence.StandardKey.ZoomOut)
@@ -515,6 +517,12 @@ class MainWindow(QMainWindow):
         self.load_lines_action.setEnabled(has_lines)
         self.save_lines_action.setEnabled(has_lines)
         self.clear_square_action.setEnabled(self.inputs_pane.square_on() is not None)
+        for action in self.geometry_menu.actions():
+            self.geometry_menu.removeAction(action)  # (not clear(): the bar owns them)
+        bar = self.inputs_pane.bar()
+        for action in [] if bar is None else bar.menu_actions():
+            self.geometry_menu.addAction(action)
+        self.geometry_menu.setEnabled(bar is not None)
         inputs = self.doc.current.inputs
         self.open_first_action.setText(f"&Open {inputs[0].name.replace('_', ' ')}…")
         self.open_second_action.setVisible(len(inputs) > 1)

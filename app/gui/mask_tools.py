@@ -21,10 +21,9 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QBrush, QColor, QImage, QPainterPath, QPen, QPixmap
+from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
+from PySide6.QtGui import QAction, QActionGroup, QBrush, QColor, QImage, QPainterPath, QPixmap
 from PySide6.QtWidgets import (
-    QButtonGroup,
     QDialog,
     QDialogButtonBox,
     QFormLayout,
@@ -32,11 +31,9 @@ from PySide6.QtWidgets import (
     QGraphicsPathItem,
     QGraphicsPixmapItem,
     QGraphicsRectItem,
-    QHBoxLayout,
     QLabel,
     QSpinBox,
-    QToolButton,
-    QWidget,
+    QToolBar,
 )
 
 from weft.core.geometry import MAX_SIDE, Margins, Mask
@@ -142,18 +139,23 @@ class MaskTool(Tool):
         self.points = []
         self.lasso_item.setPath(QPainterPath())
         self.overlay.setPixmap(QPixmap())
-        self.cursor.hide()
+        self._show_cursor(None)
 
     def _draw(self, mask: Mask | None) -> None:
         self.overlay.setPixmap(mask_overlay(mask if mask is not None and mask else None))
 
     def _show_cursor(self, pos) -> None:
+        """The brush's circle at ``pos`` (the mouse pointer a small cross inside it); None hides it."""
         if pos is None or self.mode not in (BRUSH, ERASER):
-            self.cursor.hide()
+            if self.cursor.isVisible():
+                self.cursor.hide()
+                self.view.viewport().unsetCursor()
             return
         r = self.size / 2.0
         self.cursor.setRect(QRectF(pos.x() - r, pos.y() - r, 2 * r, 2 * r))
-        self.cursor.show()
+        if not self.cursor.isVisible():
+            self.cursor.show()
+            self.view.viewport().setCursor(Qt.CursorShape.CrossCursor)
 
     @staticmethod
     def _pixel(pos) -> tuple[float, float]:
@@ -405,9 +407,9 @@ class ExtendDialog(QDialog):
         self.result_label.setText(f"canvas {w}x{h} → {gw}x{gh}")
 
 
-class GeometryBar(QWidget):
-    """The buttons of a view's mask and margins tools (module docstring). ``message(text)``: a
-    one-line note (why an action did nothing)."""
+class GeometryBar(QToolBar):
+    """The buttons of a view's mask and margins tools (module docstring); what does not fit the
+    pane's width goes to the bar's » menu. ``message(text)``: a one-line note (why an action did nothing)."""
 
     message = Signal(str)
 
@@ -416,59 +418,62 @@ class GeometryBar(QWidget):
         self.doc = doc
         self.mask_tool: MaskTool | None = None
         self.margins_tool: MarginsTool | None = None
-        row = QHBoxLayout(self)
-        row.setContentsMargins(4, 1, 4, 1)
-        row.setSpacing(2)
-        self.mode_group = QButtonGroup(self)
-        self.mode_buttons = {}
-        tips = {BRUSH: "paint the mask (B; [ and ] size the brush)", ERASER: "erase the mask (E)",
-                LASSO_ADD: "draw a closed outline to add to the mask (L)",
+        self.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+        self.setIconSize(QSize(12, 12))
+        self.setStyleSheet("QToolBar { spacing: 1px; padding: 0px; }")
+        self.mode_group = QActionGroup(self)
+        self.mode_actions: dict[str, QAction] = {}
+        tips = {BRUSH: "paint the mask ([ and ] size the brush; Esc cancels a stroke)", ERASER: "erase the mask",
+                LASSO_ADD: "draw a closed outline to add to the mask",
                 LASSO_SUBTRACT: "draw a closed outline to take from the mask"}
         labels = {BRUSH: "Brush", ERASER: "Eraser", LASSO_ADD: "Lasso +", LASSO_SUBTRACT: "Lasso −"}
         for mode in MODES:
-            b = QToolButton()
-            b.setText(labels[mode])
-            b.setCheckable(True)
-            b.setToolTip(tips[mode])
-            b.setAutoRaise(True)
-            self.mode_group.addButton(b)
-            self.mode_buttons[mode] = b
-            b.toggled.connect(lambda on, m=mode: on and self.mask_tool is not None and self.mask_tool.set_mode(m))
-            row.addWidget(b)
+            action = QAction(labels[mode], self)  # owned by the bar (the window's menu shows them too)
+            self.addAction(action)
+            action.setCheckable(True)
+            action.setToolTip(tips[mode])
+            self.mode_group.addAction(action)
+            self.mode_actions[mode] = action
+            action.toggled.connect(lambda on, m=mode: on and self.mask_tool is not None and self.mask_tool.set_mode(m))
+        self.mode_buttons = {mode: self.widgetForAction(a) for mode, a in self.mode_actions.items()}
         self.size_box = QSpinBox()
         self.size_box.setRange(BRUSH_MIN, BRUSH_MAX)
         self.size_box.setSuffix(" px")
         self.size_box.setToolTip("brush size in image pixels ([ smaller, ] larger)")
         self.size_box.valueChanged.connect(lambda v: self.mask_tool is not None and self.mask_tool.set_size(v))
-        row.addWidget(self.size_box)
-        self.clear_button = self._button(row, "Clear mask", "remove the whole mask", self.clear_mask)
-        self.invert_button = self._button(row, "Invert", "swap what the mask covers and what it does not",
-                                          self.invert_mask)
-        self.transparent_button = self._button(row, "Fill transparent", "", self.fill_transparent)
-        self.extend_button = self._button(row, "Extend canvas…", "type the pixels to add on each side "
-                                          "(or drag outside the image)", self.extend_dialog)
-        row.addStretch(1)
+        self.size_action = self.addWidget(self.size_box)
+        self.clear_action = self._action("Clear mask", "remove the whole mask", self.clear_mask)
+        self.invert_action = self._action("Invert", "swap what the mask covers and what it does not", self.invert_mask)
+        self.transparent_action = self._action("Fill transparent", "", self.fill_transparent)
+        self.extend_action = self._action("Extend canvas…", "type the pixels to add on each side (or drag outside "
+                                          "the image)", self.extend_dialog)
+        self.clear_button, self.invert_button, self.transparent_button, self.extend_button = (
+            self.widgetForAction(a) for a in (self.clear_action, self.invert_action, self.transparent_action,
+                                              self.extend_action))
 
-    def _button(self, row, text, tip, slot) -> QToolButton:
-        b = QToolButton()
-        b.setText(text)
-        b.setToolTip(tip)
-        b.setAutoRaise(True)
-        b.clicked.connect(slot)
-        row.addWidget(b)
-        return b
+    def _action(self, text, tip, slot) -> QAction:
+        action = QAction(text, self)
+        self.addAction(action)
+        action.setToolTip(tip)
+        action.triggered.connect(lambda _=False: slot())
+        return action
+
+    def menu_actions(self) -> list[QAction]:
+        """Its actions that apply now (for the window's Edit menu)."""
+        return [a for a in (*self.mode_actions.values(), self.clear_action, self.invert_action,
+                            self.transparent_action, self.extend_action) if a.isVisible()]
 
     def attach(self, mask_tool: MaskTool | None, margins_tool: MarginsTool | None) -> None:
         """Show the buttons of these tools (a view with neither hides the bar)."""
         self.mask_tool, self.margins_tool = mask_tool, margins_tool
         has_mask = mask_tool is not None
-        for b in [*self.mode_buttons.values(), self.size_box, self.clear_button, self.invert_button,
-                  self.transparent_button]:
-            b.setVisible(has_mask)
-        self.extend_button.setVisible(margins_tool is not None)
+        for a in [*self.mode_actions.values(), self.size_action, self.clear_action, self.invert_action,
+                  self.transparent_action]:
+            a.setVisible(has_mask)
+        self.extend_action.setVisible(margins_tool is not None)
         if has_mask:
             mask_tool.on_size = self._show_size
-            self.mode_buttons[mask_tool.mode].setChecked(True)
+            self.mode_actions[mask_tool.mode].setChecked(True)
             self._show_size(mask_tool.size)
         self.setVisible(has_mask or margins_tool is not None)
         self.refresh()
@@ -490,8 +495,8 @@ class GeometryBar(QWidget):
         on, item = self._on_image()
         pretty = on.replace("_", " ")
         mask = self.mask_tool.mask()
-        self.clear_button.setEnabled(mask is not None and bool(mask))
-        self.invert_button.setEnabled(item is not None)
+        self.clear_action.setEnabled(mask is not None and bool(mask))
+        self.invert_action.setEnabled(item is not None)
         alpha = None if item is None else item.alpha
         if item is None:
             why = f"no {pretty} is open"
@@ -501,8 +506,8 @@ class GeometryBar(QWidget):
             why = f"the {pretty} has an alpha channel but no transparent pixel"
         else:
             why = ""
-        self.transparent_button.setEnabled(not why)
-        self.transparent_button.setToolTip(why or f"make the mask the transparent pixels of the {pretty}")
+        self.transparent_action.setEnabled(not why)
+        self.transparent_action.setToolTip(why or f"make the mask the transparent pixels of the {pretty}")
 
     def _size(self) -> tuple[int, int]:
         return self.mask_tool.view.image_size()

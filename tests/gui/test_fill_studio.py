@@ -23,6 +23,7 @@ from weft.core.registry import InputSpec, Method, Result
 from weft.core.studio import MARGINS, MASK, Geometry, Studio
 
 from .helpers import mouse
+from .test_artist_session import _click_menu_item
 
 W, H = 80, 64
 
@@ -45,7 +46,7 @@ def _mean_fill(inputs, params, *, rng=None, progress=None, cancel=None):
         raise WeftError("the hole is not the size of the picture")
     if params.grow:
         left, top, right, bottom = params.grow
-        picture = np.pad(picture, ((top, bottom), (left, right), (0, 0)))
+        picture = np.pad(picture, ((top, bottom), (left, right)) + ((0, 0),) * (picture.ndim - 2))
         bits = np.pad(bits, ((top, bottom), (left, right)), constant_values=True)
     out = picture.copy()
     if bits.any() and not bits.all():
@@ -350,8 +351,7 @@ def test_extend_canvas_by_dragging_an_edge_outward(studio, qtbot):
 
 def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
     bar = studio.inputs_pane.bar()
-    assert bar.extend_button.isVisible()
-    qtbot.mouseClick(bar.extend_button, Qt.MouseButton.LeftButton)
+    _click_menu_item(qtbot, studio.geometry_menu, bar.extend_action)  # Edit > Mask and Canvas > Extend canvas…
     dialog = bar.dialog
     qtbot.waitUntil(dialog.isVisible, timeout=5000)
     for side, value in zip(("left", "top", "right", "bottom"), (3, 5, 0, 12)):
