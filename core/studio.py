@@ -257,9 +257,10 @@ class Around:
     box: tuple[int, int, int, int]
     offset: tuple[int, int]
 
-    def paste(self, base: np.ndarray, part: np.ndarray) -> np.ndarray | None:
+    def paste(self, base: np.ndarray, part: np.ndarray, *, copy: bool = True) -> np.ndarray | None:
         """``base`` (a full result) with ``part`` (the crop's result, scaled back to the box) pasted
-        at the box; None when they do not fit together (another size or channel count)."""
+        at the box (into a copy, or with ``copy=False`` into ``base`` itself); None when they do not
+        fit together (another size or channel count)."""
         from .image import resize
 
         x0, y0, x1, y1 = self.box
@@ -272,7 +273,7 @@ class Around:
         if (part.ndim != base.ndim or (part.ndim == 3 and part.shape[2] != base.shape[2])
                 or y0 + dy < 0 or x0 + dx < 0 or y1 + dy > base.shape[0] or x1 + dx > base.shape[1]):
             return None
-        out = base.copy()
+        out = base.copy() if copy else base
         out[y0 + dy:y1 + dy, x0 + dx:x1 + dx] = part
         return out
 

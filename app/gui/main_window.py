@@ -40,7 +40,7 @@ from PySide6.QtWidgets import (
 from weft.core.errors import WeftError
 from weft.core.examples import example, examples
 from weft.core.jobs import JobRunner
-from weft.core.studio import SQUARE
+from weft.core.studio import MARGINS, MASK, SQUARE
 
 from .canvas import InputsPane, titled
 from .convert import to_qimage
@@ -567,11 +567,13 @@ class MainWindow(QMainWindow):
 
     # --- results ---------------------------------------------------------------------------------
     def _on_around_shown(self, shown) -> None:
+        self.result_view.set_notice(None)
         self.result_view.set_image(shown.image)
         self.statusBar().showMessage(describe(shown) + " (around the stroke)")
 
     def _on_shown(self, shown) -> None:
         self.result_view.set_stale(None)  # a render succeeded: what is shown follows the panel
+        self.result_view.set_notice(None)
         self.result_view.set_image(shown.image)
         if shown.before is not None and shown.before is not self.result_view.compare_image:
             self.result_view.set_compare(shown.before)  # the input of this result, not of the panel
@@ -611,8 +613,25 @@ class MainWindow(QMainWindow):
         else:
             self._end_preparing()
 
+    def _nothing_drawn(self) -> str | None:
+        """What to draw, when the current method works on a drawn region (a mask, margins) and none
+        is drawn yet: its geometry's help, e.g. "paint what to fill"."""
+        geometry = self.doc.studio.geometry
+        if not any(g.kind in (MASK, MARGINS) for g in geometry) or any(self.doc.value(g.key) is not None
+                                                                         for g in geometry):
+            return None
+        words = "; ".join(g.help for g in geometry if g.help) or "draw on the input"
+        return words[0].upper() + words[1:]
+
     def _on_failed(self, message: str) -> None:
         self.show_message(message)
+        draw = self._nothing_drawn()
+        if message.startswith("render failed") and draw is not None:
+            # nothing drawn yet (the method has nothing to do): the input, and what to draw on it
+            self.result_view.set_stale(None)
+            self.result_view.set_image(self.doc.image(self.doc.studio.canvas))
+            self.result_view.set_notice(draw)
+            return
         if message.startswith("render failed"):  # not a warm-up's: the result no longer matches the panel
             self.result_view.set_stale(f"Out of date — {message}. The result shown is from earlier settings"
                                        f" (F5 renders again).")

@@ -166,7 +166,7 @@ class Renderer(QObject):
         """A mask stroke is being painted (``box`` the region of its latest dab, in the painted image's
         pixels): preview the region around it soon (coalesced with the dabs that follow). False if
         the method previews no stroke that way."""
-        if self.doc.studio.preview_around is None or self.last is None:
+        if self.doc.studio.preview_around is None:
             return False
         if self._around_box is None:
             self._around_box = tuple(box)
@@ -323,17 +323,26 @@ class Renderer(QObject):
                           recipe, before, masks)
         self.shown.emit(self.last)
 
+    def _around_base(self) -> np.ndarray | None:
+        """What a preview around a stroke is pasted into: the last full result of this method, else
+        (none yet, e.g. it refused to run with nothing painted) its canvas input."""
+        last = self.last
+        if last is not None and last.final and last.recipe is not None and last.recipe.method == self.doc.method:
+            return last.image
+        return self.doc.method_inputs().get(self.doc.studio.canvas)
+
     def _show_around(self, res, crop, job_id: int, seconds: float) -> None:
         """Paste a preview around a stroke into the full result (and the stroke's earlier ones)."""
-        if self.last is None:
+        fresh = self._around_image is None
+        base = self._around_base() if fresh else self._around_image
+        if base is None:
             return
-        base = self._around_image if self._around_image is not None else self.last.image
-        pasted = crop.paste(base if self._around_image is not None else base.copy(), res.image)
+        pasted = crop.paste(base, res.image, copy=fresh)
         if pasted is None:
             return  # the crop's result does not fit the full one (another size): the release renders
         self._around_image = pasted
         self.around_shown.emit(Shown(pasted, job_id, seconds, dict(res.figures), False, recipe=None,
-                                     before=self.last.before))
+                                     before=None if self.last is None else self.last.before))
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
         if slot != "final" or job_id != self.latest_final:

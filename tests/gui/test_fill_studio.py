@@ -41,6 +41,8 @@ def _mean_fill(inputs, params, *, rng=None, progress=None, cancel=None):
     picture = inputs["picture"]
     CALLS.append(picture.shape[:2])
     hole = inputs.get("hole")
+    if hole is None and not params.grow:
+        raise WeftError("nothing to fill: give a hole or margins")
     bits = np.zeros(picture.shape[:2], bool) if hole is None else np.asarray(hole) > 0.5
     if hole is not None and hole.shape[:2] != picture.shape[:2]:
         raise WeftError("the hole is not the size of the picture")
@@ -96,9 +98,9 @@ def studio(plugin, qtbot, settings, tmp_path):
     box = window.method_panel.method_box
     box.setCurrentIndex(box.findData(plugin.name))
     picture = _picture(tmp_path / "picture.png")
-    window.open_input("picture", str(picture))
-    qtbot.waitUntil(lambda: window.doc.image("picture") is not None, timeout=10000)
-    qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=10000)
+    with qtbot.waitSignal(window.renderer.failed, timeout=10000):  # nothing to fill yet
+        window.open_input("picture", str(picture))
+    assert window.doc.image("picture") is not None
     view = window.canvas_view
     view.actual_size()
     view.zoom_by(4.0)
@@ -126,6 +128,13 @@ def _final_after(window, qtbot, action):
                           check_params_cb=lambda shown: shown.final):
         action()
     return window.renderer.last
+
+
+def test_with_nothing_painted_the_result_shows_the_picture_and_what_to_do(studio):
+    view = studio.result_view
+    assert np.array_equal(view.image, studio.doc.image("picture"))
+    assert view.notice.isVisible() and view.notice.text() == "Paint the hole; drag an edge outward"
+    assert not view.stale.isVisible()  # not an error: there is nothing to fill yet
 
 
 def test_the_mask_input_is_painted_over_its_image_not_a_view_of_its_own(studio):
@@ -160,9 +169,11 @@ def test_a_brush_stroke_paints_the_pixels_under_it_and_is_one_undo_step(studio, 
     assert doc.undo_stack.count() == steps + 1 and doc.undo_stack.text(steps) == "Brush stroke"
     # Ctrl+Z undoes the whole stroke
     view.setFocus()
-    _final_after(studio, qtbot, lambda: qtbot.keyClick(studio, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier))
+    assert studio.result_view.notice.isHidden()
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):  # nothing to fill again
+        qtbot.keyClick(studio, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
     assert _mask(studio) is None
-    assert np.array_equal(studio.renderer.last.image, source)
+    assert np.array_equal(studio.result_view.image, source) and studio.result_view.notice.isVisible()
     assert tool.overlay.pixmap().isNull()
 
 
@@ -243,7 +254,8 @@ def test_clear_and_invert_are_undoable(studio, qtbot):
     assert bar.clear_button.isEnabled()
     _final_after(studio, qtbot, lambda: qtbot.mouseClick(bar.invert_button, Qt.MouseButton.LeftButton))
     assert np.array_equal(_mask(studio).bits, ~painted.bits)
-    _final_after(studio, qtbot, lambda: qtbot.mouseClick(bar.clear_button, Qt.MouseButton.LeftButton))
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):  # nothing to fill
+        qtbot.mouseClick(bar.clear_button, Qt.MouseButton.LeftButton)
     assert _mask(studio) is None and not bar.clear_button.isEnabled()
     doc.undo_stack.undo()
     doc.undo_stack.undo()
@@ -279,8 +291,7 @@ def test_a_mask_that_no_longer_fits_its_image_is_dropped_with_a_message(studio, 
         studio.open_input("picture", str(other))
     assert "does not fit" in said.args[0] and "dropped" in said.args[0]
     assert _mask(studio) is None
-    qtbot.waitUntil(lambda: studio.renderer.last.final and studio.renderer.last.image.shape[:2] == (50, 70),
-                    timeout=10000)
+    qtbot.waitUntil(lambda: studio.result_view.image.shape[:2] == (50, 70), timeout=10000)
     studio.doc.undo_stack.undo()  # the old picture and its mask come back together
     assert studio.doc.inputs["picture"].path == str(studio.picture) and _mask(studio) == painted
 
@@ -380,13 +391,26 @@ def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
     assert not shown.final and shown.image.shape == (H, W, 3)
     assert CALLS and max(CALLS[0]) < max(H, W) and max(CALLS[0]) <= AROUND_SIDE  # a crop, not the whole picture
     live = studio.doc.live[1]
-    # the stroke so far is filled in the preview; far from it the last full result is kept
+    # the stroke so far is filled in the preview, pasted into the picture (no full result yet: nothing
+    # was painted before)
     source = studio.doc.image("picture")
     assert not np.allclose(shown.image[live.bits], source[live.bits])
-    assert np.array_equal(shown.image[50:, 60:], studio.renderer.last.image[50:, 60:])
+    assert np.array_equal(shown.image[40:, 40:], source[40:, 40:])
+    assert np.array_equal(studio.result_view.image, shown.image)
     assert _mask(studio) is None  # nothing committed before the release
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
     assert result.image.shape == (H, W, 3) and _mask(studio) is not None
+    # the next stroke's previews are pasted into that full result
+    around.clear()
+    _stroke(view, [(60.5, 50.5), (64.5, 52.5)], release=False)
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    assert np.array_equal(around[-1].image[:20, :20], result.image[:20, :20])  # the first stroke, filled
+    assert not np.array_equal(result.image[:20, :20], source[:20, :20])
+    view.setFocus()
+    with qtbot.waitSignal(studio.renderer.shown, timeout=10000):  # Esc: the full result again
+        qtbot.keyClick(view, Qt.Key.Key_Escape)
+    mouse(view, "release", (64.5, 52.5))
+    assert np.array_equal(studio.result_view.image, result.image)
 
 
 def test_a_session_whose_mask_no_longer_fits_its_image_opens_without_it_and_says_so(studio, qtbot, tmp_path):
