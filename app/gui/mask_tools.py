@@ -22,14 +22,14 @@ from typing import Callable
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
-from PySide6.QtGui import QAction, QActionGroup, QBrush, QColor, QImage, QPainterPath, QPixmap
+from PySide6.QtGui import QAction, QActionGroup, QBrush, QColor, QImage, QPainterPath
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
     QFormLayout,
     QGraphicsEllipseItem,
+    QGraphicsItem,
     QGraphicsPathItem,
-    QGraphicsPixmapItem,
     QGraphicsRectItem,
     QLabel,
     QSpinBox,
@@ -46,15 +46,52 @@ BRUSH, ERASER, LASSO_ADD, LASSO_SUBTRACT = "brush", "eraser", "lasso add", "lass
 MODES = (BRUSH, ERASER, LASSO_ADD, LASSO_SUBTRACT)
 
 
-def mask_overlay(mask: Mask | None) -> QPixmap:
-    """The mask as a pixmap: its colour where it is set, transparent elsewhere."""
-    if mask is None:
-        return QPixmap()
-    h, w = mask.shape
-    rgba = np.zeros((h, w, 4), dtype=np.uint8)
-    rgba[mask.bits] = MASK_RGBA
-    image = QImage(rgba.data, w, h, 4 * w, QImage.Format.Format_RGBA8888)
-    return QPixmap.fromImage(image.copy())  # a deep copy first: fromImage may share the numpy buffer, which goes
+class MaskOverlay(QGraphicsItem):
+    """The mask drawn over its image: its colour where it is set, transparent elsewhere. A stroke
+    updates only the pixels around each dab (:meth:`update_box`), so painting costs the dab's area,
+    not the image's."""
+
+    def __init__(self):
+        super().__init__()
+        self._rgba: np.ndarray | None = None  # (H, W, 4) uint8: the QImage's pixels (kept alive with it)
+        self._image = QImage()
+
+    def image(self) -> QImage:
+        """What is drawn (a null image when the mask is empty or none)."""
+        return self._image
+
+    def set_mask(self, mask: Mask | None) -> None:
+        self.prepareGeometryChange()
+        if mask is None or not mask:
+            self._rgba, self._image = None, QImage()
+        else:
+            h, w = mask.shape
+            self._rgba = np.zeros((h, w, 4), dtype=np.uint8)
+            self._rgba[mask.bits] = MASK_RGBA
+            self._image = QImage(self._rgba.data, w, h, 4 * w, QImage.Format.Format_RGBA8888)
+        self.update()
+
+    def update_box(self, mask: Mask, box: tuple[int, int, int, int]) -> None:
+        """Redraw ``box`` = (x0, y0, x1, y1) of ``mask`` (a mask of the same size as the one shown)."""
+        if self._rgba is None or self._rgba.shape[:2] != mask.shape:
+            self.set_mask(mask)
+            return
+        x0, y0, x1, y1 = box
+        h, w = mask.shape
+        x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
+        if x0 >= x1 or y0 >= y1:
+            return
+        part = self._rgba[y0:y1, x0:x1]
+        part[:] = 0
+        part[mask.bits[y0:y1, x0:x1]] = MASK_RGBA
+        self.update(QRectF(x0, y0, x1 - x0, y1 - y0))
+
+    def boundingRect(self) -> QRectF:  # noqa: N802 (Qt naming)
+        return QRectF(0, 0, self._image.width(), self._image.height())
+
+    def paint(self, painter, option, widget=None) -> None:
+        if not self._image.isNull():
+            painter.drawImage(QPointF(0, 0), self._image)
 
 
 class MaskTool(Tool):
@@ -67,7 +104,7 @@ class MaskTool(Tool):
         self.mode = BRUSH
         self.size = BRUSH_DEFAULT  # brush diameter in image pixels
         scene = view.scene()
-        self.overlay = QGraphicsPixmapItem()
+        self.overlay = MaskOverlay()
         self.overlay.setZValue(5)
         scene.addItem(self.overlay)
         self.cursor = QGraphicsEllipseItem()
@@ -138,11 +175,11 @@ class MaskTool(Tool):
         self.live = None
         self.points = []
         self.lasso_item.setPath(QPainterPath())
-        self.overlay.setPixmap(QPixmap())
+        self.overlay.set_mask(None)
         self._show_cursor(None)
 
     def _draw(self, mask: Mask | None) -> None:
-        self.overlay.setPixmap(mask_overlay(mask if mask is not None and mask else None))
+        self.overlay.set_mask(mask)
 
     def _show_cursor(self, pos) -> None:
         """The brush's circle at ``pos`` (the mouse pointer a small cross inside it); None hides it."""
@@ -166,10 +203,11 @@ class MaskTool(Tool):
         value = self.mode == BRUSH
         self.live = self.live.painted_line(p0, p1, self.radius, value)
         self.last = p1
-        self._draw(self.live)
+        r = self.radius + 1
+        box = (min(p0[0], p1[0]) - r, min(p0[1], p1[1]) - r, max(p0[0], p1[0]) + r, max(p0[1], p1[1]) + r)
+        self.overlay.update_box(self.live, (int(np.floor(box[0])), int(np.floor(box[1])),
+                                            int(np.ceil(box[2])) + 1, int(np.ceil(box[3])) + 1))
         if self.on_stroke is not None and value:
-            r = self.radius + 1
-            box = (min(p0[0], p1[0]) - r, min(p0[1], p1[1]) - r, max(p0[0], p1[0]) + r, max(p0[1], p1[1]) + r)
             self.on_stroke(self.live, box)
 
     def press(self, view, pos, event):

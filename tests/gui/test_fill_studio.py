@@ -122,6 +122,13 @@ def _stroke(view, points, *, release=True):
         mouse(view, "release", points[-1])
 
 
+def _painted(overlay) -> np.ndarray:
+    """Where the mask's overlay is drawn (its alpha), as a bool (H, W) array."""
+    image = overlay.image().convertToFormat(QImage.Format.Format_RGBA8888)
+    rgba = np.frombuffer(image.constBits(), np.uint8).reshape(image.height(), image.bytesPerLine() // 4, 4)
+    return rgba[:, :image.width(), 3] > 0
+
+
 def _final_after(window, qtbot, action):
     """Do ``action`` and wait for the full-size result it causes."""
     with qtbot.waitSignal(window.renderer.shown, timeout=10000,
@@ -164,7 +171,7 @@ def test_a_brush_stroke_paints_the_pixels_under_it_and_is_one_undo_step(studio, 
     assert np.allclose(result.image[mask.bits], source[~mask.bits].mean(axis=0), atol=1e-5)
     assert np.array_equal(result.image[~mask.bits], source[~mask.bits])
     # the overlay shows the mask over the image: coloured where painted, clear elsewhere
-    overlay = tool.overlay.pixmap().toImage()
+    overlay = tool.overlay.image()
     assert overlay.width() == W and overlay.pixelColor(20, 20).alpha() > 0 and overlay.pixelColor(20, 40).alpha() == 0
     assert doc.undo_stack.count() == steps + 1 and doc.undo_stack.text(steps) == "Brush stroke"
     # Ctrl+Z undoes the whole stroke
@@ -174,7 +181,7 @@ def test_a_brush_stroke_paints_the_pixels_under_it_and_is_one_undo_step(studio, 
         qtbot.keyClick(studio, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
     assert _mask(studio) is None
     assert np.array_equal(studio.result_view.image, source) and studio.result_view.notice.isVisible()
-    assert tool.overlay.pixmap().isNull()
+    assert tool.overlay.image().isNull()
 
 
 def test_square_brackets_size_the_brush_and_its_circle_cursor(studio, qtbot):
@@ -216,6 +223,7 @@ def test_the_eraser_removes_and_esc_cancels_a_stroke_in_progress(studio, qtbot):
     tool.set_size(3)
     _final_after(studio, qtbot, lambda: _stroke(view, [(35.5, 20.5), (35.5, 40.5)]))
     erased = _mask(studio)
+    assert np.array_equal(_painted(tool.overlay), erased.bits)
     assert not erased.bits[25:36, 34:37].any() and erased.bits[30, 33] and erased.bits[30, 37]
     assert erased.area < painted.area
     assert doc.undo_stack.text(doc.undo_stack.index() - 1) == "Erase"
@@ -312,7 +320,7 @@ def test_session_save_and_open_restores_the_mask_and_margins(studio, qtbot, tmp_
     doc.set_margins("grow", None)
     assert studio.open_session(str(session))
     assert _mask(studio) == painted and doc.value("grow") == Margins(4, 0, 8, 2)
-    assert studio.inputs_pane.mask_tool().overlay.pixmap().width() == W
+    assert studio.inputs_pane.mask_tool().overlay.image().width() == W
 
 
 def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(studio, qtbot, tmp_path, capsys):
@@ -391,6 +399,7 @@ def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
     assert not shown.final and shown.image.shape == (H, W, 3)
     assert CALLS and max(CALLS[0]) < max(H, W) and max(CALLS[0]) <= AROUND_SIDE  # a crop, not the whole picture
     live = studio.doc.live[1]
+    assert np.array_equal(_painted(studio.inputs_pane.mask_tool().overlay), live.bits)  # drawn as it is painted
     # the stroke so far is filled in the preview, pasted into the picture (no full result yet: nothing
     # was painted before)
     source = studio.doc.image("picture")
