@@ -148,9 +148,12 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
         except WeftError:
             picture = load_image(example("gravel")).image
         picture = resize(picture, (side, side))
+        answered: list = []  # the first render: a result, or "nothing to fill" with nothing painted yet
+        window.renderer.shown.connect(answered.append)
+        window.renderer.failed.connect(answered.append)
         doc.restore(DocumentState(inputs={studio.canvas: InputImage(None, picture)}, method=method))
         window.renderer.final(now=True)
-        _wait(app, lambda: window.renderer.last is not None, 60)
+        _wait(app, lambda: bool(answered), 120)
         view = window.canvas_view
         tool = window.inputs_pane.mask_tool()
         tool.set_size(max(8, side // 24))
@@ -200,8 +203,8 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
             send("move", x, y)
         _wait(app, lambda: time.perf_counter() - start >= values * step + 0.5, 5)
         send("release", *points[-1])
-        _wait(app, lambda: window.renderer.last.final and doc.value(tool.geometry_key) is not None
-              and not window.renderer.running(), 120)
+        _wait(app, lambda: window.renderer.last is not None and window.renderer.last.final
+              and doc.value(tool.geometry_key) is not None and not window.renderer.running(), 120)
         heartbeat.stop()
         gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:])]
         window.doc.undo_stack.setClean()

@@ -160,6 +160,10 @@ class Studio:
         stroke is drawn, the method runs on a crop of its inputs around the painted region
         (:func:`crop_around`) and the crop's result is pasted into the last full result; None: a
         stroke previews nothing until it is released.
+    own_inputs : optional inputs the method takes only when they were opened for it (while it was the
+        studio's method): the studio shares inputs by name between methods, and an image opened as
+        another method's input of that name must not change what this one does (``fill``'s optional
+        ``texture``, a source to copy from, is not ``quilt``'s texture).
     """
 
     title: str
@@ -173,6 +177,7 @@ class Studio:
     rank: int = 100
     figures: Mapping[str, Figure] = field(default_factory=dict)
     preview_around: str | None = None
+    own_inputs: tuple[str, ...] = ()
 
     def describe(self, figures: Mapping[str, Any]) -> list[str]:
         """A result's figures in words and units (see :func:`describe_figures`)."""

@@ -46,6 +46,7 @@ class InputImage:
     path: str | None
     image: np.ndarray
     with_alpha: np.ndarray | None = None
+    opened_for: str | None = None  # the method that was current when it was opened (Studio.own_inputs)
 
     @property
     def alpha(self) -> np.ndarray | None:
@@ -134,8 +135,16 @@ class Document(QObject):
     def current_params(self) -> Params:
         return self.params[self.method]
 
-    def image(self, name: str) -> np.ndarray | None:
+    def item(self, name: str) -> InputImage | None:
+        """Input ``name`` as the current method sees it: None if not open, or if it is one of the
+        method's own inputs (``Studio.own_inputs``) opened for another method."""
         item = self.inputs.get(name)
+        if item is not None and name in self.studio.own_inputs and item.opened_for != self.method:
+            return None
+        return item
+
+    def image(self, name: str) -> np.ndarray | None:
+        item = self.item(name)
         return None if item is None else item.image
 
     def missing_inputs(self) -> list[str]:
@@ -207,7 +216,7 @@ class Document(QObject):
         painted = {g.input for g in self.studio.geometry if g.kind == MASK}
         out = {}
         for spec in self.current.inputs:
-            item = self.inputs.get(spec.name)
+            item = self.item(spec.name)
             if item is not None and spec.name not in painted:
                 keep = keeps_alpha(spec) and item.with_alpha is not None
                 out[spec.name] = item.with_alpha if keep else item.image
@@ -238,7 +247,8 @@ class Document(QObject):
         """The recipe of a render of the document now with ``params`` (default :meth:`run_params`);
         input paths absolute (``Recipe.to_json(relative_to=...)`` writes them relative to its file)."""
         names = {i.name for i in self.current.inputs}
-        inputs = {name: item.path for name, item in self.inputs.items() if name in names and item.path}
+        inputs = {name: item.path for name, item in self.inputs.items()
+                  if name in names and item.path and self.item(name) is not None}
         params = self.run_params(live=False) if params is None else params
         return Recipe(method=self.method, params=params.to_dict(), inputs=inputs,
                       seed=self.seed, region=self.region())
@@ -275,11 +285,11 @@ class Document(QObject):
                 return
             self.set_mask(g.key, mask, f"Open {name.replace('_', ' ')} {Path(path).name if path else ''}".strip())
             return
-        self.push(SetInput(self, name, InputImage(path, image, with_alpha)))
+        self.push(SetInput(self, name, InputImage(path, image, with_alpha, self.method)))
 
     def clear_input(self, name: str) -> None:
         """Undoable removal of an open input (the method then runs without it)."""
-        if name in self.inputs:
+        if self.item(name) is not None:
             self.push(SetInput(self, name, None))
 
     def set_method(self, method: str) -> None:

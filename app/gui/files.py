@@ -261,7 +261,11 @@ class FileActions(QObject):
         return data, images
 
     def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
-        """Put a read session into the document (one clean state, no undo history) and render it."""
+        """Put a read session into the document (one clean state, no undo history) and render it.
+        The session's method's own inputs (``Studio.own_inputs``) count as opened for it."""
+        own = registry.studio_methods()[data["method"]].studio.own_inputs
+        images = {name: dataclasses.replace(item, opened_for=data["method"]) if name in own else item
+                  for name, item in images.items()}
         self.doc.restore(DocumentState(inputs=images, method=data["method"], params=data["params"],
                                        geometry=data["geometry"], seed=data["seed"]))
         self.renderer.final(now=True)

@@ -524,7 +524,7 @@ class GeometryBar(QToolBar):
 
     def _on_image(self) -> tuple[str, object | None]:
         on = self.mask_tool.geometry.input_for(self.doc.inputs)
-        return on, self.doc.inputs.get(on)
+        return on, self.doc.item(on)
 
     def refresh(self) -> None:
         """Enable the actions that can do something now (a disabled one says why in its tooltip)."""

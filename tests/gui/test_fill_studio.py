@@ -51,27 +51,39 @@ def _mean_fill(inputs, params, *, rng=None, progress=None, cancel=None):
         picture = np.pad(picture, ((top, bottom), (left, right)) + ((0, 0),) * (picture.ndim - 2))
         bits = np.pad(bits, ((top, bottom), (left, right)), constant_values=True)
     out = picture.copy()
+    swatch = inputs.get("swatch")
+    if bits.any() and swatch is not None:
+        mean = swatch.reshape(-1, swatch.shape[-1]).mean(axis=0)
     if bits.any() and not bits.all():
-        mean = picture[~bits].mean(axis=0)
+        mean = picture[~bits].mean(axis=0) if swatch is None else mean
         out[bits] = picture[bits] + params.amount * (mean - picture[bits])
     return Result(out, {"hole_pixels": int(bits.sum())})
 
 
 MEAN_FILL = Method(
     name="mean-fill", summary="fill a painted hole with the mean colour of the rest", params=MeanFillParams,
-    inputs=(InputSpec("picture", "the picture"), InputSpec("hole", "white = fill", required=False)),
+    inputs=(InputSpec("picture", "the picture"), InputSpec("hole", "white = fill", required=False),
+            InputSpec("swatch", "take the colour from this image instead", required=False)),
     run=_mean_fill,
-    studio=Studio(title="Mean fill", canvas="picture", preview_around="hole",
+    studio=Studio(title="Mean fill", canvas="picture", preview_around="hole", own_inputs=("swatch",),
                   geometry=(Geometry(MASK, on=("picture",), input="hole", help="paint the hole"),
                             Geometry(MARGINS, on=("picture",), param="grow", help="drag an edge outward"))),
 )
 
 
+SHOW_SWATCH = Method(  # another method whose input has the name of mean-fill's own "swatch" input
+    name="show-swatch", summary="the swatch as it is", params=MeanFillParams,
+    inputs=(InputSpec("swatch", "a swatch"),), run=lambda inputs, params, **kw: Result(inputs["swatch"]),
+    studio=Studio(title="Show a swatch", canvas="swatch", rank=200))
+
+
 @pytest.fixture
 def plugin():
     registry.register(MEAN_FILL)
+    registry.register(SHOW_SWATCH)
     yield MEAN_FILL
     registry.unregister(MEAN_FILL.name)
+    registry.unregister(SHOW_SWATCH.name)
 
 
 def _picture(path, seed=3, alpha=None):
@@ -456,3 +468,24 @@ def test_unsaved_masks_and_margins_reach_the_recovery_file(studio, qtbot, settin
         assert not (private_recovery / "recovery.weft.mean-fill.hole.png").exists()
     finally:
         again.shutdown()
+
+
+def test_an_own_input_opened_for_another_method_is_not_used(studio, qtbot, tmp_path):
+    """mean-fill's optional "swatch" is its own (Studio.own_inputs): the swatch opened for another
+    method of the studio does not change its fill; one opened for it does."""
+    doc, view = studio.doc, studio.canvas_view
+    swatch = tmp_path / "swatch.png"
+    save_image(swatch, np.full((8, 8, 3), 0.25, np.float32))
+    doc.set_method(SHOW_SWATCH.name)
+    studio.open_input("swatch", str(swatch))
+    qtbot.waitUntil(lambda: doc.image("swatch") is not None, timeout=10000)
+    doc.set_method(MEAN_FILL.name)
+    assert doc.image("swatch") is None and "swatch" not in doc.method_inputs()
+    studio.inputs_pane.mask_tool().set_size(5)
+    result = _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
+    bits = _mask(studio).bits
+    picture = doc.image("picture")
+    assert np.allclose(result.image[bits], picture[~bits].mean(axis=0), atol=1e-5)  # not the swatch's colour
+    assert "swatch" not in result.recipe.inputs
+    result = _final_after(studio, qtbot, lambda: studio.open_input("swatch", str(swatch)))  # opened for it
+    assert np.allclose(result.image[bits], load_image(swatch).image.mean(), atol=1e-5)  # 64/255
