@@ -328,12 +328,17 @@ class MarginsTool(Tool):
     def press(self, view, pos, event):
         w, h = view.image_size()
         sides = (pos.x() < 0, pos.y() < 0, pos.x() > w, pos.y() > h)  # left, top, right, bottom
-        self.drag = (sides, (pos.x(), pos.y()), self.margins())
+        # the drag is measured on screen: the scene grows with the frame, and a view centres a scene
+        # smaller than itself, so a scene point under the mouse moves while the frame grows
+        at = event.position()
+        self.drag = (sides, (at.x(), at.y()), self.margins())
         self.live = self.margins()
 
-    def _dragged(self, pos) -> Margins:
+    def _dragged(self, event) -> Margins:
         sides, (x0, y0), m = self.drag
-        dx, dy = pos.x() - x0, pos.y() - y0
+        k = self.view.screen_to_image_distance(1.0)
+        at = event.position()
+        dx, dy = (at.x() - x0) * k, (at.y() - y0) * k
         moves = (-dx, -dy, dx, dy)
         return Margins(*(max(0, min(MAX_SIDE, int(round(v + d)))) if s else v
                          for v, d, s in zip(m, moves, sides)))
@@ -341,7 +346,7 @@ class MarginsTool(Tool):
     def move(self, view, pos, event):
         if self.drag is None or not (event.buttons() & Qt.MouseButton.LeftButton):
             return
-        self.live = self._dragged(pos)
+        self.live = self._dragged(event)
         self._show(self.live)
         if self.on_drag is not None:
             self.on_drag(self.live)
@@ -349,7 +354,7 @@ class MarginsTool(Tool):
     def release(self, view, pos, event):
         if self.drag is None:
             return
-        margins = self._dragged(pos)
+        margins = self._dragged(event)
         self.drag = None
         self.live = None
         if margins != self.margins():

@@ -356,25 +356,46 @@ def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(stu
     assert Mask.read(tmp_path / "r.hole.png") == painted
 
 
+def _screen_drag(view, start_scene, steps_px, *, last=True):
+    """Press at a scene point, then move the mouse by screen offsets (dx, dy) from there, as a hand
+    does (the scene may move under it meanwhile), and release at the last one."""
+    from PySide6.QtCore import QEvent, QPointF
+    from PySide6.QtGui import QMouseEvent
+    from PySide6.QtWidgets import QApplication
+
+    origin = QPointF(view.mapFromScene(QPointF(*start_scene)))
+
+    def send(kind, at):
+        etype = {"press": QEvent.Type.MouseButtonPress, "move": QEvent.Type.MouseMove,
+                 "release": QEvent.Type.MouseButtonRelease}[kind]
+        button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
+        held = Qt.MouseButton.NoButton if kind == "release" else Qt.MouseButton.LeftButton
+        QApplication.sendEvent(view.viewport(), QMouseEvent(etype, at, QPointF(view.viewport().mapToGlobal(at)),
+                                                            button, held, Qt.KeyboardModifier.NoModifier))
+
+    send("press", origin)
+    for dx, dy in steps_px:
+        send("move", origin + QPointF(dx, dy))
+    if last:
+        send("release", origin + QPointF(*steps_px[-1]))
+
+
 def test_extend_canvas_by_dragging_an_edge_outward(studio, qtbot):
     view, doc = studio.canvas_view, studio.doc
     view.fit()  # the whole image with room around it
     tool = studio.inputs_pane.margins_tool()
     assert view.sceneRect().left() < 0 and view.sceneRect().right() > W  # room to drag in
-    start = (W + 1.0, H / 2)  # just right of the image
-    mouse(view, "press", start)
-    mouse(view, "move", (W + 8.0, H / 2))
+    k = view.scale_factor()  # screen pixels per image pixel
+    _screen_drag(view, (W + 1.0, H / 2), [(7 * k, 0)], last=False)
     assert tool.frame.isVisible() and tool.frame.rect().width() == W + 7  # the grown frame, drawn
-    mouse(view, "move", (W + 21.0, H / 2))
-    result = _final_after(studio, qtbot, lambda: mouse(view, "release", (W + 21.0, H / 2)))
-    assert doc.value("grow") == Margins(0, 0, 20, 0)
+    result = _final_after(studio, qtbot, lambda: _screen_drag(view, (W + 1.0, H / 2), [(14 * k, 0), (20 * k, 0)]))
+    assert doc.value("grow") == Margins(0, 0, 20, 0)  # (its press started the drag again)
     assert doc.undo_stack.text(doc.undo_stack.index() - 1) == "Extend canvas 0,0,20,0"
     assert result.image.shape == (H, W + 20, 3)
     assert _mask(studio) is None  # the press outside the image painted nothing
     # the top-left corner drags two edges
-    mouse(view, "press", (-1.0, -1.0))
-    mouse(view, "move", (-5.0, -1.0))
-    _final_after(studio, qtbot, lambda: mouse(view, "release", (-11.0, -7.0)))
+    k = view.scale_factor()
+    _final_after(studio, qtbot, lambda: _screen_drag(view, (-1.0, -1.0), [(-4 * k, 0), (-10 * k, -6 * k)]))
     assert doc.value("grow") == Margins(10, 6, 20, 0)
     doc.undo_stack.undo()
     assert doc.value("grow") == Margins(0, 0, 20, 0)
