@@ -341,7 +341,7 @@ class Renderer(QObject):
         if pasted is None:
             return  # the crop's result does not fit the full one (another size): the release renders
         self._around_image = pasted
-        self.around_shown.emit(Shown(pasted, job_id, seconds, dict(res.figures), False, recipe=None,
+        self.around_shown.emit(Shown(pasted, job_id, seconds, {}, False, recipe=None,  # (the crop's figures: not the image's)
                                      before=None if self.last is None else self.last.before))
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
