@@ -232,6 +232,11 @@ class MaskTool(Tool):
             self.points.append(p)
             self._draw_lasso()
 
+    def leave(self) -> None:
+        """The mouse left the view: no circle (a stroke in progress keeps it)."""
+        if not self.active:
+            self._show_cursor(None)
+
     def _draw_lasso(self) -> None:
         path = QPainterPath()
         if self.points:
@@ -401,6 +406,12 @@ class ToolSet(Tool):
         tool, self.grabbed = self.grabbed, None
         if tool is not None:
             tool.release(view, pos, event)
+
+    def leave(self) -> None:
+        for tool in self.tools:
+            leave = getattr(tool, "leave", None)
+            if leave is not None:
+                leave()
 
     def key(self, view, event) -> bool:
         order = ([self.grabbed] if self.grabbed is not None else []) + [t for t in self.tools if t is not self.grabbed]

@@ -191,6 +191,12 @@ class ImageView(QGraphicsView):
             return
         super().mouseReleaseEvent(event)
 
+    def leaveEvent(self, event):  # noqa: N802
+        leave = getattr(self.tool, "leave", None)  # (a brush's circle goes with the mouse)
+        if leave is not None:
+            leave()
+        super().leaveEvent(event)
+
     def keyPressEvent(self, event):  # noqa: N802
         if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
             self._space = True

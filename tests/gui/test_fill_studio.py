@@ -203,6 +203,13 @@ def test_square_brackets_size_the_brush_and_its_circle_cursor(studio, qtbot):
     tool.set_size(8)
     mouse(view, "move", (40.5, 30.5), buttons=Qt.MouseButton.NoButton)
     assert tool.cursor.isVisible()
+    from PySide6.QtCore import QEvent
+    from PySide6.QtWidgets import QApplication
+
+    QApplication.sendEvent(view, QEvent(QEvent.Type.Leave))  # the mouse leaves the view: no circle
+    assert not tool.cursor.isVisible()
+    mouse(view, "move", (40.5, 30.5), buttons=Qt.MouseButton.NoButton)
+    assert tool.cursor.isVisible()
     on_screen = view.mapFromScene(tool.cursor.rect()).boundingRect().width()
     assert abs(on_screen - 8 * view.scale_factor()) <= 2  # the brush's size on screen
     view.setFocus()
