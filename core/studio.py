@@ -203,12 +203,6 @@ class Studio:
         return self.canvas
 
 
-def keeps_alpha(spec) -> bool:
-    """Whether a method's input (an ``InputSpec``) takes its image with the alpha channel (``weft run``
-    loads it with ``load_image(..., alpha=True)``): the studio gives it the same pixels."""
-    return bool(getattr(spec, "alpha", False))
-
-
 def reduce_for_preview(studio: Studio, inputs: Mapping[str, np.ndarray], params, side: int
                        ) -> tuple[dict[str, np.ndarray], Any]:
     """Inputs and parameters of a reduced render: the studio's ``preview_inputs`` that are open

@@ -30,7 +30,7 @@ from weft.core.errors import WeftError
 from weft.core.geometry import LINES, MARGINS, MASK, SQUARE, LineDraft, Margins, Mask, Square
 from weft.core.params import Params, Recipe, relative_path
 from weft.core.session import SESSION_VERSION, mask_file, read_session  # noqa: F401 (read_session: the studio reads sessions)
-from weft.core.studio import Geometry, Studio, keeps_alpha
+from weft.core.studio import Geometry, Studio
 
 _MERGE_PARAM = 1001
 
@@ -62,25 +62,10 @@ def read_input(path: str | Path) -> InputImage:
     loaded = load_image(path)
     with_alpha = None
     if loaded.info.had_alpha:
-        try:
-            kept = load_image(path, alpha=True).image
-        except TypeError:  # a weft.core.image that drops alpha always
-            kept = _pillow_with_alpha(path, loaded.image)
+        kept = load_image(path, alpha=True).image
         if kept.ndim == 3 and kept.shape[2] in (2, 4) and kept.shape[:2] == loaded.image.shape[:2]:
             with_alpha = kept
     return InputImage(str(path), loaded.image, with_alpha)
-
-
-def _pillow_with_alpha(path, image: np.ndarray) -> np.ndarray:
-    """``image`` with the file's alpha channel read by Pillow (8 or 16 bits) appended."""
-    from PIL import Image, ImageOps
-
-    with Image.open(path) as im:
-        im = ImageOps.exif_transpose(im)
-        band = (im if "A" in im.getbands() else im.convert("RGBA")).getchannel("A")
-        alpha = np.asarray(band, dtype=np.float32) / (65535.0 if band.mode.startswith("I") else 255.0)
-    colour = image if image.ndim == 3 else image[..., None]
-    return np.ascontiguousarray(np.concatenate([colour, alpha[..., None]], axis=2)) if alpha.shape == image.shape[:2] else image
 
 
 @dataclass(frozen=True)
@@ -218,7 +203,7 @@ class Document(QObject):
         for spec in self.current.inputs:
             item = self.item(spec.name)
             if item is not None and spec.name not in painted:
-                keep = keeps_alpha(spec) and item.with_alpha is not None
+                keep = spec.alpha and item.with_alpha is not None
                 out[spec.name] = item.with_alpha if keep else item.image
         out.update({name: mask.to_image() for name, mask in self.masks(live=live).items()})
         region = self.region()

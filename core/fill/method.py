@@ -254,15 +254,16 @@ def _memory(shapes: Mapping[str, tuple[int, ...]], params: FillParams) -> float:
     return float(h * w * 120)  # canvas, masks, costs, positions (float32/float64 copies), measured order
 
 
-#: The studio's description of fill, as issue 15's interface fixes it; ``METHOD.studio`` once the
-#: studio draws masks (see METHOD below).
+#: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting
+#: the mask previews the region around the stroke (``preview_around``); the optional ``texture`` is
+#: fill's own (``own_inputs``: the texture the studio has open for quilt and fast is not a source).
 STUDIO = Studio(
     title="Fill and extend",
     canvas="image",
     geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)"),
               Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas")),
     preview_inputs=("image", "mask", "source_mask", "texture"),
-    examples={"image": "brick"}, rank=7,
+    examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
     figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
              "hole_fraction": Figure("filled", "%", "of the image", digits=2),
              "source_pixels": Figure("copied from", "px")})
@@ -285,8 +286,7 @@ METHOD = Method(
     warm_up=warm_up,
     memory=_memory,
     depth_from="image",
-    # studio=STUDIO once the studio has a tool for mask geometry (issue 15's STUDIO helper; without
-    # one, app/gui refuses a method whose description draws a mask, and every studio test with it)
+    studio=STUDIO,
 )
 
 __all__ = ["ANCHORS", "METHOD", "STUDIO", "fill_image", "warm_up"]

@@ -16,6 +16,13 @@ from weft.core.studio import Figure, describe_figures
 SNAKE = re.compile(r"\b[a-z0-9]+(?:_[a-z0-9]+)+\b")
 
 
+def _hole(side: int) -> np.ndarray:
+    """A mask with a white square in the middle (what to fill)."""
+    mask = np.zeros((side, side), np.float32)
+    mask[side // 3:side // 2, side // 3:side // 2] = 1.0
+    return mask
+
+
 def _small(name: str, side: int) -> np.ndarray:
     img = load_image(example(name)).image
     h, w = img.shape[:2]
@@ -35,6 +42,7 @@ CASES = [
     ("quilt", lambda: {"texture": _small("brick", 64)}, {"size": (64, 64), "mode": "mincut"}),
     ("quilt", lambda: {"texture": _small("brick", 64), "target": _small("astronaut", 48)}, {}),
     ("affine", lambda: {"texture": _small("cat-fur", 96)}, {"block": 16, "boundary": "shaker"}),
+    ("fill", lambda: {"image": _small("brick", 64), "mask": _hole(64)}, {}),
     ("nfpt", lambda: {"photo": load_image(example("perspective")).image},
      {"lines": _lines(), "size": (64, 64), "block": 32, "overlap": 8, "into_photo": True}),
 ]

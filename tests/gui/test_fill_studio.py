@@ -39,6 +39,8 @@ CALLS: list[tuple[int, int]] = []  # the picture sizes the method ran on (previe
 
 def _mean_fill(inputs, params, *, rng=None, progress=None, cancel=None):
     picture = inputs["picture"]
+    if picture.ndim == 3 and picture.shape[2] == 4:  # (its alpha is not used here)
+        picture = picture[..., :3]
     CALLS.append(picture.shape[:2])
     hole = inputs.get("hole")
     if hole is None and not params.grow:
@@ -62,7 +64,7 @@ def _mean_fill(inputs, params, *, rng=None, progress=None, cancel=None):
 
 MEAN_FILL = Method(
     name="mean-fill", summary="fill a painted hole with the mean colour of the rest", params=MeanFillParams,
-    inputs=(InputSpec("picture", "the picture"), InputSpec("hole", "white = fill", required=False),
+    inputs=(InputSpec("picture", "the picture", alpha=True), InputSpec("hole", "white = fill", required=False),
             InputSpec("swatch", "take the colour from this image instead", required=False)),
     run=_mean_fill,
     studio=Studio(title="Mean fill", canvas="picture", preview_around="hole", own_inputs=("swatch",),
@@ -300,7 +302,8 @@ def test_fill_transparent_paints_the_images_transparent_pixels(studio, qtbot, tm
     studio.open_input("picture", str(rgba))
     qtbot.waitUntil(lambda: studio.doc.inputs["picture"].path == str(rgba), timeout=10000)
     assert studio.doc.inputs["picture"].alpha is not None
-    assert studio.doc.image("picture").shape == (H, W, 3)  # the method gets colour, as weft run gives it
+    assert studio.doc.image("picture").shape == (H, W, 3)  # shown in colour ...
+    assert studio.doc.method_inputs()["picture"].shape == (H, W, 4)  # ... the method gets RGBA, as weft run
     qtbot.waitUntil(bar.transparent_button.isEnabled, timeout=5000)
     result = _final_after(studio, qtbot, lambda: qtbot.mouseClick(bar.transparent_button, Qt.MouseButton.LeftButton))
     assert _mask(studio) == Mask.from_alpha(alpha)
@@ -517,3 +520,52 @@ def test_an_own_input_opened_for_another_method_is_not_used(studio, qtbot, tmp_p
     assert "swatch" not in result.recipe.inputs
     result = _final_after(studio, qtbot, lambda: studio.open_input("swatch", str(swatch)))  # opened for it
     assert np.allclose(result.image[bits], load_image(swatch).image.mean(), atol=1e-5)  # 64/255
+
+
+def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, settings, tmp_path, capsys):
+    """The real fill, as an artist meets it: the studio opens on its examples, fill is picked, a hole
+    is painted with the mouse (previewed around the stroke), filled on release, exported and re-run."""
+    from scipy.ndimage import binary_dilation
+
+    from weft.app.gui.main_window import MainWindow
+
+    window = MainWindow(settings=settings)
+    qtbot.addWidget(window)
+    window.resize(1300, 820)
+    window.show()
+    try:
+        qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
+        assert window.doc.image("texture") is not None  # the other methods' texture is open ...
+        box = window.method_panel.method_box
+        with qtbot.waitSignal(window.renderer.failed, timeout=30000):  # nothing painted yet
+            box.setCurrentIndex(box.findData("fill"))
+        assert window.doc.image("texture") is None  # ... but it is not fill's source to copy from
+        assert window.result_view.notice.isVisible() and "Paint what to fill" in window.result_view.notice.text()
+        view, doc = window.canvas_view, window.doc
+        image = doc.image("image")
+        h, w = image.shape[:2]
+        view.actual_size()
+        view.zoom_by(2.0)
+        view.centerOn(w / 2, h / 2)
+        window.inputs_pane.mask_tool().set_size(9)
+        around = []
+        window.renderer.around_shown.connect(around.append)
+        y = h / 2 + 0.5
+        _stroke(view, [(w * 0.35, y), (w * 0.45, y), (w * 0.55, y)], release=False)
+        qtbot.waitUntil(lambda: len(around) > 0, timeout=30000)
+        assert around[-1].image.shape == image.shape
+        result = _final_after(window, qtbot, lambda: mouse(view, "release", (w * 0.55, y)))
+        hole = doc.value("mask").bits
+        assert result.image.shape == image.shape and result.figures["hole_pixels"] == int(hole.sum())
+        near = binary_dilation(hole, np.ones((3, 3), bool), iterations=doc.current_params.band + 1)  # (8-connected)
+        assert np.array_equal(result.image[~near], image[~near])  # known pixels outside the blend band untouched
+        assert not np.allclose(result.image[hole], image[hole])
+        out = tmp_path / "filled.png"
+        assert window.export_result(str(out))
+        assert (tmp_path / "filled.mask.png").is_file()
+        again = tmp_path / "again.png"
+        assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
+        assert np.array_equal(load_image(out).image, load_image(again).image)
+    finally:
+        window.doc.undo_stack.setClean()
+        window.shutdown()

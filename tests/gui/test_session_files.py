@@ -50,7 +50,8 @@ def edited(window):
 def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_moves(window, qtbot, tmp_path):
     doc = window.doc
     project = tmp_path / "project"
-    files = {"texture": project / "tex.png", "target": project / "img" / "target.png", "photo": project / "photo.png"}
+    files = {"texture": project / "tex.png", "target": project / "img" / "target.png", "photo": project / "photo.png",
+             "image": project / "img" / "hole.png"}  # (every input the studio has open: fill's image too)
     for i, (name, path) in enumerate(files.items()):
         doc.set_input(name, str(_image(path, i)), load_image(path).image)
     doc.set_param("p", 0.3)
@@ -58,7 +59,8 @@ def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_mov
     assert window.save_session(str(session))
 
     data = json.loads(session.read_text(encoding="utf-8"))  # plain JSON, nothing else
-    assert data["inputs"] == {"texture": "tex.png", "target": os.path.join("img", "target.png"), "photo": "photo.png"}
+    assert data["inputs"] == {"texture": "tex.png", "target": os.path.join("img", "target.png"), "photo": "photo.png",
+                              "image": os.path.join("img", "hole.png")}
     assert data["weft_session"] == 1 and data["method"] == "fast" and data["params"]["fast"]["p"] == 0.3
     assert doc.undo_stack.isClean()
 

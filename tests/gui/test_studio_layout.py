@@ -9,6 +9,7 @@ from PySide6.QtCore import QRect, Qt
 
 from weft.core import registry
 from weft.core.examples import RESOURCES
+from weft.core.geometry import MASK, Mask
 from weft.app.gui.main_window import MainWindow
 
 from .helpers import drag, mouse
@@ -39,6 +40,10 @@ def test_the_status_line_gives_a_results_figures_in_words_and_units(window, qtbo
         data = json.loads((RESOURCES / "perspective-lines.json").read_text())
         window.doc.set_lines(data["image_lines"], data["frontal_lines"], frontal_size=data["frontal_size"])
         window.doc.set_param("size", (256, 192))
+    if any(g.kind == MASK for g in window.doc.studio.geometry):  # fill: a painted hole, so it has work to do
+        g = next(g for g in window.doc.studio.geometry if g.kind == MASK)
+        h, w = window.doc.image(g.input_for(window.doc.inputs)).shape[:2]
+        window.doc.set_mask(g.key, Mask.empty(w, h).painted_line((w / 3, h / 2), (w / 2, h / 2), 6), "Brush stroke")
     qtbot.waitUntil(lambda: _final_of(window, method) and not window.renderer.running(), timeout=60000)
     shown = window.renderer.last
     text = window.statusBar().currentMessage()
