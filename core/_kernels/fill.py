@@ -92,14 +92,16 @@ def refresh(img, conf, tpos, nnf, dist, p):
 
 
 @njit(cache=True, nogil=True)
-def patchmatch_pass(img, conf, valid, tpos, tmap, nnf, dist, p, reverse, state):
+def patchmatch_pass(img, conf, valid, tpos, tmap, nnf, dist, p, reverse, state, bias):
     """One PatchMatch sweep (Barnes et al. 2009) improving ``nnf``/``dist`` in place.
 
     ``valid`` (H-p+1, W-p+1) says which top-left corners are allowed sources (the patch lies wholly
     in the source region); ``tmap`` gives the index of the target patch at a corner, or -1. A
     forward sweep propagates from the left and upper neighbours, a backward one (``reverse``) from
     the right and lower ones; then random search samples one candidate in windows of radius
-    max(H, W) halving down to 1 around the best match."""
+    max(H, W) halving down to 1 around the best match. ``bias`` >= 0 favours coherence: a
+    propagated candidate (the neighbour's offset) replaces the current match when its distance is
+    below ``(1 + bias)`` times the current one's (0 = plain PatchMatch)."""
     n = tpos.shape[0]
     hv, wv = valid.shape
     step = -1 if reverse else 1
@@ -118,8 +120,9 @@ def patchmatch_pass(img, conf, valid, tpos, tmap, nnf, dist, p, reverse, state):
                 cy = nnf[m, 0]
                 cx = nnf[m, 1] + step
                 if 0 <= cx < wv and valid[cy, cx] and (cy != by or cx != bx):
-                    d = _dist(img, conf, ty, tx, cy, cx, p, bd)
-                    if d < bd:
+                    lim = bd * (1.0 + bias)
+                    d = _dist(img, conf, ty, tx, cy, cx, p, lim)
+                    if d < lim:
                         by = cy
                         bx = cx
                         bd = d
@@ -130,8 +133,9 @@ def patchmatch_pass(img, conf, valid, tpos, tmap, nnf, dist, p, reverse, state):
                 cy = nnf[m, 0] + step
                 cx = nnf[m, 1]
                 if 0 <= cy < hv and valid[cy, cx] and (cy != by or cx != bx):
-                    d = _dist(img, conf, ty, tx, cy, cx, p, bd)
-                    if d < bd:
+                    lim = bd * (1.0 + bias)
+                    d = _dist(img, conf, ty, tx, cy, cx, p, lim)
+                    if d < lim:
                         by = cy
                         bx = cx
                         bd = d

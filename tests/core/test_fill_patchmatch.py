@@ -187,6 +187,34 @@ def test_a_source_without_a_whole_patch_is_refused(gravel):
     assert np.array_equal(out[~hole], gravel[~hole])
 
 
+
+@pytest.mark.parametrize("bias, takes_neighbours_offset", [(0.0, False), (1.0, True)])
+def test_a_coherence_bias_lets_propagation_take_a_neighbours_offset_within_the_margin(bias, takes_neighbours_offset):
+    from weft.core._kernels import fill as kf
+
+    p = 3
+    img = np.random.default_rng(5).random((20, 20, 1))
+    img[10:13, 10:13] = img[2:5, 2:5]  # target 0 at (10, 10) is an exact copy of source (2, 2)
+    img[10:13, 13] = img[2:5, 5] + 0.1  # and target 1 at (10, 11) nearly one of source (2, 3)
+    conf = np.ones((20, 20), np.float32)
+    valid = np.zeros((18, 18), bool)
+    valid[2, 2:4] = True  # the only allowed sources: target 0's match and its right neighbour
+    tpos = np.array([[10, 10], [10, 11]], np.int64)
+    tmap = np.full((18, 18), -1, np.int64)
+    tmap[10, 10], tmap[10, 11] = 0, 1
+    # target 1's current match (outside the source, as a stale match may be) is 1.5x closer than the
+    # offset target 0 propagates to it: only a bias above 0.5 takes the neighbour's offset
+    d_prop = kf._dist(img, conf, 10, 11, 2, 3, p, np.inf)
+    assert d_prop > 0 and kf._dist(img, conf, 10, 11, 2, 2, p, np.inf) > d_prop
+    nnf = np.array([[2, 2], [15, 15]], np.int64)
+    dist = np.array([0.0, d_prop / 1.5])
+    kf.patchmatch_pass(img, conf, valid, tpos, tmap, nnf, dist, p, False, np.array([7], np.int64), bias)
+    assert nnf[0].tolist() == [2, 2] and dist[0] == 0.0
+    if takes_neighbours_offset:
+        assert nnf[1].tolist() == [2, 3] and dist[1] == d_prop
+    else:
+        assert nnf[1].tolist() == [15, 15] and dist[1] == d_prop / 1.5
+
 _COMPILE_SCRIPT = r"""
 import json, sys
 import numpy as np
