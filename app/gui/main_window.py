@@ -624,8 +624,10 @@ class MainWindow(QMainWindow):
         return words[0].upper() + words[1:]
 
     def _on_failed(self, message: str) -> None:
-        self.show_message(message)
         draw = self._nothing_drawn()
+        # nothing drawn yet is not a failure: the status line says what to do, not "render failed"
+        # with the command line's options (seen under Xvfb: "give a mask (--mask MASK), ...")
+        self.show_message(draw if message.startswith("render failed") and draw is not None else message)
         if message.startswith("render failed") and draw is not None:
             # nothing drawn yet (the method has nothing to do): the input, and what to draw on it
             self.result_view.set_stale(None)

@@ -156,6 +156,7 @@ def test_with_nothing_painted_the_result_shows_the_picture_and_what_to_do(studio
     assert np.array_equal(view.image, studio.doc.image("picture"))
     assert view.notice.isVisible() and view.notice.text() == "Paint the hole; drag an edge outward"
     assert not view.stale.isVisible()  # not an error: there is nothing to fill yet
+    assert studio.statusBar().currentMessage() == "Paint the hole; drag an edge outward"
 
 
 def test_the_mask_input_is_painted_over_its_image_not_a_view_of_its_own(studio):
