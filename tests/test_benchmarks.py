@@ -1,6 +1,7 @@
 """The benchmark harness runs a registered case and reports time, memory and quality figures."""
 
 import json
+import sys
 
 import pytest
 
@@ -67,3 +68,140 @@ def test_cold_runs_a_command_with_stderr_on_a_terminal_and_tables_the_rows(tmp_p
     assert table.splitlines()[2] == "| fast --target | 2.5 (2.4–2.7) | 0.8 (0.8–0.9) | 3.1x | 0.6 s | 1.3 s |"
     assert set(cold.commands(tmp_path)) >= {"studio", "quilt --target, 3 passes", "nfpt 1024x768", "affine",
                                               "fast --target", "warm-up (all methods)"}
+
+
+# --- fill and extend (issue 15): benchmarks/fill.py and its peer runner --------------------------------------
+
+def _tiny_fill_case():
+    import numpy as np
+
+    from benchmarks import fill
+
+    def build():
+        from skimage import data
+
+        truth = data.gravel()[:64, :64].copy()
+        hole = np.zeros(truth.shape, bool)
+        hole[24:40, 20:44] = True
+        image = truth.copy()
+        image[hole] = 255
+        return fill.FillInputs(truth, hole, image, 255)
+
+    return fill.FillCase("fill-tiny", build, "a 64x64 test case")
+
+
+def test_fill_cases_are_deterministic_with_a_truth_that_agrees_outside_the_hole():
+    import numpy as np
+
+    from benchmarks import fill
+
+    names = [c.name for c in fill.CASES]
+    assert len(names) == len(set(names)) and all(n.startswith("fill-") for n in names)
+    assert not set(names) & {c.name for c in CASES}
+    for case in fill.CASES:
+        a, b = case.build(), case.build()
+        assert np.array_equal(a.image, b.image) and np.array_equal(a.hole, b.hole)
+        h, w = a.truth.shape[:2]
+        assert 256 <= min(h, w) and max(h, w) <= 384
+        assert a.hole.shape == (h, w) and 0 < a.hole.mean() < 0.6
+        assert np.array_equal(a.image[~a.hole], a.truth[~a.hole])  # known pixels are the truth's
+        assert not np.array_equal(a.image[a.hole], a.truth[a.hole])  # the hole holds no truth
+    uncrop = fill.by_name()["fill-uncrop"].build()
+    assert uncrop.known_part.shape == (256, 256) and uncrop.truth.shape == (384, 384)
+    assert np.array_equal(uncrop.known_part, uncrop.truth[64:320, 64:320])
+
+
+def test_fill_figures_see_changed_known_pixels_and_the_truth_scores_itself():
+    import numpy as np
+
+    from benchmarks import fill
+
+    inputs = _tiny_fill_case().build()
+    truth = fill.figures(inputs.truth, inputs)
+    assert truth["known_max"] == 0 and truth["reach_px"] == 0 and truth["unfilled"] == 0
+    for name, value in fill.truth_figures(inputs).items():  # the truth's own figures, as the table shows them
+        assert truth[name] == value
+    out = inputs.truth.copy()
+    out[24:40, 17] = out[24:40, 17] // 2 + 10  # 3 px left of the hole: outside the 2-px band
+    out[30, 19] = 0  # touching it: inside the band
+    figs = fill.figures(out, inputs)
+    assert figs["known_max"] == int(np.abs(inputs.truth[24:40, 17].astype(int) - out[24:40, 17]).max())
+    assert figs["reach_px"] == 3.0
+    painted = fill.figures(inputs.image, inputs)  # nothing filled: the placeholder is still there
+    assert painted["unfilled"] == 1.0 and painted["known_max"] == 0
+
+
+def test_fill_peer_runner_fills_the_hole(tmp_path):
+    import numpy as np
+
+    from benchmarks import fill_peers
+
+    inputs = _tiny_fill_case().build()
+    for peer in ("telea", "shiftmap"):
+        out = fill_peers.fill(peer, inputs.image, inputs.hole)
+        assert out.shape == inputs.image.shape and out.dtype == np.uint8
+        assert (out[inputs.hole] == 255).mean() < 0.2  # the white placeholder is gone
+    colour = np.repeat(inputs.image[..., None], 3, axis=2)
+    assert fill_peers.fill("telea", colour, inputs.hole).shape == colour.shape
+    with pytest.raises(SystemExit, match="unknown peer 'nope'"):
+        fill_peers.fill("nope", inputs.image, inputs.hole)
+
+
+def test_run_fill_case_rows_and_table(monkeypatch):
+    from benchmarks import fill
+
+    case = _tiny_fill_case()
+    absent = fill.Tool("absent peer", lambda *a: ["true"], lambda: "not installed here")
+    rows = fill.run_fill_case(case, repeats=1, quick=True, tools=[*fill.tools_named(["OpenCV Telea"]), absent])
+    telea, missing, truth = rows
+    assert telea["tool"] == "OpenCV Telea" and telea["runs"] == 1 and telea["size"] == [64, 64]
+    assert 0 < telea["process_s"] and 1 < telea["peak_mib"] < 2000
+    assert telea["known_max"] == 0 and telea["unfilled"] == 0
+    assert telea["detail"] < 0.6 * truth["detail"]  # diffusion smears: the benchmark's reason to be
+    assert missing["missing"] == "not installed here" and "process_s" not in missing
+    assert truth["tool"] == "ground truth"
+    table = fill.markdown_table(rows)
+    assert table.splitlines()[0].startswith("fill-tiny (64x64, load average ")
+    assert "| absent peer | not run: not installed here |" in table
+    assert "| ground truth |" in table
+
+
+def test_fill_goals_compare_weft_with_the_peers_and_the_truth():
+    from benchmarks import fill
+
+    case = fill.by_name()["fill-gravel"]
+    peers = [{"tool": fill.GMIC, "coherence": 10.0, "process_s": 1.0},
+             {"tool": fill.SHIFTMAP, "coherence": 8.0, "process_s": 1.2}]
+    truth = {"detail": 1.0, "seam": 1.0}
+    good = {"tool": "weft", "coherence": 9.0, "detail": 1.1, "seam": 0.9, "known_max": 0, "process_s": 0.8}
+    assert fill.goals(good, peers + [good], truth, case) == "coherence yes, detail yes, seam yes, known yes, time yes"
+    bad = {"tool": "weft", "coherence": 9.9, "detail": 0.5, "seam": 1.3, "known_max": 4, "process_s": 1.1}
+    assert fill.goals(bad, peers + [bad], truth, case) == "coherence NO, detail NO, seam NO, known NO, time NO"
+    uncrop = fill.by_name()["fill-uncrop"]
+    assert fill.goals({**good, "process_s": 1.4}, peers, truth, uncrop).endswith("time yes")  # ≤ 1.5 s
+
+
+def test_fill_process_peak_is_the_childs_own():
+    import os
+
+    import numpy as np
+
+    from benchmarks import fill
+
+    if not os.path.exists(fill.GNU_TIME):
+        pytest.skip("GNU time is not installed: the peak is an upper bound there")
+    ballast = np.ones(2**25)  # 256 MiB held by this process while the child runs
+    _, rss, err = fill._run(["/bin/true"])
+    assert err == "" and 0 < rss < 32 * 2**20 < ballast.nbytes
+    _, _, err = fill._run([sys.executable, "-c", "raise SystemExit('boom: a one-line reason')"])
+    assert err == "boom: a one-line reason"
+
+
+def test_command_line_selects_fill_cases_by_pattern(capsys):
+    assert bench_main(["--list"]) == 0
+    listed = capsys.readouterr().out
+    assert "fill-gravel" in listed and "fill-uncrop" in listed and "quilt-mincut-512" in listed
+    assert bench_main(["nothing-*"]) == 2
+    assert "unknown case nothing-*" in capsys.readouterr().err
+    assert bench_main(["fill-gravel", "--tools", "nobody"]) == 2
+    assert "no tool matches nobody" in capsys.readouterr().err
