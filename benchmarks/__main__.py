@@ -54,6 +54,7 @@ def main(argv: list[str] | None = None) -> int:
             fill_rows += fill.run_fill_case(case, repeats=repeats, quick=args.quick, tools=tools, keep=args.keep)
         else:
             rows.append(run_case(case, repeats=repeats, quick=args.quick))
+    write_json(rows + fill_rows, args.json)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
           f", load average {load:.1f}{', quick' if args.quick else ''}")
@@ -61,8 +62,6 @@ def main(argv: list[str] | None = None) -> int:
         print(markdown_table(rows))
     if fill_rows:
         print(fill.markdown_table(fill_rows))
-    rows += fill_rows
-    write_json(rows, args.json)
     print(f"(written to {args.json})", file=sys.stderr)
     return 0
 

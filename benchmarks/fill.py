@@ -405,6 +405,8 @@ def run_fill_case(case: FillCase, *, repeats: int = 5, quick: bool = False, tool
                   keep: Path | None = None, cold: bool = True) -> list[dict[str, Any]]:
     """Every tool on ``case``: the rows (one per tool, then the ground truth's)."""
     if case.preview:
+        if tools is not None and not any(t.weft for t in tools):
+            return []
         rows = preview_times(2 if quick else max(20, repeats))
         rows[0]["load"] = os.getloadavg()[0]
         return rows
@@ -488,7 +490,7 @@ def preview_times(repeats: int = 20, engines: tuple[str | None, ...] = (None, *W
     try:
         from weft.core.fill import fill
     except ImportError as e:
-        return [{"case": "fill-preview-128", "tool": "weft", "error": f"weft.core.fill: {e}"}]
+        return [{"case": "fill-preview-128", "tool": "weft", "size": [128, 128], "error": f"weft.core.fill: {e}"}]
     for engine in engines:
         row: dict[str, Any] = {"case": "fill-preview-128", "tool": "weft" + (f" --engine {engine}" if engine else ""),
                                "size": [128, 128]}
@@ -533,7 +535,9 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
     for name in dict.fromkeys(r["case"] for r in rows):
         part = [r for r in rows if r["case"] == name]
         cols = [c for c in _COLUMNS if any(c[0] in r for r in part)]
-        w, h = part[0]["size"]
+        if len(cols) == 1:  # only notes: give them a column
+            cols.append(("note", "", "{}"))
+        w, h = part[0].get("size", ("?", "?"))
         load = f", load average {part[0]['load']:.1f}" if "load" in part[0] else ""
         out.append(f"{name} ({w}x{h}{load})")
         out.append("| " + " | ".join(c[1] for c in cols) + " |")

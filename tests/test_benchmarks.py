@@ -205,3 +205,33 @@ def test_command_line_selects_fill_cases_by_pattern(capsys):
     assert "unknown case nothing-*" in capsys.readouterr().err
     assert bench_main(["fill-gravel", "--tools", "nobody"]) == 2
     assert "no tool matches nobody" in capsys.readouterr().err
+
+
+@pytest.mark.skipif("fill" not in __import__("weft.core.registry", fromlist=["names"]).names(),
+                    reason="the fill method is not registered in this checkout")
+def test_fill_weft_rows_run_the_command_line_on_a_hole_and_an_uncrop():
+    import numpy as np
+
+    from benchmarks import fill
+
+    hole_case = _tiny_fill_case()
+    rows = fill.run_fill_case(hole_case, repeats=1, quick=True, tools=fill.tools_named(["weft"]))
+    weft_rows = [r for r in rows if r["tool"].startswith("weft")]
+    assert [r["tool"] for r in weft_rows] == ["weft", *(f"weft --engine {e}" for e in fill.WEFT_ENGINES)]
+    for row in weft_rows:
+        assert "error" not in row, row
+        assert row["known_max"] == 0 and row["reach_px"] <= fill.BAND and row["unfilled"] < 0.05
+        assert row["goals"].startswith("detail") and "known yes" in row["goals"]  # no G'MIC row: no coherence goal
+
+    def build_uncrop():
+        inputs = hole_case.build()
+        hole = np.ones(inputs.truth.shape, bool)
+        hole[16:48, 16:48] = False
+        image = inputs.truth.copy()
+        image[hole] = 0
+        return fill.FillInputs(inputs.truth, hole, image, 0, extend=(16, 16, 16, 16))
+
+    uncrop = fill.FillCase("fill-tiny-uncrop", build_uncrop, "64x64 from its 32x32 centre", uncrop=True)
+    row = fill.run_fill_case(uncrop, repeats=1, quick=True, tools=fill.tools_named(["weft"])[:1])[0]
+    assert "error" not in row, row
+    assert row["known_max"] == 0 and row["unfilled"] < 0.05 and row["size"] == [64, 64]
