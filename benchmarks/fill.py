@@ -29,7 +29,8 @@ that run every tool once each, in turn, so that machine noise hits them alike; t
 median whole-process seconds and peak memory, and the figures of ``weft.core.metrics`` on the last
 output: ``fill_coherence`` (against the input), ``fill_detail``, ``fill_seam``, next to the ground
 truth's own; "known Δ" is the largest change, in 8-bit levels, of a known pixel more than 2 px from
-the hole (weft's blend band), "reach" the distance in px of the farthest known pixel changed at all,
+the hole (weft's blend band; distances in 8-connected steps, as the band is measured), "reach" the
+distance in px of the farthest known pixel changed at all,
 and "unfilled" the share of the hole still holding the input's placeholder (white, or black for the
 uncrop border). ``goals`` checks each weft row against the issue's goals for that case.
 """
@@ -293,7 +294,7 @@ def read_output(path: Path, like: np.ndarray) -> np.ndarray:
 
 def figures(out: np.ndarray, inputs: FillInputs) -> dict[str, float]:
     """The issue's judges of one filled canvas ``out`` (uint8) and its known-pixel checks."""
-    from scipy.ndimage import distance_transform_edt
+    from scipy.ndimage import distance_transform_cdt
 
     from weft.core.metrics import fill_coherence, fill_detail, fill_seam
 
@@ -304,14 +305,16 @@ def figures(out: np.ndarray, inputs: FillInputs) -> dict[str, float]:
     f = _float(out)
     row = {"coherence": fill_coherence(f, hole, _float(inputs.image)),
            "detail": fill_detail(f, hole), "seam": fill_seam(f, hole)}
-    dist = distance_transform_edt(~hole)  # each known pixel's distance to the hole (1 = touching)
+    # each known pixel's distance to the hole in 8-connected steps (1 = touching, corners included):
+    # the method's band is the square neighbourhood, 2 px = every pixel of a 5x5 square around a hole pixel
+    dist = distance_transform_cdt(~hole, metric="chessboard")
     diff = np.abs(out.astype(np.int16) - inputs.image.astype(np.int16))
     if diff.ndim == 3:
         diff = diff.max(axis=2)
     known = ~hole
     row["known_max"] = int(diff[known & (dist > BAND)].max(initial=0))
     changed = known & (diff > 0)
-    row["reach_px"] = float(dist[changed].max(initial=0.0))
+    row["reach_px"] = int(dist[changed].max(initial=0))
     if inputs.placeholder >= 0:
         same = out == inputs.placeholder
         same = same.all(axis=2) if same.ndim == 3 else same
@@ -523,7 +526,7 @@ _COLUMNS = [
     ("detail", "detail", "{:.2f}"),
     ("seam", "seam", "{:.2f}"),
     ("known_max", "known Δ", "{}"),
-    ("reach_px", "reach px", "{:.1f}"),
+    ("reach_px", "reach px", "{}"),
     ("unfilled", "unfilled", "{:.1%}"),
     ("goals", "goals", "{}"),
 ]
