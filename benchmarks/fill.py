@@ -28,10 +28,11 @@ Per case: one untimed warm-up run per tool (numba's and the OS's caches), then `
 that run every tool once each, in turn, so that machine noise hits them alike; the table gives the
 median whole-process seconds and peak memory, and the figures of ``weft.core.metrics`` on the last
 output: ``fill_coherence`` (against the input), ``fill_detail``, ``fill_seam``, next to the ground
-truth's own; "known Δ" is the largest change, in 8-bit levels, of a known pixel more than 2 px from
-the hole (weft's blend band; distances in 8-connected steps, as the band is measured), "reach" the
-distance in px of the farthest known pixel changed at all,
-and "unfilled" the share of the hole still holding the input's placeholder (white, or black for the
+truth's own; "band Δ" is the largest change, in 8-bit levels, of a known pixel within 2 px of the
+hole (where weft's blend band may change it too; distances in 8-connected steps, as the band is
+measured), "known Δ" the largest change of a known pixel further away (weft: none), "reach" the
+distance in px of the farthest known pixel changed at all, and "unfilled" the share of the hole
+still holding the input's placeholder (white, or black for the
 uncrop border). ``goals`` checks each weft row against the issue's goals for that case.
 """
 
@@ -312,6 +313,7 @@ def figures(out: np.ndarray, inputs: FillInputs) -> dict[str, float]:
     if diff.ndim == 3:
         diff = diff.max(axis=2)
     known = ~hole
+    row["band_max"] = int(diff[known & (dist <= BAND)].max(initial=0))
     row["known_max"] = int(diff[known & (dist > BAND)].max(initial=0))
     changed = known & (diff > 0)
     row["reach_px"] = int(dist[changed].max(initial=0))
@@ -525,6 +527,7 @@ _COLUMNS = [
     ("coherence", "coherence", "{:.2f}"),
     ("detail", "detail", "{:.2f}"),
     ("seam", "seam", "{:.2f}"),
+    ("band_max", "band Δ", "{}"),
     ("known_max", "known Δ", "{}"),
     ("reach_px", "reach px", "{}"),
     ("unfilled", "unfilled", "{:.1%}"),

@@ -118,7 +118,7 @@ def test_fill_figures_see_changed_known_pixels_and_the_truth_scores_itself():
 
     inputs = _tiny_fill_case().build()
     truth = fill.figures(inputs.truth, inputs)
-    assert truth["known_max"] == 0 and truth["reach_px"] == 0 and truth["unfilled"] == 0
+    assert truth["known_max"] == 0 and truth["band_max"] == 0 and truth["reach_px"] == 0 and truth["unfilled"] == 0
     for name, value in fill.truth_figures(inputs).items():  # the truth's own figures, as the table shows them
         assert truth[name] == value
     out = inputs.truth.copy()
@@ -126,7 +126,8 @@ def test_fill_figures_see_changed_known_pixels_and_the_truth_scores_itself():
     out[30, 19] = 0  # touching it: inside the band
     figs = fill.figures(out, inputs)
     assert figs["known_max"] == int(np.abs(inputs.truth[24:40, 17].astype(int) - out[24:40, 17]).max())
-    assert figs["reach_px"] == 3.0
+    assert figs["reach_px"] == 3
+    assert figs["band_max"] == int(inputs.truth[30, 19])  # the one change within 2 px of the hole
     painted = fill.figures(inputs.image, inputs)  # nothing filled: the placeholder is still there
     assert painted["unfilled"] == 1.0 and painted["known_max"] == 0
 
