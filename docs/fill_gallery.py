@@ -6,8 +6,8 @@ One picture per case of ``python -m benchmarks 'fill-*'`` (``benchmarks/fill.py`
 scikit-image's data): the input with the hole outlined in red, the ground truth, weft's fill (the
 default engine, seed 1), then G'MIC ``inpaint_matchpatch``, OpenCV's shift-map, ``pypatchmatch``,
 the PyPI Resynthesizer and OpenCV Telea, each captioned with its coherence / detail / seam (the
-truth's own under the truth) and, when it changed known pixels more than 2 px from the hole, the
-largest change. Every tool runs as in the benchmark, as its own process on the same files; a tool
+truth's own under the truth) and, when it changed known pixels, the largest change within 2 px of the
+hole and beyond. Every tool runs as in the benchmark, as its own process on the same files; a tool
 that is not installed gets a grey panel that says so.
 """
 
@@ -49,7 +49,9 @@ def caption(name: str, figs: dict) -> str:
         return f"{name}|failed"
     text = f"{name}|coh {figs['coherence']:.1f}  detail {figs['detail']:.2f}  seam {figs['seam']:.2f}"
     if figs.get("known_max", 0) > 0:
-        text += f"|changes known px: {figs['known_max']} levels"
+        text += f"|known px moved: {figs['band_max']} levels within 2 px, {figs['known_max']} beyond"
+    elif figs.get("band_max", 0) > 0:
+        text += f"|known px moved: {figs['band_max']} levels within 2 px"
     return text
 
 
