@@ -522,6 +522,7 @@ _COLUMNS = [
     ("process_s", "process s", "{:.2f}"),
     ("cold_s", "first run s", "{:.1f}"),
     ("peak_mib", "peak MiB", "{:.0f}"),
+    ("hole_px", "hole px", "{}"),
     ("median_ms", "median ms", "{:.1f}"),
     ("max_ms", "max ms", "{:.1f}"),
     ("coherence", "coherence", "{:.2f}"),
