@@ -84,11 +84,7 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
         watch = _PaintWatch(painted)
         window.result_view.viewport().installEventFilter(watch)
 
-        beats: list[float] = []
-        heartbeat = QTimer()
-        heartbeat.setInterval(5)
-        heartbeat.timeout.connect(lambda: beats.append(time.perf_counter()))
-        heartbeat.start()
+        heartbeat, beats = _heartbeat()
 
         slider = window.params_panel.row("p").editor
         slider.setSliderDown(True)
@@ -105,17 +101,9 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
         _wait(app, lambda: window.renderer.last.final and doc.current_params.p == series[-1], 30)
         _wait(app, lambda: False, 0.2)
         heartbeat.stop()
-        gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:])]
         window.doc.undo_stack.setClean()  # the slider moves are not work to save: close without asking
         window.close()
-    latencies.sort()
-    return {
-        "median_ms": round(statistics.median(latencies), 1) if latencies else None,
-        "p95_ms": round(latencies[min(len(latencies) - 1, int(0.95 * len(latencies)))], 1) if latencies else None,
-        "max_stall_ms": round(max(gaps), 1) if gaps else None,
-        "previews": len(latencies),
-        "values": values,
-    }
+    return _summary(latencies, beats, values)
 
 
 def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = None, side: int = 512) -> dict:
@@ -175,11 +163,7 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
 
         watch = _PaintWatch(painted)
         window.result_view.viewport().installEventFilter(watch)
-        beats: list[float] = []
-        heartbeat = QTimer()
-        heartbeat.setInterval(5)
-        heartbeat.timeout.connect(lambda: beats.append(time.perf_counter()))
-        heartbeat.start()
+        heartbeat, beats = _heartbeat()
 
         def send(kind, x, y):
             pos = view.mapFromScene(QPointF(x, y))
@@ -206,12 +190,26 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
         _wait(app, lambda: window.renderer.last is not None and window.renderer.last.final
               and doc.value(tool.geometry_key) is not None and not window.renderer.running(), 120)
         heartbeat.stop()
-        gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:])]
         window.doc.undo_stack.setClean()
         window.close()
-    latencies.sort()
+    return {"method": method, **_summary(latencies, beats, values)}
+
+
+def _heartbeat() -> tuple[QTimer, list[float]]:
+    """A started 5 ms timer and the times it fired at: a gap between two beats is a GUI-thread stall."""
+    beats: list[float] = []
+    heartbeat = QTimer()
+    heartbeat.setInterval(5)
+    heartbeat.timeout.connect(lambda: beats.append(time.perf_counter()))
+    heartbeat.start()
+    return heartbeat, beats
+
+
+def _summary(latencies: list[float], beats: list[float], values: int) -> dict:
+    """Median and p95 latency (ms), the longest gap between heartbeats, and the counts."""
+    latencies = sorted(latencies)
+    gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:])]
     return {
-        "method": method,
         "median_ms": round(statistics.median(latencies), 1) if latencies else None,
         "p95_ms": round(latencies[min(len(latencies) - 1, int(0.95 * len(latencies)))], 1) if latencies else None,
         "max_stall_ms": round(max(gaps), 1) if gaps else None,
