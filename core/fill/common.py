@@ -52,7 +52,12 @@ def whole_patches(region: np.ndarray, patch: int) -> np.ndarray:
 def onion_order(hole: np.ndarray) -> np.ndarray:
     """The hole's pixels from its edge inwards ((N, 2) int64 rows of (y, x)): by distance to the
     nearest known pixel (the fill front), ties in scan order."""
-    dist = cv2.distanceTransform((hole).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    from scipy.ndimage import distance_transform_edt
+
+    # exact and the same on every call (OpenCV's precise transform varies in its last bit between
+    # calls, which reordered ties and broke the pixel engine's determinism under a seed)
+    # (the image's border is not a known pixel: an uncrop grows from the image inwards-out)
+    dist = distance_transform_edt(hole) if hole.any() and not hole.all() else np.zeros(hole.shape)
     ys, xs = np.nonzero(hole)
     order = np.lexsort((xs, ys, dist[ys, xs]))
     return np.stack([ys[order], xs[order]], axis=1).astype(np.int64)

@@ -68,6 +68,8 @@ def _mask_bits(mask, shape: tuple[int, int], what: str, against: str) -> np.ndar
 
 
 def _margins(params: FillParams, w: int, h: int) -> Margins | None:
+    """The margins to add, or None when nothing grows the canvas (no --extend/--size, or a --size
+    equal to the image's)."""
     if params.extend:
         return params.extend
     if params.size is None:
@@ -81,7 +83,7 @@ def _margins(params: FillParams, w: int, h: int) -> Margins | None:
     row = {"top": 0, "bottom": 2}.get(params.anchor.split("-")[0], 1)
     left = (0, dx // 2, dx)[col]
     top = (0, dy // 2, dy)[row]
-    return Margins(left, top, dx - left, dy - top)
+    return Margins(left, top, dx - left, dy - top) if dx or dy else None
 
 
 def _largest_square(region: np.ndarray) -> int:
@@ -191,7 +193,15 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     def engine_progress(done: int, total: int) -> None:
         reporter.update(int(100 * done // max(1, total)))
 
-    extra = {"band": params.band} if params.engine == "quilt" and CUT_INTO_BAND else {}
+    extra = {}
+    if params.engine == "quilt" and CUT_INTO_BAND and params.band > 0:
+        # the image's own band (never its transparent pixels), on the engine's canvas: a band worked
+        # out there would also take the image's last rows and columns beside a texture's gap
+        from .band import band_region
+
+        cut = np.zeros(work_hole.shape, dtype=bool)
+        cut[:ch, :cw] = band_region(hole, params.band, exclude=transparent) & ~hole
+        extra = {"cuttable": cut}
     # quilt and pixel report progress(done, total); the PatchMatch engine reports weft.core.jobs.Progress
     # itself (its ProgressReporter), so it gets the method's callback as it is
     engine_report = progress if params.engine == "patchmatch" else engine_progress

@@ -69,7 +69,8 @@ def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: in
     score[y0:y1, x0:x1] = part[y0 - ya:y1 - ya, x0 - xa:x1 - xa]
 
 
-def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0) -> np.ndarray:
+def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0,
+               cuttable=None) -> np.ndarray:
     """Fill ``hole`` of ``image`` with blocks quilted from ``source`` (default: the known pixels).
 
     Parameters
@@ -82,6 +83,10 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     progress : ``progress(done, total)`` in filled pixels, called when the percentage changes.
     cancel : a ``CancelToken``, checked before every block.
     band : int >= 0, default 0: known pixels within this many px of the hole may be cut into (above).
+    cuttable : bool (H, W) or None: the known pixels that may be cut into, given instead of ``band``
+        (the method gives it when the engine's canvas is more than the image: the image's own band,
+        without its transparent pixels; a band worked out on that canvas would reach into the image
+        from the gap below it).
 
     Returns
     -------
@@ -99,10 +104,13 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     known = ~hole  # original known pixels: never written
     have = known.copy()  # known or filled
     filled = np.zeros((h, w), dtype=bool)
-    if band > 0:  # known pixels within the band may be cut into: they count as filled ones
+    if cuttable is not None:
+        cuttable = np.asarray(cuttable, dtype=bool) & ~hole
+    elif band > 0:  # known pixels within the band may be cut into: they count as filled ones
         from .band import band_region
 
         cuttable = band_region(hole, band) & ~hole
+    if cuttable is not None:
         filled |= cuttable
     # the search image: the bounding box of the source, its non-source pixels never inside a chosen block
     ys, xs = np.nonzero(src)
@@ -172,6 +180,6 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         _score(have, score, b, max(0, y0 - r), min(h, y0 + b + r), max(0, x0 - r), min(w, x0 + b + r))
         report(total - left)
     out = img.copy()
-    changed = hole if band <= 0 else (hole | cuttable)
+    changed = hole if cuttable is None else (hole | cuttable)
     out[changed] = canvas[changed]
     return out.reshape(shape)

@@ -145,6 +145,32 @@ def test_texture_is_the_source(gravel, brick):
     assert np.array_equal(out[~hole], gravel[~hole])
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+def test_texture_fill_keeps_the_images_pixels_beyond_the_band(engine, gravel, brick):
+    """The texture sits below the image on the engine's canvas with a gap between them; the band
+    is the image's own, not one that reaches into the image's last rows from that gap (review)."""
+    hole = square_hole(gravel.shape)
+    out = fill(gravel, hole, texture=brick[:80, :80], seed=1, engine=engine, band=2)
+    beyond = ~band_region(hole, 2) & ~hole
+    assert np.array_equal(out[beyond], gravel[beyond])
+
+
+def test_onion_order_is_the_same_on_every_call():
+    from weft.core.fill.common import onion_order
+
+    rng = np.random.default_rng(3)
+    hole = rng.random((40, 40)) < 0.3
+    first = onion_order(hole)
+    for _ in range(20):  # OpenCV's precise distance transform varied in its last bit between calls
+        assert np.array_equal(onion_order(hole), first)
+
+
+def test_pixel_engine_same_seed_same_pixels_in_one_process(gravel):
+    hole = square_hole(gravel.shape, 20, 50, 10, 70)
+    runs = [fill(gravel, hole, engine="pixel", patch=3, seed=558) for _ in range(6)]
+    assert all(np.array_equal(r, runs[0]) for r in runs)
+
+
 def test_python_api_refusals(gravel):
     with pytest.raises(WeftError, match="nothing to fill: give a mask"):
         fill(gravel)
@@ -154,6 +180,8 @@ def test_python_api_refusals(gravel):
         fill(gravel, np.ones((10, 10), bool))
     with pytest.raises(WeftError, match="covers the whole image: nothing is left to copy from"):
         fill(gravel, np.ones(gravel.shape, bool))
+    with pytest.raises(WeftError, match="nothing to fill: give a mask"):
+        fill(gravel, size=(96, 96))  # the image's own size grows nothing
     with pytest.raises(InvalidParameter, match="parameter 'size' = 64x64 is smaller than the 96x96 image"):
         fill(gravel, size=(64, 64))
     with pytest.raises(InvalidParameter, match="cannot be given together"):
