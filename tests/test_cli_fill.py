@@ -180,3 +180,23 @@ def test_bad_inputs(files, tmp_path, capsys):
     # no mask, no alpha, no extend
     _refused(capsys, ["fill", paths["grey"], *base], o,
              "nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size")
+
+
+def test_a_mask_painted_on_a_transparent_layer_is_read_with_its_alpha(tmp_path):
+    """White strokes on a transparent layer (RGB white everywhere): only the opaque strokes are the
+    hole (review: the alpha was dropped and the mask 'covered the whole image')."""
+    from PIL import Image
+
+    img = (load_image(example("gravel")).image[:64, :64] * 255).astype(np.uint8)
+    Image.fromarray(img).save(tmp_path / "img.png")
+    layer = np.zeros((64, 64, 4), np.uint8)
+    layer[..., :3] = 255
+    layer[20:30, 20:40, 3] = 255
+    Image.fromarray(layer, "RGBA").save(tmp_path / "mask.png")
+    out = tmp_path / "out.png"
+    assert main(["fill", str(tmp_path / "img.png"), "--mask", str(tmp_path / "mask.png"), "--band", "0",
+                 "-o", str(out)]) == 0
+    res = np.asarray(Image.open(out))
+    keep = np.ones((64, 64), bool)
+    keep[20:30, 20:40] = False
+    assert np.array_equal(res[keep], img[keep]) and not np.array_equal(res[~keep], img[~keep])

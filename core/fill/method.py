@@ -59,8 +59,8 @@ def _split_alpha(image: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray |
 
 def _mask_bits(mask, shape: tuple[int, int], what: str, against: str) -> np.ndarray:
     m = np.asarray(mask)
-    if m.dtype != bool:
-        m = np.asarray(validate_image(m if m.ndim != 3 or m.shape[2] not in (2, 4) else m[..., 0], what))
+    if m.dtype != bool and not (m.ndim == 3 and m.shape[2] in (2, 4)):  # (with alpha: Mask.from_image reads it)
+        m = np.asarray(validate_image(m, what))
     if m.shape[:2] != tuple(shape):
         raise _error(ImageError, f"the {what.replace('_', ' ')} is {m.shape[1]}x{m.shape[0]} but the {against} is "
                      f"{shape[1]}x{shape[0]}; they must be the same size", what)
@@ -287,9 +287,10 @@ METHOD = Method(
     inputs=(
         InputSpec("image", "the image to fill (a transparent region is the hole when no mask is given)", alpha=True,
                   min_side=3),
-        InputSpec("mask", "white = the pixels to fill; the image's size", required=False),
-        InputSpec("source_mask", "white = the only pixels to copy from (the image's size, or the texture's)",
-                  required=False),
+        InputSpec("mask", "white = the pixels to fill; the image's size (a transparent pixel is black)",
+                  required=False, alpha=True),
+        InputSpec("source_mask", "white = the only pixels to copy from (the image's size, or the texture's; "
+                  "a transparent pixel is black)", required=False, alpha=True),
         InputSpec("texture", "copy from this image instead of the rest of the image", required=False),
     ),
     run=_run,
