@@ -155,11 +155,12 @@ def test_bad_inputs(files, tmp_path, capsys):
     # mask covering everything
     _refused(capsys, ["fill", paths["grey"], "--mask", paths["white"], *base], o,
              "white.png", "covers the whole image: nothing is left to copy from", "whole 24x24 patch")
-    # too little to copy from for the patch size (the hole leaves a 72x8 strip)
+    # too little to copy from for the patch size given (the hole leaves a 72x8 strip; with no --patch
+    # the default block shrinks to the 8x8 the strip holds)
     strip = np.ones((72, 72), np.float32)
     strip[:8] = 0
     save_image(tmp_path / "strip.png", strip)
-    _refused(capsys, ["fill", paths["grey"], "--mask", tmp_path / "strip.png", *base], o,
+    _refused(capsys, ["fill", paths["grey"], "--mask", tmp_path / "strip.png", "--patch", "24", *base], o,
              "grey.png", "needs at least one whole 24x24 patch of known pixels", "largest is 8x8")
     # a patch larger than the image allows
     _refused(capsys, ["fill", paths["grey"], "--mask", paths["mask"], "--patch", "100", *base], o,

@@ -25,9 +25,9 @@ def _next(state):
 
 
 @njit(cache=True, nogil=True)
-def _cost(canvas, have, src, py, px, sy, sx, r, limit):
+def _cost(canvas, have, src, py, px, sy, sx, r):
     """Mean squared difference over the valued neighbours of (py, px) against source (sy, sx); the
-    source window is whole (``valid``). Stops early above ``limit`` (returns inf)."""
+    source window is whole (``valid``)."""
     h, w, c = canvas.shape
     total = 0.0
     n = 0
@@ -55,7 +55,7 @@ def fill_pixels(canvas, have, pos, src, valid, order, start, stop, r, n_random, 
     ``have`` (H, W) bool: the pixel has a value (known or filled; set here as pixels are filled);
     ``pos`` (H, W, 2) int64: each filled pixel's source position (-1: none, e.g. a known pixel);
     ``src`` (Hs, Ws, C) the source image; ``valid`` (Hs, Ws) bool: the ``n x n`` window centred
-    there lies in the source region; ``valid_list`` is drawn from at random via ``state``.
+    there lies in the source region (random candidates are drawn among those positions via ``state``).
     """
     h, w, c = canvas.shape
     hs, ws = valid.shape
@@ -91,7 +91,7 @@ def fill_pixels(canvas, have, pos, src, valid, order, start, stop, r, n_random, 
                     continue
                 if sy == by and sx == bx:
                     continue
-                cost = _cost(canvas, have, src, py, px, sy, sx, r, best)
+                cost = _cost(canvas, have, src, py, px, sy, sx, r)
                 if cost < best:
                     best = cost
                     by = sy
@@ -100,7 +100,7 @@ def fill_pixels(canvas, have, pos, src, valid, order, start, stop, r, n_random, 
             j = flat[np.int64(_next(state) % np.uint64(nvalid))]
             sy = j // ws
             sx = j % ws
-            cost = _cost(canvas, have, src, py, px, sy, sx, r, best)
+            cost = _cost(canvas, have, src, py, px, sy, sx, r)
             if cost < best:
                 best = cost
                 by = sy

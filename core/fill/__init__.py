@@ -6,7 +6,9 @@
 With no mask, an image's transparent pixels (alpha < 50 %) are the hole.
 
 Engines (``--engine``), all with one signature ``fill_x(image, hole, source=None, *, patch, rng,
-progress, cancel)`` and the guarantee that every pixel outside the hole is returned unchanged:
+progress, cancel)`` and the guarantee that every pixel outside the hole is returned unchanged (the
+quilt engine's cut may also run through the known pixels of the blend band, when the method gives it
+``band`` or ``cuttable``; :mod:`weft.core.fill.band` then re-solves that band):
 
 * ``quilt`` (:func:`weft.core.fill.quilt.fill_quilt`) -- the quilting paper's hole filling: blocks in
   fill-front order, SSD over known pixels only, minimum-error cut;

@@ -111,6 +111,8 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     colour, alpha = _split_alpha(image, "image")
     h, w = colour.shape[:2]
     patch = params.resolved_patch()
+    if params.engine == "pixel":
+        patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
     hole = np.zeros((h, w), dtype=bool)
     named = None  # what made the hole, for messages
     if mask is not None:
@@ -140,6 +142,8 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         if alpha is not None:
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
+    if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
+        patch = max(3, min(ch, cw) // 2) | (1 if params.engine == "pixel" else 0)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
         raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
@@ -166,6 +170,10 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
             raise _error(WeftError, f"the {'mask' if named == 'mask' else 'hole'} covers the whole image: nothing is "
                          f"left to copy from (needs at least one whole {patch}x{patch} patch of known pixels)",
                          "mask" if named == "mask" else "image")
+    if params.patch is None and not whole_patches(src_region, patch).any():
+        side = _largest_square(src_region)  # a default patch shrinks to the largest the source holds
+        if side >= 3:
+            patch = side if params.engine != "pixel" or side % 2 else side - 1
     if not whole_patches(src_region, patch).any():
         side = _largest_square(src_region)
         raise _error(WeftError, f"too little to copy from: the {engine_text(params)} needs at least one whole "

@@ -36,7 +36,8 @@ class FillParams(Params):
                              "pixel: coherent pixel synthesis (Ashikhmin)"
                              + ("; patchmatch: multi-scale patch search with voting" if "patchmatch" in ENGINES else ""))
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
-                       help="patch side in pixels (quilt: the block; pixel: the neighbourhood); default per engine: "
+                       help="patch side in pixels (quilt: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
+                            "default per engine, smaller on a small image: "
                             + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items() if k in ENGINES))
     extend: Margins = param(None, kind="geometry", type=Margins, optional=True,
                             help="uncrop: pixels added on the left, top, right and bottom, filled like the hole")
@@ -51,6 +52,12 @@ class FillParams(Params):
         if self.extend is not None and self.size is not None:
             raise InvalidParameter("parameters 'extend' and 'size' cannot be given together (both set the canvas)",
                                    name="size", value=self.size)
+        if self.engine == "patchmatch" and self.patch is not None:
+            from .patchmatch import MAX_PATCH
+
+            if self.patch > MAX_PATCH:
+                raise InvalidParameter(f"parameter 'patch' = {self.patch} is outside 3..{MAX_PATCH} for the patchmatch "
+                                       f"engine", name="patch", value=self.patch)
 
     def resolved_patch(self) -> int:
         return self.patch if self.patch is not None else DEFAULT_PATCH[self.engine]

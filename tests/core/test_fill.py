@@ -266,3 +266,17 @@ def test_numpy_cut_and_solver_agree_with_the_kernels():
     b = np.zeros_like(rhs)
     kernel_cg(nbr, ndeg, rhs, b, 1e-10, 500)
     assert np.allclose(a, b, atol=1e-7)
+
+
+def test_a_default_patch_fits_a_small_image_and_an_even_pixel_patch_is_the_next_odd_one(gravel):
+    small = gravel[:20, :20]
+    hole = square_hole(small.shape, 8, 13, 8, 13)
+    for engine in ENGINES:  # quilt's default block is 24: larger than the image
+        out = fill(small, hole, engine=engine, seed=0, band=0)
+        assert np.array_equal(out[~hole], small[~hole]) and np.isfinite(out).all()
+    half = np.zeros((20, 20), bool)
+    half[:, 8:] = True  # the source is 8 px wide: an 8x8 patch would fit, the 9x9 neighbourhood does not
+    with pytest.raises(WeftError, match="needs at least one whole 9x9 patch"):  # --patch 8: a 9x9 neighbourhood
+        fill(small, half, engine="pixel", patch=8)
+    with pytest.raises(InvalidParameter, match="parameter 'patch' = 64 is outside 3..63 for the patchmatch engine"):
+        FillParams(engine="patchmatch", patch=64)
