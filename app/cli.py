@@ -139,14 +139,15 @@ class _PreparingLine:
             self.thread.join()
 
 
-def _add_common(p: argparse.ArgumentParser) -> None:
+def _add_common(p: argparse.ArgumentParser, region: bool = True) -> None:
     p.add_argument("-o", "--output", required=True, metavar="OUT",
                    help="output image (.png, .jpg, .tif); PNGs carry the recipe")
     p.add_argument("--seed", metavar="N", help="random seed (default: a fresh one, recorded in the recipe)")
     p.add_argument("--bit-depth", metavar="BITS",
                    help="8 or 16 bits per channel (16: PNG, TIFF); default 8 (fill: the image's own)")
-    p.add_argument("--region", metavar="X,Y,S",
-                   help="use only this square of the texture (top-left corner and side, pixels) as the source")
+    if region:
+        p.add_argument("--region", metavar="X,Y,S",
+                       help="use only this square of the texture (top-left corner and side, pixels) as the source")
     p.add_argument("--report", action="store_true", help="print one JSON line with the compute time and figures")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
@@ -185,7 +186,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             metavar = spec.type.METAVAR if spec.kind == "geometry" else spec.kind.upper()
             group.add_argument(spec.option, dest="param_" + spec.name, metavar=metavar,
                                help="; ".join(bits).replace("%", "%%"))
-        _add_common(p)
+        _add_common(p, region=method.takes_region)
         p.set_defaults(method=method.name)
     w = sub.add_parser("warm-up", help="prepare every method's compiled kernels now (installers, render nodes, CI)",
                        description="Compile (or load) every method's numba kernels ahead of time, in parallel "
@@ -352,7 +353,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         if value is not None:
             inputs[inp.name] = value
     seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
-    region = Square.parse(args.region) if args.region is not None else None
+    region = Square.parse(args.region) if getattr(args, "region", None) is not None else None
     return _execute(method.name, params, inputs, seed, args, region)
 
 

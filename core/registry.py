@@ -97,6 +97,9 @@ class Method:
     #: The input whose bit depth (8 or 16) the command line's output keeps when ``--bit-depth`` is not
     #: given (``fill``: a 16-bit photo stays 16-bit; its known pixels come back unchanged). None: 8.
     depth_from: str | None = None
+    #: Whether a run may crop the first input to a source square (``--region X,Y,S``, a recipe's
+    #: ``region``). ``fill`` does not: its first input is the image whose hole it fills, not a source.
+    takes_region: bool = True
 
 
 _loaded: dict[str, Method] = {}

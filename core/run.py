@@ -96,6 +96,9 @@ def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
     from .image import load_image
 
     shown = dict(shown_paths or input_paths)
+    if region is not None and not method.takes_region:
+        raise WeftError(f"weft {method.name} takes no --region (it works on the whole {method.inputs[0].name}; "
+                        f"crop the image first)")
     keep_alpha = {spec.name for spec in method.inputs if spec.alpha}
     loaded = {name: load_image(path, alpha=name in keep_alpha) for name, path in input_paths.items()}
     images = {name: item.image for name, item in loaded.items()}

@@ -201,3 +201,20 @@ def test_a_mask_painted_on_a_transparent_layer_is_read_with_its_alpha(tmp_path):
     keep = np.ones((64, 64), bool)
     keep[20:30, 20:40] = False
     assert np.array_equal(res[keep], img[keep]) and not np.array_equal(res[~keep], img[~keep])
+
+
+def test_fill_takes_no_region(files, tmp_path, capsys):
+    """--region crops a method's source; fill's first input is the image it heals, so fill has no
+    --region (it cropped the image, then refused the mask's size or silently filled a crop)."""
+    paths, _ = files
+    o = tmp_path / "out.png"
+    code, _, err = run(["fill", paths["grey"], "--mask", paths["mask"], "--region", "0,0,40", "-o", o], capsys)
+    assert code == 2 and "--region" in err and len(err.strip().splitlines()) == 1 and not o.exists()
+    from weft.core import registry
+    from weft.core.errors import WeftError
+    from weft.core.fill import FillParams
+    from weft.core.run import render
+
+    with pytest.raises(WeftError, match="weft fill takes no --region"):
+        render(registry.get("fill"), FillParams(), {"image": str(paths["grey"]), "mask": str(paths["mask"])}, 1,
+               region=(0, 0, 40))

@@ -301,6 +301,7 @@ METHOD = Method(
                   "a transparent pixel is black)", required=False, alpha=True),
         InputSpec("texture", "copy from this image instead of the rest of the image", required=False),
     ),
+    takes_region=False,
     run=_run,
     warm_up=warm_up,
     memory=_memory,
