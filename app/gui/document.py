@@ -230,10 +230,16 @@ class Document(QObject):
 
     def recipe(self, params: Params | None = None) -> Recipe:
         """The recipe of a render of the document now with ``params`` (default :meth:`run_params`);
-        input paths absolute (``Recipe.to_json(relative_to=...)`` writes them relative to its file)."""
-        names = {i.name for i in self.current.inputs}
-        inputs = {name: item.path for name, item in self.inputs.items()
-                  if name in names and item.path and self.item(name) is not None}
+        input paths absolute (``Recipe.to_json(relative_to=...)`` writes them relative to its file).
+        Its inputs are the files of :meth:`method_inputs`: never a painted mask's name (an image opened
+        under that name for another method is not what this method ran on); the export adds the
+        painted masks the result was rendered with."""
+        painted = {g.input for g in self.studio.geometry if g.kind == MASK}
+        inputs = {}
+        for spec in self.current.inputs:  # what method_inputs gives the method: its painted masks are
+            item = self.item(spec.name)   # not files (export writes them beside the result)
+            if item is not None and item.path and spec.name not in painted:
+                inputs[spec.name] = item.path
         params = self.run_params(live=False) if params is None else params
         return Recipe(method=self.method, params=params.to_dict(), inputs=inputs,
                       seed=self.seed, region=self.region())

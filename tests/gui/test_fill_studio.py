@@ -570,3 +570,38 @@ def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, se
     finally:
         window.doc.undo_stack.setClean()
         window.shutdown()
+
+
+SHOW_HOLE = Method(  # another method with a plain input named like mean-fill's painted mask
+    name="show-hole", summary="the hole image as it is", params=MeanFillParams,
+    inputs=(InputSpec("hole", "an image named like mean-fill's painted mask"),),
+    run=lambda inputs, params, **kw: Result(inputs["hole"]),
+    studio=Studio(title="Show a hole", canvas="hole", rank=201))
+
+
+@pytest.fixture
+def show_hole():
+    registry.register(SHOW_HOLE)
+    yield SHOW_HOLE
+    registry.unregister(SHOW_HOLE.name)
+
+
+def test_an_image_opened_as_another_methods_input_of_the_masks_name_stays_out_of_the_recipe(
+        show_hole, studio, qtbot, tmp_path, capsys):
+    doc = studio.doc
+    hole = np.zeros((H, W), np.float32)
+    hole[10:30, 10:30] = 1
+    save_image(tmp_path / "hole.png", hole)
+    doc.set_method(SHOW_HOLE.name)
+    _final_after(studio, qtbot, lambda: studio.open_input("hole", str(tmp_path / "hole.png")))
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):  # nothing painted for mean-fill
+        doc.set_method(MEAN_FILL.name)
+    result = _final_after(studio, qtbot, lambda: doc.set_margins("grow", Margins(0, 0, 8, 0)))
+    assert result.figures["hole_pixels"] == 8 * H  # the margins only: show-hole's image is no hole here
+    assert "hole" not in result.recipe.inputs and set(result.recipe.inputs) == {"picture"}
+    out = tmp_path / "out.png"
+    assert studio.export_result(str(out))
+    assert "hole" not in read_recipe(out)
+    again = tmp_path / "again.png"
+    assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
+    assert np.array_equal(load_image(out).image, load_image(again).image)
