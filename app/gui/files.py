@@ -112,8 +112,9 @@ class FileActions(QObject):
         return path
 
     def save_result_dialog(self) -> None:
-        if self.renderer.last is None or not self.renderer.last.final:
-            self.show_message("nothing to export yet: wait for the full-size result")
+        why = self.window.nothing_to_export()
+        if why is not None:
+            self.show_message(why)
             return
         path = self._ask_save("Export result", ".png", SAVE_FILTER)
         if path:
@@ -121,10 +122,11 @@ class FileActions(QObject):
 
     def export_result(self, path: str) -> bool:
         """Save the shown full-size result: PNG carries the result's recipe, TIFF is 16-bit, JPEG 8-bit."""
-        shown = self.renderer.last
-        if shown is None or not shown.final:
-            self.show_message("nothing to export yet: wait for the full-size result")
+        why = self.window.nothing_to_export()
+        if why is not None:
+            self.show_message(why)
             return False
+        shown = self.renderer.last
         p = Path(path)
         if p.suffix.lower() not in (".png", ".jpg", ".jpeg", ".tif", ".tiff"):
             p = p.with_suffix(".png")
@@ -157,10 +159,11 @@ class FileActions(QObject):
 
     def export_recipe(self, path: str) -> bool:
         """Save the recipe of the shown full-size result (``weft run`` reproduces its pixels)."""
-        shown = self.renderer.last
-        if shown is None or not shown.final:
-            self.show_message("no recipe to export yet: wait for the full-size result")
+        why = self.window.nothing_to_export("export")
+        if why is not None:
+            self.show_message(why.replace("nothing to export", "no recipe to export", 1))
             return False
+        shown = self.renderer.last
         try:
             self._with_masks(shown, Path(path)).save(path)
         except WeftError as e:

@@ -112,6 +112,9 @@ class MainWindow(QMainWindow):
         self.settings = settings if settings is not None else QSettings("weft", "weft")
         self.doc = Document(self)
         self.renderer = Renderer(self.doc, self)
+        # What to draw, while the result view shows the canvas input instead of a result (the method
+        # has nothing to do yet): then there is no result to export or copy (renderer.last is older).
+        self._input_shown: str | None = None
         # Opened files are decoded off the GUI thread; the result comes back through a queued signal.
         self.loader = JobRunner(max_workers=1, on_result=self._opened.emit)
         self._opened.connect(self._on_opened)
@@ -560,7 +563,8 @@ class MainWindow(QMainWindow):
         ``mask`` None: the stroke was cancelled."""
         if mask is None:
             self.doc.live = None
-            self.renderer.stroke_cancelled()
+            if not self.renderer.stroke_cancelled():
+                self._show_before()
             return
         self.doc.live = (key, mask)
         self.renderer.preview_around(box)
@@ -572,6 +576,7 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(describe(shown) + " (around the stroke)")
 
     def _on_shown(self, shown) -> None:
+        self._input_shown = None
         self.result_view.set_stale(None)  # a render succeeded: what is shown follows the panel
         self.result_view.set_notice(None)
         self.result_view.set_image(shown.image)
@@ -630,9 +635,8 @@ class MainWindow(QMainWindow):
         self.show_message(draw if message.startswith("render failed") and draw is not None else message)
         if message.startswith("render failed") and draw is not None:
             # nothing drawn yet (the method has nothing to do): the input, and what to draw on it
-            self.result_view.set_stale(None)
-            self.result_view.set_image(self.doc.image(self.doc.studio.canvas))
-            self.result_view.set_notice(draw)
+            self._input_shown, self.renderer.input_shown = draw, True
+            self._show_before()
             return
         if message.startswith("render failed"):  # not a warm-up's: the result no longer matches the panel
             self.result_view.set_stale(f"Out of date — {message}. The result shown is from earlier settings"
@@ -640,17 +644,37 @@ class MainWindow(QMainWindow):
         if self.renderer.last is not None:
             self.result_view.set_image(self.renderer.last.image)
 
-    def _on_cancelled(self) -> None:
-        if self.renderer.last is not None:
+    def _show_before(self) -> None:
+        """Show again what the result view showed before a stroke's previews or a cancelled render:
+        the canvas input and what to draw on it while nothing is drawn, else the last result."""
+        if self._input_shown is not None:
+            self.result_view.set_stale(None)
+            self.result_view.set_image(self.doc.image(self.doc.studio.canvas))
+            self.result_view.set_notice(self._input_shown)
+            self.statusBar().showMessage(self._input_shown, 8000)
+        elif self.renderer.last is not None:
             self.result_view.set_image(self.renderer.last.image)
+
+    def nothing_to_export(self, doing: str = "export") -> str | None:
+        """Why there is no result to export or copy now (one line), or None: none rendered in full
+        yet, or the input shown instead of one (the method has nothing to do: what to draw)."""
+        if self._input_shown is not None:
+            return f"nothing to {doing}: {self._input_shown[0].lower()}{self._input_shown[1:]}"
+        if self.renderer.last is None or not self.renderer.last.final:
+            return f"nothing to {doing} yet: wait for the full-size result"
+        return None
+
+    def _on_cancelled(self) -> None:
+        self._show_before()
         self.statusBar().showMessage("cancelled; the previous result is kept", 4000)
 
     def copy_result(self) -> bool:
         """Put the shown full-size result (not a preview) on the clipboard as an image."""
-        shown = self.renderer.last
-        if shown is None or not shown.final:
-            self.show_message("no full-size result to copy yet")
+        why = self.nothing_to_export("copy")
+        if why is not None:
+            self.show_message(why)
             return False
+        shown = self.renderer.last
         QApplication.clipboard().setImage(to_qimage(shown.image))
         h, w = shown.image.shape[:2]
         self.statusBar().showMessage(f"result {w}x{h} copied to the clipboard", 4000)

@@ -142,6 +142,9 @@ class Renderer(QObject):
         self._around_jobs: set[int] = set()
         self._around_image: np.ndarray | None = None  # the last full result with the stroke's previews pasted
         self.last: Shown | None = None
+        # The window shows the canvas input instead of ``last`` (the method had nothing to do, e.g.
+        # nothing painted): ``last`` is older than the document, no base for a stroke's previews.
+        self.input_shown = False
         self.latest_final: int | None = None
         self._final_running = False  # the latest final job has not delivered yet
         self._preview_timer = QTimer(self, singleShot=True, interval=16)
@@ -177,15 +180,25 @@ class Renderer(QObject):
             self._preview_timer.start()
         return True
 
-    def stroke_cancelled(self) -> None:
-        """The stroke was cancelled: drop its previews and show the last full result again."""
+    def stroke_cancelled(self) -> bool:
+        """The stroke was cancelled: drop its previews and show the last full result again if it is
+        one of the current method and was on screen (True); else the caller shows what was there."""
         self._preview_timer.stop()
         self._around_box = None
         self._around_image = None
         self.runner.cancel("preview")
         self._preview_running, self._preview_dirty = None, False
-        if self.last is not None:
+        if self._current_final() is not None:
             self.shown.emit(self.last)
+            return True
+        return False
+
+    def _current_final(self) -> Shown | None:
+        """The last result if it is a full-size result of the current method on screen, else None."""
+        last = self.last
+        if self.input_shown or last is None or not last.final or last.recipe is None:
+            return None
+        return last if last.recipe.method == self.doc.method else None
 
     def final(self, *, now: bool = False) -> None:
         """Ask for the full-size render (coalesced; ``now`` skips the short delay)."""
@@ -319,6 +332,7 @@ class Renderer(QObject):
             return
         if final:
             self._around_image = None
+        self.input_shown = False
         self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared, compiled,
                           recipe, before, masks)
         self.shown.emit(self.last)
@@ -326,10 +340,8 @@ class Renderer(QObject):
     def _around_base(self) -> np.ndarray | None:
         """What a preview around a stroke is pasted into: the last full result of this method, else
         (none yet, e.g. it refused to run with nothing painted) its canvas input."""
-        last = self.last
-        if last is not None and last.final and last.recipe is not None and last.recipe.method == self.doc.method:
-            return last.image
-        return self.doc.method_inputs().get(self.doc.studio.canvas)
+        last = self._current_final()
+        return last.image if last is not None else self.doc.method_inputs().get(self.doc.studio.canvas)
 
     def _show_around(self, res, crop, job_id: int, seconds: float) -> None:
         """Paste a preview around a stroke into the full result (and the stroke's earlier ones)."""

@@ -605,3 +605,71 @@ def test_an_image_opened_as_another_methods_input_of_the_masks_name_stays_out_of
     again = tmp_path / "again.png"
     assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
     assert np.array_equal(load_image(out).image, load_image(again).image)
+
+
+def _switch_to_mean_fill_from_show_swatch(studio, qtbot, tmp_path):
+    """Show another method's result (show-swatch), then switch back to mean-fill, which has nothing
+    painted: the picture is shown with what to draw, and the renderer's last result is show-swatch's."""
+    swatch = tmp_path / "swatch.png"
+    save_image(swatch, np.full((8, 8, 3), 0.25, np.float32))
+    studio.doc.set_method(SHOW_SWATCH.name)
+    _final_after(studio, qtbot, lambda: studio.open_input("swatch", str(swatch)))
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):
+        studio.doc.set_method(MEAN_FILL.name)
+    assert studio.renderer.last.recipe.method == SHOW_SWATCH.name  # older than what is shown
+    assert np.array_equal(studio.result_view.image, studio.doc.image("picture"))
+
+
+def test_with_the_input_shown_instead_of_a_result_export_and_copy_refuse(studio, qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QApplication, QFileDialog
+
+    out = tmp_path / "out.png"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(out), ""))
+    words = "nothing to export: paint the hole; drag an edge outward"
+    _switch_to_mean_fill_from_show_swatch(studio, qtbot, tmp_path)
+    studio.result_view.setFocus()
+    with qtbot.waitSignal(studio.message, timeout=5000) as said:
+        qtbot.keyClick(studio, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier)  # Export Result…
+    assert said.args == [words] and not out.exists()  # not show-swatch's result
+    QApplication.clipboard().clear()
+    with qtbot.waitSignal(studio.message, timeout=5000) as said:
+        qtbot.keyClick(studio, Qt.Key.Key_C, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
+    assert said.args == ["nothing to copy: paint the hole; drag an edge outward"]
+    assert QApplication.clipboard().image().isNull()
+    # a fill, then Clear mask: the picture again, and the fill from before is not exported either
+    view, bar = studio.canvas_view, studio.inputs_pane.bar()
+    studio.inputs_pane.mask_tool().set_size(9)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (40.5, 20.5)]))
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):
+        qtbot.mouseClick(bar.clear_button, Qt.MouseButton.LeftButton)
+    assert np.array_equal(studio.result_view.image, studio.doc.image("picture"))
+    with qtbot.waitSignal(studio.message, timeout=5000) as said:
+        qtbot.keyClick(studio, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier)
+    assert said.args == [words] and not out.exists()
+    assert not studio.export_recipe(str(tmp_path / "r.json")) and not (tmp_path / "r.json").exists()
+    # a result again: exported
+    _final_after(studio, qtbot, lambda: studio.doc.set_margins("grow", Margins(0, 0, 4, 0)))
+    qtbot.keyClick(studio, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier)
+    assert out.is_file() and load_image(out).image.shape == (H, W + 4, 3)
+
+
+def test_esc_on_the_first_stroke_after_a_method_switch_shows_the_picture_again(studio, qtbot, tmp_path):
+    _switch_to_mean_fill_from_show_swatch(studio, qtbot, tmp_path)
+    view = studio.canvas_view
+    view.actual_size()
+    view.zoom_by(4.0)
+    view.centerOn(W / 2, H / 2)
+    studio.inputs_pane.mask_tool().set_size(9)
+    around = []
+    studio.renderer.around_shown.connect(around.append)
+    _stroke(view, [(20.5, 20.5), (30.5, 20.5)], release=False)
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    assert not np.array_equal(studio.result_view.image, studio.doc.image("picture"))  # the stroke's preview
+    view.setFocus()
+    qtbot.keyClick(view, Qt.Key.Key_Escape)
+    mouse(view, "release", (30.5, 20.5))
+    assert np.array_equal(studio.result_view.image, studio.doc.image("picture"))  # not show-swatch's result
+    assert studio.result_view.notice.isVisible()
+    assert studio.result_view.notice.text() == "Paint the hole; drag an edge outward"
+    assert studio.statusBar().currentMessage() == "Paint the hole; drag an edge outward"
+    assert studio.doc.live is None and _mask(studio) is None
