@@ -5,8 +5,9 @@
   brush's size on screen), lasso (add or subtract a polygon). The mask is drawn over the image in a
   semi-transparent colour. A stroke is painted with the Qt-free ``Mask.painted_line`` /
   ``painted_polygon`` and is one undo command, pushed on release; Esc cancels a stroke in progress.
-  While a brush stroke is drawn, ``on_stroke(mask, box)`` hears the mask so far and the box around
-  the latest dab (the window renders a preview around it).
+  While a brush or eraser stroke is drawn, ``on_stroke(mask, box)`` hears the mask so far and the
+  box around the latest dab (the window renders a preview around it); ``on_stroke(None, None)``: the
+  stroke ended without an edit (Esc, or a release that left the mask as it was).
 * ``MarginsTool`` edits a margins geometry (``Geometry(MARGINS, param=...)``): a press outside the
   image drags the canvas edges on that side outward (the grown frame drawn as a dashed outline);
   one undo command on release; Esc cancels.
@@ -207,7 +208,7 @@ class MaskTool(Tool):
         box = (min(p0[0], p1[0]) - r, min(p0[1], p1[1]) - r, max(p0[0], p1[0]) + r, max(p0[1], p1[1]) + r)
         self.overlay.update_box(self.live, (int(np.floor(box[0])), int(np.floor(box[1])),
                                             int(np.ceil(box[2])) + 1, int(np.ceil(box[3])) + 1))
-        if self.on_stroke is not None and value:
+        if self.on_stroke is not None:  # the eraser's strokes too: erased pixels are previewed unfilled
             self.on_stroke(self.live, box)
 
     def press(self, view, pos, event):
@@ -259,8 +260,10 @@ class MaskTool(Tool):
             text = "Lasso" if self.mode == LASSO_ADD else "Lasso subtract"
         self._end()
         if mask != self.base():
-            self.doc.set_mask(self.geometry_key, mask, text)
-        self.refresh()
+            self.doc.set_mask(self.geometry_key, mask, text)  # (the document's live stroke ends with it)
+            self.refresh()
+        else:  # nothing changed: no undo step, and the stroke's previews go as with Esc
+            self._cancelled()
 
     def _end(self) -> None:
         self.active = False
@@ -274,10 +277,13 @@ class MaskTool(Tool):
         if not self.active:
             return False
         self._end()
+        self._cancelled()
+        return True
+
+    def _cancelled(self) -> None:
         self.refresh()
         if self.on_stroke is not None:
             self.on_stroke(None, None)
-        return True
 
     def key(self, view, event) -> bool:
         if event.key() == Qt.Key.Key_Escape:

@@ -673,3 +673,43 @@ def test_esc_on_the_first_stroke_after_a_method_switch_shows_the_picture_again(s
     assert studio.result_view.notice.text() == "Paint the hole; drag an edge outward"
     assert studio.statusBar().currentMessage() == "Paint the hole; drag an edge outward"
     assert studio.doc.live is None and _mask(studio) is None
+
+
+def test_a_stroke_that_changes_nothing_ends_its_preview_with_no_undo_step(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    studio.inputs_pane.mask_tool().set_size(9)
+    result = _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (40.5, 20.5)]))
+    steps = doc.undo_stack.count()
+    around = []
+    studio.renderer.around_shown.connect(around.append)
+    _stroke(view, [(30.5, 20.5), (31.5, 20.5)], release=False)  # over what is painted already
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    assert doc.live is not None
+    assert not np.array_equal(studio.result_view.image, result.image)  # the crop's own mean: other pixels
+    with qtbot.waitSignal(studio.renderer.shown, timeout=10000) as shown:  # the full result again
+        mouse(view, "release", (31.5, 20.5))
+    assert shown.args[0] is result
+    assert doc.live is None and doc.undo_stack.count() == steps
+    assert np.array_equal(studio.result_view.image, result.image)
+
+
+def test_an_eraser_stroke_is_previewed_live(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    tool, bar = studio.inputs_pane.mask_tool(), studio.inputs_pane.bar()
+    tool.set_size(9)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 30.5), (60.5, 30.5)]))
+    qtbot.mouseClick(bar.mode_buttons["eraser"], Qt.MouseButton.LeftButton)
+    tool.set_size(5)
+    around = []
+    studio.renderer.around_shown.connect(around.append)
+    _stroke(view, [(35.5, 24.5), (35.5, 36.5)], release=False)
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    live = doc.live[1]
+    assert not live.bits[28:33, 34:37].any() and live.bits[30, 30]
+    source = doc.image("picture")
+    # erased pixels show the picture again, the rest of the hole stays filled
+    assert np.array_equal(around[-1].image[28:33, 34:37], source[28:33, 34:37])
+    assert not np.allclose(around[-1].image[30, 20], source[30, 20])
+    assert np.array_equal(studio.result_view.image, around[-1].image)
+    result = _final_after(studio, qtbot, lambda: mouse(view, "release", (35.5, 36.5)))
+    assert _mask(studio) == live and np.array_equal(result.image[28:33, 34:37], source[28:33, 34:37])
