@@ -56,12 +56,18 @@ class MaskOverlay(QGraphicsItem):
         super().__init__()
         self._rgba: np.ndarray | None = None  # (H, W, 4) uint8: the QImage's pixels (kept alive with it)
         self._image = QImage()
+        self._mask: Mask | None = None  # the mask drawn (masks are immutable: the same one is not redrawn)
 
     def image(self) -> QImage:
         """What is drawn (a null image when the mask is empty or none)."""
         return self._image
 
     def set_mask(self, mask: Mask | None) -> None:
+        """Draw ``mask`` (None or empty: nothing); nothing to do if that very mask is drawn already
+        (every parameter change syncs the tools: no rebuild of a large overlay then)."""
+        if mask is self._mask:
+            return
+        self._mask = mask
         self.prepareGeometryChange()
         if mask is None or not mask:
             self._rgba, self._image = None, QImage()
@@ -77,6 +83,7 @@ class MaskOverlay(QGraphicsItem):
         if self._rgba is None or self._rgba.shape[:2] != mask.shape:
             self.set_mask(mask)
             return
+        self._mask = mask
         x0, y0, x1, y1 = box
         h, w = mask.shape
         x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)

@@ -713,3 +713,21 @@ def test_an_eraser_stroke_is_previewed_live(studio, qtbot):
     assert np.array_equal(studio.result_view.image, around[-1].image)
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (35.5, 36.5)))
     assert _mask(studio) == live and np.array_equal(result.image[28:33, 34:37], source[28:33, 34:37])
+
+
+def test_a_parameter_change_does_not_redraw_the_masks_overlay(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    tool = studio.inputs_pane.mask_tool()
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
+    drawn = tool.overlay.image().cacheKey()
+    for amount in (0.9, 0.8):
+        _final_after(studio, qtbot, lambda: doc.set_param("amount", amount))
+    assert tool.overlay.image().cacheKey() == drawn  # the same image: not rebuilt
+    assert np.array_equal(_painted(tool.overlay), _mask(studio).bits)
+    # another mask is drawn: undo brings back the picture with nothing painted, redo the stroke
+    doc.undo_stack.undo()  # the amount (one step: edits of one parameter merge)
+    assert tool.overlay.image().cacheKey() == drawn
+    doc.undo_stack.undo()
+    assert tool.overlay.image().isNull()
+    doc.undo_stack.redo()
+    assert np.array_equal(_painted(tool.overlay), _mask(studio).bits)
