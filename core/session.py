@@ -32,19 +32,26 @@ LEGACY_SQUARE, LEGACY_LINES = "prototype", "lines"  # the version-1 keys of the 
 MAX_SEED = 2**31 - 1  # the studio's seed box
 
 
-def read_session(path: str | Path) -> dict:
+def read_session(path: str | Path, *, dropped: list[str] | None = None) -> dict:
     """Parse and validate a session file (JSON only, at most ``weft.core.params.MAX_FILE_BYTES``); input
     paths come back absolute, relative ones resolved against the session's folder. ``WeftError`` with
-    one line naming the file if anything is wrong, so a bad file never half-replaces a document."""
+    one line naming the file if anything is wrong, so a bad file never half-replaces a document.
+
+    With a ``dropped`` list, a mask PNG that is missing or unreadable is left out of the geometry
+    instead (the rest opens) and a one-line message naming it is appended to the list."""
     path = Path(path)
     data = read_json_file(path, "weft session")
+    said: list[str] | None = None if dropped is None else []
     try:
-        return _session_from_data(data, path.resolve().parent)
+        session = _session_from_data(data, path.resolve().parent, said)
     except WeftError as e:
         raise WeftError(f"{path}: {e}") from None
+    if dropped is not None:
+        dropped.extend(f"{path}: {line}" for line in said)
+    return session
 
 
-def _session_from_data(data: Any, base: Path) -> dict:
+def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) -> dict:
     if not isinstance(data, dict) or data.get("weft_session") != SESSION_VERSION:
         raise WeftError(f"not a weft session file (version {SESSION_VERSION})")
     methods = registry.methods()
@@ -102,9 +109,17 @@ def _session_from_data(data: Any, base: Path) -> dict:
                 raise WeftError(f"{name}: unknown geometry {key!r} (known: {', '.join(known) or 'none'})")
             try:
                 geometry[name][key] = _geometry_from_json(g, value, base)
+            except _UnreadableMask as e:
+                if dropped is None:
+                    raise WeftError(f"{name}: {e}") from None
+                dropped.append(f"{name}: {e}; dropped")
             except WeftError as e:
                 raise WeftError(f"{name}: {e}") from None
     return {"method": data["method"], "params": params, "inputs": inputs, "geometry": geometry, "seed": seed}
+
+
+class _UnreadableMask(WeftError):
+    """A session's mask PNG is missing or cannot be read (``read_session(dropped=...)`` drops it)."""
 
 
 def mask_file(session: str | Path, method: str, key: str) -> Path:
@@ -122,7 +137,10 @@ def _geometry_from_json(g: Geometry, value: Any, base: Path):
         if not isinstance(value, str) or not value or "\0" in value:
             raise WeftError(f"{g.key} = {value!r} must be the name of a mask PNG beside the session")
         path = Path(value) if os.path.isabs(value) else base / value
-        return Mask.read(path, g.key)
+        try:
+            return Mask.read(path, g.key)
+        except WeftError as e:
+            raise _UnreadableMask(str(e)) from None
     if g.kind == MARGINS:
         return Margins.from_json(value, g.key)
     if g.kind == SQUARE:

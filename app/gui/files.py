@@ -231,7 +231,8 @@ class FileActions(QObject):
 
         Raises ``WeftError`` naming the session file and, for an image, which input it is.
         """
-        data = read_session(path)
+        dropped: list[str] = []
+        data = read_session(path, dropped=dropped)  # a missing or unreadable mask PNG: the rest opens
         offered = registry.studio_methods()
         if data["method"] not in offered:
             raise WeftError(f"{path}: the studio does not offer method {data['method']!r} "
@@ -260,7 +261,9 @@ class FileActions(QObject):
                         value.check_size(images[on].image.shape, what=on.replace("_", " "), name=g.key)
                     except WeftError as e:
                         del values[g.key]
-                        self.show_message(f"{path}: {method}: {e}; dropped")
+                        dropped.append(f"{path}: {method}: {e}; dropped")
+        for line in dropped:  # (said once all is read: a session that does not open drops nothing)
+            self.show_message(line)
         return data, images
 
     def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:

@@ -122,3 +122,18 @@ def test_a_session_naming_a_missing_mask_or_bad_margins_says_which(hole_method, 
                                    "geometry": {HOLE.name: {"grow": [1, -2, 3, 4]}}}))
     with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: parameter 'grow' = 1,-2,3,4: the top margin -2"):
         read_session(session)
+
+
+def test_a_session_read_with_a_dropped_list_leaves_out_a_missing_mask_and_says_so(hole_method, tmp_path):
+    session = tmp_path / "s.weft.json"
+    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
+                                   "geometry": {HOLE.name: {"hole": "gone.png", "grow": [1, 2, 3, 4]}}}))
+    dropped = []
+    data = read_session(session, dropped=dropped)
+    assert data["geometry"][HOLE.name] == {"grow": Margins(1, 2, 3, 4)}
+    assert len(dropped) == 1 and dropped[0].startswith(f"{session}: hole-test: ") and "gone.png" in dropped[0]
+    assert dropped[0].endswith("; dropped")
+    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,  # not a file name: still refused
+                                   "geometry": {HOLE.name: {"hole": 3}}}))
+    with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: hole = 3 must be the name of a mask PNG"):
+        read_session(session, dropped=[])

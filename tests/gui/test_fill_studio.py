@@ -731,3 +731,24 @@ def test_a_parameter_change_does_not_redraw_the_masks_overlay(studio, qtbot):
     assert tool.overlay.image().isNull()
     doc.undo_stack.redo()
     assert np.array_equal(_painted(tool.overlay), _mask(studio).bits)
+
+
+def test_a_session_whose_mask_png_is_missing_or_unreadable_opens_without_it_and_says_so(studio, qtbot, tmp_path):
+    view, doc = studio.canvas_view, studio.doc
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
+    doc.set_margins("grow", Margins(0, 3, 0, 0))
+    session = tmp_path / "s.weft.json"
+    assert studio.save_session(str(session))
+    png = tmp_path / "s.weft.mean-fill.hole.png"
+    for spoil in (png.unlink, lambda: png.write_bytes(b"not a png")):
+        spoil()
+        doc.set_margins("grow", None)
+        messages = []
+        studio.message.connect(messages.append)
+        assert studio.open_session(str(session))
+        studio.message.disconnect(messages.append)
+        assert len(messages) == 1 and messages[0].startswith(f"{session}: mean-fill: ")
+        assert "s.weft.mean-fill.hole.png" in messages[0] and messages[0].endswith("; dropped")
+        assert "\n" not in messages[0]
+        assert _mask(studio) is None and doc.value("grow") == Margins(0, 3, 0, 0)  # the rest opened
+        assert doc.inputs["picture"].path == str(studio.picture)
