@@ -126,6 +126,7 @@ class MaskTool(Tool):
         self.lasso_item.setZValue(25)
         scene.addItem(self.lasso_item)
         self.live: Mask | None = None  # the mask with the stroke so far
+        self.start: Mask | None = None  # the document's mask when the stroke began
         self.last: tuple[float, float] | None = None
         self.points: list[tuple[float, float]] = []
         self.active = False
@@ -176,6 +177,12 @@ class MaskTool(Tool):
 
     # --- drawing -------------------------------------------------------------------------------
     def refresh(self) -> None:
+        """Draw the document's mask (the stroke so far while painting). A stroke whose mask the
+        document changed under it (Ctrl+Z, another image opened) is cancelled: its release must not
+        put the undone mask back."""
+        if self.active and self.mask() is not self.start:
+            self.cancel()
+            return
         self._draw(self.live if self.active and self.live is not None else self.mask())
 
     def hide(self) -> None:
@@ -220,6 +227,7 @@ class MaskTool(Tool):
 
     def press(self, view, pos, event):
         self.active = True
+        self.start = self.mask()
         self.live = self.base()
         p = self._pixel(pos)
         if self.mode in (BRUSH, ERASER):

@@ -752,3 +752,22 @@ def test_a_session_whose_mask_png_is_missing_or_unreadable_opens_without_it_and_
         assert "\n" not in messages[0]
         assert _mask(studio) is None and doc.value("grow") == Margins(0, 3, 0, 0)  # the rest opened
         assert doc.inputs["picture"].path == str(studio.picture)
+
+
+def test_ctrl_z_during_a_stroke_cancels_it_and_the_release_does_not_undo_the_undo(studio, qtbot):
+    view, doc = studio.canvas_view, studio.doc
+    tool = studio.inputs_pane.mask_tool()
+    tool.set_size(5)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 10.5), (20.5, 10.5)]))
+    first, steps = _mask(studio), doc.undo_stack.count()
+    _stroke(view, [(10.5, 40.5), (20.5, 40.5)], release=False)
+    assert tool.stroking
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):  # nothing to fill once undone
+        qtbot.keyClick(studio, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # the button still held
+    assert not tool.stroking and _mask(studio) is None and tool.overlay.image().isNull()
+    assert doc.live is None
+    mouse(view, "release", (20.5, 40.5))
+    assert _mask(studio) is None and doc.undo_stack.count() == steps and doc.undo_stack.canRedo()
+    assert np.array_equal(studio.result_view.image, doc.image("picture"))
+    doc.undo_stack.redo()
+    assert _mask(studio) == first
