@@ -272,16 +272,15 @@ class BatchDialog(QDialog):
 
 def _shown_recipe(window) -> Recipe | None:
     """The recipe of the full-size result on screen (what an export would carry), or None while
-    only a preview or nothing is shown."""
-    shown = window.renderer.last
-    return shown.recipe if shown is not None and shown.final else None
+    only a preview, nothing, or the input instead of a result (nothing drawn yet) is shown."""
+    return None if window.nothing_to_export() is not None else window.renderer.last.recipe
 
 
 def open_batch_dialog(window) -> BatchDialog | None:
     """Show the dialog for ``window``'s current result (one dialog per window, raised if open)."""
-    shown = window.renderer.last
-    if shown is None or not shown.final:
-        window.show_message("nothing to apply yet: wait for the full-size result")
+    why = window.nothing_to_export("apply")
+    if why is not None:
+        window.show_message(why)
         return None
     for dialog in window.findChildren(BatchDialog):
         if dialog.running:

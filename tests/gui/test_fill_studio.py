@@ -636,6 +636,9 @@ def test_with_the_input_shown_instead_of_a_result_export_and_copy_refuse(studio,
         qtbot.keyClick(studio, Qt.Key.Key_C, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
     assert said.args == ["nothing to copy: paint the hole; drag an edge outward"]
     assert QApplication.clipboard().image().isNull()
+    with qtbot.waitSignal(studio.message, timeout=5000) as said:  # File > Apply to Folder…
+        qtbot.keyClick(studio, Qt.Key.Key_B, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
+    assert said.args == ["nothing to apply: paint the hole; drag an edge outward"]
     # a fill, then Clear mask: the picture again, and the fill from before is not exported either
     view, bar = studio.canvas_view, studio.inputs_pane.bar()
     studio.inputs_pane.mask_tool().set_size(9)
