@@ -774,3 +774,23 @@ def test_ctrl_z_during_a_stroke_cancels_it_and_the_release_does_not_undo_the_und
     assert np.array_equal(studio.result_view.image, doc.image("picture"))
     doc.undo_stack.redo()
     assert _mask(studio) == first
+
+
+def test_after_clear_mask_a_strokes_previews_are_pasted_into_the_picture_not_the_old_fill(studio, qtbot):
+    view, bar = studio.canvas_view, studio.inputs_pane.bar()
+    studio.inputs_pane.mask_tool().set_size(9)
+    old = _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 10.5), (30.5, 10.5)]))
+    source = studio.doc.image("picture")
+    assert not np.array_equal(old.image[6:15, 6:35], source[6:15, 6:35])
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):
+        qtbot.mouseClick(bar.clear_button, Qt.MouseButton.LeftButton)
+    around = []
+    studio.renderer.around_shown.connect(around.append)
+    _stroke(view, [(60.5, 50.5), (64.5, 52.5)], release=False)
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    assert np.array_equal(around[-1].image[:20, :40], source[:20, :40])  # the cleared stroke is not back
+    assert np.array_equal(studio.result_view.image, around[-1].image)
+    view.setFocus()
+    qtbot.keyClick(view, Qt.Key.Key_Escape)
+    mouse(view, "release", (64.5, 52.5))
+    assert np.array_equal(studio.result_view.image, source) and studio.result_view.notice.isVisible()
