@@ -115,7 +115,11 @@ def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) 
                 dropped.append(f"{name}: {e}; dropped")
             except WeftError as e:
                 raise WeftError(f"{name}: {e}") from None
-    return {"method": data["method"], "params": params, "inputs": inputs, "geometry": geometry, "seed": seed}
+    opened_for = _get(data, "opened_for", dict, "an object of input name -> method name", None)
+    if opened_for is not None:
+        opened_for = {k: v for k, v in opened_for.items() if k in inputs and isinstance(v, str)}
+    return {"method": data["method"], "params": params, "inputs": inputs, "geometry": geometry, "seed": seed,
+            "opened_for": opened_for}
 
 
 class _UnreadableMask(WeftError):

@@ -386,6 +386,9 @@ class Document(QObject):
             "method": self.method,
             "params": {name: p.to_dict() for name, p in self.params.items()},
             "inputs": {name: path(item.path) for name, item in self.inputs.items() if item.path},
+            # which method an input was opened for, where a method takes it only then (Studio.own_inputs)
+            "opened_for": {name: item.opened_for for name, item in self.inputs.items()
+                           if item.path and item.opened_for is not None},
             "geometry": {name: {key: geometry(name, key, value) for key, value in values.items()}
                          for name, values in self.geometry.items() if values},
             "seed": self.seed,

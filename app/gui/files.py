@@ -268,10 +268,14 @@ class FileActions(QObject):
 
     def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
         """Put a read session into the document (one clean state, no undo history) and render it.
-        The session's method's own inputs (``Studio.own_inputs``) count as opened for it."""
-        own = registry.studio_methods()[data["method"]].studio.own_inputs
-        images = {name: dataclasses.replace(item, opened_for=data["method"]) if name in own else item
-                  for name, item in images.items()}
+        Each input keeps the method it was opened for (``Studio.own_inputs``: fill's texture is fill's
+        only when opened for fill; the brick open for quilt filled a gravel hole after a recovery, seen
+        under Xvfb); a session that did not record it counts the session's method's own inputs as its."""
+        opened_for = data.get("opened_for")
+        if opened_for is None:  # a session from before it was recorded: the session's method's own inputs
+            own = registry.studio_methods()[data["method"]].studio.own_inputs
+            opened_for = {name: data["method"] for name in images if name in own}
+        images = {name: dataclasses.replace(item, opened_for=opened_for.get(name)) for name, item in images.items()}
         self.doc.restore(DocumentState(inputs=images, method=data["method"], params=data["params"],
                                        geometry=data["geometry"], seed=data["seed"]))
         self.renderer.final(now=True)

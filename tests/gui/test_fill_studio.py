@@ -523,6 +523,30 @@ def test_an_own_input_opened_for_another_method_is_not_used(studio, qtbot, tmp_p
     assert np.allclose(result.image[bits], load_image(swatch).image.mean(), atol=1e-5)  # 64/255
 
 
+def test_an_own_input_opened_for_another_method_stays_its_through_a_session(studio, qtbot, tmp_path):
+    """Saved and reopened (or recovered) with mean-fill current, the swatch opened for another method
+    is still not mean-fill's (seen under Xvfb: after a recovery, the brick open for quilt filled a
+    gravel hole in fill, because a restored session counted every own input as the current method's)."""
+    doc, view = studio.doc, studio.canvas_view
+    swatch = tmp_path / "swatch.png"
+    save_image(swatch, np.full((8, 8, 3), 0.25, np.float32))
+    doc.set_method(SHOW_SWATCH.name)
+    studio.open_input("swatch", str(swatch))
+    qtbot.waitUntil(lambda: doc.image("swatch") is not None, timeout=10000)
+    doc.set_method(MEAN_FILL.name)
+    studio.inputs_pane.mask_tool().set_size(5)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
+    session = tmp_path / "s.weft.json"
+    assert studio.save_session(str(session))
+    result = _final_after(studio, qtbot, lambda: studio.open_session(str(session)))
+    assert doc.method == MEAN_FILL.name and doc.image("swatch") is None
+    bits = _mask(studio).bits
+    picture = doc.image("picture")
+    assert np.allclose(result.image[bits], picture[~bits].mean(axis=0), atol=1e-5)  # not the swatch's colour
+    doc.set_method(SHOW_SWATCH.name)
+    assert doc.image("swatch") is not None  # still open for the method it was opened for
+
+
 def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, settings, tmp_path, capsys):
     """The real fill, as an artist meets it: the studio opens on its examples, fill is picked, a hole
     is painted with the mouse (previewed around the stroke), filled on release, exported and re-run."""
