@@ -270,11 +270,9 @@ class FileActions(QObject):
         """Put a read session into the document (one clean state, no undo history) and render it.
         Each input keeps the method it was opened for (``Studio.own_inputs``: fill's texture is fill's
         only when opened for fill; the brick open for quilt filled a gravel hole after a recovery, seen
-        under Xvfb); a session that did not record it counts the session's method's own inputs as its."""
-        opened_for = data.get("opened_for")
-        if opened_for is None:  # a session from before it was recorded: the session's method's own inputs
-            own = registry.studio_methods()[data["method"]].studio.own_inputs
-            opened_for = {name: data["method"] for name in images if name in own}
+        under Xvfb); in a session that did not record it, no own input is taken (an own input a method
+        does not get shows as an empty input, which can be opened again; one it gets silently changes the result)."""
+        opened_for = data.get("opened_for") or {}  # (not recorded: no own input counts as opened for its method)
         images = {name: dataclasses.replace(item, opened_for=opened_for.get(name)) for name, item in images.items()}
         self.doc.restore(DocumentState(inputs=images, method=data["method"], params=data["params"],
                                        geometry=data["geometry"], seed=data["seed"]))
