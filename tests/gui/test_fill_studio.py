@@ -502,16 +502,23 @@ def test_unsaved_masks_and_margins_reach_the_recovery_file(studio, qtbot, settin
         again.shutdown()
 
 
-def test_an_own_input_opened_for_another_method_is_not_used(studio, qtbot, tmp_path):
-    """mean-fill's optional "swatch" is its own (Studio.own_inputs): the swatch opened for another
-    method of the studio does not change its fill; one opened for it does."""
-    doc, view = studio.doc, studio.canvas_view
+def _swatch_opened_for_another_method(studio, qtbot, tmp_path):
+    """Open a swatch while show-swatch is current, then make mean-fill (whose own input it is) current."""
+    doc = studio.doc
     swatch = tmp_path / "swatch.png"
     save_image(swatch, np.full((8, 8, 3), 0.25, np.float32))
     doc.set_method(SHOW_SWATCH.name)
     studio.open_input("swatch", str(swatch))
     qtbot.waitUntil(lambda: doc.image("swatch") is not None, timeout=10000)
     doc.set_method(MEAN_FILL.name)
+    return swatch
+
+
+def test_an_own_input_opened_for_another_method_is_not_used(studio, qtbot, tmp_path):
+    """mean-fill's optional "swatch" is its own (Studio.own_inputs): the swatch opened for another
+    method of the studio does not change its fill; one opened for it does."""
+    doc, view = studio.doc, studio.canvas_view
+    swatch = _swatch_opened_for_another_method(studio, qtbot, tmp_path)
     assert doc.image("swatch") is None and "swatch" not in doc.method_inputs()
     studio.inputs_pane.mask_tool().set_size(5)
     result = _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
@@ -528,12 +535,7 @@ def test_an_own_input_opened_for_another_method_stays_its_through_a_session(stud
     is still not mean-fill's (seen under Xvfb: after a recovery, the brick open for quilt filled a
     gravel hole in fill, because a restored session counted every own input as the current method's)."""
     doc, view = studio.doc, studio.canvas_view
-    swatch = tmp_path / "swatch.png"
-    save_image(swatch, np.full((8, 8, 3), 0.25, np.float32))
-    doc.set_method(SHOW_SWATCH.name)
-    studio.open_input("swatch", str(swatch))
-    qtbot.waitUntil(lambda: doc.image("swatch") is not None, timeout=10000)
-    doc.set_method(MEAN_FILL.name)
+    swatch = _swatch_opened_for_another_method(studio, qtbot, tmp_path)
     studio.inputs_pane.mask_tool().set_size(5)
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     session = tmp_path / "s.weft.json"
