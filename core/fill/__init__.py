@@ -14,7 +14,7 @@ quilt engine's cut may also run through the known pixels of the blend band, when
   fill-front order, SSD over known pixels only, minimum-error cut;
 * ``pixel`` (:func:`weft.core.fill.pixel.fill_pixel`) -- Ashikhmin-style coherent pixel synthesis in
   onion order with the hole's neighbourhood as the constraint;
-* ``patchmatch`` (``weft.core.fill.patchmatch.fill_patchmatch``, when the build has it) -- multi-scale
+* ``patchmatch`` (:func:`weft.core.fill.patchmatch.fill_patchmatch`) -- multi-scale
   patch search with voting (Wexler et al., Barnes et al.).
 
 **The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE` (``quilt``). Measured against

@@ -16,13 +16,7 @@ from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
 from .common import whole_patches
-from .params import ANCHORS, ENGINES, FillParams
-
-
-#: The quilting engine may cut into the known pixels of the band (measured on gravel and brick, two
-#: holes each, seeds 1-3: brick coherence 0.51 -> 0.44 and 0.54 -> 0.45 of the truth's, seam +0.16 -> +0.13
-#: and +0.38 -> +0.23 from the truth's; gravel 0.60/0.64 -> 0.61/0.57, seam -0.07/-0.29 -> -0.10/-0.36).
-CUT_INTO_BAND = True
+from .params import ANCHORS, FillParams
 
 
 def _engine(name: str):
@@ -202,7 +196,10 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         reporter.update(int(100 * done // max(1, total)))
 
     extra = {}
-    if params.engine == "quilt" and CUT_INTO_BAND and params.band > 0:
+    if params.engine == "quilt" and params.band > 0:
+        # the quilting cut may run through the band's known pixels (gravel and brick, two holes each,
+        # seeds 1-3: brick coherence 0.51 -> 0.44 and 0.54 -> 0.45 of the truth's, seam +0.16 -> +0.13
+        # and +0.38 -> +0.23 from the truth's; gravel 0.60/0.64 -> 0.61/0.57, seam -0.07/-0.29 -> -0.10/-0.36)
         # the image's own band (never its transparent pixels), on the engine's canvas: a band worked
         # out there would also take the image's last rows and columns beside a texture's gap
         from .band import band_region
@@ -243,21 +240,18 @@ def _run(inputs: Mapping[str, np.ndarray], params: FillParams, *, rng=None, prog
 
 
 def warm_up() -> None:
-    """Load (or compile) every kernel a fill can use on tiny inputs: the min-cut of the quilting
-    engine, the pixel engine's kernel, the Poisson band's solver (and the PatchMatch engine's
-    kernels when this build has them), so that no run compiles."""
+    """Load (or compile) the kernels a fill can use, on tiny inputs, so that no run compiles: the
+    PatchMatch engine's and the pixel engine's (grey and colour). The quilt engine and the blend
+    band run in numpy (:mod:`weft.core.fill.cut`) and have none."""
+    from . import patchmatch
+
+    patchmatch.warm_up()
     rng = np.random.default_rng(0)
     img = rng.random((24, 24), dtype=np.float32)
     hole = np.zeros((24, 24), dtype=bool)
     hole[8:16, 8:16] = True
-    if "patchmatch" in ENGINES:
-        from . import patchmatch
-
-        patchmatch.warm_up()
-    for engine in ("quilt", "pixel"):
-        fill_image(img, hole, params=FillParams(engine=engine, patch=5), rng=0)
-    fill_image(np.repeat(img[..., None], 3, axis=2), hole, params=FillParams(engine="quilt", patch=5), rng=0)
-    fill_image(np.repeat(img[..., None], 3, axis=2), hole, params=FillParams(engine="pixel", patch=5), rng=0)
+    for image in (img, np.repeat(img[..., None], 3, axis=2)):
+        fill_image(image, hole, params=FillParams(engine="pixel", patch=5), rng=0)
 
 
 def _memory(shapes: Mapping[str, tuple[int, ...]], params: FillParams) -> float:

@@ -12,15 +12,8 @@ from ..params import Params, param
 ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-left", "bottom", "bottom-right")
 
 
-def _engines() -> tuple[str, ...]:
-    try:  # ENGINE's multi-scale PatchMatch, when this build has it
-        from .patchmatch import fill_patchmatch  # noqa: F401
-    except ImportError:
-        return ("quilt", "pixel")
-    return ("patchmatch", "quilt", "pixel")
-
-
-ENGINES = _engines()
+#: The engines `--engine` offers (each a function of one signature, see the package docstring).
+ENGINES = ("patchmatch", "quilt", "pixel")
 #: The default engine: the one that measures best on issue 15's cases (see the package docstring for the figures).
 DEFAULT_ENGINE = "quilt"
 #: Each engine's patch side when ``patch`` is not given.
@@ -34,11 +27,11 @@ class FillParams(Params):
     engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
                         help="quilt: blocks in fill-front order with min-cut seams (Efros & Freeman); "
                              "pixel: coherent pixel synthesis (Ashikhmin)"
-                             + ("; patchmatch: multi-scale patch search with voting" if "patchmatch" in ENGINES else ""))
+                             "; patchmatch: multi-scale patch search with voting")
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
                        help="patch side in pixels (quilt: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
                             "default per engine, smaller on a small image: "
-                            + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items() if k in ENGINES))
+                            + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items()))
     extend: Margins = param(None, kind="geometry", type=Margins, optional=True,
                             help="uncrop: pixels added on the left, top, right and bottom, filled like the hole")
     size: tuple = param(None, kind="size", lo=1, hi=MAX_SIDE, optional=True,
