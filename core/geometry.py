@@ -387,6 +387,15 @@ class Mask:
         arr.flags.writeable = False
         object.__setattr__(self, "bits", arr)
 
+    @classmethod
+    def _own(cls, bits: np.ndarray) -> "Mask":
+        """A mask over ``bits``, a fresh bool array of this module's own making (no second copy: a
+        brush dab on an 8192² mask copied it twice)."""
+        mask = cls.__new__(cls)
+        bits.flags.writeable = False
+        object.__setattr__(mask, "bits", bits)
+        return mask
+
     def __setattr__(self, name, value):
         raise AttributeError("Mask is immutable")
 
@@ -498,7 +507,7 @@ class Mask:
         hit = (xx - x0 - t * dx) ** 2 + (yy - y0 - t * dy) ** 2 < r * r
         out = self.bits.copy()
         out[top:bottom, left:right][hit] = value
-        return Mask(out)
+        return Mask._own(out)
 
     def painted_polygon(self, points, value: bool = True) -> "Mask":
         """The mask with the polygon ``points`` [(x, y), ...] (a lasso, closed) set to ``value``."""
@@ -511,7 +520,7 @@ class Mask:
         cv2.fillPoly(layer, [pts], 1, lineType=cv2.LINE_8)
         out = self.bits.copy()
         out[layer > 0] = value
-        return Mask(out)
+        return Mask._own(out)
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Mask) and self.bits.shape == other.bits.shape and bool(np.array_equal(self.bits, other.bits))

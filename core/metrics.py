@@ -441,7 +441,7 @@ def fill_coherence(out, hole, reference=None, *, patch: int = 7, stride: int = 2
     if not mask.any():
         raise ImageError("hole mask is empty: there is no filled region to judge")
     touches = sliding_window_view(mask, (patch, patch)).any(axis=(-1, -2))
-    known = ~sliding_window_view(mask, (patch, patch)).any(axis=(-1, -2))
+    known = ~touches  # a window that does not touch the hole lies wholly in the known region
     q_pos = np.zeros_like(touches)
     q_pos[::stride, ::stride] = True
     d_pos = np.zeros_like(known)
