@@ -249,18 +249,23 @@ class Renderer(QObject):
     def _submit(self, slot: str, preview: bool) -> int | None:
         if not self.enabled:
             return None
-        built = self.job_inputs(preview=preview)
-        if built is None:
-            return None
-        inputs, params = built
         doc = self.doc
         around = None
         if slot == "preview" and self._around_box is not None:
+            # a stroke's preview: only the crop around it is built (not the whole-image reduced
+            # preview as well: 11.6 ms at 2048², 48.5 ms at 4096² of GUI time per preview, thrown away)
+            if doc.missing_inputs():
+                return None
             box, self._around_box = self._around_box, None
             around = crop_around(doc.studio, doc.method_inputs(live=True), doc.run_params(), box)
             if around is None:
                 return None  # nothing painted near the stroke: the release renders
             inputs, params = around.inputs, around.params
+        else:
+            built = self.job_inputs(preview=preview)
+            if built is None:
+                return None
+            inputs, params = built
         method, seed = doc.current, doc.seed
         recipe = None if preview else doc.recipe(params)
         masks = None if preview else doc.masks()
