@@ -277,6 +277,11 @@ class Around:
         return out
 
 
+def _zeros_and_ones(part: np.ndarray) -> bool:
+    """Every sample of ``part`` is 0 or 1 (a mask's, not a picture's)."""
+    return bool(((part == 0) | (part == 1)).all())
+
+
 def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke: tuple[float, float, float, float],
                 *, side: int = AROUND_SIDE, context: int = 16) -> Around | None:
     """What to render while a stroke paints the mask input ``studio.preview_around``: the inputs
@@ -286,8 +291,12 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     ``stroke`` is the stroke's ``(x0, y0, x1, y1)`` in the painted image's pixels (brush radius
     included). The crop is the bounding box of the mask's pixels within the stroke's box grown by
     ``context`` px, grown again by ``context`` px and by a quarter of its side (known pixels around
-    the hole to copy from), clipped to the image. Every input the size of the painted image (the
-    image, its masks) is cropped alike; others (a second texture) are kept. A crop longer than
+    the hole to copy from), clipped to the image. Only what belongs to the painted image is cropped
+    alike: the image, the masks painted on it, and other inputs of its size that are masks (every
+    sample 0 or 1 within the crop, e.g. a source mask opened as a file). An image of its own (a
+    second texture to copy from) is kept whole even when it is the painted image's size, and so are
+    the masks of its size then (they may be its own: fill's source mask goes with its texture when
+    one is given); an input of another size is kept whole. A crop longer than
     ``side`` is scaled down to it (``area``, a mask thresholded back to 0/1). Parameters filled by a
     margins geometry on that image are reset to their defaults (the crop is not uncropped) and their
     left/top margins give :attr:`Around.offset`. None when the studio previews no mask that way,
@@ -325,13 +334,17 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     k = min(1.0, side / max(x1 - x0, y1 - y0))
     size = (max(8, round((x1 - x0) * k)), max(8, round((y1 - y0) * k)))
     small = dict(inputs)
+    painted = {on} | {m.input for m in studio.geometry if m.kind == MASK and m.input_for(inputs) == on}
+    others = [n for n, img in inputs.items() if n not in painted and img.shape[:2] == (h, w)]
+    maskish = {n for n in others if _zeros_and_ones(inputs[n][y0:y1, x0:x1])}
+    crop = painted | (maskish if maskish == set(others) else set())  # an image of its own: its size stays whole
     for n, img in inputs.items():
-        if img.shape[:2] != (h, w):
+        if n not in crop:
             continue
         part = np.ascontiguousarray(img[y0:y1, x0:x1])
         if k < 1.0:
             part = resize(part, size, interpolation="area")
-            if n == name:
+            if n != on:  # a mask stays a mask
                 part = (part > 0.5).astype(np.float32)
         small[n] = part
     changes, offset = {}, (0, 0)

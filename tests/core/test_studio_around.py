@@ -137,3 +137,27 @@ def test_a_session_read_with_a_dropped_list_leaves_out_a_missing_mask_and_says_s
                                    "geometry": {HOLE.name: {"hole": 3}}}))
     with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: hole = 3 must be the name of a mask PNG"):
         read_session(session, dropped=[])
+
+
+def test_a_texture_the_size_of_the_painted_image_is_kept_whole_and_a_source_mask_goes_with_its_image():
+    """Only what belongs to the painted image is cropped: a second texture of the same size is an
+    image of its own (a preview with --texture must copy from all of it, not from a corner); a
+    source mask of the image's size is cropped with the image, unless such a texture is open (then it
+    is the texture's)."""
+    hole = np.zeros((300, 400), np.float32)
+    hole[100:120, 200:230] = 1.0
+    inputs = _inputs(hole=hole)
+    rng = np.random.default_rng(1)
+    inputs["texture"] = rng.random((300, 400, 3)).astype(np.float32)  # the painted image's size
+    source = np.zeros((300, 400), np.float32)
+    source[:, :200] = 1.0
+    inputs["source"] = source
+    around = crop_around(STUDIO, inputs, HoleParams(), (205, 105, 215, 115))
+    x0, y0, x1, y1 = around.box
+    assert np.array_equal(around.inputs["picture"], inputs["picture"][y0:y1, x0:x1])
+    assert np.array_equal(around.inputs["hole"], hole[y0:y1, x0:x1])
+    assert around.inputs["texture"] is inputs["texture"]
+    assert around.inputs["source"] is inputs["source"]  # goes with the texture
+    del inputs["texture"]
+    around = crop_around(STUDIO, inputs, HoleParams(), (205, 105, 215, 115))
+    assert np.array_equal(around.inputs["source"], source[y0:y1, x0:x1])  # goes with the image
