@@ -354,12 +354,32 @@ def _decode_alpha(data: np.ndarray, grey: bool, orientation: int) -> np.ndarray 
         rgba = arr[..., [2, 1, 0, 3]]
         out = np.stack([rgba[..., 0], rgba[..., 3]], axis=2) if grey else rgba
         return np.ascontiguousarray(_ORIENT[orientation](out))
+    if arr is not None and arr.dtype == np.uint16 and (arr.ndim == 2 or arr.shape[2] == 3):
+        keyed = _keyed_alpha(data, arr)
+        if keyed is not None:
+            return np.ascontiguousarray(_ORIENT[orientation](keyed))
     with _pil_open(io.BytesIO(data.tobytes()))[0] as im:  # palettes with transparency, odd layouts
         im.load()
         if not (im.mode in _ALPHA_MODES or "transparency" in im.info):
             return None
         out = np.asarray(im.convert("LA" if grey else "RGBA"))
         return np.ascontiguousarray(_ORIENT[_exif_orientation(im)](out))
+
+
+def _keyed_alpha(data: np.ndarray, arr: np.ndarray) -> np.ndarray | None:
+    """A 16-bit grey or RGB PNG whose transparency is a tRNS colour key (not an alpha channel), as
+    decoded by OpenCV without alpha (``arr``: (H, W) grey or (H, W, 3) BGR): the pixels of the key's
+    colour transparent, (H, W, 2) grey+alpha or (H, W, 4) RGBA uint16; None without such a key.
+    (Pillow reads these as 16-bit grey "I;16" or 8-bit "RGB" and loses the key, or the depth.)"""
+    with _pil_open(io.BytesIO(data.tobytes()))[0] as im:  # the header and the chunks before the pixels
+        key = im.info.get("transparency") if im.format == "PNG" else None
+    if arr.ndim == 2 and isinstance(key, int):
+        return np.stack([arr, np.where(arr == key, 0, 65535).astype(np.uint16)], axis=2)
+    if arr.ndim == 3 and isinstance(key, tuple) and len(key) == 3:
+        rgb = arr[..., ::-1]
+        hit = (rgb[..., 0] == key[0]) & (rgb[..., 1] == key[1]) & (rgb[..., 2] == key[2])
+        return np.concatenate([rgb, np.where(hit, 0, 65535).astype(np.uint16)[..., None]], axis=2)
+    return None
 
 
 def _loaded_alpha(arr: np.ndarray, name: str, fmt: str, orientation: int, src_mode: str, animated: bool,

@@ -871,3 +871,33 @@ def test_module_has_no_bgr_leak(tmp_path):
     save_image(tmp_path / "c.tif", a)
     np.testing.assert_array_equal(np.asarray(Image.open(tmp_path / "c.tif")), a)
     np.testing.assert_array_equal(load_image(tmp_path / "c.tif").image, a / np.float32(255))
+
+
+def _png16_with_trns(path, samples: np.ndarray, key: tuple[int, ...]) -> None:
+    """A 16-bit grey (colour type 0) or RGB (type 2) PNG whose transparency is a tRNS colour key."""
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
+
+    h, w = samples.shape[:2]
+    colour_type = 0 if samples.ndim == 2 else 2
+    raw = b"".join(b"\0" + samples[y].astype(">u2").tobytes() for y in range(h))
+    Path(path).write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, colour_type, 0, 0, 0))
+                           + chunk(b"tRNS", struct.pack(f">{len(key)}H", *key))
+                           + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+@pytest.mark.parametrize("colour", [False, True], ids=["grey", "rgb"])
+def test_a_16_bit_png_whose_transparency_is_a_trns_key_keeps_it(tmp_path, colour):
+    rng = np.random.default_rng(3)
+    samples = rng.integers(1000, 65000, size=(6, 7, 3) if colour else (6, 7)).astype(np.uint16)
+    key = (777, 4242, 65535) if colour else (777,)
+    samples[1:3, 2:5] = key if colour else key[0]
+    _png16_with_trns(tmp_path / "k.png", samples, key)
+    img, info = load_image(tmp_path / "k.png", alpha=True)
+    assert info.bit_depth == 16 and info.had_alpha and img.shape == (6, 7, 4 if colour else 2)
+    expected_alpha = np.ones((6, 7), np.float32)
+    expected_alpha[1:3, 2:5] = 0.0
+    np.testing.assert_array_equal(img[..., -1], expected_alpha)
+    np.testing.assert_array_equal(img[..., :-1], (samples if colour else samples[..., None]) / np.float32(65535))
+    flat, flat_info = load_image(tmp_path / "k.png")  # without alpha: the colours, 16-bit, alpha dropped
+    assert flat.shape == samples.shape and flat_info.bit_depth == 16 and "alpha channel dropped" in flat_info.notes
