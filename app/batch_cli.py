@@ -41,7 +41,8 @@ def add_batch_parser(sub) -> None:
     b.add_argument("--seed-per-item", action="store_true",
                    help="item i gets seed + i (default: every item the same seed, a consistent look across frames)")
     b.add_argument("--force", action="store_true", help="redo items whose output already exists with the same recipe")
-    b.add_argument("--bit-depth", metavar="BITS", default="8", help="8 or 16 bits per channel (16: PNG, TIFF)")
+    b.add_argument("--bit-depth", metavar="BITS",
+                   help="8 or 16 bits per channel (16: PNG, TIFF); default 8 (fill: each item's image's own)")
     b.add_argument("--report", action="store_true",
                    help="print one JSON line per item and a summary line on stdout")
     b.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -97,7 +98,7 @@ def run_batch(args: argparse.Namespace) -> int:
     from weft.core import batch
     from weft.core.errors import WeftError
 
-    bit_depth = _parse_bit_depth(args)
+    bit_depth = _parse_bit_depth(args) if args.bit_depth is not None else None  # None: per item, as `weft METHOD`
     seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
     workers = _parse_int(args.workers, "workers", 1, 1024)
     scheduler = batch.scheduler_address(args.scheduler)

@@ -374,3 +374,41 @@ def test_importing_weft_does_not_import_dask():
             "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
+
+
+def test_a_fill_batch_keeps_each_items_bit_depth_as_weft_fill_does(tmp_path, capsys):
+    """`weft fill` keeps its image's bit depth (Method.depth_from); a batch over a fill recipe does so
+    per item unless --bit-depth is given: a 16-bit frame gives a 16-bit output, an 8-bit one 8 bits,
+    each byte for byte what `weft run` writes for that item."""
+    photo = load_image(ROOT / "resources" / "gravel.png").image[:40, :40]
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    save_image(frames / "a16.png", photo, bit_depth=16)
+    save_image(frames / "b8.png", photo[::-1], bit_depth=8)
+    hole = np.zeros((40, 40), np.float32)
+    hole[14:24, 12:26] = 1.0
+    save_image(tmp_path / "mask.png", hole)
+    recipe = {"weft": 1, "method": "fill", "params": {"patch": 7}, "inputs": {"image": "frames/a16.png",
+              "mask": "mask.png"}, "seed": 3}
+    (tmp_path / "fill.json").write_text(json.dumps(recipe))
+    code, _, err = run(["batch", tmp_path / "fill.json", "--over", "image", frames,
+                        "-o", tmp_path / "out" / "{stem}.png", "--workers", "1", "-q"], capsys)
+    assert code == 0, err
+    assert load_image(tmp_path / "out" / "a16.png").info.bit_depth == 16
+    assert load_image(tmp_path / "out" / "b8.png").info.bit_depth == 8
+    for stem in ("a16", "b8"):
+        item = dict(recipe, inputs={"image": f"frames/{stem}.png", "mask": "mask.png"})
+        (tmp_path / f"{stem}.json").write_text(json.dumps(item))
+        ref = tmp_path / "ref" / f"{stem}.png"
+        ref.parent.mkdir(exist_ok=True)
+        assert run(["run", tmp_path / f"{stem}.json", "-o", ref, "-q"], capsys)[0] == 0
+        assert ref.read_bytes() == (tmp_path / "out" / f"{stem}.png").read_bytes()
+    # a re-run finds them done (the resume check expects each item's own depth)
+    code, _, err = run(["batch", tmp_path / "fill.json", "--over", "image", frames,
+                        "-o", tmp_path / "out" / "{stem}.png", "--workers", "1", "-q"], capsys)
+    assert code == 0 and err.strip() == "0 written, 2 already done", err
+    # --bit-depth decides for every item
+    code, _, err = run(["batch", tmp_path / "fill.json", "--over", "image", frames, "--bit-depth", "8",
+                        "-o", tmp_path / "out8" / "{stem}.png", "--workers", "1", "-q"], capsys)
+    assert code == 0, err
+    assert {load_image(tmp_path / "out8" / f"{s}.png").info.bit_depth for s in ("a16", "b8")} == {8}

@@ -214,6 +214,19 @@ def _png_bit_depth(path: str) -> int | None:
     return head[24] if len(head) == 26 and head[12:16] == b"IHDR" else None
 
 
+def _item_bit_depth(method, inputs: Mapping[str, str], output: str, asked: int | None) -> int:
+    """An item's output bit depth: ``asked``, else what ``weft METHOD`` writes without ``--bit-depth``
+    (the depth of the input the method keeps it from, ``Method.depth_from``; else 8; JPEG 8)."""
+    from ..image import file_bit_depth
+
+    if asked is not None:
+        return asked
+    source = inputs.get(method.depth_from) if method.depth_from else None
+    if source is None or output.lower().endswith((".jpg", ".jpeg")):
+        return 8
+    return file_bit_depth(source) or 8
+
+
 def _done_already(item: Item) -> bool:
     """The output exists, is a PNG of the item's bit depth and carries exactly the item's recipe."""
     from ..image import read_recipe
@@ -243,7 +256,7 @@ def _existing_seed(outputs: Sequence[tuple[int, str]], method: str) -> tuple[int
 
 
 def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, seed: int | None = None,
-         seed_per_item: bool = False, force: bool = False, bit_depth: int = 8, ship_inputs: bool = False,
+         seed_per_item: bool = False, force: bool = False, bit_depth: int | None = None, ship_inputs: bool = False,
          ship_outputs: bool = False, recipe=None) -> Plan:
     """Check a batch and list its items.
 
@@ -266,7 +279,10 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
         Item ``i`` gets seed ``seed + i`` instead of every item the same seed.
     force : bool
         Redo items whose output already exists with the same recipe (otherwise they are skipped).
-    bit_depth : {8, 16}
+    bit_depth : {8, 16}, optional
+        Bits per channel of every output. None (the default): as ``weft METHOD`` decides it, per item:
+        the bit depth of the item's input the method keeps it from (``Method.depth_from``: fill's
+        image, so a 16-bit image gives a 16-bit output), else 8; a JPEG output is 8.
     ship_inputs, ship_outputs : bool
         Send the inputs' bytes with each item (workers need not see the files) / have the workers
         return the encoded outputs for this process to write (workers need not see the output folder).
@@ -297,7 +313,7 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     except WeftError as e:
         raise WeftError(f"{recipe_path}: {e}") from None
     params = method.params.from_dict(params_dict)
-    if bit_depth not in (8, 16):
+    if bit_depth is not None and bit_depth not in (8, 16):
         raise WeftError(f"parameter 'bit-depth' = {bit_depth} must be 8 or 16")
 
     lists = {name: expand_over(name, where) for name, where in over}
@@ -357,7 +373,8 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
         item_seed = (seed + i) % 2**63 if seed_per_item else seed
         text = output_recipe(method, params, inputs, item_seed, recipe.region, out).to_json()
         items.append(Item(index=i, label=label, method=method.name, params=params_dict, inputs=inputs,
-                          seed=item_seed, region=recipe.region, output=out, recipe=text, bit_depth=bit_depth,
+                          seed=item_seed, region=recipe.region, output=out, recipe=text,
+                          bit_depth=_item_bit_depth(method, inputs, out, bit_depth),
                           write=not ship_outputs))
     skipped = () if force else tuple(it for it in items if _done_already(it))
     return Plan(items=tuple(items), skipped=skipped, method=method.name, seed=seed, ship_inputs=ship_inputs)

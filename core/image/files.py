@@ -344,6 +344,28 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
     return Loaded(image, info)
 
 
+def file_bit_depth(path: str | os.PathLike) -> int | None:
+    """The bits per sample :func:`load_image` gives for an image file, from its header alone: 16 for
+    a 16-bit PNG or TIFF, 8 for anything else it reads; None when the header cannot be read (loading
+    the file says why). What an output keeps when the method keeps its input's depth
+    (``Method.depth_from``) and no bit depth was asked for."""
+    name = os.fsdecode(path)
+    try:
+        with open(name, "rb") as f:
+            head = f.read(26)
+        if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
+            return 16 if head[24] == 16 else 8
+        im, _ = _pil_open(name)
+        with im:
+            if im.mode.startswith("I;16"):
+                return 16
+            bits = getattr(im, "tag_v2", {}).get(258) if im.format == "TIFF" else None
+            bits = bits if isinstance(bits, tuple) else (bits,)
+            return 16 if any(b == 16 for b in bits) else 8
+    except Exception:  # noqa: BLE001 - an unreadable file fails where it is loaded, with its own message
+        return None
+
+
 def _decode_alpha(data: np.ndarray, grey: bool, orientation: int) -> np.ndarray | None:
     """Decode keeping alpha: uint8/uint16 (H, W, 2) grey+alpha or (H, W, 4) RGBA, upright; None when
     the file turns out to have no alpha channel after all (a palette without transparency)."""
