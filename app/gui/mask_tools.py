@@ -11,19 +11,28 @@
 * ``MarginsTool`` edits a margins geometry (``Geometry(MARGINS, param=...)``): a press outside the
   image drags the canvas edges on that side outward (the grown frame drawn as a dashed outline);
   one undo command on release; Esc cancels.
-* ``ToolSet`` puts several tools on one view: a press goes to the first tool that wants it (the
-  margins tool wants presses outside the image), hover moves to all.
+* ``ToolSet`` puts several tools on one view: a press goes to the tool that claims it (the mask tool
+  claims a press whose brush would paint), else to the first that wants it (the margins tool wants
+  presses outside the image), hover moves to all (the pointer shows which: the brush's circle, or a
+  resize arrow over what drags the canvas edges).
+  **The rule with a mask and margins on one view:** outside the image, a brush or eraser press paints
+  while the brush's circle covers a pixel of the image (an artist painting along the border gets
+  paint); a press farther out, any press outside the image in a lasso mode, or a Shift+press outside
+  the image drags the canvas edges.
 * ``GeometryBar`` is the row of buttons over a view with such tools: brush, eraser, lasso +/-, brush
-  size, Clear mask, Invert, Fill transparent, Extend canvas…
+  size, Clear mask, Invert, Fill transparent, Extend canvas…; and the actions "Smaller brush" ``[``
+  and "Larger brush" ``]``, shortcuts of the whole window while the mask tool is shown (after a click
+  on a button or a slider too; a text field with the focus keeps them as text).
 """
 
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
-from PySide6.QtGui import QAction, QActionGroup, QBrush, QColor, QImage, QPainterPath
+from PySide6.QtGui import QAction, QActionGroup, QBrush, QColor, QImage, QKeySequence, QPainterPath
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
@@ -153,6 +162,25 @@ class MaskTool(Tool):
         """The brush's radius for ``Mask.painted_line``: a diameter of ``size`` pixels."""
         return (self.size - 1) / 2.0
 
+    def claims(self, pos, modifiers=Qt.KeyboardModifier.NoModifier) -> bool:
+        """A press at scene point ``pos`` outside the image is a brush stroke, not an edge drag: a
+        brush or eraser whose circle covers the centre of an image pixel there (Shift: never; the
+        module docstring has the rule)."""
+        w, h = self.view.image_size()
+        if 0 <= pos.x() <= w and 0 <= pos.y() <= h:
+            return False  # inside: not a question (nothing else wants it)
+        if self.mode not in (BRUSH, ERASER) or modifiers & Qt.KeyboardModifier.ShiftModifier or not w or not h:
+            return False
+        # the nearest pixel centre (centres at i + 0.5 in scene coordinates)
+        dx = max(0.5 - pos.x(), 0.0, pos.x() - (w - 0.5))
+        dy = max(0.5 - pos.y(), 0.0, pos.y() - (h - 0.5))
+        return math.hypot(dx, dy) <= self.size / 2.0
+
+    def reaches(self, pos, modifiers=Qt.KeyboardModifier.NoModifier) -> bool:
+        """A press at ``pos`` paints (inside the image, or :meth:`claims` outside it)."""
+        w, h = self.view.image_size()
+        return (0 <= pos.x() <= w and 0 <= pos.y() <= h) or self.claims(pos, modifiers)
+
     def set_mode(self, mode: str) -> None:
         if mode in MODES:
             self.mode = mode
@@ -237,8 +265,7 @@ class MaskTool(Tool):
             self._draw_lasso()
 
     def move(self, view, pos, event):
-        inside = 0 <= pos.x() <= view.image_size()[0] and 0 <= pos.y() <= view.image_size()[1]
-        self._show_cursor(pos if inside or self.active else None)
+        self._show_cursor(pos if self.active or self.reaches(pos, event.modifiers()) else None)
         if not self.active or not (event.buttons() & Qt.MouseButton.LeftButton):
             return
         p = self._pixel(pos)
@@ -324,7 +351,26 @@ class MarginsTool(Tool):
         view.scene().addItem(self.frame)
         self.drag = None  # (sides, start point, start margins)
         self.live: Margins | None = None
+        self.hover_cursor = True  # shows the resize arrow itself (a ToolSet does it for its tools)
+        self._arrow = False
         self.refresh()
+
+    def arrow(self, pos):
+        """The resize arrow for a press at ``pos`` (which edges it drags)."""
+        w, h = self.view.image_size()
+        left, top, right, bottom = pos.x() < 0, pos.y() < 0, pos.x() > w, pos.y() > h
+        if (left or right) and (top or bottom):
+            return Qt.CursorShape.SizeFDiagCursor if left == top else Qt.CursorShape.SizeBDiagCursor
+        return Qt.CursorShape.SizeHorCursor if left or right else Qt.CursorShape.SizeVerCursor
+
+    def show_arrow(self, pos) -> None:
+        """The resize arrow at ``pos`` (None: the view's own pointer again, if the arrow was shown)."""
+        if pos is not None:
+            self.view.viewport().setCursor(self.arrow(pos))
+            self._arrow = True
+        elif self._arrow:
+            self.view.viewport().unsetCursor()
+            self._arrow = False
 
     def margins(self) -> Margins:
         value = self.doc.value(self.geometry_key)
@@ -342,6 +388,7 @@ class MarginsTool(Tool):
         self.drag = None
         self.live = None
         self.frame.hide()
+        self.show_arrow(None)
         self.view.set_frame(None)
 
     def _show(self, m: Margins) -> None:
@@ -370,6 +417,8 @@ class MarginsTool(Tool):
                          for v, d, s in zip(m, moves, sides)))
 
     def move(self, view, pos, event):
+        if self.drag is None and self.hover_cursor:
+            self.show_arrow(pos if self.wants(pos) else None)
         if self.drag is None or not (event.buttons() & Qt.MouseButton.LeftButton):
             return
         self.live = self._dragged(event)
@@ -397,15 +446,24 @@ class MarginsTool(Tool):
 
 
 class ToolSet(Tool):
-    """Several tools on one view: a press goes to the first that ``wants`` it (else the last), the
-    rest of that drag to it; hover moves to every tool; keys to the dragging tool first."""
+    """Several tools on one view: a press goes to the first that ``claims`` it, else to the first
+    that ``wants`` it (else the last), the rest of that drag to it; hover moves to every tool, the
+    one a press would go to last (its pointer is the one shown: the brush's circle, or the margins
+    tool's resize arrow); keys to the dragging tool first. See the module docstring for the rule."""
 
     def __init__(self, tools):
         self.tools = list(tools)
         self.view = self.tools[0].view
         self.grabbed: Tool | None = None
+        for tool in self.tools:
+            if isinstance(tool, MarginsTool):
+                tool.hover_cursor = False  # shown here, when the press would be its
 
-    def _pick(self, pos) -> Tool:
+    def _pick(self, pos, modifiers=Qt.KeyboardModifier.NoModifier) -> Tool:
+        for tool in self.tools:
+            claims = getattr(tool, "claims", None)
+            if claims is not None and claims(pos, modifiers):
+                return tool
         for tool in self.tools:
             wants = getattr(tool, "wants", None)
             if wants is not None and wants(pos):
@@ -413,15 +471,21 @@ class ToolSet(Tool):
         return next((t for t in self.tools if getattr(t, "wants", None) is None), self.tools[-1])
 
     def press(self, view, pos, event):
-        self.grabbed = self._pick(pos)
+        self.grabbed = self._pick(pos, event.modifiers())
         self.grabbed.press(view, pos, event)
 
     def move(self, view, pos, event):
         if self.grabbed is not None and event.buttons() & Qt.MouseButton.LeftButton:
             self.grabbed.move(view, pos, event)
             return
+        picked = self._pick(pos, event.modifiers())
         for tool in self.tools:
+            if isinstance(tool, MarginsTool):
+                tool.show_arrow(None)
+        for tool in [t for t in self.tools if t is not picked] + [picked]:
             tool.move(view, pos, event)
+        if isinstance(picked, MarginsTool):
+            picked.show_arrow(pos)
 
     def release(self, view, pos, event):
         tool, self.grabbed = self.grabbed, None
@@ -433,6 +497,8 @@ class ToolSet(Tool):
             leave = getattr(tool, "leave", None)
             if leave is not None:
                 leave()
+            if isinstance(tool, MarginsTool) and tool.drag is None:
+                tool.show_arrow(None)
 
     def key(self, view, event) -> bool:
         order = ([self.grabbed] if self.grabbed is not None else []) + [t for t in self.tools if t is not self.grabbed]
@@ -498,9 +564,14 @@ class GeometryBar(QToolBar):
         self.setStyleSheet("QToolBar { spacing: 1px; padding: 0px; }")
         self.mode_group = QActionGroup(self)
         self.mode_actions: dict[str, QAction] = {}
-        tips = {BRUSH: "paint the mask ([ and ] size the brush; Esc cancels a stroke)", ERASER: "erase the mask",
-                LASSO_ADD: "draw a closed outline to add to the mask",
-                LASSO_SUBTRACT: "draw a closed outline to take from the mask"}
+        edges = ("; outside the image a press paints while the brush's circle covers the image, and drags the "
+                 "canvas edges farther out or with Shift")
+        tips = {BRUSH: "paint the mask ([ and ] size the brush; Esc cancels a stroke)" + edges,
+                ERASER: "erase the mask ([ and ] size the brush)" + edges,
+                LASSO_ADD: "draw a closed outline to add to the mask (start it inside the image: a press "
+                           "outside drags the canvas edges)",
+                LASSO_SUBTRACT: "draw a closed outline to take from the mask (start it inside the image: a "
+                                "press outside drags the canvas edges)"}
         labels = {BRUSH: "Brush", ERASER: "Eraser", LASSO_ADD: "Lasso +", LASSO_SUBTRACT: "Lasso −"}
         for mode in MODES:
             action = QAction(labels[mode], self)  # owned by the bar (the window's menu shows them too)
@@ -517,14 +588,30 @@ class GeometryBar(QToolBar):
         self.size_box.setToolTip("brush size in image pixels ([ smaller, ] larger)")
         self.size_box.valueChanged.connect(lambda v: self.mask_tool is not None and self.mask_tool.set_size(v))
         self.size_action = self.addWidget(self.size_box)
+        # [ and ]: shortcuts of the window while the size box is shown (the mask tool is), whatever has
+        # the focus -- a button or slider just clicked too; a text field keeps them (Qt gives a key a
+        # focused text field types to the field, not to a shortcut). Actions of the size box, not
+        # buttons of the bar; the window's Edit > Mask and Canvas menu lists them.
+        self.smaller_action = self._brush_action("Smaller brush", "[", -1)
+        self.larger_action = self._brush_action("Larger brush", "]", +1)
         self.clear_action = self._action("Clear mask", "remove the whole mask", self.clear_mask)
         self.invert_action = self._action("Invert", "swap what the mask covers and what it does not", self.invert_mask)
         self.transparent_action = self._action("Fill transparent", "", self.fill_transparent)
-        self.extend_action = self._action("Extend canvas…", "type the pixels to add on each side (or drag outside "
-                                          "the image)", self.extend_dialog)
+        self.extend_action = self._action("Extend canvas…", "type the pixels to add on each side (or drag outward "
+                                          "from outside the image: beyond the brush's circle, or with Shift)",
+                                          self.extend_dialog)
         self.clear_button, self.invert_button, self.transparent_button, self.extend_button = (
             self.widgetForAction(a) for a in (self.clear_action, self.invert_action, self.transparent_action,
                                               self.extend_action))
+
+    def _brush_action(self, text: str, key: str, steps: int) -> QAction:
+        action = QAction(text, self.size_box)
+        action.setShortcut(QKeySequence(key))
+        action.setShortcutContext(Qt.ShortcutContext.WindowShortcut)
+        action.setToolTip(f"{text.lower()} ({key})")
+        action.triggered.connect(lambda _=False: self.mask_tool is not None and self.mask_tool.grow(steps))
+        self.size_box.addAction(action)
+        return action
 
     def _action(self, text, tip, slot) -> QAction:
         action = QAction(text, self)
@@ -535,15 +622,15 @@ class GeometryBar(QToolBar):
 
     def menu_actions(self) -> list[QAction]:
         """Its actions that apply now (for the window's Edit menu)."""
-        return [a for a in (*self.mode_actions.values(), self.clear_action, self.invert_action,
-                            self.transparent_action, self.extend_action) if a.isVisible()]
+        return [a for a in (*self.mode_actions.values(), self.smaller_action, self.larger_action, self.clear_action,
+                            self.invert_action, self.transparent_action, self.extend_action) if a.isVisible()]
 
     def attach(self, mask_tool: MaskTool | None, margins_tool: MarginsTool | None) -> None:
         """Show the buttons of these tools (a view with neither hides the bar)."""
         self.mask_tool, self.margins_tool = mask_tool, margins_tool
         has_mask = mask_tool is not None
-        for a in [*self.mode_actions.values(), self.size_action, self.clear_action, self.invert_action,
-                  self.transparent_action]:
+        for a in [*self.mode_actions.values(), self.size_action, self.smaller_action, self.larger_action,
+                  self.clear_action, self.invert_action, self.transparent_action]:
             a.setVisible(has_mask)
         self.extend_action.setVisible(margins_tool is not None)
         if has_mask:

@@ -367,7 +367,7 @@ def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(stu
     assert Mask.read(tmp_path / "r.hole.png") == painted
 
 
-def _screen_drag(view, start_scene, steps_px, *, last=True):
+def _screen_drag(view, start_scene, steps_px, *, last=True, modifiers=Qt.KeyboardModifier.NoModifier):
     """Press at a scene point, then move the mouse by screen offsets (dx, dy) from there, as a hand
     does (the scene may move under it meanwhile), and release at the last one."""
     from PySide6.QtCore import QEvent, QPointF
@@ -382,7 +382,7 @@ def _screen_drag(view, start_scene, steps_px, *, last=True):
         button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
         held = Qt.MouseButton.NoButton if kind == "release" else Qt.MouseButton.LeftButton
         QApplication.sendEvent(view.viewport(), QMouseEvent(etype, at, QPointF(view.viewport().mapToGlobal(at)),
-                                                            button, held, Qt.KeyboardModifier.NoModifier))
+                                                            button, held, modifiers))
 
     send("press", origin)
     for dx, dy in steps_px:
@@ -395,6 +395,7 @@ def test_extend_canvas_by_dragging_an_edge_outward(studio, qtbot):
     view, doc = studio.canvas_view, studio.doc
     view.fit()  # the whole image with room around it
     tool = studio.inputs_pane.margins_tool()
+    studio.inputs_pane.mask_tool().set_size(1)  # presses 1 px outside the image: beyond the brush's circle
     assert view.sceneRect().left() < 0 and view.sceneRect().right() > W  # room to drag in
     k = view.scale_factor()  # screen pixels per image pixel
     _screen_drag(view, (W + 1.0, H / 2), [(7 * k, 0)], last=False)
@@ -410,6 +411,84 @@ def test_extend_canvas_by_dragging_an_edge_outward(studio, qtbot):
     assert doc.value("grow") == Margins(10, 6, 20, 0)
     doc.undo_stack.undo()
     assert doc.value("grow") == Margins(0, 0, 20, 0)
+
+
+def test_a_brush_press_just_outside_the_image_paints_and_farther_out_or_with_shift_drags_the_edge(studio, qtbot):
+    """The rule (mask_tools' docstring): outside the image a brush or eraser press paints while the
+    brush's circle covers a pixel of the image; farther out, or with Shift, it drags the canvas edges;
+    the pointer says which before the press (the brush's circle, or a resize arrow)."""
+    view, doc = studio.canvas_view, studio.doc
+    view.fit()
+    tool, margins = studio.inputs_pane.mask_tool(), studio.inputs_pane.margins_tool()
+    tool.set_size(9)  # its circle reaches 4.5 px: the centres of the last column from up to 4 px outside
+    k = view.scale_factor()
+    # hover 3 px outside the right edge: the brush's circle, no resize arrow
+    mouse(view, "move", (W + 3.0, H / 2), buttons=Qt.MouseButton.NoButton)
+    assert tool.cursor.isVisible() and view.viewport().cursor().shape() == Qt.CursorShape.CrossCursor
+    # a stroke along the border that starts 3 px outside: paint, no margins
+    result = _final_after(studio, qtbot, lambda: _screen_drag(view, (W + 3.0, H / 2), [(0, -4 * k), (0, -8 * k)]))
+    assert doc.value("grow") is None and not margins.frame.isVisible()
+    painted = _mask(studio)
+    assert painted is not None and painted.bits[:, W - 1].any() and not painted.bits[:, :W - 5].any()
+    assert doc.undo_stack.text(doc.undo_stack.index() - 1) == "Brush stroke"
+    assert result.image.shape == (H, W, 3)
+    # 6 px out: beyond the circle -- the arrow shows, and the press drags the right edge
+    mouse(view, "move", (W + 6.0, H / 2), buttons=Qt.MouseButton.NoButton)
+    assert not tool.cursor.isVisible() and view.viewport().cursor().shape() == Qt.CursorShape.SizeHorCursor
+    mouse(view, "move", (-6.0, -6.0), buttons=Qt.MouseButton.NoButton)  # the top-left corner: both edges
+    assert view.viewport().cursor().shape() == Qt.CursorShape.SizeFDiagCursor
+    _final_after(studio, qtbot, lambda: _screen_drag(view, (W + 6.0, H / 2), [(5 * k, 0), (9 * k, 0)]))
+    assert doc.value("grow") == Margins(0, 0, 9, 0) and _mask(studio) == painted
+    # with Shift a press 1 px outside drags the edges whatever the brush
+    _final_after(studio, qtbot, lambda: _screen_drag(view, (W / 2, H + 1.0), [(0, 4 * k), (0, 6 * k)],
+                                                      modifiers=Qt.KeyboardModifier.ShiftModifier))
+    assert doc.value("grow") == Margins(0, 0, 9, 6) and _mask(studio) == painted
+    # back inside: the brush's circle and the cross again
+    mouse(view, "move", (W / 2, H / 2), buttons=Qt.MouseButton.NoButton)
+    assert tool.cursor.isVisible() and view.viewport().cursor().shape() == Qt.CursorShape.CrossCursor
+    # the eraser follows the same rule; a lasso starts inside the image (a press outside drags)
+    qtbot.mouseClick(studio.inputs_pane.bar().mode_buttons["eraser"], Qt.MouseButton.LeftButton)
+    _final_after(studio, qtbot, lambda: _screen_drag(view, (W + 3.0, H / 2), [(0, -4 * k), (0, -8 * k)]))
+    assert _mask(studio) is None and doc.value("grow") == Margins(0, 0, 9, 6)  # the stroke erased it all
+    qtbot.mouseClick(studio.inputs_pane.bar().mode_buttons["lasso add"], Qt.MouseButton.LeftButton)
+    _final_after(studio, qtbot, lambda: _screen_drag(view, (W + 1.0, H / 2), [(2 * k, 0), (3 * k, 0)]))
+    assert doc.value("grow") == Margins(0, 0, 12, 6)
+
+
+def test_square_brackets_size_the_brush_wherever_the_focus_is_but_a_text_field_keeps_them(studio, qtbot):
+    """[ and ] are the window's shortcuts while the mask tool is shown: after a click on a tool
+    button or on a slider (the focus is not on the canvas) they still size the brush; a text field
+    with the focus types them instead."""
+    from PySide6.QtWidgets import QApplication, QLineEdit, QSlider
+
+    tool, bar = studio.inputs_pane.mask_tool(), studio.inputs_pane.bar()
+    studio.activateWindow()
+    qtbot.waitUntil(lambda: QApplication.activeWindow() is studio, timeout=5000)
+    tool.set_size(20)
+    qtbot.mouseClick(bar.mode_buttons["eraser"], Qt.MouseButton.LeftButton)  # a tool button
+    button = bar.mode_buttons["eraser"]
+    button.setFocus()
+    assert QApplication.focusWidget() is button
+    qtbot.keyClick(button, Qt.Key.Key_BracketRight)
+    assert tool.size == 25 and bar.size_box.value() == 25
+    qtbot.keyClick(button, Qt.Key.Key_BracketLeft)
+    assert tool.size == 20
+    slider = next(s for s in studio.method_panel.findChildren(QSlider) if s.isVisible())
+    qtbot.mouseClick(slider, Qt.MouseButton.LeftButton, pos=slider.rect().center())  # a slider
+    slider.setFocus()
+    assert QApplication.focusWidget() is slider
+    qtbot.keyClick(slider, Qt.Key.Key_BracketLeft)
+    assert tool.size == 16
+    # Edit > Mask and Canvas lists them with their keys
+    texts = {a.text(): a.shortcut().toString() for a in studio.geometry_menu.actions()}
+    assert texts["Smaller brush"] == "[" and texts["Larger brush"] == "]"
+    # a text field keeps its keys
+    field = QLineEdit(studio.method_panel)
+    field.show()
+    field.setFocus()
+    qtbot.waitUntil(lambda: QApplication.focusWidget() is field, timeout=5000)
+    qtbot.keyClicks(field, "]]")
+    assert field.text() == "]]" and tool.size == 16
 
 
 def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
