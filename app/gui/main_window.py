@@ -573,7 +573,7 @@ class MainWindow(QMainWindow):
     def _on_around_shown(self, shown) -> None:
         self.result_view.set_notice(None)
         self.result_view.set_image(shown.image)
-        self.statusBar().showMessage(describe(shown) + " (around the stroke)")
+        self.statusBar().showMessage(describe(shown))  # (it says it is around the stroke)
 
     def _on_shown(self, shown) -> None:
         self._input_shown = None

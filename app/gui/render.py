@@ -70,6 +70,9 @@ class Shown:
     recipe: Recipe | None = None
     before: np.ndarray | None = None
     masks: dict | None = None  # the painted masks it was rendered with (input name -> Mask): export writes them
+    method: str | None = None  # the method that rendered it (its figures are read with its words)
+    # a preview around a stroke: (width, height) of the crop in the image and as rendered (its figures are the crop's)
+    crop: tuple[int, int, int, int] | None = None
 
 
 def _render(method, inputs, params, seed, report, cancel, *, final: bool):
@@ -276,7 +279,7 @@ class Renderer(QObject):
             # PARTIAL_INTERVAL seconds (a fast render never pays for one).
             report = None if preview or progress is None else _Partial(progress)
             return (*_render(method, inputs, params, seed, report, cancel, final=not preview), recipe, before,
-                    masks, around)
+                    masks, around, method.name)
 
         if slot == "final":
             self.runner.cancel("preview")
@@ -331,15 +334,15 @@ class Renderer(QObject):
             return
         if self.last is not None and result.job_id < self.last.job_id:
             return  # older than what is shown: stale
-        res, seconds, final, prepared, compiled, recipe, before, masks, crop = result.value
+        res, seconds, final, prepared, compiled, recipe, before, masks, crop, name = result.value
         if crop is not None:
-            self._show_around(res, crop, result.job_id, seconds)
+            self._show_around(res, crop, result.job_id, seconds, name)
             return
         if final:
             self._around_image = None
         self.input_shown = False
         self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared, compiled,
-                          recipe, before, masks)
+                          recipe, before, masks, method=name)
         self.shown.emit(self.last)
 
     def _around_base(self) -> np.ndarray | None:
@@ -348,7 +351,7 @@ class Renderer(QObject):
         last = self._current_final()
         return last.image if last is not None else self.doc.method_inputs().get(self.doc.studio.canvas)
 
-    def _show_around(self, res, crop, job_id: int, seconds: float) -> None:
+    def _show_around(self, res, crop, job_id: int, seconds: float, method: str) -> None:
         """Paste a preview around a stroke into the full result (and the stroke's earlier ones)."""
         fresh = self._around_image is None
         base = self._around_base() if fresh else self._around_image
@@ -358,8 +361,11 @@ class Renderer(QObject):
         if pasted is None:
             return  # the crop's result does not fit the full one (another size): the release renders
         self._around_image = pasted
-        self.around_shown.emit(Shown(pasted, job_id, seconds, {}, False, recipe=None,  # (the crop's figures: not the image's)
-                                     before=None if self.last is None else self.last.before))
+        x0, y0, x1, y1 = crop.box
+        rh, rw = res.image.shape[:2]
+        self.around_shown.emit(Shown(pasted, job_id, seconds, dict(res.figures), False, recipe=None,
+                                     before=None if self.last is None else self.last.before, method=method,
+                                     crop=(x1 - x0, y1 - y0, rw, rh)))
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
         if slot != "final" or job_id != self.latest_final:
@@ -404,10 +410,17 @@ class Renderer(QObject):
 
 
 def describe(shown: Shown) -> str:
-    """Status-bar text for a shown result."""
+    """Status-bar text for a shown result, a preview, or a preview around a stroke: its figures in
+    its method's words and units (``Studio.figures``), for a preview as for the full result; a
+    stroke's preview says they are its crop's."""
     h, w = shown.image.shape[:2]
     kind = "result" if shown.final else "preview"
     figs = ", ".join(_figure_words(shown))
+    if shown.crop is not None:
+        cw, ch, rw, rh = shown.crop
+        at = "" if (rw, rh) == (cw, ch) else f" (rendered at {rw}x{rh})"
+        return (f"preview around the stroke in {shown.seconds * 1000:.0f} ms — its {cw}x{ch} crop{at}"
+                + (f": {figs}" if figs else ""))
     prepared = ""
     if shown.compiled:
         prepared = f" (after preparing its kernels for {shown.prepared:.1f} s, first run only)"
@@ -419,9 +432,10 @@ def describe(shown: Shown) -> str:
 def _figure_words(shown: Shown) -> list[str]:
     """The result's figures in words and units, as its method's studio description reads them."""
     studio = None
-    if shown.recipe is not None:
+    name = shown.method or (shown.recipe.method if shown.recipe is not None else None)
+    if name is not None:  # (a preview has no recipe: its method still names its figures)
         try:
-            studio = registry.get(shown.recipe.method).studio
+            studio = registry.get(name).studio
         except WeftError:
             studio = None
     if studio is None:

@@ -20,7 +20,7 @@ from weft.core.geometry import Margins, Mask
 from weft.core.image import load_image, read_recipe, save_image
 from weft.core.params import Params, param
 from weft.core.registry import InputSpec, Method, Result
-from weft.core.studio import MARGINS, MASK, Geometry, Studio
+from weft.core.studio import MARGINS, MASK, Figure, Geometry, Studio
 
 from .helpers import mouse
 from .test_artist_session import _click_menu_item
@@ -68,6 +68,7 @@ MEAN_FILL = Method(
             InputSpec("swatch", "take the colour from this image instead", required=False)),
     run=_mean_fill,
     studio=Studio(title="Mean fill", canvas="picture", preview_around="hole", own_inputs=("swatch",),
+                  figures={"hole_pixels": Figure("filled", "px")},
                   geometry=(Geometry(MASK, on=("picture",), input="hole", help="paint the hole"),
                             Geometry(MARGINS, on=("picture",), param="grow", help="drag an edge outward"))),
 )
@@ -543,6 +544,38 @@ def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
         qtbot.keyClick(view, Qt.Key.Key_Escape)
     mouse(view, "release", (64.5, 52.5))
     assert np.array_equal(studio.result_view.image, result.image)
+
+
+def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does(studio, qtbot):
+    """The status line of a preview -- around a stroke, or while a slider moves -- reads the figures
+    with the method's words (Studio.figures: "filled 40 px"), as the full result's does, never as
+    raw keys ("hole_pixels", "hole pixels"); a stroke's preview says they are its crop's."""
+    import re
+
+    view = studio.canvas_view
+    studio.inputs_pane.mask_tool().set_size(5)
+    around = []
+    studio.renderer.around_shown.connect(around.append)
+    _stroke(view, [(10.5, 10.5), (14.5, 12.5)], release=False)
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    text = studio.statusBar().currentMessage()
+    assert re.fullmatch(r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?: "
+                        r"filled \d+ px", text), text
+    assert f"filled {around[-1].figures['hole_pixels']} px" in text
+    result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
+    assert studio.statusBar().currentMessage().endswith(f"— filled {result.figures['hole_pixels']} px")
+    # a slider's preview
+    slider = studio.params_panel.row("amount").editor
+    previews = []
+    studio.renderer.shown.connect(lambda shown: previews.append(shown) if not shown.final else None)
+    slider.setSliderDown(True)
+    slider.setValue(slider.value() - max(1, (slider.maximum() - slider.minimum()) // 4))
+    qtbot.waitUntil(lambda: len(previews) > 0, timeout=10000)
+    text = studio.statusBar().currentMessage()
+    slider.setSliderDown(False)
+    slider.sliderReleased.emit()
+    assert re.fullmatch(rf"preview {W}x{H} in \d+ ms — filled {previews[-1].figures['hole_pixels']} px", text), text
+    qtbot.waitUntil(lambda: not studio.renderer.running(), timeout=10000)  # (its release render ends the test)
 
 
 def test_a_session_whose_mask_no_longer_fits_its_image_opens_without_it_and_says_so(studio, qtbot, tmp_path):
