@@ -19,7 +19,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 from PySide6.QtCore import QObject, Signal
@@ -399,18 +399,31 @@ class Document(QObject):
         return {mask_file(session, name, key): value for name, values in self.geometry.items()
                 for key, value in values.items() if isinstance(value, Mask)}
 
-    def save_session(self, path: str | Path) -> None:
-        """Write the session (its masks first, as 1-bit PNGs beside it), each file atomically."""
+    def session_writer(self, path: str | Path) -> Callable[[], None]:
+        """Writing the session at ``path``, captured now: a function that encodes its masks as 1-bit
+        PNGs beside it and writes them, then the JSON, each file atomically -- on any thread (the
+        studio runs it off the GUI thread: a large mask's PNG takes a tenth of a second to encode).
+        Masks are immutable and the JSON text is made here, so later edits do not reach it."""
         from weft.core.image import atomic_write_bytes
 
         path = Path(path)
-        for file, mask in self.session_masks(path).items():
-            try:
-                mask.save(file)
-            except OSError as e:
-                raise WeftError(f"{file}: cannot write the mask ({e.strerror or e})") from None
+        masks = self.session_masks(path)
         text = json.dumps(self.session_dict(relative_to=path.resolve().parent, session=path), indent=1)
-        atomic_write_bytes(path, (text + "\n").encode("utf-8"))
+
+        def write() -> None:
+            for file, mask in masks.items():
+                try:
+                    mask.save(file)
+                except OSError as e:
+                    raise WeftError(f"{file}: cannot write the mask ({e.strerror or e})") from None
+            atomic_write_bytes(path, (text + "\n").encode("utf-8"))
+
+        return write
+
+    def save_session(self, path: str | Path) -> None:
+        """Write the session (its masks first, as 1-bit PNGs beside it), each file atomically, here
+        and now (:meth:`session_writer` is the same, to be run elsewhere)."""
+        self.session_writer(path)()
 
 
 # --- undo commands -------------------------------------------------------------------------------

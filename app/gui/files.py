@@ -3,7 +3,13 @@
 A result rendered with a painted mask (a mask geometry is an input of its method) is exported with
 that mask as a 1-bit PNG beside it, ``OUT.<input>.png`` (``out.png`` -> ``out.mask.png``), which its
 recipe names as that input, so ``weft run OUT.png`` reproduces it; a recipe exported alone gets its
-mask beside it alike. Sessions keep masks beside the session file (``Document.save_session``).
+mask beside it alike. Sessions keep masks beside the session file (``Document.session_writer``).
+
+Image files are encoded and decoded off the GUI thread: an export, its masks, a saved session and
+its masks, and a session's images and masks when it is opened, through :func:`off_gui_thread` (the
+window keeps painting, user input waits); the autosave's recovery file and its masks on a worker of
+its own (nothing waits; a newer autosave replaces one not yet started, and a recovery file removed
+meanwhile is not written again).
 
 Contract: :class:`FileActions` is given the window (a parent for dialogs, with ``show_message(text)``,
 ``statusBar()``, ``settings`` and ``_confirm(question) -> bool``, the one place the studio asks), the
@@ -21,11 +27,12 @@ import threading
 from pathlib import Path
 from typing import Callable, TypeVar
 
-from PySide6.QtCore import QEventLoop, QMetaObject, QObject, QStandardPaths, Qt, QTimer
+from PySide6.QtCore import QEventLoop, QMetaObject, QObject, QStandardPaths, Qt, QTimer, Signal
 from PySide6.QtWidgets import QFileDialog
 
 from weft.core import registry
 from weft.core.errors import WeftError
+from weft.core.jobs import JobResult, JobRunner
 from weft.core.studio import MASK, SQUARE
 from weft.core.image import atomic_write_bytes, save_image
 
@@ -36,6 +43,15 @@ T = TypeVar("T")
 SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
 AUTOSAVE_MS = 2000  # unsaved edits reach the recovery file at most this long after they are made
 RECOVERY_FILE = "recovery.weft.json"
+
+
+def _write_masks(masks: dict) -> None:
+    """(Any thread.) Write each mask of :meth:`FileActions._with_masks` as a 1-bit PNG, atomically."""
+    for file, (name, mask) in masks.items():
+        try:
+            mask.save(file)
+        except OSError as e:
+            raise WeftError(f"{file}: cannot write the {name.replace('_', ' ')} ({e.strerror or e})") from None
 
 
 def recovery_path() -> Path:
@@ -75,6 +91,8 @@ def off_gui_thread(fn: Callable[[], T]) -> T:
 class FileActions(QObject):
     """Export, recipes, sessions, autosave and recovery (see the module docstring)."""
 
+    _autosaved = Signal(object)  # a background autosave's JobResult (queued to the GUI thread)
+
     def __init__(self, window, doc, renderer):
         super().__init__(window)
         self.window, self.doc, self.renderer = window, doc, renderer
@@ -83,8 +101,19 @@ class FileActions(QObject):
         # every AUTOSAVE_MS; a clean document has no recovery file.
         self.recovery_file = recovery_path()
         self._autosave_timer = QTimer(window, singleShot=True, interval=AUTOSAVE_MS)
-        self._autosave_timer.timeout.connect(self.autosave)
+        self._autosave_timer.timeout.connect(lambda: self.autosave(wait=False))
         self._owns_recovery = False  # only a file this window wrote (or restored) is removed by it
+        # the recovery file's writes: one worker; the lock and generation keep a write from putting
+        # back a recovery file that was removed (discard_recovery) while it was being encoded
+        self._recovery_lock = threading.Lock()
+        self._recovery_generation = 0
+        self._autosaver = JobRunner(max_workers=1, on_result=self._autosaved.emit)
+        self._autosaved.connect(self._on_autosaved)
+
+    def shutdown(self) -> None:
+        """Finish a background autosave that has started (a pending one is dropped) and stop its worker."""
+        self._autosave_timer.stop()
+        self._autosaver.shutdown(wait=True, cancel=True)
 
     def show_message(self, text: str) -> None:
         self.window.show_message(text)
@@ -138,14 +167,20 @@ class FileActions(QObject):
             self.show_message(f"{p.name}: not exported (the existing file is kept)")
             return False
         try:
-            recipe = self._with_masks(shown, p).to_json(relative_to=p.resolve().parent)
+            recipe, masks = self._with_masks(shown, p)
+            recipe = recipe.to_json(relative_to=p.resolve().parent)
         except WeftError as e:
             self.show_message(str(e))
             return False
         depth = 16 if p.suffix.lower() in (".tif", ".tiff") else 8
         self.statusBar().showMessage(f"exporting {p.name}…")
-        try:  # encoding a large PNG takes a second: off the GUI thread
-            off_gui_thread(lambda: save_image(p, shown.image, recipe=recipe, bit_depth=depth))
+
+        def write() -> None:
+            _write_masks(masks)
+            save_image(p, shown.image, recipe=recipe, bit_depth=depth)
+
+        try:  # encoding a large PNG (and its mask's) takes a second: off the GUI thread
+            off_gui_thread(write)
         except WeftError as e:
             self.show_message(str(e))
             return False
@@ -165,29 +200,34 @@ class FileActions(QObject):
             return False
         shown = self.renderer.last
         try:
-            self._with_masks(shown, Path(path)).save(path)
+            recipe, masks = self._with_masks(shown, Path(path))
+
+            def write() -> None:
+                _write_masks(masks)
+                recipe.save(path)
+
+            off_gui_thread(write)
         except WeftError as e:
             self.show_message(str(e))
             return False
         return True
 
     def _with_masks(self, shown, beside: Path):
-        """The recipe of ``shown`` with each painted mask it was rendered with written as a 1-bit PNG
-        beside ``beside`` (``out.png`` -> ``out.mask.png``) and named as that input."""
+        """``(recipe, masks)``: the recipe of ``shown`` with each painted mask it was rendered with
+        named as that input, a 1-bit PNG beside ``beside`` (``out.png`` -> ``out.mask.png``), and
+        what :func:`_write_masks` writes there (file -> (input name, mask)); nothing is written here."""
         recipe = shown.recipe
         if not shown.masks:
-            return recipe
+            return recipe, {}
         inputs = dict(recipe.inputs)
+        masks = {}
         for name, mask in shown.masks.items():
             file = beside.with_name(f"{beside.stem}.{name}.png")
             if any(item.path and Path(item.path).resolve() == file.resolve() for item in self.doc.inputs.values()):
                 raise WeftError(f"{file.name}: refusing to overwrite an input image with the {name.replace('_', ' ')}")
-            try:
-                mask.save(file)
-            except OSError as e:
-                raise WeftError(f"{file}: cannot write the {name.replace('_', ' ')} ({e.strerror or e})") from None
+            masks[file] = (name, mask)
             inputs[name] = str(file.resolve())
-        return dataclasses.replace(recipe, inputs=inputs)
+        return dataclasses.replace(recipe, inputs=inputs), masks
 
     def save_session_dialog(self) -> bool:
         """Ask where, then save; True if the session was saved."""
@@ -195,8 +235,8 @@ class FileActions(QObject):
         return bool(path) and self.save_session(path)
 
     def save_session(self, path: str) -> bool:
-        try:
-            self.doc.save_session(path)
+        try:  # its masks' PNGs are encoded off the GUI thread (the document's state is captured here)
+            off_gui_thread(self.doc.session_writer(path))
         except WeftError as e:
             self.show_message(str(e))
             return False
@@ -232,22 +272,23 @@ class FileActions(QObject):
         Raises ``WeftError`` naming the session file and, for an image, which input it is.
         """
         dropped: list[str] = []
-        data = read_session(path, dropped=dropped)  # a missing or unreadable mask PNG: the rest opens
         offered = registry.studio_methods()
-        if data["method"] not in offered:
-            raise WeftError(f"{path}: the studio does not offer method {data['method']!r} "
-                            f"(it offers {', '.join(offered)}; use 'weft {data['method']}')")
-        def decode() -> dict[str, InputImage]:
+
+        def decode() -> tuple[dict, dict[str, InputImage]]:
+            data = read_session(path, dropped=dropped)  # (its mask PNGs decoded); missing or unreadable: the rest opens
+            if data["method"] not in offered:
+                raise WeftError(f"{path}: the studio does not offer method {data['method']!r} "
+                                f"(it offers {', '.join(offered)}; use 'weft {data['method']}')")
             images = {}
             for name, p in data["inputs"].items():
                 try:
                     images[name] = read_input(p)
                 except WeftError as e:
                     raise WeftError(f"{path}: the {name.replace('_', ' ')} image: {e}") from None
-            return images
+            return data, images
 
         self.statusBar().showMessage(f"opening {Path(path).name}…")
-        images = off_gui_thread(decode)
+        data, images = off_gui_thread(decode)
         for method, values in data["geometry"].items():  # a square must lie inside its image
             for g in offered[method].studio.geometry:
                 value, on = values.get(g.key), g.input_for(images)
@@ -287,39 +328,71 @@ class FileActions(QObject):
         elif not self._autosave_timer.isActive():
             self._autosave_timer.start()
 
-    def autosave(self) -> bool:
-        """Write the session (absolute paths) to :attr:`recovery_file` now, atomically.
+    def autosave(self, *, wait: bool = True) -> bool:
+        """Write the session (absolute paths) to :attr:`recovery_file`, atomically, its masks' PNGs
+        beside it, encoded off the GUI thread. The document is captured now.
+
+        ``wait`` (the default): return once written (the window keeps painting meanwhile). Without
+        it (the autosave timer) the write runs on the autosave worker and nothing waits: a failure
+        is said in the status bar when it happens.
 
         Returns
         -------
         bool
-            True if written; False if the document is clean (nothing to recover) or the write
-            failed (said once in the status bar; the next edit tries again).
+            True if written (without ``wait``: submitted); False if the document is clean (nothing to
+            recover) or the write failed (said once in the status bar; the next edit tries again).
         """
         if self.doc.undo_stack.isClean():
             return False
         data = self.doc.session_dict(session=self.recovery_file)
         data["inputs"] = {name: os.path.abspath(p) for name, p in data["inputs"].items()}
+        text = json.dumps(data, indent=1) + "\n"
+        masks = self.doc.session_masks(self.recovery_file)
+        with self._recovery_lock:
+            generation = self._recovery_generation
+        self._owns_recovery = True  # (what it writes is this window's to remove, from now)
+        if not wait:
+            self._autosaver.submit("autosave", lambda **_: self._write_recovery(generation, masks, text))
+            return True
         try:
-            self.recovery_file.parent.mkdir(parents=True, exist_ok=True)
-            for file, mask in self.doc.session_masks(self.recovery_file).items():
-                mask.save(file)
-            atomic_write_bytes(self.recovery_file, (json.dumps(data, indent=1) + "\n").encode("utf-8"))
+            off_gui_thread(lambda: self._write_recovery(generation, masks, text))
         except (OSError, WeftError) as e:
-            self.show_message(f"{self.recovery_file}: autosave failed ({' '.join(str(e).split())})")
+            self._autosave_failed(e)
             return False
-        self._owns_recovery = True
         return True
 
+    def _write_recovery(self, generation: int, masks: dict, text: str) -> bool:
+        """(Any thread.) Encode the masks, then -- unless the recovery was discarded since the
+        autosave was made (``generation``) -- write them and the JSON. False: discarded, nothing written."""
+        pngs = {file: mask.to_png() for file, mask in masks.items()}  # the slow part, outside the lock
+        with self._recovery_lock:
+            if generation != self._recovery_generation:
+                return False
+            self.recovery_file.parent.mkdir(parents=True, exist_ok=True)
+            for file, data in pngs.items():
+                atomic_write_bytes(file, data)
+            atomic_write_bytes(self.recovery_file, text.encode("utf-8"))
+        return True
+
+    def _on_autosaved(self, result: JobResult) -> None:
+        if result.error is not None and isinstance(result.error, (OSError, WeftError)):
+            self._autosave_failed(result.error)
+
+    def _autosave_failed(self, e: BaseException) -> None:
+        self.show_message(f"{self.recovery_file}: autosave failed ({' '.join(str(e).split())})")
+
     def discard_recovery(self) -> None:
-        """Remove the recovery file (the document is saved, clean, or its edits were discarded)."""
+        """Remove the recovery file (the document is saved, clean, or its edits were discarded); an
+        autosave being written meanwhile does not put it back."""
         stem = self.recovery_file.name[:-5] if self.recovery_file.name.endswith(".json") else self.recovery_file.name
-        try:
-            self.recovery_file.unlink(missing_ok=True)
-            for mask in self.recovery_file.parent.glob(f"{stem}.*.png"):  # its masks (Document.session_masks)
-                mask.unlink(missing_ok=True)
-        except OSError:
-            pass
+        with self._recovery_lock:  # (waits for a write in progress: its files go too)
+            self._recovery_generation += 1
+            try:
+                self.recovery_file.unlink(missing_ok=True)
+                for mask in self.recovery_file.parent.glob(f"{stem}.*.png"):  # its masks (Document.session_masks)
+                    mask.unlink(missing_ok=True)
+            except OSError:
+                pass
         self._owns_recovery = False
 
     def offer_recovery(self) -> bool:

@@ -742,6 +742,7 @@ class MainWindow(QMainWindow):
     def shutdown(self) -> None:
         self.renderer.shutdown()
         self.loader.shutdown(wait=True, cancel=True)
+        self.files.shutdown()
         self.inputs_pane.shutdown()
         dialog = getattr(self, "_variations", None)
         if dialog is not None:

@@ -368,6 +368,51 @@ def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(stu
     assert Mask.read(tmp_path / "r.hole.png") == painted
 
 
+def test_mask_pngs_are_encoded_and_decoded_off_the_gui_thread(studio, qtbot, tmp_path, monkeypatch, capsys,
+                                                             private_recovery):
+    """A mask's PNG (a large one takes a tenth of a second to encode) is encoded for an export, a
+    recipe, a saved session and the autosave, and decoded when a session opens, never on the GUI
+    thread; the files stay right (bit-exact round trip; weft run reproduces the export)."""
+    import threading
+
+    threads: dict[str, list[bool]] = {"encode": [], "decode": []}  # on the GUI thread?
+    to_png, read = Mask.to_png, Mask.read.__func__
+
+    def encode(self):
+        threads["encode"].append(threading.current_thread() is threading.main_thread())
+        return to_png(self)
+
+    def decode(cls, path, what="mask"):
+        threads["decode"].append(threading.current_thread() is threading.main_thread())
+        return read(cls, path, what)
+
+    monkeypatch.setattr(Mask, "to_png", encode)
+    monkeypatch.setattr(Mask, "read", classmethod(decode))
+    studio.files._autosave_timer.setInterval(10**7)  # no autosave until asked for below
+    view, doc = studio.canvas_view, studio.doc
+    _final_after(studio, qtbot, lambda: _stroke(view, [(15.5, 15.5), (35.5, 40.5)]))
+    painted = _mask(studio)
+    out = tmp_path / "out.png"
+    assert studio.export_result(str(out))
+    assert studio.export_recipe(str(tmp_path / "r.json"))
+    session = tmp_path / "s.weft.json"
+    assert studio.save_session(str(session))
+    assert len(threads["encode"]) == 3 and not any(threads["encode"])
+    # the autosave (its timer's): off the GUI thread, and nothing waits for it
+    doc.set_margins("grow", Margins(0, 0, 2, 0))
+    studio.files._autosave_timer.setInterval(10)
+    recovery = private_recovery / "recovery.weft.mean-fill.hole.png"
+    qtbot.waitUntil(lambda: (private_recovery / "recovery.weft.json").is_file() and recovery.is_file(), timeout=10000)
+    assert len(threads["encode"]) == 4 and not any(threads["encode"])
+    doc.set_mask("hole", None, "Clear mask")
+    assert studio.open_session(str(session))
+    assert threads["decode"] == [False] and _mask(studio) == painted  # bit-exact
+    assert Mask.read(tmp_path / "out.hole.png") == painted and Mask.read(tmp_path / "r.hole.png") == painted
+    again = tmp_path / "again.png"
+    assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
+    assert np.array_equal(load_image(out).image, load_image(again).image)
+
+
 def _screen_drag(view, start_scene, steps_px, *, last=True, modifiers=Qt.KeyboardModifier.NoModifier):
     """Press at a scene point, then move the mouse by screen offsets (dx, dy) from there, as a hand
     does (the scene may move under it meanwhile), and release at the last one."""
