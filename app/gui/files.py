@@ -375,7 +375,7 @@ class FileActions(QObject):
         return True
 
     def _on_autosaved(self, result: JobResult) -> None:
-        if result.error is not None and isinstance(result.error, (OSError, WeftError)):
+        if result.error is not None:  # (a full disk, a folder gone, out of memory: said, never silent)
             self._autosave_failed(result.error)
 
     def _autosave_failed(self, e: BaseException) -> None:

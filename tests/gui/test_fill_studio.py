@@ -994,3 +994,17 @@ def test_the_mask_overlay_is_the_masks_colour_where_painted_and_clear_elsewhere(
     image = overlay.image().convertToFormat(QImage.Format.Format_RGBA8888)
     rgba = np.frombuffer(image.constBits(), np.uint8).reshape(H, image.bytesPerLine() // 4, 4)[:, :W]
     assert (rgba[more.bits] == MASK_RGBA).all() and not rgba[~more.bits].any()
+
+
+def test_a_background_autosave_that_fails_says_so_in_one_line(studio, qtbot, private_recovery):
+    """The autosave timer's write runs on a worker: a failure (here the recovery folder's place is
+    taken by a file) still reaches the status bar, in one line, and the studio goes on."""
+    private_recovery.parent.mkdir(parents=True, exist_ok=True)
+    private_recovery.write_text("not a folder")
+    studio.files._autosave_timer.setInterval(10)
+    with qtbot.waitSignal(studio.statusBar().messageChanged, timeout=10000,
+                          check_params_cb=lambda text: "autosave failed" in text) as said:
+        _stroke(studio.canvas_view, [(20.5, 20.5), (30.5, 25.5)])
+    text = said.args[0]
+    assert text.startswith(f"{private_recovery / 'recovery.weft.json'}: autosave failed (") and "\n" not in text
+    assert _mask(studio) is not None  # the edit stands
