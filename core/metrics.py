@@ -344,8 +344,7 @@ def verbatim_region(sources) -> int:
     ImageError
         If ``sources`` is not an (H, W, 2) integer array.
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    import cv2
 
     src = np.asarray(sources)
     if src.ndim != 3 or src.shape[2] != 2 or not np.issubdtype(src.dtype, np.integer):
@@ -359,19 +358,17 @@ def verbatim_region(sources) -> int:
     yy, xx = np.mgrid[0:h, 0:w]
     dy = src[..., 0].astype(np.int64) - yy
     dx = src[..., 1].astype(np.int64) - xx
-    index = np.arange(h * w).reshape(h, w)
-    rows, cols = [], []
-    # an edge between 4-neighbours that are both copies with the same offset
-    for a, b in (((slice(None), slice(None, -1)), (slice(None), slice(1, None))),
-                 ((slice(None, -1), slice(None)), (slice(1, None), slice(None)))):
-        same = valid[a] & valid[b] & (dy[a] == dy[b]) & (dx[a] == dx[b])
-        rows.append(index[a][same])
-        cols.append(index[b][same])
-    r = np.concatenate(rows)
-    c = np.concatenate(cols)
-    graph = coo_matrix((np.ones(r.size, dtype=np.int8), (r, c)), shape=(h * w, h * w))
-    _, labels = connected_components(graph, directed=False)
-    counts = np.bincount(labels[valid.ravel()])
+    # The graph drawn at twice the resolution: pixel (y, x) at (2y, 2x), the edge to its right
+    # neighbour at (2y, 2x + 1), to the one below at (2y + 1, 2x); an edge pixel is set where both
+    # neighbours are copies with the same offset. The 4-connected components of that image are the
+    # graph's (a node meets another only through an edge pixel), found by cv2 (scipy.sparse's
+    # csgraph took ~0.1 s to import in every quilting process).
+    grid = np.zeros((2 * h - 1, 2 * w - 1), dtype=np.uint8)
+    grid[::2, ::2] = valid
+    grid[::2, 1::2] = valid[:, :-1] & valid[:, 1:] & (dy[:, :-1] == dy[:, 1:]) & (dx[:, :-1] == dx[:, 1:])
+    grid[1::2, ::2] = valid[:-1] & valid[1:] & (dy[:-1] == dy[1:]) & (dx[:-1] == dx[1:])
+    _, labels = cv2.connectedComponents(grid, connectivity=4, ltype=cv2.CV_32S)
+    counts = np.bincount(labels[::2, ::2][valid])
     return int(counts.max())
 
 

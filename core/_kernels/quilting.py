@@ -16,7 +16,7 @@ Everything is float32 in, float64 inside sums. Random numbers come from the call
 pixels on any thread.
 
 Integer parameters of :func:`place_block` travel in one int64 array (fewer arguments to dispatch
-per block; see the ``P_*`` indices in ``quilting_codes``).
+per block; see the ``P_*`` indices in ``weft.core.quilting.codes``).
 
 Compile cost (numba compiles a kernel and everything it calls on first use, ~0.1-3 s a function
 when the cache is cold): the selection rules and the Poisson band are separate kernels so that a
@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from .poisson import poisson_cg
-from .quilting_codes import (  # noqa: F401 (re-exported: the codes of place_block's array)
+from ..quilting.codes import (  # noqa: F401 (re-exported: the codes of place_block's array)
     MODE_MINCUT, MODE_OVERLAP, MODE_RANDOM, N_IPARAMS, P_B, P_BAND, P_BOTTOM, P_LEFT, P_MODE, P_POISSON, P_RIGHT,
     P_SX, P_SY, P_TOP, P_WRAP, P_X0, P_Y0, SAMPLE_FRACTION, TOP_FRACTION,
 )

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._kernels import quilting_codes as _K  # the kernel's array codes, without importing numba
+from . import codes as _K  # the kernel's array codes, without importing numba (a test checks it)
 from ..grid import block_grid
 from ..jobs import CancelToken, ProgressReporter
 
@@ -143,7 +143,10 @@ def _record(sources: np.ndarray, y0: int, x0: int, sy: int, sx: int, b: int, mas
     """Write the source coordinates of the pixels a block pasted (all, or where ``mask``) into ``sources``."""
     hc, wc = sources.shape[:2]
     ar = np.arange(b)
-    iy, ix = np.ix_((y0 + ar) % hc, (x0 + ar) % wc)
+    if y0 + b <= hc and x0 + b <= wc:  # inside the canvas: a view, written in place
+        iy, ix = slice(y0, y0 + b), slice(x0, x0 + b)
+    else:  # a tileable canvas's last blocks wrap around
+        iy, ix = np.ix_((y0 + ar) % hc, (x0 + ar) % wc)
     sub = sources[iy, ix]
     new_y = np.broadcast_to((sy + ar)[:, None], (b, b))
     new_x = np.broadcast_to((sx + ar)[None, :], (b, b))
@@ -278,7 +281,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and synthesis
                  and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "weft.core._kernels.quilting" not in sys.modules)
     if use_numpy:
-        place, template, blend, error, cut = _place_block_numpy, _make_template_numpy, None, None, None
+        place, template, blend = _place_block_numpy, _make_template_numpy, None
+        error, cut = _block_error_numpy, _cut_mask_into_numpy
         by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,
                                                _choose_sampled_numpy)
         by_seam, best_k, seam_error, seam_cut, block_error = _by_seam_numpy, None, None, None, None
@@ -404,7 +408,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                         _forbid_continuations(cross, src.ph, src.pw, y0, x0,
                                               _neighbours(chosen, i, j, ys, xs, hc, wc, wrap), avoid)
                     sq = src.sq((top, left, right, bottom), p)
-                    if pool and overlaps:
+                    seam_cut_done = bool(pool and overlaps)
+                    if seam_cut_done:  # the winner's cut is left in mask
                         pick = by_seam(cross, sq, float(const), cost_buf, pool, candidates, canvas, filled, tex,
                                         ip, err, mask, best_k, block_error, seam_cut, seam_error, src.pw)
                     else:
@@ -412,7 +417,8 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                     ip[_K.P_SY], ip[_K.P_SX] = divmod(pick, src.pw)
                 else:  # synthesis, first block: a random position
                     ip[_K.P_SY], ip[_K.P_SX] = first
-                if mincut and overlaps and cut is not None:
+                    seam_cut_done = False
+                if mincut and overlaps and not seam_cut_done:
                     error(canvas, filled, tex, ip, err)
                     cut(err, top, left, right, bottom, mask)
                 place(canvas, filled, tex, ip, mask, win, label, old)
@@ -441,9 +447,11 @@ def _by_seam(cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, 
     whose minimum-error cut runs through the least error (``seam_error``; ties: the earlier
     candidate). The overlap SSD ranks a block by its whole overlap, but what shows is the error
     along the cut; on brick_128 (T1) cutting 8 candidates instead of drawing one of the best 2
-    lowers coherence (fewer broken mortar joints at the seams)."""
+    lowers coherence (fewer broken mortar joints at the seams). The winner's cut is left in
+    ``mask`` (the caller pastes with it)."""
     n = int(best_k(cross, sq, const, cost_buf, pool, candidates))
     best, best_err = int(candidates[0]), np.inf
+    best_mask = np.empty_like(mask)
     for c in candidates[:n]:
         ip[_K.P_SY], ip[_K.P_SX] = divmod(int(c), pw)
         block_error(canvas, filled, tex, ip, err)
@@ -451,6 +459,8 @@ def _by_seam(cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, 
         e = float(seam_error(err, mask))
         if e < best_err:
             best, best_err = int(c), e
+            best_mask[...] = mask
+    mask[...] = best_mask
     return best
 
 
@@ -528,15 +538,31 @@ def _choose_sampled_numpy(cross, sq, const, cost_buf, u: float, seed: int) -> in
 
 
 def _vertical_acc_numpy(err: np.ndarray) -> np.ndarray:
-    """The kernel's ``_vertical_acc`` for a stack of error surfaces (K, h, w)."""
+    """The kernel's ``_vertical_acc`` for a stack of error surfaces (K, h, w).
+
+    The rows are accumulated into a buffer padded with +inf columns, three ufunc calls a row
+    written in place (the run is ``h`` steps of calls on tiny arrays, so the number of calls is
+    the cost); the values are the kernel's (the same additions, min is exact)."""
     k, h, w = err.shape
-    acc = np.empty((k, h, w))
-    acc[:, h - 1] = err[:, h - 1]
-    pad = np.full((k, w + 2), np.inf)
+    accp = np.full((k, h, w + 2), np.inf)
+    accp[:, h - 1, 1:-1] = err[:, h - 1]
+    tmp = np.empty((k, w))
     for y in range(h - 2, -1, -1):
-        pad[:, 1:-1] = acc[:, y + 1]
-        acc[:, y] = err[:, y] + np.minimum(np.minimum(pad[:, 1:-1], pad[:, :-2]), pad[:, 2:])
-    return acc
+        below = accp[:, y + 1]
+        np.minimum(below[:, :-2], below[:, 2:], out=tmp)
+        np.minimum(tmp, below[:, 1:-1], out=tmp)
+        np.add(err[:, y], tmp, out=accp[:, y, 1:-1])
+    return accp[:, :, 1:-1]
+
+
+def _vertical_accs_numpy(strips: list[np.ndarray]) -> list[np.ndarray]:
+    """:func:`_vertical_acc_numpy` of each (K, h, w) stack of ``strips``; stacks of one shape (a
+    square block's left and transposed top strips) run as one program."""
+    if len(strips) > 1 and all(s.shape == strips[0].shape for s in strips):
+        acc = _vertical_acc_numpy(np.concatenate(strips))
+        k = strips[0].shape[0]
+        return [acc[i * k:(i + 1) * k] for i in range(len(strips))]
+    return [_vertical_acc_numpy(s) for s in strips]
 
 
 def _trace_numpy(acc: np.ndarray, y_start, x_start) -> np.ndarray:
@@ -565,16 +591,27 @@ def _trace_numpy(acc: np.ndarray, y_start, x_start) -> np.ndarray:
 
 def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: int) -> np.ndarray:
     """The kernel's ``cut_mask`` in numpy (horizontal cuts by transposition), for one error surface
-    (h, w) or a stack of them (K, h, w) (the seam rule's candidates, cut together)."""
+    (h, w) or a stack of them (K, h, w) (the seam rule's candidates, cut together). The dynamic
+    programs of all sides run together when their strips have one shape (see
+    :func:`_vertical_accs_numpy`)."""
     if err.ndim == 2:
         return _cut_mask_numpy(err[None], top, left, right, bottom)[0]
     k, h, w = err.shape
     mask = np.ones((k, h, w), dtype=bool)
-    yy, xx = np.mgrid[0:h, 0:w]
+    yy, xx = np.arange(h)[:, None], np.arange(w)[None, :]
     zero = np.zeros(k, dtype=np.int64)
+    strips, sides = [], []
+    if left > 0:
+        strips.append(err[:, :, :left]); sides.append("left")
+    if top > 0:
+        strips.append(err[:, :top, :].transpose(0, 2, 1)); sides.append("top")  # (K, w, top): rows = columns
+    if right > 0:
+        strips.append(err[:, :, w - right:]); sides.append("right")
+    if bottom > 0:
+        strips.append(err[:, h - bottom:, :].transpose(0, 2, 1)); sides.append("bottom")
+    accs = dict(zip(sides, _vertical_accs_numpy(strips)))
     if left > 0 and top > 0:
-        ev = _vertical_acc_numpy(err[:, :, :left])
-        eh = _vertical_acc_numpy(err[:, :top, :].transpose(0, 2, 1))  # (K, w, top): rows = columns
+        ev, eh = accs["left"], accs["top"]
         corner = ev[:, :top, :left] + eh[:, :left, :top].transpose(0, 2, 1) - err[:, :top, :left]
         r, c = np.divmod(corner.reshape(k, -1).argmin(axis=1), left)
         vpath = _trace_numpy(ev, r, c)
@@ -584,16 +621,16 @@ def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: in
         b = np.where(xx >= c3, yy >= hpath[:, None, :], yy >= r3)
         mask &= a & b
     elif left > 0:
-        ev = _vertical_acc_numpy(err[:, :, :left])
+        ev = accs["left"]
         mask &= xx >= _trace_numpy(ev, zero, ev[:, 0].argmin(axis=1))[:, :, None]
     elif top > 0:
-        eh = _vertical_acc_numpy(err[:, :top, :].transpose(0, 2, 1))
+        eh = accs["top"]
         mask &= yy >= _trace_numpy(eh, zero, eh[:, 0].argmin(axis=1))[:, None, :]
     if right > 0:
-        ev = _vertical_acc_numpy(err[:, :, w - right:])
+        ev = accs["right"]
         mask &= xx <= (_trace_numpy(ev, zero, ev[:, 0].argmin(axis=1)) + (w - right))[:, :, None]
     if bottom > 0:
-        eh = _vertical_acc_numpy(err[:, h - bottom:, :].transpose(0, 2, 1))
+        eh = accs["bottom"]
         mask &= yy <= (_trace_numpy(eh, zero, eh[:, 0].argmin(axis=1)) + (h - bottom))[:, None, :]
     return mask
 
@@ -642,49 +679,63 @@ def _block_error_numpy(canvas, filled, tex, ip, err: np.ndarray) -> None:
     err[...] = _block_errors_numpy(canvas, filled, tex, ip, [(int(ip[_K.P_SY]), int(ip[_K.P_SX]))])[0]
 
 
+def _seam_errors_numpy(err: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """:func:`_seam_error_numpy` of a stack (K, h, w) at once (the same sums: the cumulative sum
+    in row-major order with zeros between the terms adds the same terms in the same order)."""
+    m = mask.astype(bool)
+    off = np.zeros_like(m)
+    off[:, 1:] |= ~m[:, :-1]
+    off[:, :-1] |= ~m[:, 1:]
+    off[:, :, 1:] |= ~m[:, :, :-1]
+    off[:, :, :-1] |= ~m[:, :, 1:]
+    vals = np.where(m & off, err, 0.0).reshape(len(err), -1)
+    return np.cumsum(vals, axis=1)[:, -1]
+
+
 def _by_seam_numpy(cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, ip, err, mask,
                    *kernels_and_pw) -> int:
-    """:func:`_by_seam` in numpy, the candidates' cuts computed together (same choice)."""
+    """:func:`_by_seam` in numpy, the candidates' cuts computed together (same choice, the
+    winner's cut left in ``mask``)."""
     pw = kernels_and_pw[-1]
     n = _best_k_numpy(cross, sq, const, cost_buf, pool, candidates)
     cands = [int(c) for c in candidates[:n]]
     errs = _block_errors_numpy(canvas, filled, tex, ip, [divmod(c, pw) for c in cands])
     masks = _cut_mask_numpy(errs, *(int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM)))
-    seam = [_seam_error_numpy(e, m) for e, m in zip(errs, masks)]
-    return cands[int(np.argmin(seam))]
+    best = int(np.argmin(_seam_errors_numpy(errs, masks)))
+    mask[...] = masks[best]
+    return cands[best]
 
 
-def _place_block_numpy(canvas, filled, tex, ip, *work):
-    """The kernels' ``block_error``, ``cut_mask`` and ``place_block`` (no Poisson band), in numpy
-    (same pixels).
+def _cut_mask_into_numpy(err, top, left, right, bottom, mask) -> None:
+    """The kernel's ``cut_mask`` signature: the cut of ``err`` written into ``mask``."""
+    mask[...] = _cut_mask_numpy(err, int(top), int(left), int(right), int(bottom))
 
-    ``work`` are the kernel's work buffers; numpy makes its own arrays (this engine only runs small
-    jobs, where reuse does not matter), except that the cut is written into ``work[0]`` (the mask),
-    as the numba engine's ``cut_mask`` leaves it there for the record of source positions.
+
+def _place_block_numpy(canvas, filled, tex, ip, mask, *work):
+    """The kernel's ``place_block`` (no Poisson band), in numpy (same pixels): in min-cut mode a
+    block with overlaps pastes where ``mask`` (the caller's cut) is 1.
+
+    The other arguments are the kernel's work buffers (the Poisson band's), unused here.
     """
     hc, wc, nc = canvas.shape
     b = int(ip[_K.P_B])
     y0, x0 = int(ip[_K.P_Y0]), int(ip[_K.P_X0])
     top, left, right, bottom = (int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM))
     sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
-    iy = (y0 + np.arange(b)) % hc
-    ix = (x0 + np.arange(b)) % wc
+    if y0 + b <= hc and x0 + b <= wc:  # the block lies inside the canvas: views
+        iy, ix = slice(y0, y0 + b), slice(x0, x0 + b)
+    else:  # a tileable canvas's last blocks wrap around
+        iy, ix = np.ix_((y0 + np.arange(b)) % hc, (x0 + np.arange(b)) % wc)
     block = tex[sy:sy + b, sx:sx + b]
     if ip[_K.P_MODE] == _K.MODE_MINCUT and (top or left or right or bottom):
-        old = canvas[np.ix_(iy, ix)]
-        err = np.empty((b, b))
-        _block_error_numpy(canvas, filled, tex, ip, err)
-        mask = _cut_mask_numpy(err, top, left, right, bottom)
-        if work:
-            work[0][...] = mask
-        merged = np.where(mask[..., None], block, old)
-        canvas[np.ix_(iy, ix)] = merged
-        f = filled[np.ix_(iy, ix)]
-        f[mask] = 1
-        filled[np.ix_(iy, ix)] = f
+        m = mask.astype(bool)
+        canvas[iy, ix] = np.where(m[..., None], block, canvas[iy, ix])
+        f = filled[iy, ix]
+        f[m] = 1
+        filled[iy, ix] = f
     else:
-        canvas[np.ix_(iy, ix)] = block
-        filled[np.ix_(iy, ix)] = 1
+        canvas[iy, ix] = block
+        filled[iy, ix] = 1
 
 
 def _pad_to(img: np.ndarray, h: int, w: int) -> np.ndarray:
