@@ -311,6 +311,27 @@ def test_seam_rule_kernels_match_numpy():
     assert k.seam_error(err, np.ones((6, 5), np.uint8)) == 0.0 == engine._seam_error_numpy(err, np.ones((6, 5)))
 
 
+@pytest.mark.parametrize("shape, sides", [((16, 16), (5, 5, 0, 0)), ((16, 16), (0, 5, 0, 0)), ((16, 16), (5, 0, 0, 0)),
+                                          ((16, 16), (5, 5, 5, 5)), ((12, 17), (3, 4, 2, 0)), ((9, 9), (0, 0, 3, 3))])
+def test_stacked_numpy_cuts_match_the_kernel(shape, sides):
+    """The numpy engine cuts the seam rule's candidates as one stack (the strips of one shape in one
+    dynamic program) and scores them together: each cut and score is the kernel's, bit for bit."""
+    from weft.core._kernels import quilting as k
+    from weft.core._kernels import seams
+    from weft.core.quilting import engine
+
+    rng = np.random.default_rng(sum(shape) + sum(sides))
+    # few levels, so that ties between paths happen and the tie rules are compared too
+    errs = np.floor(rng.random((7, *shape)) * 4)
+    masks = engine._cut_mask_numpy(errs, *sides)
+    scores = engine._seam_errors_numpy(errs, masks)
+    for e, m, score in zip(errs, masks, scores):
+        mk = np.empty(shape, np.uint8)
+        seams.cut_mask(np.ascontiguousarray(e), *sides, mk)
+        assert np.array_equal(m, mk.astype(bool))
+        assert score == k.seam_error(np.ascontiguousarray(e), mk) == engine._seam_error_numpy(e, mk)
+
+
 # --------------------------------------------------------------------------------------------
 # verbatim runs (issue 17): the record of source positions, the rule against continuations
 
