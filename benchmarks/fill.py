@@ -52,7 +52,7 @@ from typing import Any, Callable
 import numpy as np
 
 PEERS_SCRIPT = Path(__file__).resolve().with_name("fill_peers.py")
-WEFT_ENGINES = ("patchmatch", "quilt", "pixel")
+WEFT_ENGINES = ("patchmatch", "quilt", "pixel", "hybrid")
 BAND = 2  # px around the hole inside which weft may change known pixels (the method's default band)
 
 

@@ -13,11 +13,11 @@ ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-le
 
 
 #: The engines `--engine` offers (each a function of one signature, see the package docstring).
-ENGINES = ("patchmatch", "quilt", "pixel")
+ENGINES = ("patchmatch", "quilt", "pixel", "hybrid")
 #: The default engine: the one that measures best on issue 15's cases (see the package docstring for the figures).
 DEFAULT_ENGINE = "quilt"
 #: Each engine's patch side when ``patch`` is not given.
-DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7}
+DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7, "hybrid": 48}
 
 
 @dataclass(frozen=True)
@@ -27,9 +27,10 @@ class FillParams(Params):
     engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
                         help="quilt: blocks in fill-front order with min-cut seams (Efros & Freeman); "
                              "pixel: coherent pixel synthesis (Ashikhmin)"
-                             "; patchmatch: multi-scale patch search with voting")
+                             "; patchmatch: multi-scale patch search with voting"
+                             "; hybrid: quilt, then full-resolution patch search refines the seams")
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
-                       help="patch side in pixels (quilt: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
+                       help="patch side in pixels (quilt, hybrid: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
                             "default per engine, smaller on a small image: "
                             + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items()))
     extend: Margins = param(None, kind="geometry", type=Margins, optional=True,
