@@ -202,7 +202,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         reporter.update(int(100 * done // max(1, total)))
 
     extra = {}
-    if params.engine in ("quilt", "hybrid") and params.band > 0:
+    if params.engine in ("quilt", "hybrid", "patchmatch") and params.band > 0:
         # the quilting cut may run through the band's known pixels (gravel and brick, two holes each,
         # seeds 1-3: brick coherence 0.51 -> 0.44 and 0.54 -> 0.45 of the truth's, seam +0.16 -> +0.13
         # and +0.38 -> +0.23 from the truth's; gravel 0.60/0.64 -> 0.61/0.57, seam -0.07/-0.29 -> -0.10/-0.36)
@@ -220,7 +220,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
                                     cancel=cancel, **extra)
     filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
     out3 = filled if filled.ndim == 3 else filled[..., None]
-    if params.engine != "hybrid":  # (the hybrid engine's refine re-synthesises the band itself)
+    if params.engine not in ("hybrid", "patchmatch"):  # (their refine re-synthesises the band itself)
         out3 = blend_band(np.ascontiguousarray(out3), hole, params.band, exclude=transparent)
     out = out3 if colour.ndim == 3 else out3[..., 0]
     if alpha is not None:

@@ -28,8 +28,15 @@ search of Barnes et al., "PatchMatch" (SIGGRAPH 2009):
    its edge instead (their patches lie mostly on known pixels and agree with them): the cut between
    a copied region and the known pixels softens to what the known texture has (seam -0.05..-0.13 on
    the 256-384 px gravel/brick/photo cases, coherence no worse).
+4. With a blend band (``cuttable``: the known pixels within ``--band`` px of the hole, which the
+   method passes), that last edge average is skipped and the hole and the band are refined together
+   at full resolution by :func:`refine_patchmatch` (3 EM iterations copying only from beyond the
+   band): the band becomes a continuation of the copies instead of a Poisson blend, and the windows
+   across the hole's edge get closer to known ones (seeds 0-1 medians on the 320-384 px benchmark
+   cases, against the Poisson band: gravel coherence 10.7 -> 9.7, brick 1.43 -> 1.22, photo 5.5 ->
+   4.8 with its seam 0.82 -> 1.09, the truth's 1.07).
 
-Every pixel outside the hole is returned exactly as given.
+Every pixel outside the hole (and ``cuttable``) is returned exactly as given.
 """
 
 from __future__ import annotations
@@ -59,6 +66,9 @@ _SWEEPS_COARSEST, _SWEEPS_FINER = 4, 2  # PatchMatch sweeps of a level's first E
 # 4.3 -> 5.1), nor on the finest (no effect).
 _COHERENCE_BIAS = 1.0
 _EDGE_BLEND = 2.0  # the final vote averages the hole's pixels this close (px) to its edge
+# EM iterations of the final refine over the hole and the blend band (``cuttable``); 1 / 2 / 3 gave
+# gravel coherence 11.12 / 10.31 / 9.85, object 5.11 / 4.90 / 4.82 (seeds 0-1 medians)
+_BAND_REFINE = 3
 
 
 def _box_sum(a: np.ndarray, p: int) -> np.ndarray:
@@ -147,6 +157,7 @@ def fill_patchmatch(
     cancel: CancelToken | None = None,
     levels: int | None = None,
     iterations: int | None = None,
+    cuttable: np.ndarray | None = None,
 ) -> np.ndarray:
     """Fill the ``hole`` of ``image`` with patches of its ``source`` region (see the module text).
 
@@ -174,6 +185,11 @@ def fill_patchmatch(
         deep, as long as a level keeps 16 whole source patches and both sides >= 2 patches.
     iterations : int, optional
         EM iterations on every level; default 8 on the coarsest, 4 on intermediate, 2 on the finest.
+    cuttable : bool array (H, W), optional
+        Known pixels that may change (the method's blend band): the finished fill, these pixels and
+        the hole are then refined together by :func:`refine_patchmatch`, copying only from source
+        pixels outside them, so the band becomes a continuation of the copies (and the method runs
+        no Poisson blend for this engine).
 
     Returns
     -------
@@ -259,7 +275,7 @@ def fill_patchmatch(
             sigma2 = max(float(np.percentile(dn, 75)), 1e-12)
             weight = np.exp(-dn / (2.0 * sigma2))
             kf.vote_offset(lv.img, lv.hole, lv.tmap, nnf, weight, p)
-            if li == 0 and it == schedule[li] - 1:
+            if li == 0 and it == schedule[li] - 1 and cuttable is None:
                 # the hole's outermost pixels: the weighted mean of the matches (their patches lie
                 # mostly on known pixels and agree with them), so the edge shows no cut
                 edge = np.ascontiguousarray(lv.hole & (_depth_of(lv.hole) <= _EDGE_BLEND))
@@ -271,6 +287,11 @@ def fill_patchmatch(
         out[hole] = res[..., 0][hole]
     else:
         out[hole] = res[hole]
+    if cuttable is not None:
+        region = hole | np.asarray(cuttable, dtype=bool)
+        if _box_sum(source & ~region, p).max() >= p * p - 0.5:
+            out = refine_patchmatch(out, region, source & ~region, out, patch=p, iterations=_BAND_REFINE, rng=gen,
+                                    cancel=cancel)
     return out
 
 

@@ -185,3 +185,26 @@ def test_hybrid_uncrop_keeps_the_image(brick):
     out = fill(brick[:64, :64], extend=(16, 16, 16, 16), engine="hybrid", seed=0, band=0)
     assert out.shape == (96, 96)
     assert np.array_equal(out[16:80, 16:80], brick[:64, :64])
+
+
+def test_patchmatch_with_a_band_refines_it_and_leaves_every_other_known_pixel(gravel):
+    """fill_patchmatch's ``cuttable`` (the method passes the blend band): the band's known pixels are
+    re-synthesised with the hole, every pixel beyond them is returned bit for bit, and the result
+    is deterministic under a seed."""
+    from weft.core.fill.patchmatch import fill_patchmatch
+
+    hole = square_hole(gravel.shape)
+    band = band_region(hole, 2) & ~hole
+    a = fill_patchmatch(gravel, hole, rng=3, cuttable=band)
+    b = fill_patchmatch(gravel, hole, rng=3, cuttable=band)
+    plain = fill_patchmatch(gravel, hole, rng=3)
+    assert np.array_equal(a, b)
+    assert np.array_equal(a[~(hole | band)], gravel[~(hole | band)])
+    assert not np.array_equal(a[band], gravel[band])
+    assert np.array_equal(plain[~hole], gravel[~hole])
+    # through the method: the band is the only place known pixels change, and no Poisson solve smooths it
+    out = fill(gravel, hole, engine="patchmatch", seed=3, band=2)
+    assert np.array_equal(out[~(hole | band)], gravel[~(hole | band)])
+    truth_detail = metrics.fill_detail(gravel, hole)
+    assert 0.8 * truth_detail <= metrics.fill_detail(out, hole) <= 1.25 * truth_detail
+    assert metrics.fill_coherence(out, hole, gravel) <= 0.75 * metrics.fill_coherence(gravel, hole)
