@@ -15,7 +15,13 @@ quilt engine's cut may also run through the known pixels of the blend band, when
 * ``pixel`` (:func:`weft.core.fill.pixel.fill_pixel`) -- Ashikhmin-style coherent pixel synthesis in
   onion order with the hole's neighbourhood as the constraint;
 * ``patchmatch`` (:func:`weft.core.fill.patchmatch.fill_patchmatch`) -- multi-scale
-  patch search with voting (Wexler et al., Barnes et al.).
+  patch search with voting (Wexler et al., Barnes et al.);
+* ``hybrid`` (:func:`weft.core.fill.hybrid.fill_hybrid`) -- the quilt engine with 48-px blocks, then
+  :func:`weft.core.fill.patchmatch.refine_patchmatch` (full-resolution patch search and voting from
+  that fill) over the hole and the blend band.
+
+``patchmatch`` and ``hybrid`` are given the band too (``cuttable``) and re-synthesise it with the
+hole; the method then runs no Poisson blend for them.
 
 **The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE` (``quilt``). Measured against
 the other two on issue 15's judges (``weft.core.metrics.fill_*``; ground truth in brackets; lower
@@ -86,7 +92,7 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
     extend : ``Margins`` or ``(left, top, right, bottom)`` or ``"L,T,R,B"``: pixels added (and filled).
     size, anchor : ``(width, height)`` of a larger canvas, and where the image sits on it
         (:data:`ANCHORS`); not with ``extend``.
-    engine : ``"quilt"``, ``"pixel"`` (or ``"patchmatch"`` when built in); default :data:`DEFAULT_ENGINE`.
+    engine : ``"quilt"``, ``"pixel"``, ``"patchmatch"`` or ``"hybrid"``; default :data:`DEFAULT_ENGINE`.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
     source_mask : (H, W) (of the texture when one is given): the only pixels to copy from.
     texture : ndarray: copy from this image instead of the rest of ``image``.
