@@ -18,7 +18,6 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-import scipy.fft as sfft
 
 # Singular values of a candidate T are kept in this range: a stretch by more than 4 is never a
 # plausible deformation of a texture patch and a near-singular pair would otherwise give inf.
@@ -245,6 +244,8 @@ def correlate_indexed(frames: np.ndarray, index: np.ndarray, flip: np.ndarray, t
     R = radius
     g = np.zeros((n, L, L), np.float32)
     g[:, R:R + B, R:R + B] = targets
+    import scipy.fft as sfft  # here, not at import: 0.12 s that every weft process paid
+
     G = sfft.rfft2(g)[:, None]
     F = sfft.rfft2(frames)
     # rho[u] = sum g[v] f[v - u]: spectrum G conj(F); a turned frame has spectrum phase conj(F),
