@@ -9,7 +9,12 @@ around the band as fixed (Dirichlet) values and, as the guidance field, the imag
 -- except across the hole's edge, where the difference between a known and a filled pixel (the
 seam) is replaced by the mean of the differences one step further on either side (the local slope
 continued). So the texture's detail inside the band is kept and the seam's step is spread evenly
-over the band's ``2 band`` pixels. ``band = 0`` changes nothing outside the hole.
+over the band's ``2 band`` pixels. Only the part of a step beyond ``STEP`` times the texture's own
+mean step between known neighbours in the band is replaced: a seam the quilting cut already hid is
+left as it is (spreading every step smoothed the texture at the edge: gravel's seam figure fell to
+0.15 under the truth's; with ``STEP = 2``, seeds 0-4 medians with the quilt engine: gravel
+coherence 9.53 -> 9.11, seam -0.11 -> -0.06 from the truth's; brick 1.08 -> 1.08).
+``band = 0`` changes nothing outside the hole.
 """
 
 from __future__ import annotations
@@ -18,6 +23,9 @@ import cv2
 import numpy as np
 
 _STEPS = ((1, 0), (-1, 0), (0, 1), (0, -1))
+#: Only the part of a seam's step beyond STEP times the texture's own mean step (between known
+#: 4-neighbours in the band) is spread; 0 = every step.
+STEP = 2.0
 
 
 def band_region(hole: np.ndarray, band: int, exclude: np.ndarray | None = None) -> np.ndarray:
@@ -54,6 +62,15 @@ def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarr
         ok = (yy >= 0) & (yy < h) & (xx >= 0) & (xx < w)
         return ok, np.clip(yy, 0, h - 1), np.clip(xx, 0, w - 1)
 
+    # the texture's own step size: the mean absolute difference between 4-neighbours in the band
+    scale = 0.0
+    if STEP > 0:
+        dyy = np.abs(np.diff(f, axis=0)).mean(axis=2)
+        dxx = np.abs(np.diff(f, axis=1)).mean(axis=2)
+        known_y = ~hole[1:] & ~hole[:-1] & ring[1:]
+        known_x = ~hole[:, 1:] & ~hole[:, :-1] & ring[:, 1:]
+        vals = np.concatenate([dyy[known_y], dxx[known_x]])
+        scale = float(vals.mean()) if vals.size else 0.0
     for k, (dy, dx) in enumerate(_STEPS):
         qy, qx = ys + dy, xs + dx
         valid, qyc, qxc = at(qy, qx)
@@ -68,6 +85,10 @@ def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarr
             fwd = f[qyc, qxc] - f[fyy, fxx]
             wsum = (by_ok.astype(np.float64) + fy_ok)[:, None]
             slope = (back * by_ok[:, None] + fwd * fy_ok[:, None]) / np.maximum(wsum, 1.0)
+            if STEP > 0:  # only the part of the step beyond the texture's own variation is spread
+                excess = g - slope
+                keep = np.clip(excess, -STEP * scale, STEP * scale)
+                slope = slope + keep
             g = np.where(cross[:, None], slope, g)
         i = np.nonzero(valid)[0]
         ndeg[i] += 1

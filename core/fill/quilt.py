@@ -20,7 +20,25 @@ One block at a time, until no pixel of the hole is left:
    -0.09/-0.38, +0.11/+0.16, -0.18/-0.36 to -0.04/-0.22, +0.05/+0.01, -0.16/-0.17, for coherence
    0.50-0.62 -> 0.42-0.62 of the truth's. A block is picked at random among those within
    ``(1 + EPSILON)`` times the best cost (E&F §2.1's rule).
-3. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
+3. **Locality.** Blocks are searched only within ``REACH`` px of the window (the whole source when
+   that holds no whole block, e.g. a ``--texture``), as Resynthesizer and Criminisi et al. prefer
+   sources near the hole: the matches near a hole are the likeliest continuation, and the search
+   costs ~3x less on a 320 px image.
+4. **Coarse colour guide** (colour images only). The hole is filled by diffusion (``cv2.inpaint``,
+   Telea) at 1/``GUIDE_SCALE`` scale; for the window's *unknown* pixels, ``GUIDE`` times the SSD
+   between the chroma (colour less its grey mean) of that guide and of the blurred source block
+   is added (two more correlations): which material goes where in the hole (wood, not the
+   saucer's red or the coffee), not its texture, which the known pixels' SSD matches. Grey images
+   have no chroma and no guide (a grey guide pulled blocks towards flat ones: brick coherence
+   1.07 -> 1.28).
+5. **Continuing a copy.** Where earlier blocks already wrote into the window, the blocks that
+   continue their copies (same source offset; the ``CONTINUE`` most frequent in the window) are
+   candidates too, and the cheapest is taken when it costs at most ``(1 + COHERE)`` times the
+   best: neighbouring blocks then form one verbatim copy with no seam between them, as a
+   shift-map's labels do. The judge ``fill_coherence`` (distance of every 7x7 window to the
+   nearest known one) is ~0 inside a copy and high across a seam: on gravel's hole interior
+   (windows 6+ px inside) the quilt without it scored 8.8, shift-map 0.9.
+6. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
    overlap strip of ``B // 3`` pixels), E&F's dynamic-programming cut
    runs over the squared difference between those pixels and the new block (one path per side, in
    numpy: :func:`weft.core.fill.cut.min_cut`, so a fill loads no numba); unknown pixels and
@@ -52,6 +70,41 @@ _BIG = 1e6
 DETAIL = 3.0
 #: How far a block moves away from its known pixels, as a fraction of their centroid's offset.
 SHIFT = 2.0 / 3.0
+#: Blocks are searched within this many px of their window (step 3); all of the source when none lies there.
+REACH = 96
+#: Weight of the coarse colour guide (step 4; colour images only); 0 = none.
+GUIDE = 3.0
+#: The guide is a diffusion fill of the hole at 1/GUIDE_SCALE; the blocks are blurred by GUIDE_SCALE / 2 to meet it.
+GUIDE_SCALE = 4
+#: A neighbouring block's copy is continued when it costs at most (1 + COHERE) times the best (step 5).
+COHERE = 1.0
+#: How many of the copies already in a window (the most frequent first) are tried for continuing.
+CONTINUE = 4
+
+
+def _chroma(img: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float32: the colour of ``img``'s first three channels less their mean (grey = 0)."""
+    rgb = img[..., :3]
+    return np.ascontiguousarray(rgb - rgb.mean(axis=2, keepdims=True), dtype=np.float32)
+
+
+def _coarse_guide(canvas: np.ndarray, hole: np.ndarray, scale: int) -> np.ndarray:
+    """(H, W, C) float32: the hole filled by diffusion (cv2.inpaint, Telea) at 1/scale, brought back
+    to full size; the known pixels' own values elsewhere (only the hole's are read)."""
+    h, w, c = canvas.shape
+    sh, sw = max(1, h // scale), max(1, w // scale)
+    small = cv2.resize(canvas, (sw, sh), interpolation=cv2.INTER_AREA).reshape(sh, sw, c)
+    cover = cv2.resize(hole.astype(np.float32), (sw, sh), interpolation=cv2.INTER_AREA)
+    known_share = np.maximum(1.0 - cover, 1e-6)[..., None]
+    small = small / known_share  # the mean of the known pixels alone (the hole is 0 in the canvas)
+    shole = (cover > 0.5).astype(np.uint8)
+    out = np.empty_like(small)
+    for k in range(c):
+        ch8 = np.clip(np.rint(small[..., k] * 255), 0, 255).astype(np.uint8)
+        out[..., k] = cv2.inpaint(ch8, shole, 3, cv2.INPAINT_TELEA).astype(np.float32) / 255.0 if shole.any() \
+            else ch8 / 255.0
+    up = cv2.resize(out, (w, h), interpolation=cv2.INTER_LINEAR).reshape(h, w, c)
+    return np.ascontiguousarray(up, dtype=np.float32)
 
 
 def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: int, x1: int) -> None:
@@ -104,6 +157,8 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     known = ~hole  # original known pixels: never written
     have = known.copy()  # known or filled
     filled = np.zeros((h, w), dtype=bool)
+    shift = np.zeros((2, h, w), dtype=np.int32)  # a written pixel's source less its position (dy, dx)
+    cutonly = np.zeros((h, w), dtype=bool)  # the band's known pixels no block has written yet
     if cuttable is not None:
         cuttable = np.asarray(cuttable, dtype=bool) & ~hole
     elif band > 0:  # known pixels within the band may be cut into: they count as filled ones
@@ -112,6 +167,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         cuttable = band_region(hole, band) & ~hole
     if cuttable is not None:
         filled |= cuttable
+        cutonly |= cuttable
     # the search image: the bounding box of the source, its non-source pixels never inside a chosen block
     ys, xs = np.nonzero(src)
     sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
@@ -119,6 +175,11 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
     search_sq = np.ascontiguousarray((search * search).sum(axis=2))
     search_sum = np.ascontiguousarray(search.sum(axis=2))
+    guided = GUIDE > 0 and c >= 3
+    if guided:  # the colour (not the texture) of a coarse diffusion fill steers the blocks: chroma only
+        guide = _chroma(_coarse_guide(canvas, hole, GUIDE_SCALE))
+        blur = _chroma(cv2.GaussianBlur(search, (0, 0), GUIDE_SCALE / 2.0).reshape(search.shape))
+        blur_sq = np.ascontiguousarray((blur * blur).sum(axis=2))
     total = int(hole.sum())
     report = Progress(progress, cancel, total)
     report(0)
@@ -143,25 +204,55 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         win = (slice(y0, y0 + b), slice(x0, x0 + b))
         weight = have[win].astype(np.float32)
         template = np.ascontiguousarray(canvas[win])
+        un = (~have[win]).astype(np.float32)
+        hs, ws = valid.shape
+        ry0, rx0, ry1, rx1 = 0, 0, hs, ws
+        if REACH > 0:  # the locality prior: blocks from near the window, if any lies there
+            ry0, ry1 = max(0, y0 - sy0 - REACH), min(hs, y0 - sy0 + REACH + 1)
+            rx0, rx1 = max(0, x0 - sx0 - REACH), min(ws, x0 - sx0 + REACH + 1)
+            if ry0 >= ry1 or rx0 >= rx1 or not valid[ry0:ry1, rx0:rx1].any():
+                ry0, rx0, ry1, rx1 = 0, 0, hs, ws
+        crop = (slice(ry0, ry1 + b - 1), slice(rx0, rx1 + b - 1))
+        ok = valid[ry0:ry1, rx0:rx1]
         if weight.any():
             # masked SSD = sum M I^2 - 2 sum M T I + sum M T^2 (the squares summed over channels first)
-            energy = cv2.matchTemplate(search_sq, weight, cv2.TM_CCORR)  # sum M I^2
-            cost = energy - 2.0 * cv2.matchTemplate(search, np.ascontiguousarray(template * weight[..., None]), cv2.TM_CCORR)
+            energy = cv2.matchTemplate(search_sq[crop], weight, cv2.TM_CCORR)  # sum M I^2
+            cost = energy - 2.0 * cv2.matchTemplate(search[crop], np.ascontiguousarray(template * weight[..., None]),
+                                                    cv2.TM_CCORR)
             cost += float((weight[..., None] * template * template).sum())
             if DETAIL > 0:  # the contrast term: the block's and the template's standard deviations
                 n = float(weight.sum()) * c
-                s1 = cv2.matchTemplate(search_sum, weight, cv2.TM_CCORR) / n
+                s1 = cv2.matchTemplate(search_sum[crop], weight, cv2.TM_CCORR) / n
                 sq = np.maximum(energy / n - s1 * s1, 0)
                 tm = float((weight[..., None] * template).sum()) / n
                 tv = max(float((weight[..., None] * template * template).sum()) / n - tm * tm, 0.0)
                 cost += DETAIL * n * (np.sqrt(sq) - np.sqrt(tv)) ** 2
-            cost = np.where(valid & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
         else:
-            cost = np.where(valid, 0.0, np.inf)
+            cost = np.zeros(ok.shape, dtype=np.float32)
+        if guided and un.any():
+            g = np.ascontiguousarray(guide[win] * un[..., None])
+            gc = cv2.matchTemplate(blur_sq[crop], un, cv2.TM_CCORR) - 2.0 * cv2.matchTemplate(blur[crop], g, cv2.TM_CCORR)
+            gc += float((g * guide[win]).sum())
+            cost = cost + GUIDE * np.maximum(gc, 0.0)
+        cost = np.where(ok & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
         best = float(cost.min())
         cand = np.flatnonzero(cost.ravel() <= best * (1.0 + EPSILON) + 1e-9)
         pick = int(cand[gen.integers(len(cand))])
         cy, cx = divmod(pick, cost.shape[1])
+        if COHERE > 0:  # continue a neighbouring block's copy when it costs little more: no seam there at all
+            mine = filled[win] & ~cutonly[win]  # pixels earlier blocks wrote
+            if mine.any():
+                shifts, counts = np.unique(shift[:, y0:y0 + b, x0:x0 + b][:, mine].T, axis=0, return_counts=True)
+                conts = []
+                for dy, dx in shifts[np.argsort(-counts, kind="stable")[:CONTINUE]]:
+                    ty, tx = y0 + int(dy) - sy0 - ry0, x0 + int(dx) - sx0 - rx0  # that copy's block here
+                    if 0 <= ty < cost.shape[0] and 0 <= tx < cost.shape[1] and np.isfinite(cost[ty, tx]):
+                        conts.append((float(cost[ty, tx]), ty, tx))
+                if conts:
+                    c_cost, ty, tx = min(conts)
+                    if c_cost <= best * (1.0 + COHERE) + 1e-9:
+                        cy, cx = ty, tx
+        cy, cx = cy + ry0, cx + rx0
         block = search[cy:cy + b, cx:cx + b]
         new_region = ~have[win]
         soft = filled[win]
@@ -174,7 +265,10 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
             new_region |= soft & cut
         left -= int(np.count_nonzero(new_region & ~have[win]))
         canvas[win][new_region] = block[new_region]
+        shift[0][win][new_region] = sy0 + cy - y0
+        shift[1][win][new_region] = sx0 + cx - x0
         filled[win] |= new_region
+        cutonly[win] &= ~new_region
         have[win] |= new_region
         r = b // 2 + 1
         _score(have, score, b, max(0, y0 - r), min(h, y0 + b + r), max(0, x0 - r), min(w, x0 + b + r))
@@ -183,3 +277,4 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     changed = hole if cuttable is None else (hole | cuttable)
     out[changed] = canvas[changed]
     return out.reshape(shape)
+
