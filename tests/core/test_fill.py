@@ -280,3 +280,52 @@ def test_a_default_patch_fits_a_small_image_and_an_even_pixel_patch_is_the_next_
         fill(small, half, engine="pixel", patch=8)
     with pytest.raises(InvalidParameter, match="parameter 'patch' = 64 is outside 3..63 for the patchmatch engine"):
         FillParams(engine="patchmatch", patch=64)
+
+
+def test_band_leaves_a_step_the_texture_itself_has(monkeypatch):
+    """Only the part of a seam's step beyond twice the texture's own step is spread: a noise texture
+    whose hole holds its own pixels changes far less than when every step is spread, and a real step
+    at the edge is still spread."""
+    from weft.core.fill import band
+
+    rng = np.random.default_rng(0)
+    img = (rng.random((48, 48, 1)) * 0.1 + 0.4).astype(np.float32)
+    hole = np.zeros((48, 48), dtype=bool)
+    hole[12:36, 12:36] = True
+    ring = band_region(hole, 2)
+    kept = np.abs(blend_band(img, hole, 2) - img)[ring].mean()
+    stepped = img.copy()
+    stepped[hole] += 0.5
+    assert np.abs(blend_band(stepped, hole, 2) - stepped)[ring].mean() > 0.05
+    monkeypatch.setattr(band, "STEP", 0.0)
+    every = np.abs(blend_band(img, hole, 2) - img)[ring].mean()
+    assert kept < 0.5 * every
+
+
+def test_quilt_continues_neighbouring_copies(monkeypatch):
+    """A block that continues a neighbour's copy is preferred when it costs little more: the fill
+    holds fewer seams, so more of its 7x7 windows are verbatim known ones (lower coherence)."""
+    from weft.core.fill import quilt
+
+    img = load_image(example("gravel")).image[:160, :160]
+    hole = np.zeros(img.shape, dtype=bool)
+    hole[40:100, 40:100] = True
+    default = [metrics.fill_coherence(fill_quilt(img, hole, rng=s), hole) for s in range(3)]
+    monkeypatch.setattr(quilt, "COHERE", 0.0)
+    seams = [metrics.fill_coherence(fill_quilt(img, hole, rng=s), hole) for s in range(3)]
+    assert np.median(default) < 0.9 * np.median(seams)
+
+
+def test_quilt_colour_guide_only_on_colour(monkeypatch):
+    """The coarse colour guide steers the blocks of a colour image (the output changes without it)
+    and plays no part on a grey one (the same output with and without it)."""
+    from weft.core.fill import quilt
+
+    photo = load_image(example("brick")).image[:96, :96]
+    rng = np.random.default_rng(0)
+    colour = np.stack([photo, photo[::-1], rng.random(photo.shape, dtype=np.float32)], axis=2)
+    hole = square_hole(photo.shape)
+    guided, grey = fill_quilt(colour, hole, patch=16, rng=1), fill_quilt(photo, hole, patch=16, rng=1)
+    monkeypatch.setattr(quilt, "GUIDE", 0.0)
+    assert not np.array_equal(fill_quilt(colour, hole, patch=16, rng=1), guided)
+    assert np.array_equal(fill_quilt(photo, hole, patch=16, rng=1), grey)
