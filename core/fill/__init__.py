@@ -23,33 +23,20 @@ quilt engine's cut may also run through the known pixels of the blend band, when
 ``patchmatch`` and ``hybrid`` are given the band too (``cuttable``) and re-synthesise it with the
 hole; the method then runs no Poisson blend for them.
 
-**The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE` (``quilt``). Measured against
-the other two on issue 15's judges (``weft.core.metrics.fill_*``; ground truth in brackets; lower
-coherence is better) and looked at side by side: ``quilt`` has the lowest coherence on the regular
-texture and keeps its straight structure (brick mortar lines continue through the hole and across an
-uncrop), where ``patchmatch`` bends and breaks the mortar lines and leaves a vertical seam in the
-brick uncrop; ``patchmatch`` is better on the stochastic texture (gravel coherence 7.7-7.8 vs
-8.9-9.8) and on the photo, where ``quilt``'s fill reads as a lighter rectangle; ``pixel`` is the
-least coherent everywhere and copies visible junk into the photo. One artefact (the photo) against
-two (both brick cases) decides for ``quilt``. Median of 3 runs (seconds: compute in-process), 2-core machine shared with other jobs, seed 1,
-default patch and band, 256x256 crops of the bundled examples (the measuring script is in the
-hand-in report of issue 15)::
-
-    case                    engine      seconds  coherence      detail       seam
-    gravel hole 96x64       patchmatch  0.05      7.82 (14.58)  1.04 (0.93)  0.97 (1.00)
-                            quilt       0.11      8.93          1.02         0.89
-                            pixel       0.04     12.80          0.88         0.84
-    brick hole 96x64        patchmatch  0.05      1.71 (2.70)   0.93 (1.15)  0.63 (0.61)
-                            quilt       0.07      0.88          0.89         0.59
-                            pixel       0.07      2.38          0.97         0.63
-    chelsea hole 96x64      patchmatch  0.07      4.77 (8.31)   1.33 (1.13)  1.09 (1.19)
-                            quilt       0.14      4.77          0.85         1.08
-                            pixel       0.07      7.19          1.08         1.11
-    brick uncrop 128->256   patchmatch  0.21      1.34 (3.13)   0.76 (0.96)  0.86 (0.99)
-                            quilt       0.27      0.82          0.97         1.12
-                            pixel       0.30      2.06          0.92         0.98
-    brick uncrop 256->384   patchmatch  0.52      1.27          0.84         1.11
-                            quilt       0.71      0.96          1.01         1.25
+**The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE` (``quilt``). Measured
+against the others on issue 15's cases and judges (``python -m benchmarks 'fill-*'``, whole-process
+seconds, seed 1, quiet machine; coherence / detail / seam, the truth's in the README):
+``quilt`` meets every goal on the stochastic texture (gravel 8.78 / 0.94 / 1.06, 0.25 s) and the
+uncrop (0.70 / 1.06 / 1.02, 0.55 s), all but the seam on brick (0.94 / 1.06 / 0.97, 0.24 s), and
+fails coherence and seam on the photo (6.27 / 1.30 / 0.86, 0.40 s); it loads no numba, so its first
+run costs what the second does, and it is the fastest (at or under G'MIC's time on every case).
+``hybrid`` (quilt with 48-px blocks, then the refine) has a lower coherence than ``quilt`` on
+every hole (7.51 / 0.91 / 4.96) but smears the photo (detail 0.75 of the truth's) and leaves a red
+ghost of the spoon's handle there, and its refine costs 0.03-0.06 s more than G'MIC's whole process.
+``patchmatch`` is the best on the photo (4.52 / 1.22 / 1.07) but bends brick mortar (1.10) and pays
+numba's fixed cost in every process (0.83-1.14 s; 3.3 s on a first run). ``pixel`` is the least
+coherent everywhere. No engine meets every goal; ``quilt`` misses the fewest and is the quickest.
+The README's "Fill and extend against the peers" has the tables and the pictures.
 
 Switching the default is the one line :data:`~weft.core.fill.params.DEFAULT_ENGINE`.
 
@@ -57,7 +44,8 @@ Switching the default is the one line :data:`~weft.core.fill.params.DEFAULT_ENGI
 quilting engine's minimum-error cut may run through the known pixels within ``band`` px of the hole,
 and then the pixels within ``band`` px (8-connected) of the hole's edge, on both sides, are re-solved by a Poisson
 equation whose guidance is the image's own gradients except across the hole's edge, where the
-step is replaced by the continued slope of both sides (:mod:`weft.core.fill.band`); every pixel
+step beyond twice the texture's own is replaced by the continued slope of both sides
+(:mod:`weft.core.fill.band`; ``patchmatch`` and ``hybrid`` re-synthesise the band instead); every pixel
 further away is bit-identical to the input. ``--band 0``: no known pixel changes.
 
 **Alpha.** The image keeps its alpha channel (``InputSpec.alpha``): with no mask its transparent pixels
