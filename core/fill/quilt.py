@@ -6,7 +6,13 @@ One block at a time, until no pixel of the hole is left:
 1. **Fill-front order.** Among the unknown pixels next to a known (or already filled) one, the next
    block is centred on the one whose ``B x B`` window holds the most known or filled pixels (a box
    filter of the known mask; ties: the first in scan order). Concave corners of the hole, where the
-   most context is, are filled first; the front moves inwards.
+   most context is, are filled first; the front moves inwards. On colour images that count is
+   multiplied by ``1 + DATA * g / G`` (``g`` the mean gradient magnitude of the window's original
+   known pixels, ``G`` that of the whole known region): edges that run into the hole are continued
+   before the flat regions beside them grow over them (Criminisi et al.'s data term, simplified).
+   On the photo case (a spoon over a saucer's rim, seeds 0-4 medians) it took the seam figure from
+   0.21 under the truth's to 0.02 and coherence 6.35 -> 6.09, at no cost in time; on grey brick it
+   took coherence 1.04 -> 1.35, so grey images keep the count alone.
 2. **SSD over known pixels only.** The window's known and filled pixels are the template; the cost
    of every source position is the masked sum of squared differences over them, all colour channels
    (``sum M I^2 - 2 sum M T I + sum M T^2``: two ``cv2.matchTemplate`` correlations, the source's
@@ -80,6 +86,8 @@ GUIDE_SCALE = 4
 COHERE = 1.0
 #: How many of the copies already in a window (the most frequent first) are tried for continuing.
 CONTINUE = 4
+#: Weight of the structure term in the fill order (step 1; colour images only); 0 = the count alone.
+DATA = 3.0
 
 
 def _chroma(img: np.ndarray) -> np.ndarray:
@@ -107,7 +115,21 @@ def _coarse_guide(canvas: np.ndarray, hole: np.ndarray, scale: int) -> np.ndarra
     return np.ascontiguousarray(up, dtype=np.float32)
 
 
-def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: int, x1: int) -> None:
+def _edges(canvas: np.ndarray, known: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The structure term's inputs (step 1): float32 (H, W) gradient magnitude of the known pixels
+    whose 3x3 neighbourhood is known (0 elsewhere, ~normalised by its mean there) and that mask."""
+    grey = canvas.mean(axis=2).astype(np.float32)
+    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
+    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
+    inner = cv2.erode(known.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
+                      borderValue=1) > 0
+    mag = np.where(inner, np.sqrt(gx * gx + gy * gy), 0.0).astype(np.float32)
+    mean = float(mag[inner].mean()) if inner.any() else 0.0
+    return (mag / mean if mean > 0 else mag), inner.astype(np.float32)
+
+
+def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: int, x1: int,
+           edges: tuple[np.ndarray, np.ndarray] | None = None) -> None:
     """Recompute ``score`` (see :func:`fill_quilt`) on rows ``[y0, y1)`` and columns ``[x0, x1)``."""
     h, w = have.shape
     m = b // 2 + 2  # context the box filter and the front's dilation read around the region
@@ -118,6 +140,11 @@ def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: in
     near = cv2.dilate(sub.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
                       borderValue=0) > 0
     front = ~sub & near
+    if edges is not None:  # step 1's structure term: count x (1 + DATA g / G)
+        mag, inner = edges[0][ya:yb, xa:xb], edges[1][ya:yb, xa:xb]
+        g = cv2.boxFilter(mag, -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
+        n = cv2.boxFilter(inner, -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
+        count = count * (1.0 + DATA * g / np.maximum(n, 1.0))
     part = np.where(front, count, -1.0)
     score[y0:y1, x0:x1] = part[y0 - ya:y1 - ya, x0 - xa:x1 - xa]
 
@@ -186,7 +213,8 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     # score: for an unknown pixel next to a valued one (the front), the valued pixels of the B x B
     # window centred on it; -1 elsewhere. Updated around each block only.
     score = np.full((h, w), -1.0, dtype=np.float32)
-    _score(have, score, b, 0, h, 0, w)
+    edges = _edges(canvas, known) if DATA > 0 and c >= 3 else None
+    _score(have, score, b, 0, h, 0, w, edges)
     left = total
     while left > 0:
         py, px = np.unravel_index(int(np.argmax(score)), score.shape)
@@ -271,7 +299,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         cutonly[win] &= ~new_region
         have[win] |= new_region
         r = b // 2 + 1
-        _score(have, score, b, max(0, y0 - r), min(h, y0 + b + r), max(0, x0 - r), min(w, x0 + b + r))
+        _score(have, score, b, max(0, y0 - r), min(h, y0 + b + r), max(0, x0 - r), min(w, x0 + b + r), edges)
         report(total - left)
     out = img.copy()
     changed = hole if cuttable is None else (hole | cuttable)

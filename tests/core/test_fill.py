@@ -329,3 +329,32 @@ def test_quilt_colour_guide_only_on_colour(monkeypatch):
     monkeypatch.setattr(quilt, "GUIDE", 0.0)
     assert not np.array_equal(fill_quilt(colour, hole, patch=16, rng=1), guided)
     assert np.array_equal(fill_quilt(photo, hole, patch=16, rng=1), grey)
+
+
+def test_quilt_fill_order_puts_an_edge_first_on_colour_only(monkeypatch):
+    """Step 1's structure term: of two front pixels whose windows hold as many known pixels, the
+    one whose known pixels carry an edge is filled first on a colour image; a grey image keeps the
+    count alone (the same output with and without the term)."""
+    from weft.core.fill import quilt
+
+    h, w, b = 64, 96, 16
+    img = np.full((h, w, 3), 0.5, np.float32)
+    img[:, 70:] = (0.8, 0.2, 0.1)  # an edge at x = 70, in the right half only
+    hole = np.zeros((h, w), dtype=bool)
+    hole[24:40, 8:88] = True  # a slot across both halves: the front is alike on both sides
+    known = ~hole
+    canvas = np.where(hole[..., None], 0.0, img).astype(np.float32)
+    plain = np.full((h, w), -1.0, np.float32)
+    quilt._score(known, plain, b, 0, h, 0, w)
+    boosted = np.full((h, w), -1.0, np.float32)
+    quilt._score(known, boosted, b, 0, h, 0, w, quilt._edges(canvas, known))
+    assert plain[24, 30] == plain[24, 70] > 0  # the count alone cannot tell them apart
+    assert boosted[24, 70] > 1.5 * boosted[24, 30]  # the edge's window goes first
+    py, px = np.unravel_index(int(np.argmax(boosted)), boosted.shape)
+    assert abs(px - 70) <= b // 2
+
+    photo = load_image(example("brick")).image[:96, :96]
+    square = square_hole(photo.shape)
+    grey = fill_quilt(photo, square, patch=16, rng=1)
+    monkeypatch.setattr(quilt, "DATA", 0.0)
+    assert np.array_equal(fill_quilt(photo, square, patch=16, rng=1), grey)
