@@ -28,11 +28,11 @@ against the others on issue 15's cases and judges (``python -m benchmarks 'fill-
 seconds, seed 1, quiet machine; coherence / detail / seam, the truth's in the README):
 ``quilt`` meets every goal on the stochastic texture (gravel 8.78 / 0.94 / 1.06, 0.25 s) and the
 uncrop (0.70 / 1.06 / 1.02, 0.55 s), all but the seam on brick (0.94 / 1.06 / 0.97, 0.24 s), and
-fails coherence and seam on the photo (6.27 / 1.30 / 0.86, 0.40 s); it loads no numba, so its first
+all but coherence on the photo (6.53 / 1.35 / 1.00, 0.39 s); it loads no numba, so its first
 run costs what the second does, and it is the fastest (at or under G'MIC's time on every case).
 ``hybrid`` (quilt with 48-px blocks, then the refine) has a lower coherence than ``quilt`` on
-every hole (7.51 / 0.91 / 4.96) but smears the photo (detail 0.75 of the truth's) and leaves a red
-ghost of the spoon's handle there, and its refine costs 0.03-0.06 s more than G'MIC's whole process.
+every hole (7.51 / 0.91 / 5.56) but leaves a red ghost of the spoon's handle on the photo, and its
+refine costs 0.03-0.06 s more than G'MIC's whole process.
 ``patchmatch`` is the best on the photo (4.52 / 1.22 / 1.07) but bends brick mortar (1.10) and pays
 numba's fixed cost in every process (0.83-1.14 s; 3.3 s on a first run). ``pixel`` is the least
 coherent everywhere. No engine meets every goal; ``quilt`` misses the fewest and is the quickest.
