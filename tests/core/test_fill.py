@@ -11,23 +11,9 @@ from weft.core.fill import ENGINES, FillParams, fill, fill_pixel, fill_quilt
 from weft.core.fill.band import band_region, blend_band
 from weft.core.image import load_image
 
+from .fill_cases import brick, gravel, square_hole  # noqa: F401 (fixtures)
+
 ENGINE_FUNCS = {"quilt": fill_quilt, "pixel": fill_pixel}
-
-
-@pytest.fixture(scope="module")
-def gravel():
-    return load_image(example("gravel")).image[:96, :96]
-
-
-@pytest.fixture(scope="module")
-def brick():
-    return load_image(example("brick")).image[:96, :96]
-
-
-def square_hole(shape, y0=32, y1=60, x0=30, x1=66):
-    hole = np.zeros(shape[:2], dtype=bool)
-    hole[y0:y1, x0:x1] = True
-    return hole
 
 
 @pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))

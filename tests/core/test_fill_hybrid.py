@@ -8,29 +8,13 @@ import pytest
 
 from weft.core import metrics
 from weft.core.errors import Cancelled, ImageError, InvalidParameter, WeftError
-from weft.core.examples import example
 from weft.core.fill import fill, fill_quilt
 from weft.core.fill.band import band_region
 from weft.core.fill.hybrid import fill_hybrid
 from weft.core.fill.patchmatch import refine_patchmatch
-from weft.core.image import load_image
 from weft.core.jobs import CancelToken
 
-
-@pytest.fixture(scope="module")
-def gravel():
-    return load_image(example("gravel")).image[:96, :96]
-
-
-@pytest.fixture(scope="module")
-def brick():
-    return load_image(example("brick")).image[:96, :96]
-
-
-def square_hole(shape, y0=32, y1=60, x0=30, x1=66):
-    hole = np.zeros(shape[:2], dtype=bool)
-    hole[y0:y1, x0:x1] = True
-    return hole
+from .fill_cases import brick, gravel, square_hole  # noqa: F401 (fixtures)
 
 
 def _quilted(img, hole, seed=1):
