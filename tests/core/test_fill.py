@@ -342,5 +342,8 @@ def test_quilt_fill_order_puts_an_edge_first_on_colour_only(monkeypatch):
     photo = load_image(example("brick")).image[:96, :96]
     square = square_hole(photo.shape)
     grey = fill_quilt(photo, square, patch=16, rng=1)
+    as_rgb = np.repeat(photo[..., None], 3, axis=2)  # a grey picture stored as RGB is grey too
+    grey_rgb = fill_quilt(as_rgb, square, patch=16, rng=1)
     monkeypatch.setattr(quilt, "DATA", 0.0)
     assert np.array_equal(fill_quilt(photo, square, patch=16, rng=1), grey)
+    assert np.array_equal(fill_quilt(as_rgb, square, patch=16, rng=1), grey_rgb)
