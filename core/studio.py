@@ -164,6 +164,9 @@ class Studio:
         studio's method): the studio shares inputs by name between methods, and an image opened as
         another method's input of that name must not change what this one does (``fill``'s optional
         ``texture``, a source to copy from, is not ``quilt``'s texture).
+    masks_of : inputs that are masks of another input without being painted (opened as files): each
+        belongs to the first of its images that is open (``fill``'s ``source_mask`` is the texture's
+        when one is open, else the image's); :func:`crop_around` crops it with that image.
     """
 
     title: str
@@ -178,6 +181,7 @@ class Studio:
     figures: Mapping[str, Figure] = field(default_factory=dict)
     preview_around: str | None = None
     own_inputs: tuple[str, ...] = ()
+    masks_of: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     def describe(self, figures: Mapping[str, Any]) -> list[str]:
         """A result's figures in words and units (see :func:`describe_figures`)."""
@@ -277,11 +281,6 @@ class Around:
         return out
 
 
-def _zeros_and_ones(part: np.ndarray) -> bool:
-    """Every sample of ``part`` is 0 or 1 (a mask's, not a picture's)."""
-    return bool(((part == 0) | (part == 1)).all())
-
-
 def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke: tuple[float, float, float, float],
                 *, side: int = AROUND_SIDE, context: int = 16) -> Around | None:
     """What to render while a stroke paints the mask input ``studio.preview_around``: the inputs
@@ -292,11 +291,9 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     included). The crop is the bounding box of the mask's pixels within the stroke's box grown by
     ``context`` px, grown again by ``context`` px and by a quarter of its side (known pixels around
     the hole to copy from), clipped to the image. Only what belongs to the painted image is cropped
-    alike: the image, the masks painted on it, and other inputs of its size that are masks (every
-    sample 0 or 1 within the crop, e.g. a source mask opened as a file). An image of its own (a
-    second texture to copy from) is kept whole even when it is the painted image's size, and so are
-    the masks of its size then (they may be its own: fill's source mask goes with its texture when
-    one is given); an input of another size is kept whole. A crop longer than
+    alike: the image, the masks painted on it, and the masks ``studio.masks_of`` gives to it (a
+    source mask opened as a file, unless its texture is open); every other input (a second texture
+    to copy from, even of the image's size) is kept whole. A crop longer than
     ``side`` is scaled down to it (``area``, a mask thresholded back to 0/1). Parameters filled by a
     margins geometry on that image are reset to their defaults (the crop is not uncropped) and their
     left/top margins give :attr:`Around.offset`. None when the studio previews no mask that way,
@@ -334,12 +331,10 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     k = min(1.0, side / max(x1 - x0, y1 - y0))
     size = (max(8, round((x1 - x0) * k)), max(8, round((y1 - y0) * k)))
     small = dict(inputs)
-    painted = {on} | {m.input for m in studio.geometry if m.kind == MASK and m.input_for(inputs) == on}
-    others = [n for n, img in inputs.items() if n not in painted and img.shape[:2] == (h, w)]
-    maskish = {n for n in others if _zeros_and_ones(inputs[n][y0:y1, x0:x1])}
-    crop = painted | (maskish if maskish == set(others) else set())  # an image of its own: its size stays whole
+    crop = {on} | {m.input for m in studio.geometry if m.kind == MASK and m.input_for(inputs) == on}
+    crop |= {n for n, of in studio.masks_of.items() if next((i for i in of if i in inputs), None) == on}
     for n, img in inputs.items():
-        if n not in crop:
+        if n not in crop or img.shape[:2] != (h, w):  # a mask of another size: the method says so
             continue
         part = np.ascontiguousarray(img[y0:y1, x0:x1])
         if k < 1.0:

@@ -20,7 +20,7 @@ class HoleParams(Params):
     grow: Margins = param(None, kind="geometry", type=Margins, optional=True, help="margins")
 
 
-STUDIO = Studio(title="t", canvas="picture", preview_around="hole",
+STUDIO = Studio(title="t", canvas="picture", preview_around="hole", masks_of={"source": ("texture", "picture")},
                 geometry=(Geometry(MASK, on=("picture",), input="hole"),
                           Geometry(MARGINS, on=("picture",), param="grow")))
 
