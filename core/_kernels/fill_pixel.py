@@ -59,6 +59,8 @@ def fill_pixels(canvas, have, pos, src, valid, order, start, stop, r, n_random, 
     """
     h, w, c = canvas.shape
     hs, ws = valid.shape
+    # the random candidates' positions (y * ws + x): two loops, not np.flatnonzero(valid), whose
+    # compile made a first pixel fill 0.18 s slower (1.37 against 1.19 s, fresh NUMBA_CACHE_DIR, 3 each)
     nvalid = 0
     for y in range(hs):
         for x in range(ws):
