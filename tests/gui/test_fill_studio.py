@@ -137,6 +137,16 @@ def _stroke(view, points, *, release=True):
         mouse(view, "release", points[-1])
 
 
+def _previewed(window, qtbot, view, points, timeout=10000):
+    """Press and drag through ``points`` without releasing; the previews shown around the stroke
+    (``renderer.around_shown``), once the first has come."""
+    around = []
+    window.renderer.around_shown.connect(around.append)
+    _stroke(view, points, release=False)
+    qtbot.waitUntil(lambda: len(around) > 0, timeout=timeout)
+    return around
+
+
 def _painted(overlay) -> np.ndarray:
     """Where the mask's overlay is drawn (its alpha), as a bool (H, W) array."""
     image = overlay.image().convertToFormat(QImage.Format.Format_RGBA8888)
@@ -560,10 +570,7 @@ def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     CALLS.clear()
-    around = []
-    studio.renderer.around_shown.connect(around.append)
-    _stroke(view, [(10.5, 10.5), (14.5, 12.5)], release=False)
-    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     shown = around[-1]
     assert not shown.final and shown.image.shape == (H, W, 3)
     assert CALLS and max(CALLS[0]) < max(H, W) and max(CALLS[0]) <= AROUND_SIDE  # a crop, not the whole picture
@@ -599,10 +606,7 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
 
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
-    around = []
-    studio.renderer.around_shown.connect(around.append)
-    _stroke(view, [(10.5, 10.5), (14.5, 12.5)], release=False)
-    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     text = studio.statusBar().currentMessage()
     assert re.fullmatch(r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?: "
                         r"filled \d+ px", text), text
@@ -846,10 +850,7 @@ def test_esc_on_the_first_stroke_after_a_method_switch_shows_the_picture_again(s
     view.zoom_by(4.0)
     view.centerOn(W / 2, H / 2)
     studio.inputs_pane.mask_tool().set_size(9)
-    around = []
-    studio.renderer.around_shown.connect(around.append)
-    _stroke(view, [(20.5, 20.5), (30.5, 20.5)], release=False)
-    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    around = _previewed(studio, qtbot, view, [(20.5, 20.5), (30.5, 20.5)])
     assert not np.array_equal(studio.result_view.image, studio.doc.image("picture"))  # the stroke's preview
     view.setFocus()
     qtbot.keyClick(view, Qt.Key.Key_Escape)
@@ -866,10 +867,7 @@ def test_a_stroke_that_changes_nothing_ends_its_preview_with_no_undo_step(studio
     studio.inputs_pane.mask_tool().set_size(9)
     result = _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (40.5, 20.5)]))
     steps = doc.undo_stack.count()
-    around = []
-    studio.renderer.around_shown.connect(around.append)
-    _stroke(view, [(30.5, 20.5), (31.5, 20.5)], release=False)  # over what is painted already
-    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    around = _previewed(studio, qtbot, view, [(30.5, 20.5), (31.5, 20.5)])  # over what is painted already
     assert doc.live is not None
     assert not np.array_equal(studio.result_view.image, result.image)  # the crop's own mean: other pixels
     with qtbot.waitSignal(studio.renderer.shown, timeout=10000) as shown:  # the full result again
@@ -886,10 +884,7 @@ def test_an_eraser_stroke_is_previewed_live(studio, qtbot):
     _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 30.5), (60.5, 30.5)]))
     qtbot.mouseClick(bar.mode_buttons["eraser"], Qt.MouseButton.LeftButton)
     tool.set_size(5)
-    around = []
-    studio.renderer.around_shown.connect(around.append)
-    _stroke(view, [(35.5, 24.5), (35.5, 36.5)], release=False)
-    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    around = _previewed(studio, qtbot, view, [(35.5, 24.5), (35.5, 36.5)])
     live = doc.live[1]
     assert not live.bits[28:33, 34:37].any() and live.bits[30, 30]
     source = doc.image("picture")
@@ -967,10 +962,7 @@ def test_after_clear_mask_a_strokes_previews_are_pasted_into_the_picture_not_the
     assert not np.array_equal(old.image[6:15, 6:35], source[6:15, 6:35])
     with qtbot.waitSignal(studio.renderer.failed, timeout=10000):
         qtbot.mouseClick(bar.clear_button, Qt.MouseButton.LeftButton)
-    around = []
-    studio.renderer.around_shown.connect(around.append)
-    _stroke(view, [(60.5, 50.5), (64.5, 52.5)], release=False)
-    qtbot.waitUntil(lambda: len(around) > 0, timeout=10000)
+    around = _previewed(studio, qtbot, view, [(60.5, 50.5), (64.5, 52.5)])
     assert np.array_equal(around[-1].image[:20, :40], source[:20, :40])  # the cleared stroke is not back
     assert np.array_equal(studio.result_view.image, around[-1].image)
     view.setFocus()
