@@ -352,9 +352,9 @@ def warm_up() -> None:
     transfer(tiny, size=(8, 8), n=3, rng=0)
 
 
-def _auto(params: FastParams, open_inputs: frozenset) -> dict:
-    """What "auto" resolves to with these inputs (the studio shows it beside the box)."""
-    resolved = params.resolved("target" in open_inputs)
+def _auto(params: FastParams, shapes: Mapping[str, tuple]) -> dict:
+    """What "auto" resolves to with inputs of these shapes (the studio shows it beside the box)."""
+    resolved = params.resolved("target" in shapes)
     return {name: getattr(resolved, name) for name in ("p", "p_l")}
 
 

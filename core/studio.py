@@ -149,8 +149,11 @@ class Studio:
     preview_inputs : inputs scaled down for a preview while a slider moves (the output follows them).
     preview_params : size parameters ``(width, height)`` scaled down for a preview instead, when
         none of ``preview_inputs`` is open.
-    auto : ``auto(params, open_inputs) -> {name: value}``: what the optional ("auto") parameters
-        resolve to for these inputs, shown greyed beside their "auto" box; may raise ``WeftError``.
+    auto : ``auto(params, shapes) -> {name: value}``: what the optional ("auto") parameters resolve
+        to for these inputs, shown greyed beside their "auto" box; ``shapes`` maps each open input's
+        name to the shape of the array the method would get (a source region's crop, a painted
+        mask's image), so a default may depend on an input's size (quilt's block on the sample's);
+        may raise ``WeftError``.
     compare : the "before" image of Compare: the first of these inputs that is open (default the canvas).
     examples : a bundled example (``weft.core.examples``) per input, opened when the studio starts.
     rank : position in the method list (lowest first; the first is the studio's starting method).
@@ -174,7 +177,7 @@ class Studio:
     geometry: tuple[Geometry, ...] = ()
     preview_inputs: tuple[str, ...] = ()
     preview_params: tuple[str, ...] = ()
-    auto: Callable[[Any, frozenset], Mapping[str, Any]] | None = None
+    auto: Callable[[Any, Mapping[str, tuple]], Mapping[str, Any]] | None = None
     compare: tuple[str, ...] = ()
     examples: Mapping[str, str] = field(default_factory=dict)
     rank: int = 100
@@ -191,12 +194,13 @@ class Studio:
         """The geometry drawn on ``input_name`` given the open inputs."""
         return tuple(g for g in self.geometry if g.input_for(open_inputs) == input_name)
 
-    def resolved(self, params, open_inputs) -> dict[str, Any]:
-        """What "auto" parameters resolve to (empty if the method says nothing or refuses the inputs)."""
+    def resolved(self, params, shapes: Mapping[str, tuple]) -> dict[str, Any]:
+        """What "auto" parameters resolve to for inputs of these shapes (input name -> array shape;
+        empty if the method says nothing or refuses the inputs)."""
         if self.auto is None:
             return {}
         try:
-            return dict(self.auto(params, frozenset(open_inputs)))
+            return dict(self.auto(params, {name: tuple(shape) for name, shape in shapes.items()}))
         except WeftError:
             return {}
 

@@ -151,9 +151,19 @@ def test_too_small_texture_names_file_size_and_minimum(corpus, tmp_path, capsys,
 
 
 def test_parameter_that_does_not_fit_names_the_file(corpus, tmp_path, capsys):
-    path = corpus["thin_2x3000"]  # wide enough for quilting's minimum block (2), not for the default 32
+    path = corpus["thin_2x3000"]  # wide enough for quilting's minimum block (2), not for block 8
     out = tmp_path / "out.png"
-    code = cli.main(["quilt", str(path), "--size", "24x24", "-o", str(out), "-q"])
+    code = cli.main(["quilt", str(path), "--size", "24x24", "--block", "8", "-o", str(out), "-q"])
     err = capsys.readouterr().err.strip()
     assert code == 2 and not out.exists()
-    assert err == f"weft: {path}: parameter 'block' = 32 is outside 2..2 (must fit in the texture, 2x3000)"
+    assert err == f"weft: {path}: parameter 'block' = 8 is outside 2..2 (must fit in the texture, 2x3000)"
+
+
+def test_default_block_fits_a_thin_sample(corpus, tmp_path):
+    """The synthesis block defaults to a share of the sample's shorter side, so a sample 2 px wide
+    quilts with the defaults (a fixed default block refused it)."""
+    from weft.core.image import load_image
+
+    out = tmp_path / "out.png"
+    assert cli.main(["quilt", str(corpus["thin_2x3000"]), "--size", "24x24", "-o", str(out), "-q"]) == 0
+    assert load_image(out).image.shape[:2] == (24, 24)

@@ -236,3 +236,19 @@ def test_fill_weft_rows_run_the_command_line_on_a_hole_and_an_uncrop():
     row = fill.run_fill_case(uncrop, repeats=1, quick=True, tools=fill.tools_named(["weft"])[:1])[0]
     assert "error" not in row, row
     assert row["known_max"] == 0 and row["unfilled"] < 0.05 and row["size"] == [64, 64]
+
+
+def test_quilt_samples_tables_old_and_new_defaults(capsys):
+    """``python -m benchmarks.quilt_samples``: one row per sample with the resolved default block and
+    each figure old -> new; the new figures are the defaults' own."""
+    from benchmarks import quilt_samples
+    from weft.core.metrics import coherence
+    from weft.core.quilting import METHOD, QuiltParams
+
+    assert quilt_samples.main(["--seeds", "1", "--samples", "cat-fur"]) == 0
+    row = capsys.readouterr().out.strip().splitlines()[-1]
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[0] == "cat-fur 104x104" and cells[1] == "46"
+    tex = quilt_samples.sample("cat-fur")
+    new = coherence(METHOD.run({"texture": tex}, QuiltParams(size=(208, 208)), rng=0).image, tex)
+    assert cells[2].split(" → ")[1] == f"{new:.4f}"

@@ -212,6 +212,25 @@ class Document(QObject):
             out[g.on[0]] = region.crop(out[g.on[0]], what=g.on[0].replace("_", " "))
         return out
 
+    def input_shapes(self) -> dict[str, tuple[int, ...]]:
+        """The shapes of what :meth:`method_inputs` gives the current method (input name -> array
+        shape), without building it: what its "auto" parameters depend on (``Studio.resolved``)."""
+        painted = {g.input for g in self.studio.geometry if g.kind == MASK}
+        out = {}
+        for spec in self.current.inputs:
+            item = self.item(spec.name)
+            if item is not None and spec.name not in painted:
+                keep = spec.alpha and item.with_alpha is not None
+                out[spec.name] = (item.with_alpha if keep else item.image).shape
+        out.update({name: mask.shape for name, mask in self.masks().items()})
+        region = self.region()
+        g = next((g for g in self.studio.geometry if g.param is None and g.kind == SQUARE), None)
+        if region is not None and g is not None and g.on[0] in out:
+            shape = out[g.on[0]]
+            if region.x + region.side <= shape[1] and region.y + region.side <= shape[0]:
+                out[g.on[0]] = (region.side, region.side) + tuple(shape[2:])
+        return out
+
     def run_params(self, *, live: bool = True) -> Params:
         """The current method's parameters as a run uses them: its geometry put into the parameters it
         fills (typed; with ``live``, the one being dragged instead of the stored one)."""

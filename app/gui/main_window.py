@@ -508,6 +508,7 @@ class MainWindow(QMainWindow):
         elif what == "geometry":
             self.inputs_pane.geometry_changed()
             self.method_panel.show_square()
+            self.method_panel.show_params()  # an "auto" value may depend on the source region's size
             self.renderer.final()
         elif what == "seed":
             self.method_panel.show_seed()

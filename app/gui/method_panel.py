@@ -194,7 +194,7 @@ class MethodPanel(QWidget):
 
     def show_params(self) -> None:
         doc = self.doc
-        self.params_panel.show_params(doc.current_params, doc.studio.resolved(doc.current_params, doc.inputs))
+        self.params_panel.show_params(doc.current_params, doc.studio.resolved(doc.current_params, doc.input_shapes()))
 
     def show_seed(self) -> None:
         self.seed_box.blockSignals(True)

@@ -127,7 +127,7 @@ class VariationsDialog(QDialog):
         params = self.doc.params[self.method]
         current = getattr(params, spec.name)
         if current is None:
-            current = self.doc.studio.resolved(params, self.doc.inputs).get(spec.name)
+            current = self.doc.studio.resolved(params, self.doc.input_shapes()).get(spec.name)
         if current is None:
             current = spec.default if spec.default is not None else spec.lo
         span = (spec.hi - spec.lo) / 4

@@ -345,7 +345,7 @@ METHOD = Method(
                            help="drag to draw feature lines; drag an end to move it; click a line + "
                                 "Delete to remove it"),),
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
-        auto=lambda params, open_inputs: {"sigma_d": params.overlap / 2.0}, rank=3,
+        auto=lambda params, shapes: {"sigma_d": params.overlap / 2.0}, rank=3,
         figures={**{f"rectify_{k}": f.prefixed("rectification") if f.unit == "px" else f
                     for k, f in RECTIFY_FIGURES.items()},
                  "patches": Figure("patches"), "repaired_pixels": Figure("repaired pixels"),

@@ -9,7 +9,7 @@ from ..errors import InvalidParameter
 from ..image import validate_image
 from ..params import out_of_range
 from ..grid import block_grid
-from .params import ITERATIVE_BLOCK, SYNTH_BLOCK, TRANSFER_BLOCK, QuiltParams, _round_half_up, transfer_schedule
+from .params import ITERATIVE_BLOCK, TRANSFER_BLOCK, QuiltParams, _round_half_up, synth_block, transfer_schedule
 
 # --------------------------------------------------------------------------------------------
 # checks shared by synthesis and transfer
@@ -117,7 +117,7 @@ def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: QuiltParams) 
         return _memory_need(tex, out_w, out_h, passes, tile=params.tile, transfer=True)
     if params.mode == "random":
         return 0.0
-    b = params.block or SYNTH_BLOCK
+    b = params.block or synth_block(tex)
     ov = params.overlap if params.overlap is not None else max(1, -(-b // 6))
     out_w, out_h = params.size if params.size is not None else (2 * tex[1], 2 * tex[0])
     return _memory_need(tex, out_w, out_h, [(b, ov)], tile=params.tile, transfer=False)

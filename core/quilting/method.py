@@ -10,7 +10,7 @@ from ..params import out_of_range
 from ..registry import InputSpec, Method, Result
 from ..studio import SQUARE, Figure, Geometry, Studio
 from .checks import _blocks, _transfer_passes, memory_estimate
-from .params import SYNTH_BLOCK, QuiltParams
+from .params import QuiltParams, synth_block, synth_tol
 from .synthesis import _synthesize, synthesize
 from .transfer import _transfer, transfer
 
@@ -29,7 +29,7 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
         if params.iterations > 1:
             raise out_of_range("iterations", params.iterations, 1, 1, "more passes need a target (--target)")
         mode = params.mode
-        block = params.block or SYNTH_BLOCK
+        block = params.block or synth_block(texture.shape)
         record: dict = {}
         image = _synthesize(texture, params, rng=rng, progress=progress, cancel=cancel, record=record)
         h, w = image.shape[:2]
@@ -51,15 +51,18 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
     return Result(image, {"iterations": len(images)})
 
 
-def _auto(params: QuiltParams, open_inputs: frozenset) -> dict:
-    """What "auto" block and overlap resolve to with these inputs (the studio shows them beside
-    their box, and unticking "auto" starts from them): a transfer's first pass, or the synthesis
-    defaults."""
-    if "target" in open_inputs:
+def _auto(params: QuiltParams, shapes: Mapping[str, tuple]) -> dict:
+    """What "auto" block, overlap and tol resolve to with inputs of these shapes (the studio shows
+    them beside their box, and unticking "auto" starts from them): a transfer's first pass, or the
+    synthesis defaults (the block from the sample's size; nothing for it before a sample is open)."""
+    if "target" in shapes:
         block, overlap, _alpha = _transfer_passes(params)[0]
-        return {"block": block, "overlap": overlap}
-    block = params.block or SYNTH_BLOCK
-    return {"block": block, "overlap": params.overlap if params.overlap is not None else max(1, -(-block // 6))}
+        return {"block": block, "overlap": overlap, "tol": params.tol or 1}
+    if params.block is None and "texture" not in shapes:
+        return {}
+    block = params.block or synth_block(shapes["texture"])
+    return {"block": block, "overlap": params.overlap if params.overlap is not None else max(1, -(-block // 6)),
+            "tol": params.tol or synth_tol(block)}
 
 
 def warm_up() -> None:

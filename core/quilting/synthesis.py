@@ -10,7 +10,7 @@ from ..params import as_rng
 from ..grid import block_grid
 from .engine import _Pass, _quilt_pass
 from .checks import _check_block_fits, _check_limits, _check_overlap, _check_texture, _check_tile_size, _finish
-from .params import SYNTH_BLOCK, SYNTH_TOL, QuiltParams
+from .params import QuiltParams, synth_block, synth_tol
 
 # --------------------------------------------------------------------------------------------
 # synthesis
@@ -43,7 +43,8 @@ def synthesize(
     size : (width, height), optional
         Output size in pixels (1..16384 per side). Default: twice the texture's size.
     block : int, optional
-        Block side B in pixels, 2..min(H, W) of the texture; default (None) 32.
+        Block side B in pixels, 2..min(H, W) of the texture; default (None) 7/16 of min(H, W)
+        rounded, at most 56 (:func:`weft.core.quilting.params.synth_block`).
     overlap : int, optional
         Overlap between neighbouring blocks, 1..B-1; default ceil(B / 6) (E&F §2.1: "the size of
         the overlap was 1/6 of the size of the block"). Unused in ``random`` mode.
@@ -54,7 +55,7 @@ def synthesize(
         of the texture, and pasted over them (Fig. 2b). ``mincut``: as ``overlap``, then pasted only
         on its side of the minimum-error boundary cut through the overlap (Fig. 2c, :mod:`weft.core.seams`).
     tol : int, optional
-        Default (None) 2. Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD positions (Ngo's ``tol``; 1 =
+        Default (None) 2, or 6 from block 48 up. Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD positions (Ngo's ``tol``; 1 =
         always the best). In ``mincut`` mode the seam rule takes its place: of the ``4 x tol``
         lowest-cost positions, the one whose minimum-error cut runs through the least error
         (``weft.core.quilting.engine.SEAM_POOL``).
@@ -109,9 +110,10 @@ def synthesize(
 def _synthesize(texture: np.ndarray, params: QuiltParams, *, rng=None, progress=None, cancel=None,
                 record: dict | None = None) -> np.ndarray:
     """:func:`synthesize` with its options in ``params`` (``None`` block and tol: the synthesis defaults)."""
-    if params.block is None or params.tol is None:
-        params = params.replace(block=params.block or SYNTH_BLOCK, tol=params.tol or SYNTH_TOL)
     tex = _check_texture(texture)
+    if params.block is None or params.tol is None:
+        block = params.block or synth_block(tex.shape)
+        params = params.replace(block=block, tol=params.tol or synth_tol(block))
     h, w = tex.shape[:2]
     b = params.block
     _check_block_fits(b, tex)

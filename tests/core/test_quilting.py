@@ -312,17 +312,20 @@ def test_seam_rule_kernels_match_numpy():
 
 
 @pytest.mark.parametrize("shape, sides", [((16, 16), (5, 5, 0, 0)), ((16, 16), (0, 5, 0, 0)), ((16, 16), (5, 0, 0, 0)),
-                                          ((16, 16), (5, 5, 5, 5)), ((12, 17), (3, 4, 2, 0)), ((9, 9), (0, 0, 3, 3))])
-def test_stacked_numpy_cuts_match_the_kernel(shape, sides):
+                                          ((16, 16), (5, 5, 5, 5)), ((12, 17), (3, 4, 2, 0)), ((9, 9), (0, 0, 3, 3)),
+                                          ((56, 56), (10, 10, 0, 0)), ((40, 33), (7, 6, 5, 4))])
+@pytest.mark.parametrize("stack", [7, 24])
+def test_stacked_numpy_cuts_match_the_kernel(shape, sides, stack):
     """The numpy engine cuts the seam rule's candidates as one stack (the strips of one shape in one
-    dynamic program) and scores them together: each cut and score is the kernel's, bit for bit."""
+    dynamic program) and scores them together: each cut and score is the kernel's, bit for bit (a
+    large stack's paths are traced by whole-stack steps, a small one's by scalar steps)."""
     from weft.core._kernels import quilting as k
     from weft.core._kernels import seams
     from weft.core.quilting import engine
 
     rng = np.random.default_rng(sum(shape) + sum(sides))
     # few levels, so that ties between paths happen and the tie rules are compared too
-    errs = np.floor(rng.random((7, *shape)) * 4)
+    errs = np.floor(rng.random((stack, *shape)) * 4)
     masks = engine._cut_mask_numpy(errs, *sides)
     scores = engine._seam_errors_numpy(errs, masks)
     for e, m, score in zip(errs, masks, scores):
@@ -406,3 +409,38 @@ def test_synthesis_spreads_its_use_of_the_sample(brick64, monkeypatch):
     for seed, ((s, comp), (s0, _)) in enumerate(zip(spread, without)):
         assert s < s0 - 0.03, seed
         assert comp < 0.008, seed
+
+
+def test_the_default_synthesis_block_scales_with_the_sample(brick64):
+    """Issue 17: the synthesis block defaults to 7/16 of the sample's shorter side (56 for the
+    peers' 128-px brick_128), at most 56 and at least 2, and tol to 2, or 6 from block 48 up; the
+    defaults give exactly the pixels of those explicit values."""
+    from weft.core.quilting import METHOD, QuiltParams, synth_block, synth_tol
+
+    assert [synth_block(s) for s in [(128, 128), (64, 64), (112, 128, 3), (104, 104), (3000, 2), (512, 400)]] \
+        == [56, 28, 49, 46, 2, 56]
+    assert [synth_tol(b) for b in (2, 32, 47, 48, 56, 200)] == [2, 2, 2, 6, 6, 6]
+    out = synthesize(brick64, size=(96, 80), rng=3)
+    assert np.array_equal(out, synthesize(brick64, size=(96, 80), block=28, tol=2, rng=3))
+    assert not np.array_equal(out, synthesize(brick64, size=(96, 80), block=32, tol=2, rng=3))
+    big = np.tile(brick64, (2, 2))  # 128 px: block 56, tol 6
+    out = synthesize(big, size=(120, 120), rng=3)
+    assert np.array_equal(out, synthesize(big, size=(120, 120), block=56, tol=6, rng=3))
+    assert not np.array_equal(out, synthesize(big, size=(120, 120), block=56, tol=2, rng=3))
+    # the run's block count follows the resolved block: 28 / overlap 5 on a 96x80 canvas
+    assert METHOD.run({"texture": brick64}, QuiltParams(size=(96, 80)), rng=3).figures["blocks"] == 4 * 4
+
+
+def test_studio_auto_shows_the_block_the_sample_gives():
+    """What the studio shows beside "auto" comes from the shapes of the open inputs: the sample's
+    size for a synthesis (a source region's crop is such a sample), a transfer's first pass with a
+    target, and no block before a sample is open."""
+    from weft.core.quilting import METHOD, QuiltParams
+
+    studio, params = METHOD.studio, QuiltParams()
+    assert studio.resolved(params, {"texture": (128, 128)}) == {"block": 56, "overlap": 10, "tol": 6}
+    assert studio.resolved(params, {"texture": (40, 60, 3)}) == {"block": 18, "overlap": 3, "tol": 2}
+    assert studio.resolved(params.replace(block=20), {"texture": (128, 128)})["block"] == 20
+    assert studio.resolved(params, {"texture": (128, 128), "target": (64, 64)}) \
+        == {"block": 9, "overlap": 3, "tol": 1}
+    assert studio.resolved(params, {}) == {}

@@ -398,3 +398,29 @@ def test_the_zoom_label_follows_a_refit_when_the_window_is_resized(window, qtbot
     window.resize(window.width() + 300, window.height() + 200)
     qtbot.waitUntil(lambda: abs(result.scale_factor() - before) > 0.01, timeout=5000)
     qtbot.waitUntil(lambda: window.zoom_label.text() == f"result {result.scale_factor() * 100:.0f}%", timeout=5000)
+
+
+def test_auto_block_follows_the_sample_and_its_source_region(window, qtbot):
+    """Issue 17: quilting's synthesis block defaults to a share of the sample's size, so what the
+    studio shows beside "auto" follows the texture, then the square drawn on it (the source region
+    is the sample a run quilts from)."""
+    from .helpers import drag
+
+    doc = window.doc
+    doc.set_method("quilt")
+    doc.clear_input("target")  # a synthesis: the wood-grain sample, 128x112
+    qtbot.waitUntil(lambda: "block" in window.params_panel.rows
+                    and window.params_panel.row("block").auto.isVisible(), timeout=5000)
+    row = window.params_panel.row("block")
+    qtbot.waitUntil(lambda: "now 49" in row.editor.toolTip(), timeout=5000)  # 7/16 of 112
+    view = window.views["texture"]
+    window.input_tabs.setCurrentIndex(0)
+    view.actual_size()
+    view.centerOn(40, 40)
+    drag(view, (8.2, 8.2), (72.2, 72.2))
+    assert doc.square == (8, 8, 64)
+    qtbot.waitUntil(lambda: "now 28" in row.editor.toolTip(), timeout=5000)  # 7/16 of 64
+    qtbot.mouseClick(row.auto, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: doc.current_params.block is not None, timeout=5000)
+    assert doc.current_params.block == 28 and row.editor.value() == 28
+    window.renderer.cancel()
