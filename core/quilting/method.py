@@ -40,7 +40,7 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
             blocks = _blocks(h, w, block, ov, params.tile)
         from ..metrics import verbatim_fraction
 
-        return Result(image, {"blocks": blocks,
+        return Result(image, {"block": block, "blocks": blocks,
                               "verbatim_fraction": round(verbatim_fraction(record["sources"], texture.shape), 4)})
     if params.size is not None:
         raise InvalidParameter("parameter 'size' cannot be given with a target: the transfer has the target's size",
@@ -108,7 +108,7 @@ METHOD = Method(
         preview_inputs=("target", "target_map"), preview_params=("size",), auto=_auto,
         compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=1,
-        figures={"blocks": Figure("blocks"),
+        figures={"block": Figure("block", "px"), "blocks": Figure("blocks"),
                  "verbatim_fraction": Figure("largest verbatim copy", "%", "of the sample", digits=2),
                  "iterations": Figure("passes")}),
 )

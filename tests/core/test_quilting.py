@@ -385,7 +385,7 @@ def test_verbatim_fraction_is_a_figure_of_synthesis(brick64):
 
     res = METHOD.run({"texture": brick64}, QuiltParams(block=16, size=(96, 96)), rng=3)
     assert 0.03 < res.figures["verbatim_fraction"] <= 0.07
-    assert set(res.figures) == {"blocks", "verbatim_fraction"}
+    assert set(res.figures) == {"block", "blocks", "verbatim_fraction"}
 
 
 def test_synthesis_spreads_its_use_of_the_sample(brick64, monkeypatch):
@@ -428,7 +428,8 @@ def test_the_default_synthesis_block_scales_with_the_sample(brick64):
     assert np.array_equal(out, synthesize(big, size=(120, 120), block=56, tol=6, rng=3))
     assert not np.array_equal(out, synthesize(big, size=(120, 120), block=56, tol=2, rng=3))
     # the run's block count follows the resolved block: 28 / overlap 5 on a 96x80 canvas
-    assert METHOD.run({"texture": brick64}, QuiltParams(size=(96, 80)), rng=3).figures["blocks"] == 4 * 4
+    figures = METHOD.run({"texture": brick64}, QuiltParams(size=(96, 80)), rng=3).figures
+    assert figures["block"] == 28 and figures["blocks"] == 4 * 4  # --report says which block the default gave
 
 
 def test_studio_auto_shows_the_block_the_sample_gives():
