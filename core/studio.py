@@ -93,6 +93,10 @@ class Figure:
     unit : ``"%"`` (the value is a fraction, shown times 100), ``"px"``, ``"dB"``, ``"s"`` or ``""``.
     after : words after the value and unit, e.g. ``"of the sample"``.
     digits : significant digits of a number.
+    whole : the value is the same whatever part of the image is rendered (a parameter, e.g. the
+        engine): a preview around a stroke, which renders a crop (:func:`crop_around`), shows it.
+        A figure that counts or measures pixels (``False``, the default) would describe the crop,
+        not the image, and is shown only with the full result.
 
     ``Figure("largest verbatim copy", "%", "of the sample", digits=2).render(0.0532)`` is
     ``"largest verbatim copy 5.3 % of the sample"``.
@@ -102,6 +106,7 @@ class Figure:
     unit: str = ""
     after: str = ""
     digits: int = 3
+    whole: bool = False
 
     def render(self, value: Any) -> str:
         if isinstance(value, (bool, np.bool_)):
@@ -119,18 +124,22 @@ class Figure:
 
     def prefixed(self, words: str) -> "Figure":
         """The same figure with ``words`` before its label (a figure of a step, e.g. the rectification)."""
-        return Figure(f"{words} {self.label}".strip(), self.unit, self.after, self.digits)
+        return Figure(f"{words} {self.label}".strip(), self.unit, self.after, self.digits, self.whole)
 
 
-def describe_figures(figures: Mapping[str, Any], known: Mapping[str, Figure]) -> list[str]:
+def describe_figures(figures: Mapping[str, Any], known: Mapping[str, Figure], *, crop: bool = False) -> list[str]:
     """``figures`` (a ``Result.figures``) in words: each scalar by its :class:`Figure` in ``known``,
     in the order of ``figures``; lists, tables and missing values (``None``) are left to the report.
-    A key no table describes reads as its words (``"some_count"`` -> ``"some count"``)."""
+    A key no table describes reads as its words (``"some_count"`` -> ``"some count"``). ``crop``: the
+    figures of a render of a crop (a preview around a stroke): only those ``known`` as
+    :attr:`Figure.whole` (the others, and unknown keys, would describe the crop, not the image)."""
     out = []
     for key, value in figures.items():
         if value is None or isinstance(value, (list, tuple, dict, np.ndarray)):
             continue
         figure = known.get(key)
+        if crop and (figure is None or not figure.whole):
+            continue
         if figure is None:
             figure = Figure(key.replace("_", " "))
         out.append(figure.render(value))
@@ -162,7 +171,8 @@ class Studio:
     preview_around : the input of a mask geometry whose painting previews *around the stroke*: while a
         stroke is drawn, the method runs on a crop of its inputs around the painted region
         (:func:`crop_around`) and the crop's result is pasted into the last full result; None: a
-        stroke previews nothing until it is released.
+        stroke previews nothing until it is released. Such a preview states only the figures that
+        hold for the whole image (:attr:`Figure.whole`).
     own_inputs : optional inputs the method takes only when they were opened for it (while it was the
         studio's method): the studio shares inputs by name between methods, and an image opened as
         another method's input of that name must not change what this one does (``fill``'s optional
@@ -186,9 +196,10 @@ class Studio:
     own_inputs: tuple[str, ...] = ()
     masks_of: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
-    def describe(self, figures: Mapping[str, Any]) -> list[str]:
-        """A result's figures in words and units (see :func:`describe_figures`)."""
-        return describe_figures(figures, self.figures)
+    def describe(self, figures: Mapping[str, Any], *, crop: bool = False) -> list[str]:
+        """A result's figures in words and units (see :func:`describe_figures`; ``crop``: of a
+        preview around a stroke, only the :attr:`Figure.whole` ones)."""
+        return describe_figures(figures, self.figures, crop=crop)
 
     def geometry_on(self, input_name: str, open_inputs) -> tuple[Geometry, ...]:
         """The geometry drawn on ``input_name`` given the open inputs."""

@@ -599,18 +599,19 @@ def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
 
 
 def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does(studio, qtbot):
-    """The status line of a preview -- around a stroke, or while a slider moves -- reads the figures
-    with the method's words (Studio.figures: "filled 40 px"), as the full result's does, never as
-    raw keys ("hole_pixels", "hole pixels"); a stroke's preview says they are its crop's."""
+    """The status line of a preview while a slider moves reads the figures with the method's words
+    (Studio.figures: "filled 40 px"), as the full result's does, never as raw keys ("hole_pixels",
+    "hole pixels"); a stroke's preview renders a crop, whose count of pixels is not the picture's: it
+    says the figures come on release (test_a_strokes_preview_states_only_figures_of_the_whole_image)."""
     import re
 
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     text = studio.statusBar().currentMessage()
-    assert re.fullmatch(r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?: "
-                        r"filled \d+ px", text), text
-    assert f"filled {around[-1].figures['hole_pixels']} px" in text
+    # (a count of pixels describes the crop, not the picture: only the full result states it)
+    assert re.fullmatch(r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?; "
+                        r"the image's figures on release", text), text
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
     assert studio.statusBar().currentMessage().endswith(f"— filled {result.figures['hole_pixels']} px")
     # a slider's preview
@@ -1000,3 +1001,71 @@ def test_a_background_autosave_that_fails_says_so_in_one_line(studio, qtbot, pri
     text = said.args[0]
     assert text.startswith(f"{private_recovery / 'recovery.weft.json'}: autosave failed (") and "\n" not in text
     assert _mask(studio) is not None  # the edit stands
+
+
+def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, settings):
+    """The real fill, painted with the mouse: its preview around the stroke renders a crop, so it
+    must not state the crop's hole as the image's ("filled 9.4 % of the image" while the stroke
+    covered 1.3 % of it, seen in the studio); on release the full result states the image's own."""
+    from weft.app.gui.main_window import MainWindow
+    from weft.core.studio import AROUND_SIDE
+
+    window = MainWindow(settings=settings)
+    qtbot.addWidget(window)
+    window.resize(1300, 820)
+    window.show()
+    try:
+        qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
+        box = window.method_panel.method_box
+        with qtbot.waitSignal(window.renderer.failed, timeout=30000):  # nothing painted yet
+            box.setCurrentIndex(box.findData("fill"))
+        view, doc = window.canvas_view, window.doc
+        h, w = doc.image("image").shape[:2]
+        assert max(h, w) > AROUND_SIDE  # (the crop is a part of the image)
+        view.actual_size()
+        view.centerOn(w / 2, h / 2)
+        window.inputs_pane.mask_tool().set_size(9)
+        y = h / 2 + 0.5
+        around = _previewed(window, qtbot, view, [(w * 0.4, y), (w * 0.5, y)], timeout=30000)
+        text = window.statusBar().currentMessage()
+        assert text.startswith("preview around the stroke") and "crop" in text, text
+        assert "of the image" not in text, text  # the crop's hole fraction is not the image's
+        studio = doc.studio
+        for key, value in around[-1].figures.items():  # the crop's own figures ...
+            figure = studio.figures.get(key)
+            if figure is not None and not getattr(figure, "whole", False) and not isinstance(value, (list, dict)):
+                assert figure.render(value) not in text, text  # ... are not stated as the image's
+        assert text.endswith("the image's figures on release"), text
+        result = _final_after(window, qtbot, lambda: mouse(view, "release", (w * 0.5, y)))
+        hole = doc.value("mask").bits
+        text = window.statusBar().currentMessage()
+        assert studio.figures["hole_fraction"].render(round(float(hole.mean()), 4)) in text, text  # the image's
+        assert result.figures["hole_pixels"] == int(hole.sum())
+    finally:
+        window.doc.undo_stack.setClean()
+        window.shutdown()
+
+
+def test_a_crops_status_keeps_the_figures_its_method_marks_as_the_whole_images(qtbot):
+    """``Figure.whole``: a figure that does not depend on the part rendered (a parameter) is stated
+    for a stroke's preview too; the rest only with the full result."""
+    from weft.app.gui.render import Shown, describe
+
+    method = Method(name="whole-figures", summary="figures", params=MeanFillParams,
+                    inputs=(InputSpec("picture", "the picture"),), run=_mean_fill,
+                    studio=Studio(title="Whole figures", canvas="picture", rank=300,
+                                  figures={"engine": Figure("engine", whole=True),
+                                           "hole_pixels": Figure("filled", "px")}))
+    registry.register(method)
+    try:
+        figures = {"engine": "quilt", "hole_pixels": 40, "canvas": [80, 64]}
+        image = np.zeros((H, W, 3), np.float32)
+        crop = describe(Shown(image, 1, 0.012, figures, False, method=method.name, crop=(40, 30, 40, 30)))
+        assert crop == "preview around the stroke in 12 ms — its 40x30 crop: engine quilt; the image's figures on release"
+        full = describe(Shown(image, 2, 0.5, figures, True, method=method.name))
+        assert full == f"result {W}x{H} in 500 ms — engine quilt, filled 40 px"
+        only_whole = describe(Shown(image, 3, 0.012, {"engine": "quilt"}, False, method=method.name,
+                                    crop=(40, 30, 20, 15)))
+        assert only_whole == "preview around the stroke in 12 ms — its 40x30 crop (rendered at 20x15): engine quilt"
+    finally:
+        registry.unregister(method.name)
