@@ -103,6 +103,7 @@ class InputsPane(QSplitter):
             view.hovered.connect(lambda x, y, v=view: self.hovered.emit(v, x, y))
             view.zoomed.connect(lambda scale, v=view: self.zoomed.emit(v, scale))
             view.file_dropped.connect(lambda path, n=name: self.open_requested.emit(n, path))
+            view.image_shown.connect(lambda n=name: self._image_shown(n))
             self.views[name] = view
             self._boxes[name] = titled(view, name)
             self._boxes[name].clear_button.clicked.connect(lambda _=False, n=name: self.clear_requested.emit(n))
@@ -234,6 +235,16 @@ class InputsPane(QSplitter):
         """The bar of the current method's mask or margins tool, or None."""
         tool = self.mask_tool() or self.margins_tool()
         return None if tool is None else self._bars.get(next(n for n, v in self.views.items() if v is tool.view))
+
+    def _image_shown(self, name: str) -> None:
+        """A large image reached its view after its conversion (``ImageView.image_shown``): the
+        geometry drawn on it (a mask, margins) fits it now."""
+        view = self.views[name]
+        if view.tool is not None:
+            view.tool.refresh()
+        bar = self._bars.get(name)
+        if bar is not None:
+            bar.refresh()
 
     def input_changed(self, name: str) -> None:
         self.view(name).set_image(self.doc.image(name), fit=True)

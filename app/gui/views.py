@@ -4,21 +4,123 @@
 Space held (or with no tool active), pans; ``fit()`` and ``actual_size()`` reset the zoom. A *tool*
 (``weft.app.gui.tools``) may be attached: it receives the left-button events in image coordinates and
 draws its overlay items in the view's scene. ``ResultView`` adds a before/after split.
+
+The GUI thread never converts a large image: an image of more than ``ASYNC_PIXELS`` pixels is turned
+into the QImage the view draws (:func:`~weft.app.gui.convert.display_qimage`) on a worker thread,
+and the view keeps showing the previous image until it is ready (``image_shown`` then; ``image`` is
+always the image on screen). A view draws that QImage itself: no QPixmap (which only the GUI thread
+may make, 35 ms for a 4096² image) is made. Requests made while one is converted are coalesced: the
+newest is converted next, and a conversion older than what is on screen is dropped.
 """
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Any, Callable
 
 import numpy as np
-from PySide6.QtCore import QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QPainter, QPen, QPixmap
-from PySide6.QtWidgets import (QGraphicsLineItem, QGraphicsPixmapItem, QGraphicsRectItem, QGraphicsScene, QGraphicsView,
-                               QLabel)
+from PySide6.QtCore import QObject, QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QImage, QPainter, QPen
+from PySide6.QtWidgets import QGraphicsItem, QGraphicsLineItem, QGraphicsRectItem, QGraphicsScene, QGraphicsView, QLabel
 
-from .convert import to_qimage
+from .convert import display_qimage
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
+
+#: Images of more pixels than this are converted for display on a worker thread (512² takes ~5 ms on
+#: the GUI thread, 1024² ~20 ms, 4096² ~150 ms: more than a frame).
+ASYNC_PIXELS = 512 * 512
+
+_converters = ThreadPoolExecutor(max_workers=2, thread_name_prefix="weft-display")
+
+
+class ImageItem(QGraphicsItem):
+    """Draws a QImage (made on any thread) at the scene's origin, one scene unit per pixel, as a
+    ``QGraphicsPixmapItem`` with fast transformation draws its pixmap."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._image = QImage()
+
+    def qimage(self) -> QImage:
+        return self._image
+
+    def set_qimage(self, image: QImage) -> None:
+        self.prepareGeometryChange()
+        self._image = image
+        self.update()
+
+    def boundingRect(self) -> QRectF:  # noqa: N802 (Qt naming)
+        return QRectF(0, 0, self._image.width(), self._image.height())
+
+    def paint(self, painter, option, widget=None) -> None:
+        if not self._image.isNull():
+            painter.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, False)
+            painter.drawImage(QPointF(0, 0), self._image)
+
+
+class DisplayConverter(QObject):
+    """Turns images into the QImages a view draws and hands them to ``show(image, qimage, extra)``
+    on the GUI thread: at once when small, else from a worker thread (module docstring). One
+    conversion at a time per converter; :meth:`request` while one runs replaces the waiting request."""
+
+    _converted = Signal(int, object, object, object)  # generation, image, QImage (or the error), extra
+
+    def __init__(self, show: Callable[[np.ndarray | None, QImage | None, Any], None], parent=None):
+        super().__init__(parent)
+        self._show = show
+        self._generation = 0  # of the latest request
+        self._shown = 0  # of what is on screen
+        self._waiting: tuple[int, np.ndarray, Any] | None = None
+        self._running = False
+        self.latest: np.ndarray | None = None  # the image of the latest request
+        self._converted.connect(self._on_converted)
+
+    @property
+    def pending(self) -> bool:
+        """A requested image is not on screen yet."""
+        return self._shown != self._generation
+
+    def request(self, image: np.ndarray | None, extra: Any = None) -> None:
+        self._generation += 1
+        self.latest = image
+        if image is None or image.shape[0] * image.shape[1] <= ASYNC_PIXELS:
+            self._waiting = None
+            self._shown = self._generation
+            self._show(image, None if image is None else display_qimage(image), extra)
+            return
+        self._waiting = (self._generation, image, extra)
+        if not self._running:
+            self._start()
+
+    def _start(self) -> None:
+        generation, image, extra = self._waiting
+        self._waiting = None
+        self._running = True
+        done = self._converted
+
+        def work() -> None:
+            try:
+                q: Any = display_qimage(image)
+            except Exception as e:  # raised on the GUI thread
+                q = e
+            try:
+                done.emit(generation, image, q, extra)
+            except RuntimeError:  # the view is gone
+                pass
+
+        _converters.submit(work)
+
+    def _on_converted(self, generation: int, image, q, extra) -> None:
+        self._running = False
+        if self._waiting is not None:
+            self._start()
+        if isinstance(q, Exception):
+            raise q
+        if generation > self._shown:  # (older than what is on screen: dropped)
+            self._shown = generation
+            self._show(image, q, extra)
 
 
 class ImageView(QGraphicsView):
@@ -31,15 +133,17 @@ class ImageView(QGraphicsView):
     hovered = Signal(int, int)
     zoomed = Signal(float)
     file_dropped = Signal(str)
+    image_shown = Signal()  # the image on screen changed (``image``): at once, or once converted
 
     def __init__(self, parent=None, *, title: str = ""):
         super().__init__(parent)
         self.title = title
         self.setScene(QGraphicsScene(self))
-        self._item = QGraphicsPixmapItem()
-        self._item.setTransformationMode(Qt.TransformationMode.FastTransformation)
+        self._item = ImageItem()
         self.scene().addItem(self._item)
-        self.image: np.ndarray | None = None
+        self.image: np.ndarray | None = None  # the image on screen
+        self._converter = DisplayConverter(self._show_image, self)
+        self._fit_wanted = False
         self.tool = None
         self.auto_fit = True  # keep fitting the image to the window until the user zooms
         self._frame: QRectF | None = None  # a tool's frame around the image (an uncrop's grown canvas)
@@ -57,18 +161,36 @@ class ImageView(QGraphicsView):
     # --- image ---------------------------------------------------------------------------------
     def set_image(self, image: np.ndarray | None, *, fit: bool = False) -> None:
         """Show ``image`` (float32 [0, 1]); ``fit`` also fits it to the window, as does an image of
-        another size while the view is fitting (the user has not zoomed)."""
+        another size while the view is fitting (the user has not zoomed). A large image is shown
+        once converted on a worker thread (module docstring); the previous one stays until then."""
+        self._fit_wanted = self._fit_wanted or fit
+        self._converter.request(image)
+
+    @property
+    def converting(self) -> bool:
+        """An image given to :meth:`set_image` is not on screen yet (it is being converted)."""
+        return self._converter.pending
+
+    def _show_image(self, image: np.ndarray | None, q: QImage | None, _extra=None) -> None:
         first = self.image is None
         resized = not first and image is not None and self.image.shape[:2] != image.shape[:2]
         self.image = image
         if image is None:
-            self._item.setPixmap(QPixmap())
+            self._item.set_qimage(QImage())
+            self._image_changed()
+            self.image_shown.emit()
             return
-        self._item.setPixmap(QPixmap.fromImage(to_qimage(image)))
+        fit, self._fit_wanted = self._fit_wanted, False
+        self._item.set_qimage(q)
         self._set_scene_rect()
         if fit or first or (resized and self.auto_fit):
             self.fit()
+        self._image_changed()
         self.viewport().update()
+        self.image_shown.emit()
+
+    def _image_changed(self) -> None:
+        """(For subclasses: what follows the image on screen.)"""
 
     def set_frame(self, rect: QRectF | None, *, fit: bool = True) -> None:
         """A tool draws a frame around the image (the grown canvas of an uncrop): the scene keeps
@@ -158,7 +280,8 @@ class ImageView(QGraphicsView):
             self.viewport().setCursor(Qt.CursorShape.ClosedHandCursor)
             event.accept()
             return
-        if self.tool is not None and event.button() == Qt.MouseButton.LeftButton and self.image is not None:
+        if (self.tool is not None and event.button() == Qt.MouseButton.LeftButton and self.image is not None
+                and not self.converting):  # (not on the image being replaced: its geometry is the new one's)
             self.setFocus()
             self.tool.press(self, self.mapToScene(event.position().toPoint()), event)
             event.accept()
@@ -244,7 +367,8 @@ class ResultView(ImageView):
         self._clip = QGraphicsRectItem()
         self._clip.setPen(QPen(Qt.PenStyle.NoPen))
         self._clip.setFlag(QGraphicsRectItem.GraphicsItemFlag.ItemClipsChildrenToShape, True)
-        self._before = QGraphicsPixmapItem(self._clip)
+        self._before = ImageItem(self._clip)
+        self._before_converter = DisplayConverter(self._show_compare, self)
         self._divider = QGraphicsLineItem()
         pen = QPen(QColor(255, 255, 255, 220), 0)
         self._divider.setPen(pen)
@@ -314,10 +438,15 @@ class ResultView(ImageView):
             self._place_stale()
 
     def set_compare(self, image: np.ndarray | None) -> None:
-        """The "before" image (e.g. the target), shown left of the divider when comparing."""
+        """The "before" image (e.g. the target), shown left of the divider when comparing (a large
+        one once converted, as :meth:`set_image`)."""
+        if image is not self._before_converter.latest:  # (the same one again: converted once)
+            self._before_converter.request(image)
+
+    def _show_compare(self, image: np.ndarray | None, q: QImage | None, _extra=None) -> None:
         self.compare_image = image
         if image is not None:
-            self._before.setPixmap(QPixmap.fromImage(to_qimage(image)))
+            self._before.set_qimage(q)
         self._update_compare()
 
     def set_comparing(self, on: bool) -> None:
@@ -328,8 +457,7 @@ class ResultView(ImageView):
         self.split = float(np.clip(fraction, 0.0, 1.0))
         self._update_compare()
 
-    def set_image(self, image, *, fit: bool = False) -> None:
-        super().set_image(image, fit=fit)
+    def _image_changed(self) -> None:
         self._update_compare()
 
     def _update_compare(self) -> None:
@@ -339,8 +467,8 @@ class ResultView(ImageView):
         if not show:
             return
         w, h = self.image_size()
-        bw = self._before.pixmap().width() or 1
-        bh = self._before.pixmap().height() or 1
+        bw = self._before.qimage().width() or 1
+        bh = self._before.qimage().height() or 1
         self._before.setTransform(self._before.transform().fromScale(w / bw, h / bh))
         x = self.split * w
         self._clip.setRect(QRectF(0, 0, x, h))
