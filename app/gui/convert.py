@@ -37,11 +37,38 @@ def _wrapped(image: np.ndarray) -> tuple[QImage, np.ndarray]:
     return q, arr
 
 
-def display_qimage(image: np.ndarray) -> QImage:
-    """``image`` as the view draws it (any thread): :func:`to_qimage` in the format a QPixmap made
-    from it would hold on a raster screen (RGB32, or premultiplied ARGB32 with alpha), converted by
-    Qt as ``QPixmap.fromImage`` converts it, so the pixels shown are the same and drawing needs no
-    conversion on the GUI thread."""
-    q, _pixels = _wrapped(image)  # (RGB888, Grayscale8 or RGBA8888: converting makes new pixels)
-    fmt = QImage.Format.Format_ARGB32_Premultiplied if q.hasAlphaChannel() else QImage.Format.Format_RGB32
-    return q.convertToFormat(fmt)
+def display_qimage(image: np.ndarray) -> tuple[QImage, np.ndarray]:
+    """``image`` as the view draws it, on any thread: ``(qimage, pixels)``, a QImage over ``pixels``
+    (keep them together) in the format a QPixmap made from :func:`to_qimage` holds on a raster screen
+    -- RGB32, or premultiplied ARGB32 with alpha, premultiplied as Qt's ``qPremultiply`` does -- so
+    the pixels shown are the same and drawing converts nothing on the GUI thread. Built in numpy
+    only, which leaves Python's GIL to the GUI thread: Qt's ``QImage.copy`` and ``convertToFormat``
+    held it for ~35 ms on a 4096² image."""
+    arr = np.asarray(image)
+    h, w = arr.shape[:2]
+    if arr.dtype == np.uint8:
+        scaled = arr
+    else:  # as to_qimage: clip(x, 0, 1) * 255 + 0.5, truncated
+        scaled = np.multiply(arr, np.float32(255.0), dtype=np.float32)
+        scaled += np.float32(0.5)
+        np.clip(scaled, np.float32(0.0), np.float32(255.5), out=scaled)
+    if scaled.ndim == 3 and scaled.shape[2] == 1:
+        scaled = scaled[..., 0]
+    grey = scaled.ndim == 2 or scaled.shape[2] == 2
+    has_alpha = scaled.ndim == 3 and scaled.shape[2] in (2, 4)
+    pixels = np.empty((h, w, 4), dtype=np.uint8)  # B, G, R, A in memory: a 32-bit ARGB word on little-endian
+    for i, c in enumerate((2, 1, 0)):
+        pixels[..., i] = scaled if scaled.ndim == 2 else scaled[..., 0 if grey else c]
+    if has_alpha:
+        pixels[..., 3] = scaled[..., -1]
+        a = pixels[..., 3:4].astype(np.uint16)
+        t = pixels[..., :3] * a  # qPremultiply: (t + (t >> 8) + 0x80) >> 8
+        t += (t >> 8) + 0x80
+        pixels[..., :3] = t >> 8
+        fmt = QImage.Format.Format_ARGB32_Premultiplied
+    else:
+        pixels[..., 3] = 255
+        fmt = QImage.Format.Format_RGB32
+    if not np.little_endian:  # (a big-endian word is A, R, G, B in memory)
+        pixels = np.ascontiguousarray(pixels[..., ::-1])
+    return QImage(pixels.data, w, h, pixels.strides[0], fmt), pixels

@@ -42,13 +42,15 @@ class ImageItem(QGraphicsItem):
     def __init__(self, parent=None):
         super().__init__(parent)
         self._image = QImage()
+        self._pixels: np.ndarray | None = None  # the buffer the QImage reads (kept alive with it)
 
     def qimage(self) -> QImage:
         return self._image
 
-    def set_qimage(self, image: QImage) -> None:
+    def set_qimage(self, shown: tuple[QImage, np.ndarray] | None) -> None:
+        """Draw ``shown`` = :func:`~weft.app.gui.convert.display_qimage`'s (QImage, pixels); None: nothing."""
         self.prepareGeometryChange()
-        self._image = image
+        self._image, self._pixels = (QImage(), None) if shown is None else shown
         self.update()
 
     def boundingRect(self) -> QRectF:  # noqa: N802 (Qt naming)
@@ -65,9 +67,9 @@ class DisplayConverter(QObject):
     on the GUI thread: at once when small, else from a worker thread (module docstring). One
     conversion at a time per converter; :meth:`request` while one runs replaces the waiting request."""
 
-    _converted = Signal(int, object, object, object)  # generation, image, QImage (or the error), extra
+    _converted = Signal(int, object, object, object)  # generation, image, (QImage, pixels) or the error, extra
 
-    def __init__(self, show: Callable[[np.ndarray | None, QImage | None, Any], None], parent=None):
+    def __init__(self, show: Callable[[np.ndarray | None, tuple | None, Any], None], parent=None):
         super().__init__(parent)
         self._show = show
         self._generation = 0  # of the latest request
@@ -171,12 +173,12 @@ class ImageView(QGraphicsView):
         """An image given to :meth:`set_image` is not on screen yet (it is being converted)."""
         return self._converter.pending
 
-    def _show_image(self, image: np.ndarray | None, q: QImage | None, _extra=None) -> None:
+    def _show_image(self, image: np.ndarray | None, q: tuple | None, _extra=None) -> None:
         first = self.image is None
         resized = not first and image is not None and self.image.shape[:2] != image.shape[:2]
         self.image = image
         if image is None:
-            self._item.set_qimage(QImage())
+            self._item.set_qimage(None)
             self._image_changed()
             self.image_shown.emit()
             return
@@ -443,7 +445,7 @@ class ResultView(ImageView):
         if image is not self._before_converter.latest:  # (the same one again: converted once)
             self._before_converter.request(image)
 
-    def _show_compare(self, image: np.ndarray | None, q: QImage | None, _extra=None) -> None:
+    def _show_compare(self, image: np.ndarray | None, q: tuple | None, _extra=None) -> None:
         self.compare_image = image
         if image is not None:
             self._before.set_qimage(q)

@@ -196,3 +196,25 @@ def test_the_compare_image_of_a_large_result_is_converted_off_the_gui_thread(qtb
     qtbot.waitUntil(lambda: view.image is after and view.compare_image is before, timeout=10000)
     assert held.on_gui_thread == [False, False]
     assert view._clip.isVisible() and view._clip.rect().width() == pytest.approx(BIG / 2)
+
+
+@pytest.mark.parametrize("channels", [3, 1, 4, 2])
+def test_display_pixels_are_qts_own_conversion_of_the_image(qtbot, channels):
+    """``display_qimage`` (numpy, off the GUI thread) gives exactly the pixels Qt's conversion of
+    ``to_qimage`` gives -- out-of-range values clipped, every alpha level premultiplied as Qt does."""
+    from PySide6.QtGui import QImage
+
+    from weft.app.gui.convert import display_qimage
+
+    rng = np.random.default_rng(channels)
+    values = np.linspace(-0.1, 1.1, 256, dtype=np.float32)
+    image = np.stack([rng.permutation(values) for _ in range(256)])  # (256, 256): every level, shuffled
+    if channels > 1:
+        image = np.dstack([rng.permutation(image.ravel()).reshape(256, 256) for _ in range(channels)])
+    if channels in (2, 4):
+        image[..., -1] = np.arange(256, dtype=np.float32)[None, :] / 255.0  # every alpha level
+    qt = to_qimage(image)
+    qt = qt.convertToFormat(QImage.Format.Format_ARGB32_Premultiplied if qt.hasAlphaChannel()
+                            else QImage.Format.Format_RGB32)
+    ours, _pixels = display_qimage(image)
+    assert ours.format() == qt.format() and ours == qt
