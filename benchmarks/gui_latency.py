@@ -13,6 +13,14 @@ or ``--method``) on its bundled example (or gravel) resized to ``--side`` px; a 
 ``--values`` mouse moves at ``--hz`` is painted on the canvas with real mouse events. For every
 preview around the stroke that reaches the screen, the latency is the time from the mouse move of the
 latest dab it includes to the end of the result view's next paint. Same JSON line, plus ``"method"``.
+
+``--open [--side 4096] [--runs 5] [--method fill]``: the longest GUI-thread stall (the 5 ms heartbeat)
+while a large picture (``--side`` px square) reaches the views, each step in a fresh window with the
+method's kernels loaded: ``session`` opening a session of it (nothing drawn: the result view shows
+the picture too), ``open`` File > Open of it as the canvas input, ``result`` the method's full-size
+result of it (with a small painted mask for a method that fills one) from its arrival until both
+views show it, ``export`` exporting that result. Prints one JSON line with each step's median over
+the runs (ms) and every run's figure.
 """
 
 from __future__ import annotations
@@ -195,6 +203,102 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
     return {"method": method, **_summary(latencies, beats, values)}
 
 
+def _picture_file(folder: str, side: int) -> str:
+    """A smooth colour picture of ``side``² px as a PNG (random values bilinearly enlarged)."""
+    import numpy as np
+
+    from weft.core.image import resize, save_image
+
+    small = np.random.default_rng(0).random((max(2, side // 16),) * 2 + (3,), dtype=np.float32)
+    path = os.path.join(folder, f"picture-{side}.png")
+    save_image(path, resize(small, (side, side), interpolation="linear").clip(0, 1))
+    return path
+
+
+def _stall_since(beats: list[float], t0: float) -> float:
+    """The longest gap between heartbeats that ends after ``t0`` (ms)."""
+    gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:]) if b >= t0]
+    return round(max(gaps), 1) if gaps else 0.0
+
+
+def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> dict:
+    import numpy as np
+
+    from weft.app.gui.document import DocumentState, read_input
+    from weft.app.gui.main_window import MainWindow
+    from weft.core import registry
+    from weft.core.geometry import Mask
+    from weft.core.studio import MASK
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    registry.warm_up(method)  # (the studio loads them at start: no kernel loading in the figures)
+    steps: dict[str, list[float]] = {"session": [], "open": [], "result": [], "export": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["WEFT_RECOVERY_DIR"] = tmp
+        picture = _picture_file(tmp, side)
+        item = read_input(picture)
+        session = os.path.join(tmp, "big.weft.json")
+        for run in range(runs):
+            settings = QSettings(os.path.join(tmp, f"weft{run}.ini"), QSettings.Format.IniFormat)
+            window = MainWindow(settings=settings, load_defaults=False)
+            window.resize(1400, 900)
+            window.show()
+            doc, studio = window.doc, window.doc.methods[method].studio
+            canvas = studio.canvas
+            doc.restore(DocumentState(inputs={canvas: item}, method=method))
+            doc.save_session(session)
+            doc.restore(DocumentState(inputs={}, method=method))
+            _wait(app, lambda: not window.renderer.running(), 30)
+            answered: list[float] = []
+            window.renderer.shown.connect(lambda _s: answered.append(time.perf_counter()))
+            window.renderer.failed.connect(lambda _m: answered.append(time.perf_counter()))
+
+            def views_show(image) -> bool:
+                views = (window.canvas_view, window.result_view)
+                return all(v.image is not None and v.image.shape[:2] == image.shape[:2]
+                           and not getattr(v, "converting", False) for v in views)
+
+            def step(name: str, action, done, settle: float = 0.3, since=None) -> None:
+                heartbeat, beats = _heartbeat()
+                t0 = time.perf_counter()
+                action()
+                _wait(app, done, 300)
+                _wait(app, lambda: False, settle)
+                heartbeat.stop()
+                steps[name].append(_stall_since(beats, since() if since is not None else t0))
+
+            # a session of the picture (nothing drawn: the result view shows the picture)
+            step("session", lambda: window.open_session(session),
+                 lambda: answered and views_show(item.image) and window.result_view.image is doc.image(canvas))
+            # File > Open of the picture (decoded off the GUI thread, then shown)
+            del answered[:]
+            step("open", lambda: window.open_input(canvas, picture),
+                 lambda: doc.image(canvas) is not item.image and answered and views_show(item.image)
+                 and window.result_view.image is doc.image(canvas))
+            # the method's full-size result (a small painted mask if it fills one): the stall from its arrival
+            g = next((g for g in studio.geometry if g.kind == MASK), None)
+            del answered[:]
+            if g is not None:
+                doc.set_mask(g.key, Mask.empty(side, side).painted_line((side * 0.4, side * 0.4),
+                                                                       (side * 0.45, side * 0.42), side / 200, True),
+                             "stroke")
+            else:
+                window.renderer.final(now=True)
+            step("result", lambda: None,
+                 lambda: bool(answered) and window.renderer.last is not None and window.renderer.last.final
+                 and window.result_view.image is window.renderer.last.image
+                 and not getattr(window.result_view, "converting", False),
+                 settle=0.5, since=lambda: answered[0])
+            out = os.path.join(tmp, f"out{run}.png")
+            step("export", lambda: window.export_result(out), lambda: os.path.exists(out), settle=0.2)
+            doc.undo_stack.setClean()
+            window.close()
+            del window
+    return {"side": side, "method": method, "runs": runs,
+            **{f"{k}_stall_ms": round(statistics.median(v), 1) for k, v in steps.items()},
+            "each": steps}
+
+
 def _heartbeat() -> tuple[QTimer, list[float]]:
     """A started 5 ms timer and the times it fired at: a gap between two beats is a GUI-thread stall."""
     beats: list[float] = []
@@ -235,10 +339,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--hz", type=float, default=60.0)
     ap.add_argument("--paint", action="store_true", help="paint a mask stroke instead of moving a slider")
     ap.add_argument("--method", default=None, help="with --paint: the method (default: the first that previews strokes)")
-    ap.add_argument("--side", type=int, default=512, help="with --paint: the picture's side in pixels")
+    ap.add_argument("--side", type=int, default=None, help="with --paint (512) or --open (4096): the picture's side")
+    ap.add_argument("--open", action="store_true", help="open a large picture: the longest GUI-thread stalls")
+    ap.add_argument("--runs", type=int, default=5, help="with --open: the runs (median)")
     args = ap.parse_args(argv)
-    if args.paint:
-        print(json.dumps(measure_painting(args.values or 60, args.hz, args.method, args.side)))
+    if args.open:
+        print(json.dumps(measure_opening(args.side or 4096, args.runs, args.method or "fill")))
+    elif args.paint:
+        print(json.dumps(measure_painting(args.values or 60, args.hz, args.method, args.side or 512)))
     else:
         print(json.dumps(measure(args.values or 30, args.hz)))
     return 0
