@@ -198,19 +198,32 @@ class Document(QObject):
     def method_inputs(self, *, live: bool = False) -> dict[str, np.ndarray]:
         """The current method's loaded inputs (its painted masks among them, as images; with
         ``live`` the stroke being drawn); the canvas cropped to the source region if there is one."""
+        return self.deferred_inputs(live=live)()
+
+    def deferred_inputs(self, *, live: bool = False) -> Callable[..., dict[str, np.ndarray]]:
+        """:meth:`method_inputs` captured now and built when called, on any thread: the slow part
+        (a painted mask's float image, 64 MB for a 4096² mask, and a crop to the source region) is
+        left to the call, so a render job does it on its worker, not the GUI thread. The call
+        takes ``names`` (default all): only those inputs."""
         painted = {g.input for g in self.studio.geometry if g.kind == MASK}
-        out = {}
+        arrays = {}
         for spec in self.current.inputs:
             item = self.item(spec.name)
             if item is not None and spec.name not in painted:
                 keep = spec.alpha and item.with_alpha is not None
-                out[spec.name] = item.with_alpha if keep else item.image
-        out.update({name: mask.to_image() for name, mask in self.masks(live=live).items()})
+                arrays[spec.name] = item.with_alpha if keep else item.image
+        masks = self.masks(live=live)  # (immutable: safe to read on another thread)
         region = self.region()
         g = next((g for g in self.studio.geometry if g.param is None and g.kind == SQUARE), None)
-        if region is not None and g is not None and g.on[0] in out:
-            out[g.on[0]] = region.crop(out[g.on[0]], what=g.on[0].replace("_", " "))
-        return out
+
+        def build(names=None) -> dict[str, np.ndarray]:
+            out = {n: a for n, a in arrays.items() if names is None or n in names}
+            out.update({n: m.to_image() for n, m in masks.items() if names is None or n in names})
+            if region is not None and g is not None and g.on[0] in out:
+                out[g.on[0]] = region.crop(out[g.on[0]], what=g.on[0].replace("_", " "))
+            return out
+
+        return build
 
     def input_shapes(self) -> dict[str, tuple[int, ...]]:
         """The shapes of what :meth:`method_inputs` gives the current method (input name -> array

@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
@@ -74,6 +76,9 @@ class Shown:
     # a preview around a stroke: (width, height) of the crop in the image and as rendered (its figures are the
     # crop's: only those of the whole image are stated, ``describe``)
     crop: tuple[int, int, int, int] | None = None
+    # a preview around a stroke: (x0, y0, x1, y1) of ``image`` it changed since the stroke's previous preview
+    # (``image`` is the same array: pasted into in place); None: all of it (the stroke's first preview)
+    changed: tuple[int, int, int, int] | None = None
 
 
 def _render(method, inputs, params, seed, report, cancel, *, final: bool):
@@ -240,36 +245,51 @@ class Renderer(QObject):
 
     # --- job construction ----------------------------------------------------------------------
     def job_inputs(self, *, preview: bool) -> tuple[dict[str, np.ndarray], Params] | None:
-        """Inputs and parameters of a render of the current method, or None if inputs are missing."""
+        """Inputs and parameters of a render of the current method, or None if inputs are missing
+        (built here and now; a render job builds them on its worker: :meth:`_preparation`)."""
+        prepare = self._preparation(preview=preview)
+        return None if prepare is None else prepare()[:2]
+
+    def _preparation(self, *, preview: bool, around_box=None) -> Callable[[], tuple | None] | None:
+        """What a job of the current method runs on, captured now (the document's inputs and
+        parameters) and built by the returned call, on the job's worker: its painted masks as float
+        images, a crop to the source region, a preview's reduction (``reduce_for_preview``: 48.5 ms
+        at 4096² on the GUI thread before) or a stroke's crop (``crop_around``, with the whole
+        image's mask: 0.15-0.57 s per preview at 4096² on the GUI thread before). The call gives
+        ``(inputs, params, around)`` (``around``: the stroke's :class:`~weft.core.studio.Around`, or
+        None), or None when there is nothing painted near the stroke. None here: inputs are missing."""
         doc = self.doc
         if doc.missing_inputs():
             return None
-        inputs = doc.method_inputs()
+        studio = doc.studio
+        build = doc.deferred_inputs(live=around_box is not None)
         params = doc.run_params()
-        if preview:
-            inputs, params = reduce_for_preview(doc.studio, inputs, params, PREVIEW_SIDE)
-        return inputs, params
+
+        def prepare():
+            if around_box is not None:
+                around = crop_around(studio, build(), params, around_box)
+                return None if around is None else (around.inputs, around.params, around)
+            if preview:
+                return (*reduce_for_preview(studio, build(), params, PREVIEW_SIDE), None)
+            return build(), params, None
+
+        return prepare
 
     def _submit(self, slot: str, preview: bool) -> int | None:
         if not self.enabled:
             return None
         doc = self.doc
-        around = None
+        box = None
         if slot == "preview" and self._around_box is not None:
             # a stroke's preview: only the crop around it is built (not the whole-image reduced
-            # preview as well: 11.6 ms at 2048², 48.5 ms at 4096² of GUI time per preview, thrown away)
+            # preview as well: 11.6 ms at 2048², 48.5 ms at 4096² per preview, thrown away)
             if doc.missing_inputs():
                 return None
             box, self._around_box = self._around_box, None
-            around = crop_around(doc.studio, doc.method_inputs(live=True), doc.run_params(), box)
-            if around is None:
-                return None  # nothing painted near the stroke: the release renders
-            inputs, params = around.inputs, around.params
-        else:
-            built = self.job_inputs(preview=preview)
-            if built is None:
-                return None
-            inputs, params = built
+        prepare = self._preparation(preview=preview, around_box=box)
+        if prepare is None:
+            return None
+        params = doc.run_params()
         method, seed = doc.current, doc.seed
         recipe = None if preview else doc.recipe(params)
         masks = None if preview else doc.masks()
@@ -278,8 +298,12 @@ class Renderer(QObject):
         def job(*, progress=None, cancel=None):
             # Previews report nothing; a final render's partial images are built at most every
             # PARTIAL_INTERVAL seconds (a fast render never pays for one).
+            prepared = prepare()
+            if prepared is None:
+                return None  # nothing painted near the stroke: the release renders
+            inputs, run_params, around = prepared
             report = None if preview or progress is None else _Partial(progress)
-            return (*_render(method, inputs, params, seed, report, cancel, final=not preview), recipe, before,
+            return (*_render(method, inputs, run_params, seed, report, cancel, final=not preview), recipe, before,
                     masks, around, method.name)
 
         if slot == "final":
@@ -287,7 +311,7 @@ class Renderer(QObject):
             self._preview_running, self._preview_dirty = None, False
             self._around_box = None
         handle = self.runner.submit(slot, job)
-        if around is not None:
+        if box is not None:
             self._around_jobs.add(handle.id)
         if slot == "preview":
             self._preview_running = handle.id
@@ -333,6 +357,8 @@ class Renderer(QObject):
             if not around and (self.last is None or result.job_id > self.last.job_id):
                 self.failed.emit(f"render failed: {result.error}")
             return
+        if result.value is None:
+            return  # a stroke's preview with nothing painted near it
         if self.last is not None and result.job_id < self.last.job_id:
             return  # older than what is shown: stale
         res, seconds, final, prepared, compiled, recipe, before, masks, crop, name = result.value
@@ -350,7 +376,8 @@ class Renderer(QObject):
         """What a preview around a stroke is pasted into: the last full result of this method, else
         (none yet, e.g. it refused to run with nothing painted) its canvas input."""
         last = self._current_final()
-        return last.image if last is not None else self.doc.method_inputs().get(self.doc.studio.canvas)
+        canvas = self.doc.studio.canvas
+        return last.image if last is not None else self.doc.deferred_inputs()(names=(canvas,)).get(canvas)
 
     def _show_around(self, res, crop, job_id: int, seconds: float, method: str) -> None:
         """Paste a preview around a stroke into the full result (and the stroke's earlier ones)."""
@@ -363,10 +390,12 @@ class Renderer(QObject):
             return  # the crop's result does not fit the full one (another size): the release renders
         self._around_image = pasted
         x0, y0, x1, y1 = crop.box
+        dx, dy = crop.offset
         rh, rw = res.image.shape[:2]
         self.around_shown.emit(Shown(pasted, job_id, seconds, dict(res.figures), False, recipe=None,
                                      before=None if self.last is None else self.last.before, method=method,
-                                     crop=(x1 - x0, y1 - y0, rw, rh)))
+                                     crop=(x1 - x0, y1 - y0, rw, rh),
+                                     changed=None if fresh else (x0 + dx, y0 + dy, x1 + dx, y1 + dy)))
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
         if slot != "final" or job_id != self.latest_final:
