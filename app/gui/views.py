@@ -47,6 +47,10 @@ class ImageItem(QGraphicsItem):
     def qimage(self) -> QImage:
         return self._image
 
+    def pixels(self) -> np.ndarray | None:
+        """The (H, W, 4) buffer the QImage reads (a part written there shows at the next paint), or None."""
+        return self._pixels
+
     def set_qimage(self, shown: tuple[QImage, np.ndarray] | None) -> None:
         """Draw ``shown`` = :func:`~weft.app.gui.convert.display_qimage`'s (QImage, pixels); None: nothing."""
         self.prepareGeometryChange()
@@ -83,6 +87,12 @@ class DisplayConverter(QObject):
     def pending(self) -> bool:
         """A requested image is not on screen yet."""
         return self._shown != self._generation
+
+    def shown_now(self) -> None:
+        """What is on screen was changed by its owner (a part redrawn): newer than any conversion running."""
+        self._generation += 1
+        self._shown = self._generation
+        self._waiting = None
 
     def request(self, image: np.ndarray | None, extra: Any = None) -> None:
         self._generation += 1
@@ -161,12 +171,38 @@ class ImageView(QGraphicsView):
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
 
     # --- image ---------------------------------------------------------------------------------
-    def set_image(self, image: np.ndarray | None, *, fit: bool = False) -> None:
+    def set_image(self, image: np.ndarray | None, *, fit: bool = False, changed=None) -> None:
         """Show ``image`` (float32 [0, 1]); ``fit`` also fits it to the window, as does an image of
         another size while the view is fitting (the user has not zoomed). A large image is shown
-        once converted on a worker thread (module docstring); the previous one stays until then."""
+        once converted on a worker thread (module docstring); the previous one stays until then.
+
+        ``changed`` = ``(x0, y0, x1, y1)``: ``image`` is the very array on screen, changed in place
+        only there since it was shown (a stroke's preview pasted into the result): only that part
+        is converted and redrawn, at once when it is small."""
+        if changed is not None and self._redraw_part(image, changed):
+            return
         self._fit_wanted = self._fit_wanted or fit
         self._converter.request(image)
+
+    def _redraw_part(self, image: np.ndarray | None, box) -> bool:
+        """Redraw ``box`` of the array on screen (see :meth:`set_image`); False when that does not
+        apply (another array, one being converted, or a part too large to convert here)."""
+        pixels = self._item.pixels()
+        if image is None or image is not self.image or self.converting or pixels is None:
+            return False
+        h, w = image.shape[:2]
+        x0, y0, x1, y1 = (int(v) for v in box)
+        x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
+        if x0 >= x1 or y0 >= y1:
+            return True  # nothing on screen changed
+        if (x1 - x0) * (y1 - y0) > ASYNC_PIXELS or pixels.shape[:2] != (h, w):
+            return False
+        _q, part = display_qimage(image[y0:y1, x0:x1])
+        pixels[y0:y1, x0:x1] = part
+        self._converter.shown_now()  # (a conversion still running is older: dropped)
+        self._item.update(QRectF(x0, y0, x1 - x0, y1 - y0))
+        self.image_shown.emit()
+        return True
 
     @property
     def converting(self) -> bool:

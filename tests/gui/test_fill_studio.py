@@ -1105,3 +1105,20 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
     assert all(on_gui.values()), on_gui  # each was called ...
     assert not any(any(flags) for flags in on_gui.values()), on_gui  # ... never on the GUI thread
 
+
+def test_a_strokes_later_previews_name_the_part_they_changed(studio, qtbot):
+    """A stroke's first preview is a new image (the last result with the crop pasted: the result view
+    converts it whole); each later one is pasted into that same image and names the part it changed,
+    so the view converts only that part (a 4096² result is not converted again per preview)."""
+    view = studio.canvas_view
+    studio.inputs_pane.mask_tool().set_size(5)
+    around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
+    assert around[0].changed is None
+    mouse(view, "move", (40.5, 40.5))
+    qtbot.waitUntil(lambda: len(around) > 1, timeout=10000)
+    last = around[-1]
+    assert last.image is around[0].image and last.changed is not None
+    x0, y0, x1, y1 = last.changed
+    assert x0 < 40 < x1 and y0 < 40 < y1 and (x1 - x0) * (y1 - y0) < W * H
+    assert studio.result_view.image is last.image
+    _final_after(studio, qtbot, lambda: mouse(view, "release", (40.5, 40.5)))

@@ -218,3 +218,27 @@ def test_display_pixels_are_qts_own_conversion_of_the_image(qtbot, channels):
                             else QImage.Format.Format_RGB32)
     ours, _pixels = display_qimage(image)
     assert ours.format() == qt.format() and ours == qt
+
+
+def test_a_part_changed_in_place_is_redrawn_at_once_and_alone(qtbot, monkeypatch):
+    """``set_image(image, changed=box)`` with the array on screen (a stroke's preview pasted into the
+    result): only the box is converted, at once, and the view then draws exactly the whole array."""
+    view = ImageView()
+    qtbot.addWidget(view)
+    view.resize(300, 240)
+    view.show()
+    image = _picture(BIG, 4)
+    with qtbot.waitSignal(view.image_shown, timeout=10000):
+        view.set_image(image, fit=True)
+    held = _Held(monkeypatch)
+    image[100:140, 200:260] = _picture(60, 8)[:40]  # pasted in place
+    view.set_image(image, changed=(200, 100, 260, 140))
+    assert held.sizes == [(40, 60)] and held.on_gui_thread == [True]  # the part alone, here and now
+    assert view.image is image and not view.converting
+    assert view.viewport().grab().toImage() == _reference_grab(image, view)
+    other = image.copy()  # another array: converted whole (on a worker), whatever part is named
+    view.set_image(other, changed=(0, 0, 8, 8))
+    assert view.converting and held.started.wait(10)
+    held.release()
+    qtbot.waitUntil(lambda: view.image is other, timeout=10000)
+    assert held.sizes[-1] == (BIG, BIG)
