@@ -6,11 +6,13 @@ Space held (or with no tool active), pans; ``fit()`` and ``actual_size()`` reset
 draws its overlay items in the view's scene. ``ResultView`` adds a before/after split.
 
 The GUI thread never converts a large image: an image of more than ``ASYNC_PIXELS`` pixels is turned
-into the QImage the view draws (:func:`~weft.app.gui.convert.display_qimage`) on a worker thread,
-and the view keeps showing the previous image until it is ready (``image_shown`` then; ``image`` is
-always the image on screen). A view draws that QImage itself: no QPixmap (which only the GUI thread
-may make, 35 ms for a 4096² image) is made. Requests made while one is converted are coalesced: the
-newest is converted next, and a conversion older than what is on screen is dropped.
+into the QImage the view draws (:func:`~weft.app.gui.convert.display_qimage`, numpy only, so the
+worker leaves Python's GIL to the GUI thread) on a worker thread, and the view keeps showing the
+previous image until it is ready (``image_shown`` then; ``image`` is always the image on screen). A
+view draws that QImage itself: no QPixmap (which only the GUI thread may make, 35 ms for a 4096²
+image) is made. Requests made while one is converted are coalesced: the newest is converted next,
+and a conversion older than what is on screen is dropped. ``set_image(image, changed=box)`` redraws
+only a part of the array on screen changed in place (a stroke's preview pasted into the result).
 """
 
 from __future__ import annotations
@@ -28,8 +30,8 @@ from .convert import display_qimage
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
 
-#: Images of more pixels than this are converted for display on a worker thread (512² takes ~5 ms on
-#: the GUI thread, 1024² ~20 ms, 4096² ~150 ms: more than a frame).
+#: Images of more pixels than this are converted for display on a worker thread (display_qimage:
+#: 0.4 ms for 512², 10 ms for 1024², 39 ms for 2048², 145 ms for 4096², median of 7, loaded machine).
 ASYNC_PIXELS = 512 * 512
 
 _converters = ThreadPoolExecutor(max_workers=2, thread_name_prefix="weft-display")
@@ -67,7 +69,7 @@ class ImageItem(QGraphicsItem):
 
 
 class DisplayConverter(QObject):
-    """Turns images into the QImages a view draws and hands them to ``show(image, qimage, extra)``
+    """Turns images into what a view draws and hands it to ``show(image, (qimage, pixels), extra)``
     on the GUI thread: at once when small, else from a worker thread (module docstring). One
     conversion at a time per converter; :meth:`request` while one runs replaces the waiting request."""
 
