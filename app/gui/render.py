@@ -18,6 +18,9 @@
   (``Studio.preview_around``; ``weft.core.studio.crop_around`` crops the inputs to at most
   ``AROUND_SIDE`` px): its result is pasted into the last full result and shown; the release renders
   full size. A preview around a stroke that fails says nothing (the release's render will).
+* A job captures the document's inputs and parameters when it is submitted and builds what it runs
+  on (painted masks as images, the preview's reduction, the stroke's crop) on its worker: the GUI
+  thread only takes references (``Document.deferred_inputs``).
 * A job running longer than ``PROGRESS_DELAY_MS`` shows its progress (with partial previews where the
   method gives them) and can be cancelled; after a cancel or an error the last good result stays.
 """
