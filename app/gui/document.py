@@ -205,6 +205,33 @@ class Document(QObject):
         (a painted mask's float image, 64 MB for a 4096² mask, and a crop to the source region) is
         left to the call, so a render job does it on its worker, not the GUI thread. The call
         takes ``names`` (default all): only those inputs."""
+        arrays, masks, region, on = self._input_parts(live)
+
+        def build(names=None) -> dict[str, np.ndarray]:
+            out = {n: a for n, a in arrays.items() if names is None or n in names}
+            out.update({n: m.to_image() for n, m in masks.items() if names is None or n in names})
+            if region is not None and on in out:
+                out[on] = region.crop(out[on], what=on.replace("_", " "))
+            return out
+
+        return build
+
+    def input_shapes(self) -> dict[str, tuple[int, ...]]:
+        """The shapes of what :meth:`method_inputs` gives the current method (input name -> array
+        shape), without building it: what its "auto" parameters depend on (``Studio.resolved``)."""
+        arrays, masks, region, on = self._input_parts(False)
+        out = {name: a.shape for name, a in arrays.items()}
+        out.update({name: mask.shape for name, mask in masks.items()})
+        if region is not None and on in out:
+            shape = out[on]
+            if region.x + region.side <= shape[1] and region.y + region.side <= shape[0]:
+                out[on] = (region.side, region.side) + tuple(shape[2:])
+        return out
+
+    def _input_parts(self, live: bool):
+        """What the current method's inputs are made of: the open images it gets (name -> array, with
+        alpha where its ``InputSpec`` asks), its painted masks (name -> ``Mask``), and its source region
+        with the name of the input it crops (or None, None)."""
         painted = {g.input for g in self.studio.geometry if g.kind == MASK}
         arrays = {}
         for spec in self.current.inputs:
@@ -213,36 +240,9 @@ class Document(QObject):
                 keep = spec.alpha and item.with_alpha is not None
                 arrays[spec.name] = item.with_alpha if keep else item.image
         masks = self.masks(live=live)  # (immutable: safe to read on another thread)
-        region = self.region()
         g = next((g for g in self.studio.geometry if g.param is None and g.kind == SQUARE), None)
-
-        def build(names=None) -> dict[str, np.ndarray]:
-            out = {n: a for n, a in arrays.items() if names is None or n in names}
-            out.update({n: m.to_image() for n, m in masks.items() if names is None or n in names})
-            if region is not None and g is not None and g.on[0] in out:
-                out[g.on[0]] = region.crop(out[g.on[0]], what=g.on[0].replace("_", " "))
-            return out
-
-        return build
-
-    def input_shapes(self) -> dict[str, tuple[int, ...]]:
-        """The shapes of what :meth:`method_inputs` gives the current method (input name -> array
-        shape), without building it: what its "auto" parameters depend on (``Studio.resolved``)."""
-        painted = {g.input for g in self.studio.geometry if g.kind == MASK}
-        out = {}
-        for spec in self.current.inputs:
-            item = self.item(spec.name)
-            if item is not None and spec.name not in painted:
-                keep = spec.alpha and item.with_alpha is not None
-                out[spec.name] = (item.with_alpha if keep else item.image).shape
-        out.update({name: mask.shape for name, mask in self.masks().items()})
-        region = self.region()
-        g = next((g for g in self.studio.geometry if g.param is None and g.kind == SQUARE), None)
-        if region is not None and g is not None and g.on[0] in out:
-            shape = out[g.on[0]]
-            if region.x + region.side <= shape[1] and region.y + region.side <= shape[0]:
-                out[g.on[0]] = (region.side, region.side) + tuple(shape[2:])
-        return out
+        region = self.region() if g is not None else None
+        return arrays, masks, region, None if g is None else g.on[0]
 
     def run_params(self, *, live: bool = True) -> Params:
         """The current method's parameters as a run uses them: its geometry put into the parameters it

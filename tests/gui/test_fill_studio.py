@@ -6,6 +6,7 @@ with the mean colour of the rest of the picture, and grows the canvas by its mar
 border alike), so they test the studio, not any one method; nothing in app/gui knows it.
 """
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -711,11 +712,10 @@ def test_an_own_input_opened_for_another_method_stays_its_through_a_session(stud
     assert doc.image("swatch") is not None  # still open for the method it was opened for
 
 
-def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, settings, tmp_path, capsys):
-    """The real fill, as an artist meets it: the studio opens on its examples, fill is picked, a hole
-    is painted with the mouse (previewed around the stroke), filled on release, exported and re-run."""
-    from scipy.ndimage import binary_dilation
-
+@contextmanager
+def _fill_in_the_studio(qtbot, settings):
+    """The studio as it opens on its bundled examples, switched to fill with the method box (nothing
+    is painted yet, so that render fails); shut down on leaving."""
     from weft.app.gui.main_window import MainWindow
 
     window = MainWindow(settings=settings)
@@ -724,11 +724,23 @@ def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, se
     window.show()
     try:
         qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
-        assert window.doc.image("texture") is not None  # the other methods' texture is open ...
+        assert window.doc.image("texture") is not None  # the other methods' texture is open
         box = window.method_panel.method_box
         with qtbot.waitSignal(window.renderer.failed, timeout=30000):  # nothing painted yet
             box.setCurrentIndex(box.findData("fill"))
-        assert window.doc.image("texture") is None  # ... but it is not fill's source to copy from
+        yield window
+    finally:
+        window.doc.undo_stack.setClean()
+        window.shutdown()
+
+
+def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, settings, tmp_path, capsys):
+    """The real fill, as an artist meets it: the studio opens on its examples, fill is picked, a hole
+    is painted with the mouse (previewed around the stroke), filled on release, exported and re-run."""
+    from scipy.ndimage import binary_dilation
+
+    with _fill_in_the_studio(qtbot, settings) as window:
+        assert window.doc.image("texture") is None  # the other methods' texture is not fill's source
         assert window.result_view.notice.isVisible() and "Paint what to fill" in window.result_view.notice.text()
         view, doc = window.canvas_view, window.doc
         image = doc.image("image")
@@ -755,9 +767,6 @@ def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, se
         again = tmp_path / "again.png"
         assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
         assert np.array_equal(load_image(out).image, load_image(again).image)
-    finally:
-        window.doc.undo_stack.setClean()
-        window.shutdown()
 
 
 SHOW_HOLE = Method(  # another method with a plain input named like mean-fill's painted mask
@@ -1007,18 +1016,9 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, setting
     """The real fill, painted with the mouse: its preview around the stroke renders a crop, so it
     must not state the crop's hole as the image's ("filled 9.4 % of the image" while the stroke
     covered 1.3 % of it, seen in the studio); on release the full result states the image's own."""
-    from weft.app.gui.main_window import MainWindow
     from weft.core.studio import AROUND_SIDE
 
-    window = MainWindow(settings=settings)
-    qtbot.addWidget(window)
-    window.resize(1300, 820)
-    window.show()
-    try:
-        qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
-        box = window.method_panel.method_box
-        with qtbot.waitSignal(window.renderer.failed, timeout=30000):  # nothing painted yet
-            box.setCurrentIndex(box.findData("fill"))
+    with _fill_in_the_studio(qtbot, settings) as window:
         view, doc = window.canvas_view, window.doc
         h, w = doc.image("image").shape[:2]
         assert max(h, w) > AROUND_SIDE  # (the crop is a part of the image)
@@ -1041,9 +1041,6 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, setting
         text = window.statusBar().currentMessage()
         assert studio.figures["hole_fraction"].render(round(float(hole.mean()), 4)) in text, text  # the image's
         assert result.figures["hole_pixels"] == int(hole.sum())
-    finally:
-        window.doc.undo_stack.setClean()
-        window.shutdown()
 
 
 def test_a_crops_status_keeps_the_figures_its_method_marks_as_the_whole_images(qtbot):
