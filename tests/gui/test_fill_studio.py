@@ -615,16 +615,7 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
                         r"the image's figures on release", text), text
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
     assert studio.statusBar().currentMessage().endswith(f"— filled {result.figures['hole_pixels']} px")
-    # a slider's preview
-    slider = studio.params_panel.row("amount").editor
-    previews = []
-    studio.renderer.shown.connect(lambda shown: previews.append(shown) if not shown.final else None)
-    slider.setSliderDown(True)
-    slider.setValue(slider.value() - max(1, (slider.maximum() - slider.minimum()) // 4))
-    qtbot.waitUntil(lambda: len(previews) > 0, timeout=10000)
-    text = studio.statusBar().currentMessage()
-    slider.setSliderDown(False)
-    slider.sliderReleased.emit()
+    previews, text = _slider_previewed(studio, qtbot, "amount")  # a slider's preview
     assert re.fullmatch(rf"preview {W}x{H} in \d+ ms — filled {previews[-1].figures['hole_pixels']} px", text), text
     qtbot.waitUntil(lambda: not studio.renderer.running(), timeout=10000)  # (its release render ends the test)
 
@@ -710,6 +701,21 @@ def test_an_own_input_opened_for_another_method_stays_its_through_a_session(stud
     assert np.allclose(result.image[bits], picture[~bits].mean(axis=0), atol=1e-5)  # not the swatch's colour
     doc.set_method(SHOW_SWATCH.name)
     assert doc.image("swatch") is not None  # still open for the method it was opened for
+
+
+def _slider_previewed(studio, qtbot, name: str):
+    """Hold parameter ``name``'s slider down and move it a quarter of its range, as a hand does, until
+    its first preview shows, then release it: ``(the previews shown, the status text meanwhile)``."""
+    slider = studio.params_panel.row(name).editor
+    previews = []
+    studio.renderer.shown.connect(lambda shown: previews.append(shown) if not shown.final else None)
+    slider.setSliderDown(True)
+    slider.setValue(slider.value() - max(1, (slider.maximum() - slider.minimum()) // 4))
+    qtbot.waitUntil(lambda: len(previews) > 0, timeout=10000)
+    text = studio.statusBar().currentMessage()
+    slider.setSliderDown(False)
+    slider.sliderReleased.emit()
+    return previews, text
 
 
 @contextmanager
@@ -1090,14 +1096,7 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
     studio.inputs_pane.mask_tool().set_size(5)
     _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
-    slider = studio.params_panel.row("amount").editor
-    previews = []
-    studio.renderer.shown.connect(lambda shown: previews.append(shown) if not shown.final else None)
-    slider.setSliderDown(True)
-    slider.setValue(slider.value() - max(1, (slider.maximum() - slider.minimum()) // 4))
-    qtbot.waitUntil(lambda: len(previews) > 0, timeout=10000)
-    slider.setSliderDown(False)
-    slider.sliderReleased.emit()
+    _slider_previewed(studio, qtbot, "amount")
     qtbot.waitUntil(lambda: not studio.renderer.running(), timeout=10000)
     assert all(on_gui.values()), on_gui  # each was called ...
     assert not any(any(flags) for flags in on_gui.values()), on_gui  # ... never on the GUI thread
