@@ -15,45 +15,63 @@ from __future__ import annotations
 import numpy as np
 
 
-def _vertical_path(err: np.ndarray) -> np.ndarray:
-    """Column of the least-error 8-connected top-to-bottom path in every row of ``err`` (h, w)."""
-    h, w = err.shape
-    acc = err.astype(np.float64).copy()
+def _vertical_paths(err: np.ndarray) -> np.ndarray:
+    """Column of the least-error 8-connected top-to-bottom path in every row of each ``err[k]``
+    ((k, h, w) -> (k, h)): the k strips' dynamic programmes run together, one numpy step per row
+    (a block's up to four overlap strips in one pass; ties: the lowest column, as ``np.argmin``)."""
+    k, h, w = err.shape
+    acc = err.astype(np.float64)  # (a copy)
+    side = np.full((k, w + 2), np.inf)
     for y in range(h - 2, -1, -1):
-        below = acc[y + 1]
-        m = below.copy()
-        if w > 1:
-            m[1:] = np.minimum(m[1:], below[:-1])
-            m[:-1] = np.minimum(m[:-1], below[1:])
-        acc[y] += m
-    path = np.empty(h, dtype=np.int64)
-    x = int(np.argmin(acc[0]))
-    path[0] = x
+        side[:, 1:-1] = acc[:, y + 1]
+        acc[:, y] += np.minimum(np.minimum(side[:, :-2], side[:, 1:-1]), side[:, 2:])
+    path = np.empty((k, h), dtype=np.int64)
+    rows = np.arange(k)
+    x = np.argmin(acc[:, 0], axis=1)
+    path[:, 0] = x
+    steps = np.array([-1, 0, 1])
     for y in range(1, h):
-        lo, hi = max(0, x - 1), min(w, x + 2)
-        x = lo + int(np.argmin(acc[y, lo:hi]))
-        path[y] = x
+        cand = x[:, None] + steps[None, :]  # x - 1, x, x + 1: argmin's first minimum is the lowest column
+        vals = np.where((cand >= 0) & (cand < w), acc[rows[:, None], y, np.clip(cand, 0, w - 1)], np.inf)
+        x = cand[rows, np.argmin(vals, axis=1)]
+        path[:, y] = x
     return path
 
 
+def _vertical_path(err: np.ndarray) -> np.ndarray:
+    """Column of the least-error 8-connected top-to-bottom path in every row of ``err`` (h, w)."""
+    return _vertical_paths(np.asarray(err)[None])[0]
+
+
 def min_cut(err: np.ndarray, *, left: int = 0, top: int = 0, right: int = 0, bottom: int = 0) -> np.ndarray:
-    """bool (h, w): where the new block shows after the cut through the given overlap strips."""
+    """bool (h, w): where the new block shows after the cut through the given overlap strips (the
+    strips of one shape -- all four on a square block with equal overlaps -- cut in one pass)."""
     h, w = err.shape
     new = np.ones((h, w), dtype=bool)
     cols = np.arange(w)[None, :]
     rows = np.arange(h)[:, None]
+    strips = []  # (side, strip as a top-to-bottom (rows, cols) array)
     if left > 0:
-        path = _vertical_path(err[:, :left])
-        new &= cols >= path[:, None]
+        strips.append(("left", err[:, :left]))
     if right > 0:
-        path = _vertical_path(err[:, w - right:]) + (w - right)
-        new &= cols <= path[:, None]
+        strips.append(("right", err[:, w - right:]))
     if top > 0:
-        path = _vertical_path(np.ascontiguousarray(err[:top, :].T))
-        new &= rows >= path[None, :]
+        strips.append(("top", err[:top, :].T))
     if bottom > 0:
-        path = _vertical_path(np.ascontiguousarray(err[h - bottom:, :].T)) + (h - bottom)
-        new &= rows <= path[None, :]
+        strips.append(("bottom", err[h - bottom:, :].T))
+    paths = {}
+    for shape in dict.fromkeys(s.shape for _, s in strips):
+        group = [(side, s) for side, s in strips if s.shape == shape]
+        for (side, _), path in zip(group, _vertical_paths(np.stack([s for _, s in group]))):
+            paths[side] = path
+    if left > 0:
+        new &= cols >= paths["left"][:, None]
+    if right > 0:
+        new &= cols <= (paths["right"] + (w - right))[:, None]
+    if top > 0:
+        new &= rows >= paths["top"][None, :]
+    if bottom > 0:
+        new &= rows <= (paths["bottom"] + (h - bottom))[None, :]
     return new
 
 

@@ -96,6 +96,22 @@ def _chroma(img: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(rgb - rgb.mean(axis=2, keepdims=True), dtype=np.float32)
 
 
+def _planes(img: np.ndarray) -> list[np.ndarray]:
+    """The channels of (H, W, C) ``img`` as C contiguous (H, W) float32 arrays."""
+    return [np.ascontiguousarray(img[..., k], dtype=np.float32) for k in range(img.shape[2])]
+
+
+def _ccorr(planes: list[np.ndarray], crop: tuple[slice, slice], template: np.ndarray) -> np.ndarray:
+    """``cv2.matchTemplate(image[crop], template, TM_CCORR)`` of the multi-channel image whose channels
+    are ``planes``, as the sum of one single-channel correlation per channel: OpenCV's multi-channel
+    correlation took 1.5-2.5x as long as three single-channel ones on the 216 px crops and 24 px
+    blocks of a fill (equal to float32 rounding)."""
+    out = cv2.matchTemplate(planes[0][crop], np.ascontiguousarray(template[..., 0]), cv2.TM_CCORR)
+    for k in range(1, len(planes)):
+        out += cv2.matchTemplate(planes[k][crop], np.ascontiguousarray(template[..., k]), cv2.TM_CCORR)
+    return out
+
+
 def _coarse_guide(canvas: np.ndarray, hole: np.ndarray, scale: int) -> np.ndarray:
     """(H, W, C) float32: the hole filled by diffusion (cv2.inpaint, Telea) at 1/scale, brought back
     to full size; the known pixels' own values elsewhere (only the hole's are read)."""
@@ -202,11 +218,13 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
     search_sq = np.ascontiguousarray((search * search).sum(axis=2))
     search_sum = np.ascontiguousarray(search.sum(axis=2))
+    search_planes = _planes(search)
     guided = GUIDE > 0 and c >= 3
     if guided:  # the colour (not the texture) of a coarse diffusion fill steers the blocks: chroma only
         guide = _chroma(_coarse_guide(canvas, hole, GUIDE_SCALE))
         blur = _chroma(cv2.GaussianBlur(search, (0, 0), GUIDE_SCALE / 2.0).reshape(search.shape))
         blur_sq = np.ascontiguousarray((blur * blur).sum(axis=2))
+        blur_planes = _planes(blur)
     total = int(hole.sum())
     report = Progress(progress, cancel, total)
     report(0)
@@ -247,8 +265,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         if weight.any():
             # masked SSD = sum M I^2 - 2 sum M T I + sum M T^2 (the squares summed over channels first)
             energy = cv2.matchTemplate(search_sq[crop], weight, cv2.TM_CCORR)  # sum M I^2
-            cost = energy - 2.0 * cv2.matchTemplate(search[crop], np.ascontiguousarray(template * weight[..., None]),
-                                                    cv2.TM_CCORR)
+            cost = energy - 2.0 * _ccorr(search_planes, crop, template * weight[..., None])
             cost += float((weight[..., None] * template * template).sum())
             if DETAIL > 0:  # the contrast term: the block's and the template's standard deviations
                 n = float(weight.sum()) * c
@@ -261,7 +278,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
             cost = np.zeros(ok.shape, dtype=np.float32)
         if guided and un.any():
             g = np.ascontiguousarray(guide[win] * un[..., None])
-            gc = cv2.matchTemplate(blur_sq[crop], un, cv2.TM_CCORR) - 2.0 * cv2.matchTemplate(blur[crop], g, cv2.TM_CCORR)
+            gc = cv2.matchTemplate(blur_sq[crop], un, cv2.TM_CCORR) - 2.0 * _ccorr(blur_planes, crop, g)
             gc += float((g * guide[win]).sum())
             cost = cost + GUIDE * np.maximum(gc, 0.0)
         cost = np.where(ok & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0

@@ -347,3 +347,22 @@ def test_quilt_fill_order_puts_an_edge_first_on_colour_only(monkeypatch):
     monkeypatch.setattr(quilt, "DATA", 0.0)
     assert np.array_equal(fill_quilt(photo, square, patch=16, rng=1), grey)
     assert np.array_equal(fill_quilt(as_rgb, square, patch=16, rng=1), grey_rgb)
+
+
+def test_batched_cut_is_each_sides_own_cut():
+    """min_cut runs a block's strips of one shape in one batched programme: the result is still the
+    intersection of each side's own cut, ties (the large constant of known pixels) included."""
+    from weft.core.fill.cut import _vertical_path, min_cut
+
+    rng = np.random.default_rng(11)
+    for _ in range(50):
+        err = rng.integers(0, 3, (24, 24)).astype(np.float64)
+        err[rng.random((24, 24)) < 0.3] = 1e6
+        sides = {k: int(v) for k, v in zip(("left", "top", "right", "bottom"), rng.integers(0, 9, 4))}
+        alone = np.ones((24, 24), bool)
+        for k, v in sides.items():
+            if v:
+                alone &= min_cut(err, **{k: v})
+        assert np.array_equal(min_cut(err, **sides), alone)
+    e = np.array([[5.0, 1.0, 1.0], [1.0, 1.0, 5.0], [5.0, 5.0, 1.0]])
+    assert _vertical_path(e).tolist() == [1, 1, 2]  # a tie in the first row (3 at columns 1 and 2): the lowest
