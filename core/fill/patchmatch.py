@@ -75,7 +75,13 @@ _BAND_REFINE = 3
 
 
 def _box_sum(a: np.ndarray, p: int) -> np.ndarray:
-    """Sums of ``a`` over every p x p window, indexed by the window's top-left corner."""
+    """Sums of ``a`` over every p x p window, indexed by the window's top-left corner (a bool ``a``:
+    exact int32 counts from OpenCV's integral image, ~10x faster than two float64 cumsums)."""
+    if a.dtype == bool:
+        import cv2
+
+        c = cv2.integral(np.ascontiguousarray(a).view(np.uint8), sdepth=cv2.CV_32S)
+        return c[p:, p:] - c[:-p, p:] - c[p:, :-p] + c[:-p, :-p]
     c = np.zeros((a.shape[0] + 1, a.shape[1] + 1), np.float64)
     np.cumsum(np.cumsum(a, axis=0, dtype=np.float64), axis=1, out=c[1:, 1:])
     return c[p:, p:] - c[:-p, p:] - c[p:, :-p] + c[:-p, :-p]
@@ -617,8 +623,8 @@ def refine_patchmatch(
             r //= _SEARCH_SHRINK
         dn = dist / (p * p)
         sigma2 = max(float(np.percentile(dn, _SIGMA_PERCENTILE)), 1e-12)
-        inexact = np.zeros((fl.h + p - 1, fl.w + p - 1))  # pixels covered by a patch that is not an exact copy
-        inexact[p - 1 + fl.ty[dist > 0.0], p - 1 + fl.tx[dist > 0.0]] = 1.0
+        inexact = np.zeros((fl.h + p - 1, fl.w + p - 1), bool)  # pixels covered by a patch that is not an exact copy
+        inexact[p - 1 + fl.ty[dist > 0.0], p - 1 + fl.tx[dist > 0.0]] = True
         changed = _vote_mode(img, hole & (_box_sum(inexact, p) > 0.5), fl, sy, sx, np.exp(-dn / (2.0 * sigma2)))
         report.update(it + 1)
     if out.ndim == 2:
