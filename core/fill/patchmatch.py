@@ -473,7 +473,7 @@ def _principal_candidates(fl: _Flat, img: np.ndarray, gen: np.random.Generator, 
         proj += cv2.filter2D(np.ascontiguousarray(img[..., ch]), cv2.CV_32F, np.ascontiguousarray(axis[..., ch]),
                              anchor=(0, 0), borderType=cv2.BORDER_CONSTANT)
     src = proj[vy, vx]
-    order = np.argsort(src, kind="stable")
+    order = _stable_argsort(src)
     pos = np.searchsorted(src[order], proj[fl.ty, fl.tx])
     lo = -(k // 2)
     out_y = np.empty((k, len(pos)), np.int64)
@@ -482,6 +482,17 @@ def _principal_candidates(fl: _Flat, img: np.ndarray, gen: np.random.Generator, 
         j = order[np.clip(pos + lo + c, 0, len(order) - 1)]
         out_y[c], out_x[c] = vy[j], vx[j]
     return out_y, out_x
+
+
+def _stable_argsort(values: np.ndarray) -> np.ndarray:
+    """``np.argsort(values, kind="stable")`` of a float32 vector without NaN, 5-7x faster: each value's
+    bits as an order-preserving int32 in the high half of an int64 key, its index in the low half,
+    so the keys are unique and a plain (unstable) sort orders them as the stable argsort does."""
+    bits = (np.asarray(values, dtype=np.float32) + np.float32(0.0)).view(np.int32)  # (-0.0 becomes 0.0)
+    ordered = np.where(bits < 0, bits ^ np.int32(0x7FFFFFFF), bits).astype(np.int64)
+    keys = (ordered << 32) | np.arange(len(bits), dtype=np.int64)
+    keys.sort()
+    return keys & np.int64(0xFFFFFFFF)
 
 
 def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight) -> np.ndarray:

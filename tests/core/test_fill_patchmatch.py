@@ -253,3 +253,18 @@ def test_warm_up_compiles_every_kernel_a_fill_uses_once():
     assert out["before"] and all(sigs for name, sigs in out["before"].items() if not name.startswith("_"))
     assert out["after"] == out["before"]  # a run compiled nothing new
     assert all(len(sigs) <= 1 for sigs in out["after"].values())
+
+
+def test_stable_argsort_is_numpys_stable_argsort():
+    """The refine's principal-axis candidates sort ~80k projections with a key sort that must order
+    ties (and -0.0 against 0.0, and infinities) exactly as np.argsort(kind="stable")."""
+    from weft.core.fill.patchmatch import _stable_argsort
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        n = int(rng.integers(1, 3000))
+        a = (rng.integers(-20, 20, n) * rng.choice([0.5, 1e-3, 1e30], n)).astype(np.float32)
+        a[rng.random(n) < 0.05] = -0.0
+        a[rng.random(n) < 0.02] = np.inf
+        a[rng.random(n) < 0.02] = -np.inf
+        assert np.array_equal(_stable_argsort(a), np.argsort(a, kind="stable"))
