@@ -64,7 +64,7 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
             progress(total + int(round(p.fraction * iterations)), span)
 
     quilted = fill_quilt(image, holes, source, patch=patch, rng=gen, progress=quilt_progress, cancel=cancel,
-                         band=band, cuttable=cuttable)
+                         band=band, cuttable=cuttable, refine=False)  # (its own refine follows)
     if cuttable is not None:
         region = holes | np.asarray(cuttable, dtype=bool)
     else:

@@ -17,6 +17,7 @@ from ..studio import Figure, Geometry, Studio
 from .band import blend_band
 from .common import whole_patches
 from .params import ANCHORS, FillParams
+from .quilt import refines
 
 
 def _engine(name: str):
@@ -220,7 +221,8 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
                                     cancel=cancel, **extra)
     filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
     out3 = filled if filled.ndim == 3 else filled[..., None]
-    if params.engine not in ("hybrid", "patchmatch"):  # (their refine re-synthesises the band itself)
+    # (the refine of hybrid, patchmatch and quilt on colour pictures re-synthesises the band itself)
+    if params.engine not in ("hybrid", "patchmatch") and not (params.engine == "quilt" and refines(work, work_hole)):
         out3 = blend_band(np.ascontiguousarray(out3), hole, params.band, exclude=transparent)
     out = out3 if colour.ndim == 3 else out3[..., 0]
     if alpha is not None:

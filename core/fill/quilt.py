@@ -88,6 +88,31 @@ COHERE = 1.0
 CONTINUE = 4
 #: Weight of the structure term in the fill order (step 1; colour images only); 0 = the count alone.
 DATA = 3.0
+#: EM iterations of the final patch-search refine (step 7; colour images only); 0 = none.
+REFINE = 2
+#: The refine searches, in each iteration, the inexact patches at or above this percentile of their distances.
+REFINE_WORST = 50.0
+#: The refine's patch side (the judge ``fill_coherence``'s window).
+REFINE_PATCH = 7
+
+
+def is_colour(img: np.ndarray, known: np.ndarray) -> bool:
+    """Whether (H, W, C) ``img`` is a colour picture on its ``known`` pixels: three channels or more,
+    not all grey (a grey picture stored as RGB has no chroma). Steps 1, 4 and 7 run on colour only."""
+    if img.shape[2] < 3 or not known.any():
+        return False
+    rgb = img[..., :3]
+    return float(np.abs(rgb - rgb.mean(axis=2, keepdims=True))[known].max()) > 1e-3
+
+
+def refines(image, hole, refine: bool | None = None) -> bool:
+    """Whether :func:`fill_quilt` ends with its patch-search refine (step 7) on this image: ``refine``
+    when given, else on colour pictures when :data:`REFINE` > 0. The method then runs no Poisson
+    blend band (the refine re-synthesises the band)."""
+    if refine is not None:
+        return bool(refine) and REFINE > 0
+    img = np.asarray(image)
+    return REFINE > 0 and img.ndim == 3 and is_colour(img, ~np.asarray(hole, dtype=bool))
 
 
 def _chroma(img: np.ndarray) -> np.ndarray:
@@ -166,7 +191,7 @@ def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: in
 
 
 def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0,
-               cuttable=None) -> np.ndarray:
+               cuttable=None, refine: bool | None = None) -> np.ndarray:
     """Fill ``hole`` of ``image`` with blocks quilted from ``source`` (default: the known pixels).
 
     Parameters
@@ -183,6 +208,8 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         (the method gives it when the engine's canvas is more than the image: the image's own band,
         without its transparent pixels; a band worked out on that canvas would reach into the image
         from the gap below it).
+    refine : bool or None (default): end with step 7's refine; None = on colour pictures only
+        (:func:`refines`).
 
     Returns
     -------
@@ -226,13 +253,16 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         blur_sq = np.ascontiguousarray((blur * blur).sum(axis=2))
         blur_planes = _planes(blur)
     total = int(hole.sum())
-    report = Progress(progress, cancel, total)
+    refining = refines(img, hole, refine)
+    # the refine's share of the progress: about its share of the time (a fifth)
+    refine_units = max(1, total // 5) if refining else 0
+    report = Progress(progress, cancel, total + refine_units)
     report(0)
     # score: for an unknown pixel next to a valued one (the front), the valued pixels of the B x B
     # window centred on it; -1 elsewhere. Updated around each block only.
     score = np.full((h, w), -1.0, dtype=np.float32)
     # the structure term on colour images only; a grey picture stored as RGB (no chroma) is grey
-    colour = c >= 3 and float(np.abs(img[..., :3] - img[..., :3].mean(axis=2, keepdims=True))[known].max()) > 1e-3
+    colour = is_colour(img, known)
     edges = _edges(canvas, known) if DATA > 0 and colour else None
     _score(have, score, b, 0, h, 0, w, edges)
     left = total
@@ -323,5 +353,23 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     out = img.copy()
     changed = hole if cuttable is None else (hole | cuttable)
     out[changed] = canvas[changed]
+    if refining:
+        out = _refine(out, hole, changed, src, gen, cancel, lambda p: report(total + int(p.fraction * refine_units)))
     return out.reshape(shape)
+
+
+def _refine(out: np.ndarray, hole: np.ndarray, region: np.ndarray, src: np.ndarray, gen, cancel, progress) -> np.ndarray:
+    """Step 7: :func:`weft.core.fill.patchmatch.refine_patchmatch` over the hole and the band
+    (``region``), copying from source pixels beyond the band (the hole alone when the band took the
+    last whole source patch); ``out`` unchanged when there is none."""
+    from .patchmatch import refine_patchmatch
+
+    p = max(3, min(REFINE_PATCH, *hole.shape))
+    sources = src & ~region
+    if not whole_patches(sources, p).any():
+        region, sources = hole, src
+        if not whole_patches(sources, p).any():
+            return out
+    return refine_patchmatch(out, region, sources, out, patch=p, iterations=REFINE, rng=gen, progress=progress,
+                             cancel=cancel, worst=REFINE_WORST)
 

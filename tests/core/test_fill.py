@@ -366,3 +366,31 @@ def test_batched_cut_is_each_sides_own_cut():
         assert np.array_equal(min_cut(err, **sides), alone)
     e = np.array([[5.0, 1.0, 1.0], [1.0, 1.0, 5.0], [5.0, 5.0, 1.0]])
     assert _vertical_path(e).tolist() == [1, 1, 2]  # a tie in the first row (3 at columns 1 and 2): the lowest
+
+
+def test_quilt_refines_colour_pictures_only():
+    """Step 7: on a colour photo the quilt ends with the patch-search refine over the hole and the
+    band (its block seams move to where copies agree: lower coherence), known pixels beyond the band
+    stay bit for bit, a seed gives the same pixels; a grey picture (or grey stored as RGB) is not
+    refined, and the method then blends the band by Poisson as before."""
+    from weft.core.fill.quilt import refines
+
+    photo = load_image(example("coffee")).image
+    hole = np.zeros(photo.shape[:2], dtype=bool)
+    hole[60:110, 180:230] = True
+    cut = band_region(hole, 2) & ~hole
+    refined = [fill_quilt(photo, hole, patch=16, rng=s, cuttable=cut) for s in (0, 1)]
+    plain = [fill_quilt(photo, hole, patch=16, rng=s, cuttable=cut, refine=False) for s in (0, 1)]
+    coh = [metrics.fill_coherence(o, hole, photo) for o in refined]
+    coh_plain = [metrics.fill_coherence(o, hole, photo) for o in plain]
+    assert np.mean(coh) < 0.9 * np.mean(coh_plain)
+    beyond = ~hole & ~cut
+    assert all(np.array_equal(o[beyond], photo[beyond]) for o in refined)
+    assert np.array_equal(fill_quilt(photo, hole, patch=16, rng=1, cuttable=cut), refined[1])
+    assert refines(photo, hole) and not refines(photo, hole, refine=False)
+
+    grey = load_image(example("brick")).image[:96, :96]
+    square = square_hole(grey.shape)
+    assert not refines(grey, square) and not refines(np.repeat(grey[..., None], 3, axis=2), square)
+    assert np.array_equal(fill_quilt(grey, square, patch=16, rng=1), fill_quilt(grey, square, patch=16, rng=1,
+                                                                                  refine=False))

@@ -192,3 +192,27 @@ def test_patchmatch_with_a_band_refines_it_and_leaves_every_other_known_pixel(gr
     truth_detail = metrics.fill_detail(gravel, hole)
     assert 0.8 * truth_detail <= metrics.fill_detail(out, hole) <= 1.25 * truth_detail
     assert metrics.fill_coherence(out, hole, gravel) <= 0.75 * metrics.fill_coherence(gravel, hole)
+
+
+def test_refine_searching_the_worst_patches_only():
+    """``worst=P`` searches only the inexact patches at or above the P-th percentile of their
+    distances: another fill than searching them all, still more coherent than its start; every pixel
+    outside the hole is kept, a seed gives the same pixels; a percentage outside 0..100 is refused in
+    one line."""
+    from weft.core.examples import example
+    from weft.core.image import load_image
+
+    photo = load_image(example("coffee")).image
+    hole = np.zeros(photo.shape[:2], dtype=bool)
+    hole[60:110, 180:230] = True
+    init = fill_quilt(photo, hole, patch=16, rng=1, refine=False)
+    every = refine_patchmatch(photo, hole, init=init, rng=2, iterations=1)
+    half = refine_patchmatch(photo, hole, init=init, rng=2, iterations=1, worst=50)
+    assert np.array_equal(half[~hole], photo[~hole])
+    assert np.array_equal(half, refine_patchmatch(photo, hole, init=init, rng=2, iterations=1, worst=50))
+    assert not np.array_equal(half, every)
+    start = metrics.fill_coherence(init, hole, photo)
+    assert metrics.fill_coherence(half, hole, photo) < start
+    for bad in (-1, 100, True, "50"):
+        with pytest.raises(InvalidParameter, match="parameter 'worst'"):
+            refine_patchmatch(photo, hole, init=init, worst=bad)
