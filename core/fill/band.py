@@ -42,10 +42,16 @@ def band_region(hole: np.ndarray, band: int, exclude: np.ndarray | None = None) 
     return ring
 
 
-def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarray | None = None) -> np.ndarray:
+def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarray | None = None,
+               written: np.ndarray | None = None) -> np.ndarray:
     """``image`` (H, W, C) float32 with its band around ``hole`` re-solved; every other pixel is
-    returned bit for bit. ``exclude``: pixels never changed (transparent ones)."""
+    returned bit for bit. ``exclude``: pixels never changed (transparent ones). ``written``: the
+    pixels the engine wrote (default ``hole``): the hole and the band's known pixels its cut ran
+    through. The seam is where written meets unwritten pixels, so that is where the step is spread:
+    with the hole's edge alone, a cut that ran through the band left its step at the band's outer
+    rows, kept as the image's own gradient (a 4-5 level line along the uncrop's whole lower edge)."""
     ring = band_region(hole, band, exclude)
+    seam = hole if written is None else (np.asarray(written, dtype=bool) | hole)
     if not ring.any() or ring.all():
         return image
     h, w, c = image.shape
@@ -67,20 +73,20 @@ def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarr
     if STEP > 0:
         dyy = np.abs(np.diff(f, axis=0)).mean(axis=2)
         dxx = np.abs(np.diff(f, axis=1)).mean(axis=2)
-        known_y = ~hole[1:] & ~hole[:-1] & ring[1:]
-        known_x = ~hole[:, 1:] & ~hole[:, :-1] & ring[:, 1:]
+        known_y = ~seam[1:] & ~seam[:-1] & ring[1:]
+        known_x = ~seam[:, 1:] & ~seam[:, :-1] & ring[:, 1:]
         vals = np.concatenate([dyy[known_y], dxx[known_x]])
         scale = float(vals.mean()) if vals.size else 0.0
     for k, (dy, dx) in enumerate(_STEPS):
         qy, qx = ys + dy, xs + dx
         valid, qyc, qxc = at(qy, qx)
         g = f[ys, xs] - f[qyc, qxc]
-        cross = valid & (hole[ys, xs] != hole[qyc, qxc])
+        cross = valid & (seam[ys, xs] != seam[qyc, qxc])
         if cross.any():  # the seam: continue the slope of both sides instead
             by_ok, byy, bxx = at(ys - dy, xs - dx)  # one step back on p's side
             fy_ok, fyy, fxx = at(qy + dy, qx + dx)  # one step on q's side
-            by_ok &= hole[byy, bxx] == hole[ys, xs]
-            fy_ok &= hole[fyy, fxx] == hole[qyc, qxc]
+            by_ok &= seam[byy, bxx] == seam[ys, xs]
+            fy_ok &= seam[fyy, fxx] == seam[qyc, qxc]
             back = f[byy, bxx] - f[ys, xs]
             fwd = f[qyc, qxc] - f[fyy, fxx]
             wsum = (by_ok.astype(np.float64) + fy_ok)[:, None]

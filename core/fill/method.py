@@ -223,7 +223,11 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     out3 = filled if filled.ndim == 3 else filled[..., None]
     # (the refine of hybrid, patchmatch and quilt on colour pictures re-synthesises the band itself)
     if params.engine not in ("hybrid", "patchmatch") and not (params.engine == "quilt" and refines(work, work_hole)):
-        out3 = blend_band(np.ascontiguousarray(out3), hole, params.band, exclude=transparent)
+        written = hole
+        if extra:  # the band's known pixels the quilting cut ran through: the seam lies beside them
+            col3 = colour if colour.ndim == 3 else colour[..., None]
+            written = hole | (extra["cuttable"][:ch, :cw] & (out3 != col3).any(axis=2))
+        out3 = blend_band(np.ascontiguousarray(out3), hole, params.band, exclude=transparent, written=written)
     out = out3 if colour.ndim == 3 else out3[..., 0]
     if alpha is not None:
         alpha = alpha.copy()

@@ -100,6 +100,25 @@ def test_band_spreads_a_step_at_the_seam():
     assert np.array_equal(out[:, :12], img[:, :12, 0]) and np.array_equal(out[:, 20:], img[:, 20:, 0])
 
 
+def test_band_spreads_the_step_where_the_cut_left_it():
+    """The quilting cut may run through the band's known pixels: the seam is then where written meets
+    unwritten pixels, inside the band, not the hole's edge. Given ``written``, the step there is
+    spread too; without it, it was kept as the image's own gradient (a line along an uncrop's edge)."""
+    rng = np.random.default_rng(0)
+    img = (0.5 + 0.01 * rng.standard_normal((32, 32, 1))).astype(np.float32)
+    hole = np.zeros((32, 32), dtype=bool)
+    hole[:, 16:] = True
+    written = hole.copy()
+    written[:, 13:16] = True  # the cut ran 3 px into the band
+    img[written] += 0.2  # the block's level: a step of 0.2 between columns 12 and 13
+    jump = lambda out: float(np.abs(out[:, 13, 0] - out[:, 12, 0]).mean())  # noqa: E731
+    assert jump(blend_band(img, hole, 4)) > 0.15  # the hole's edge alone: the step stays
+    out = blend_band(img, hole, 4, written=written)
+    assert jump(out) < 0.1
+    keep = ~band_region(hole, 4)
+    assert np.array_equal(out[keep], img[keep])
+
+
 def test_alpha_hole_and_opaque_output(gravel):
     rgba = np.dstack([np.repeat(gravel[..., None], 3, axis=2), np.ones(gravel.shape, np.float32)])
     hole = square_hole(gravel.shape)
