@@ -132,6 +132,19 @@ def test_fill_figures_see_changed_known_pixels_and_the_truth_scores_itself():
     assert painted["unfilled"] == 1.0 and painted["known_max"] == 0
 
 
+def test_fill_seed_medians_score_each_seed_against_the_truth(monkeypatch):
+    """``python -m benchmarks.fill --seeds 0-4``: the median over seeds of each judge, detail as a
+    ratio to the truth's and seam as a difference from it; the same seeds give the same figures."""
+    from benchmarks import fill
+
+    monkeypatch.setattr(fill, "by_name", lambda: {"fill-tiny": _tiny_fill_case()})
+    (row,) = fill.seed_medians(["fill-tiny"], range(3))
+    assert row["case"] == "fill-tiny" and len(row["each"]) == 3
+    assert row["coherence"] == sorted(row["each"])[1] or abs(row["coherence"] - sorted(row["each"])[1]) < 0.01
+    assert 0.5 < row["detail"] < 1.5 and abs(row["seam"]) < 0.5
+    assert fill.seed_medians(["fill-tiny"], range(3)) == [row]
+
+
 def test_fill_peer_runner_fills_the_hole(tmp_path):
     import numpy as np
 
