@@ -57,17 +57,19 @@ One block at a time, until no pixel of the hole is left:
 7. **Refine** (colour pictures only). The block seams inside the hole cost the judge most (on the
    photo case, the windows 9+ px inside the spoon's bowl scored 6.9 against 2.8 for the
    ``patchmatch`` engine's large copies). :func:`weft.core.fill.patchmatch.refine_patchmatch` then
-   runs ``REFINE`` EM iterations at full resolution over the hole and the band: every 7x7 patch
+   runs ``REFINE`` EM iteration(s) at full resolution over the hole and the band: every 7x7 patch
    touching them gets its nearest patch of the known pixels beyond the band, and every pixel is
    copied through the offset the covering patches agree on most, so the seams move to where the
    copies agree, without averaging. Each iteration searches only the inexact patches at or above
    the median of their distances (``REFINE_WORST``): the judge's mean is dominated by the worst
-   windows, and the other half cost as much to search for little (seeds 0-4 medians on the photo,
-   coherence / in-process seconds on the loaded machine: no refine 6.09 / 0.18; 3 iterations, all
-   patches 5.12 / 0.20; 3, worse half 5.18 / 0.19; 2, worse half 5.25 / 0.18; 1, all 5.30 / 0.18).
-   The method then runs no Poisson band: the refine re-synthesises the band. On grey textures the
-   refine brought gravel 8.78 -> 7.9 and brick 1.04 -> 0.99 but cost 20-40 ms of a ~0.25 s
-   process, their whole margin under G'MIC's time, and their goals are met without it.
+   windows. The method then runs no Poisson band: the refine re-synthesises the band. Seeds 0-4
+   medians on the photo, coherence / in-process ms (alternating, one process, quiet machine): no
+   refine 6.09 / 130 (with the Poisson band); 1 iteration, worse half 5.40 / 150; 1, all 5.30 /
+   165; 2, worse half 5.25 / 168; 3, all 5.12. One iteration is what the time goal affords: the
+   whole process then costs what it did before the refine (the quilt got ~20 ms faster), which was
+   already G'MIC's to within 0.01-0.02 s. On grey textures the refine brought gravel 8.78 -> 7.9 and
+   brick 1.04 -> 0.99 but cost 20-40 ms of a ~0.22 s process, their whole margin under G'MIC's
+   time, and they meet the other goals without it.
 
 Blocks are copied only from the original known pixels (never from filled ones), so errors cannot
 feed on themselves.
@@ -104,7 +106,7 @@ CONTINUE = 4
 #: Weight of the structure term in the fill order (step 1; colour images only); 0 = the count alone.
 DATA = 3.0
 #: EM iterations of the final patch-search refine (step 7; colour images only); 0 = none.
-REFINE = 2
+REFINE = 1
 #: The refine searches, in each iteration, the inexact patches at or above this percentile of their distances.
 REFINE_WORST = 50.0
 #: The refine's patch side (the judge ``fill_coherence``'s window).
