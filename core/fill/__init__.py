@@ -24,12 +24,14 @@ quilt engine's cut may also run through the known pixels of the blend band, when
 hole; the method then runs no Poisson blend for them.
 
 **The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE` (``quilt``). Measured
-against the others on issue 15's cases and judges (``python -m benchmarks 'fill-*'``, whole-process
-seconds, seed 1, quiet machine; coherence / detail / seam, the truth's in the README):
-``quilt`` meets every goal on the stochastic texture (gravel 8.78 / 0.94 / 1.06, 0.25 s) and the
-uncrop (0.70 / 1.06 / 1.02, 0.55 s), all but the seam on brick (0.94 / 1.06 / 0.97, 0.24 s), and
-all but coherence on the photo (6.53 / 1.35 / 1.00, 0.39 s); it loads no numba, so its first
-run costs what the second does, and it is the fastest (at or under G'MIC's time on every case).
+against the others on issue 15's cases and judges (``python -m benchmarks 'fill-*'``, seed 1;
+coherence / detail / seam, the truth's in the README):
+``quilt`` meets every goal on the stochastic texture (gravel 9.01 / 0.94 / 1.05) and the uncrop
+(0.72 / 1.06 / 1.05), all but the seam on brick (0.93 / 1.06 / 0.98), and all but coherence on the
+photo (5.79 / 1.36 / 0.99; its refine, step 7 of :mod:`weft.core.fill.quilt`, took it from 6.53); it
+loads no numba, so its first run costs what the second does, and its whole process is at or under
+G'MIC's on every case (on a quiet machine, interleaved: 0.21 / 0.22 / 0.35 s against G'MIC's 0.23 /
+0.24 / 0.35 s on gravel / brick / photo; the uncrop 0.44 s).
 ``hybrid`` (quilt with 48-px blocks, then the refine) has a lower coherence than ``quilt`` on
 every hole (7.51 / 0.91 / 5.56) but leaves a red ghost of the spoon's handle on the photo, and its
 refine costs 0.03-0.06 s more than G'MIC's whole process.
@@ -42,10 +44,10 @@ Switching the default is the one line :data:`~weft.core.fill.params.DEFAULT_ENGI
 
 **Known pixels** are never changed except within the blend band (``--band``, default 2 px): the
 quilting engine's minimum-error cut may run through the known pixels within ``band`` px of the hole,
-and then the pixels within ``band`` px (8-connected) of the hole's edge, on both sides, are re-solved by a Poisson
+and then (on grey pictures) the pixels within ``band`` px (8-connected) of the hole's edge, on both sides, are re-solved by a Poisson
 equation whose guidance is the image's own gradients except across the hole's edge, where the
 step beyond twice the texture's own is replaced by the continued slope of both sides
-(:mod:`weft.core.fill.band`; ``patchmatch`` and ``hybrid`` re-synthesise the band instead); every pixel
+(:mod:`weft.core.fill.band`; ``patchmatch``, ``hybrid`` and ``quilt`` on colour pictures re-synthesise the band instead); every pixel
 further away is bit-identical to the input. ``--band 0``: no known pixel changes.
 
 **Alpha.** The image keeps its alpha channel (``InputSpec.alpha``): with no mask its transparent pixels
