@@ -30,8 +30,8 @@ coherence / detail / seam, the truth's in the README):
 (0.72 / 1.06 / 1.05), all but the seam on brick (0.93 / 1.06 / 0.98), and all but coherence on the
 photo (5.79 / 1.36 / 0.99; its refine, step 7 of :mod:`weft.core.fill.quilt`, took it from 6.53); it
 loads no numba, so its first run costs what the second does, and its whole process is at or under
-G'MIC's on every case (on a quiet machine, interleaved: 0.21 / 0.22 / 0.35 s against G'MIC's 0.23 /
-0.24 / 0.35 s on gravel / brick / photo; the uncrop 0.44 s).
+G'MIC's on every case (on a quiet machine, interleaved: 0.20 / 0.20 / 0.33-0.35 s against G'MIC's
+0.23 / 0.23 / 0.35-0.36 s on gravel / brick / photo; the uncrop 0.38 s).
 ``hybrid`` (quilt with 48-px blocks, then the refine) has a lower coherence than ``quilt`` on
 every hole (7.51 / 0.91 / 5.56) but leaves a red ghost of the spoon's handle on the photo, and its
 refine costs 0.03-0.06 s more than G'MIC's whole process.
