@@ -1042,6 +1042,7 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, setting
             if figure is not None and not getattr(figure, "whole", False) and not isinstance(value, (list, dict)):
                 assert figure.render(value) not in text, text  # ... are not stated as the image's
         assert text.endswith("the image's figures on release"), text
+        assert f"engine {doc.current_params.engine}" in text, text  # a parameter holds for the whole image
         result = _final_after(window, qtbot, lambda: mouse(view, "release", (w * 0.5, y)))
         hole = doc.value("mask").bits
         text = window.statusBar().currentMessage()
