@@ -5,7 +5,8 @@
 Runs each job as its own process and reads the child's peak resident set size from ``wait4`` -- the
 figure ``/usr/bin/time -v`` prints as "Maximum resident set size" -- the median of ``--repeat`` runs
 (default 3). Inputs are made in a temporary folder: the astronaut example (colour) resized to 2048²
-and 4096² (cubic) as targets, the gravel example (256x256) as the texture.
+and 4096² (cubic) as targets, the gravel example (256x256) as the texture, and a mask of a 40 px
+square in the middle of the 4096² picture for the fill.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 LIMIT = 2 * 2**30
 
@@ -34,6 +37,10 @@ def _inputs(folder: Path) -> dict[str, str]:
         path = folder / f"astronaut{side}.png"
         cv2.imwrite(str(path), cv2.resize(picture, (side, side), interpolation=cv2.INTER_CUBIC))
         out[f"target{side}"] = str(path)
+    mask = np.zeros((4096, 4096), np.uint8)
+    mask[2000:2040, 2000:2040] = 255  # a 40 px hole (a bolt, a signature) in the 4096² picture
+    out["mask4096"] = str(folder / "mask4096.png")
+    cv2.imwrite(out["mask4096"], mask)
     return out
 
 
@@ -43,6 +50,7 @@ def _jobs(files: dict[str, str]) -> list[tuple[str, list[str]]]:
         ("fast transfer 4096x4096", ["fast", tex, "--target", files["target4096"]]),
         ("quilt synthesis 2048x2048", ["quilt", tex, "--size", "2048x2048"]),
         ("quilt transfer 2048x2048", ["quilt", tex, "--target", files["target2048"]]),
+        ("fill a 40 px hole in 4096x4096", ["fill", files["target4096"], "--mask", files["mask4096"]]),
     ]
 
 
