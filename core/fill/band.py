@@ -54,6 +54,18 @@ def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarr
     seam = hole if written is None else (np.asarray(written, dtype=bool) | hole)
     if not ring.any() or ring.all():
         return image
+    # the solve reads the ring and pixels up to 2 px from it: it runs on that box alone (a small hole
+    # in a 4096² picture: the whole-picture differences took 0.6 s)
+    ry, rx = np.nonzero(ring)
+    box = (slice(max(0, ry.min() - 2), ry.max() + 3), slice(max(0, rx.min() - 2), rx.max() + 3))
+    out = image.copy()
+    out[box] = _solve(image[box], ring[box], seam[box])
+    return out
+
+
+def _solve(image: np.ndarray, ring: np.ndarray, seam: np.ndarray) -> np.ndarray:
+    """:func:`blend_band`'s Poisson solve of ``ring`` in ``image`` (every pixel the solve reads lies in
+    ``image``), the seam between ``seam`` and the other pixels: ``image`` with the ring re-solved."""
     h, w, c = image.shape
     f = image.astype(np.float64)
     ys, xs = np.nonzero(ring)

@@ -15,7 +15,7 @@ from ..limits import check_output_size
 from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
-from .common import whole_patches
+from .common import neighbourhood, whole_patches
 from .params import ANCHORS, FillParams
 from .quilt import refines
 
@@ -217,8 +217,15 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     # quilt and pixel report progress(done, total); the PatchMatch engine reports weft.core.jobs.Progress
     # itself (its ProgressReporter), so it gets the method's callback as it is
     engine_report = progress if params.engine == "patchmatch" else engine_progress
-    filled = _engine(params.engine)(work, work_hole, work_src, patch=patch, rng=rng, progress=engine_report,
-                                    cancel=cancel, **extra)
+    # a small hole in a large picture: the engine fills the hole's neighbourhood alone
+    near = neighbourhood(work_hole, work_src, patch) if texture is None else None
+    part = (slice(None), slice(None)) if near is None else near
+    filled = _engine(params.engine)(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
+                                    progress=engine_report, cancel=cancel, **{k: v[part] for k, v in extra.items()})
+    if near is not None:
+        whole = np.array(work, dtype=np.float32)
+        whole[near] = filled
+        filled = whole
     filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
     out3 = filled if filled.ndim == 3 else filled[..., None]
     # (the refine of hybrid, patchmatch and quilt on colour pictures re-synthesises the band itself)
@@ -226,7 +233,9 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         written = hole
         if extra:  # the band's known pixels the quilting cut ran through: the seam lies beside them
             col3 = colour if colour.ndim == 3 else colour[..., None]
-            written = hole | (extra["cuttable"][:ch, :cw] & (out3 != col3).any(axis=2))
+            cut = extra["cuttable"][:ch, :cw]
+            written = hole.copy()
+            written[cut] = (out3[cut] != col3[cut]).any(axis=1)
         out3 = blend_band(np.ascontiguousarray(out3), hole, params.band, exclude=transparent, written=written)
     out = out3 if colour.ndim == 3 else out3[..., 0]
     if alpha is not None:

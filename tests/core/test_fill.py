@@ -450,30 +450,34 @@ def test_refine_percentile_is_numpys():
             assert _percentile(a, q) == float(np.percentile(a, q))
 
 
-def test_quilt_fills_a_small_hole_in_a_large_picture_from_its_neighbourhood():
-    """A 20 px hole in a 1024² picture: the quilt engine works on the hole's bounding box grown by
-    NEAR and two blocks (what its blocks can come from), so it equals the fill of that part alone,
-    and every pixel beyond the hole is the picture's own; a source mask, which may lie anywhere, and
-    a neighbourhood over a quarter of the picture keep the whole picture."""
-    from weft.core.fill import quilt
+@pytest.mark.parametrize("engine", ["quilt", "hybrid"])
+def test_a_small_hole_in_a_large_picture_is_filled_from_its_neighbourhood(engine):
+    """A 20 px hole in a 1024² picture: the method runs the engine on the hole's bounding box grown
+    by NEAR and two patches (what its copies can come from), so the fill equals the fill of that part
+    alone, and every pixel beyond it is the picture's own; a source mask, which may lie anywhere,
+    and a neighbourhood over a quarter of the picture keep the whole picture."""
+    from weft.core.fill.common import NEAR, neighbourhood
 
     rng = np.random.default_rng(4)
     img = cv2.resize(rng.random((64, 64, 3), dtype=np.float32), (1024, 1024), interpolation=cv2.INTER_CUBIC)
     img = np.clip(img, 0, 1)
     hole = np.zeros((1024, 1024), bool)
     hole[500:520, 700:720] = True
-    near = quilt._neighbourhood(hole, ~hole, 24)
-    m = quilt.NEAR + 48
+    near = neighbourhood(hole, ~hole, 24)
+    m = NEAR + 48
     assert near == (slice(500 - m, 520 + m), slice(700 - m, 720 + m))
-    out = quilt.fill_quilt(img, hole, rng=3)
-    alone = quilt.fill_quilt(img[near], hole[near], rng=3)
+    patch = FillParams(engine=engine).resolved_patch()
+    near = neighbourhood(hole, ~hole, patch)
+    out = fill(img, hole, engine=engine, seed=3)
+    alone = fill(img[near], hole[near], engine=engine, seed=3)
     assert np.array_equal(out[near], alone)
     outside = np.ones((1024, 1024), bool)
     outside[near] = False
-    assert np.array_equal(out[outside], img[outside]) and np.array_equal(out[~hole], img[~hole])
+    assert np.array_equal(out[outside], img[outside])
     source = np.zeros_like(hole)
     source[:100, :100] = True  # a source mask far from the hole
-    assert quilt._neighbourhood(hole, source, 24) is None
+    assert neighbourhood(hole, source, 24) is None
     big = np.zeros_like(hole)
     big[200:800, 200:800] = True
-    assert quilt._neighbourhood(big, ~big, 24) is None
+    assert neighbourhood(big, ~big, 24) is None
+
