@@ -560,7 +560,8 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(out).rstrip()
 
 
-def seed_medians(names: list[str], seeds: range, engine: str | None = None) -> list[dict[str, Any]]:
+def seed_medians(names: list[str], seeds: range, engine: str | None = None, patch: int | None = None
+                 ) -> list[dict[str, Any]]:
     """Per case, in-process through ``weft.core.fill.fill`` (default band): the median over ``seeds``
     of coherence, of detail as a ratio to the truth's and of seam as a difference from the truth's,
     and the seed-by-seed coherences (the README's "over seeds 0-4" line)."""
@@ -575,7 +576,7 @@ def seed_medians(names: list[str], seeds: range, engine: str | None = None) -> l
         for seed in seeds:
             kw = {} if inputs.extend is None else {"extend": inputs.extend}
             filled = fill(inputs.known_part, None if inputs.extend is not None else inputs.hole, seed=seed,
-                          engine=engine, **kw)
+                          engine=engine, patch=patch, **kw)
             rows.append(figures(np.clip(np.rint(filled * 255), 0, 255).astype(np.uint8), inputs))
         med = lambda key: statistics.median(r[key] for r in rows)  # noqa: E731
         out.append({"case": name, "coherence": med("coherence"), "detail": med("detail") / truth["detail"],
@@ -583,15 +584,16 @@ def seed_medians(names: list[str], seeds: range, engine: str | None = None) -> l
     return out
 
 
-if __name__ == "__main__":  # python -m benchmarks.fill [--seeds 0-4] [--engine E] [CASE...]
+if __name__ == "__main__":  # python -m benchmarks.fill [--seeds 0-4] [--engine E] [--patch P] [CASE...]
     import argparse
 
     ap = argparse.ArgumentParser(description="fill figures over several seeds, in-process (medians)")
     ap.add_argument("cases", nargs="*", default=[c.name for c in CASES if not c.preview])
     ap.add_argument("--seeds", default="0-4", help="first-last (inclusive)")
     ap.add_argument("--engine", default=None)
+    ap.add_argument("--patch", type=int, default=None)
     args = ap.parse_args()
     first, last = (int(v) for v in args.seeds.split("-"))
-    for r in seed_medians(args.cases, range(first, last + 1), args.engine):
+    for r in seed_medians(args.cases, range(first, last + 1), args.engine, args.patch):
         print(f"{r['case']}: coherence {r['coherence']:.2f}, detail {r['detail']:.2f} of the truth's, seam "
               f"{r['seam']:+.2f} from the truth's (seeds {args.seeds}: {r['each']})")

@@ -23,12 +23,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..params import as_rng
-from .common import whole_patches
 from .quilt import fill_quilt
 
-#: The quilting block of the hybrid engine (its ``patch``): twice the quilt engine's 24; on the
-#: benchmark's gravel / brick / photo holes (seeds 0-4) coherence 9.3 / 1.25 / 4.25 with 24-px blocks
-#: (seed 0) against 8.9 / 1.00 / 4.2 with 48.
+#: The quilting block of the hybrid engine (its ``patch``): twice the quilt engine's 24. With the
+#: quilt engine as it is now, seeds 0-4 medians (``python -m benchmarks.fill --engine hybrid
+#: [--patch 24]``), coherence with 48 / 24-px blocks: gravel 7.64 / 7.72, brick 1.03 / 0.97, photo
+#: 5.56 / 5.12, uncrop 0.68 / 0.63, and 24 takes 1.2-1.6x the time in-process (photo 0.11 / 0.18 s):
+#: 48 stays, the engine being the quicker of the refined ones.
 BLOCK = 48
 #: The refine's patch side (the coherence metric's window).
 REFINE_PATCH = 7
@@ -48,7 +49,7 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
     input exactly. Raises as :func:`~weft.core.fill.quilt.fill_quilt` does.
     """
     from .band import band_region
-    from .patchmatch import refine_patchmatch
+    from .patchmatch import refine_band
 
     gen = as_rng(rng)
     holes = np.asarray(hole, dtype=bool)
@@ -71,10 +72,5 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
         region = holes | band_region(holes, band) if band > 0 else holes
     allowed = ~holes if source is None else np.asarray(source, dtype=bool) & ~holes
     rp = max(3, min(int(refine_patch), int(patch), *holes.shape))
-    src = allowed & ~region
-    if not whole_patches(src, rp).any():  # the band took the last whole source patch: refine the hole only
-        region, src = holes, allowed
-    if not whole_patches(src, rp).any():
-        return quilted
-    return refine_patchmatch(quilted, region, src, quilted, patch=rp, iterations=iterations, rng=gen,
-                             progress=refine_progress, cancel=cancel)
+    return refine_band(quilted, holes, region, allowed, patch=rp, iterations=iterations, rng=gen,
+                       progress=refine_progress, cancel=cancel)

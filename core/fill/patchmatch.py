@@ -316,9 +316,7 @@ def fill_patchmatch(
         out[hole] = res[hole]
     if cuttable is not None:
         region = hole | np.asarray(cuttable, dtype=bool)
-        if _box_sum(source & ~region, p).max() >= p * p - 0.5:
-            out = refine_patchmatch(out, region, source & ~region, out, patch=p, iterations=_BAND_REFINE, rng=gen,
-                                    cancel=cancel)
+        out = refine_band(out, hole, region, source, patch=p, iterations=_BAND_REFINE, rng=gen, cancel=cancel)
     return out
 
 
@@ -555,6 +553,24 @@ def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight) -> 
     changed[py, px] = (new != img[py, px]).any(axis=1)
     img[py, px] = new
     return changed
+
+
+def refine_band(filled: np.ndarray, hole: np.ndarray, region: np.ndarray, source: np.ndarray, *, patch: int,
+                iterations: int, rng=0, progress=None, cancel=None, worst: float = 0.0) -> np.ndarray:
+    """:func:`refine_patchmatch` of a finished fill over ``region`` (the hole and the blend band's
+    known pixels that may change), copying only from ``source`` pixels outside it, so the band
+    becomes a continuation of the copies; over the hole alone, from the whole source, when the band
+    took the last whole source patch; ``filled`` as it is when there is none either. What the
+    ``quilt`` (colour), ``hybrid`` and ``patchmatch`` engines end with."""
+    from .common import whole_patches
+
+    sources = source & ~region
+    if not whole_patches(sources, patch).any():
+        region, sources = hole, source
+        if not whole_patches(sources, patch).any():
+            return filled
+    return refine_patchmatch(filled, region, sources, filled, patch=patch, iterations=iterations, rng=rng,
+                             progress=progress, cancel=cancel, worst=worst)
 
 
 def refine_patchmatch(

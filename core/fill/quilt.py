@@ -383,17 +383,9 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
 
 
 def _refine(out: np.ndarray, hole: np.ndarray, region: np.ndarray, src: np.ndarray, gen, cancel, progress) -> np.ndarray:
-    """Step 7: :func:`weft.core.fill.patchmatch.refine_patchmatch` over the hole and the band
-    (``region``), copying from source pixels beyond the band (the hole alone when the band took the
-    last whole source patch); ``out`` unchanged when there is none."""
-    from .patchmatch import refine_patchmatch
+    """Step 7: :func:`weft.core.fill.patchmatch.refine_band` over the hole and the band (``region``)."""
+    from .patchmatch import refine_band
 
-    p = max(3, min(REFINE_PATCH, *hole.shape))
-    sources = src & ~region
-    if not whole_patches(sources, p).any():
-        region, sources = hole, src
-        if not whole_patches(sources, p).any():
-            return out
-    return refine_patchmatch(out, region, sources, out, patch=p, iterations=REFINE, rng=gen, progress=progress,
-                             cancel=cancel, worst=REFINE_WORST)
+    return refine_band(out, hole, region, src, patch=max(3, min(REFINE_PATCH, *hole.shape)), iterations=REFINE,
+                       rng=gen, progress=progress, cancel=cancel, worst=REFINE_WORST)
 
