@@ -228,8 +228,11 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         filled = whole
     filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
     out3 = filled if filled.ndim == 3 else filled[..., None]
-    # (the refine of hybrid, patchmatch and quilt on colour pictures re-synthesises the band itself)
-    if params.engine not in ("hybrid", "patchmatch") and not (params.engine == "quilt" and refines(work, work_hole)):
+    # (the refine of hybrid, patchmatch and quilt on colour pictures re-synthesises the band itself;
+    # whether quilt refined is asked of the part it filled, as it asked itself)
+    refined = params.engine in ("hybrid", "patchmatch") or (params.engine == "quilt"
+                                                           and refines(work[part], work_hole[part]))
+    if not refined:
         written = hole
         if extra:  # the band's known pixels the quilting cut ran through: the seam lies beside them
             col3 = colour if colour.ndim == 3 else colour[..., None]

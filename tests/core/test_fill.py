@@ -481,3 +481,20 @@ def test_a_small_hole_in_a_large_picture_is_filled_from_its_neighbourhood(engine
     big[200:800, 200:800] = True
     assert neighbourhood(big, ~big, 24) is None
 
+
+def test_a_grey_neighbourhood_of_a_colour_picture_is_blended_as_the_engine_filled_it():
+    """The quilt engine refines colour pictures and leaves grey ones to the Poisson band; on a large
+    picture it fills the hole's neighbourhood alone, so the band is decided on that part too: a hole
+    in a grey region of a picture coloured only far away gets the band, as the part alone does."""
+    from weft.core.fill.common import neighbourhood
+
+    rng = np.random.default_rng(5)
+    grey = cv2.resize(rng.random((64, 64), dtype=np.float32), (1024, 1024), interpolation=cv2.INTER_CUBIC)
+    img = np.repeat(np.clip(grey, 0, 1)[..., None], 3, axis=2)
+    img[:64, :64, 0] = 1.0  # colour, far from the hole
+    hole = np.zeros((1024, 1024), bool)
+    hole[600:630, 700:730] = True
+    near = neighbourhood(hole, ~hole, 24)
+    out = fill(img, hole, seed=2)
+    assert np.array_equal(out[near], fill(img[near], hole[near], seed=2))
+
