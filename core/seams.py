@@ -18,7 +18,7 @@ import numpy as np
 from .errors import ImageError, InvalidParameter
 from .params import out_of_range
 
-__all__ = ["min_cut_mask", "min_error_path", "overlap_error"]
+__all__ = ["min_cut_mask", "min_error_path", "overlap_error", "accumulated_costs"]
 
 
 def _check_error(error, name: str = "error") -> np.ndarray:
@@ -135,3 +135,28 @@ def min_error_path(error: np.ndarray) -> np.ndarray:
 
     _k.cut_mask(err, 0, w, 0, 0, mask)
     return np.argmax(mask, axis=1).astype(np.int64)
+
+
+def accumulated_costs(error: np.ndarray) -> np.ndarray:
+    """The dynamic program's accumulated costs of a stack of vertical strips, in numpy (no numba).
+
+    ``error`` (K, h, w): the error surfaces of K strips; returns float64 (K, h, w) with
+    ``E[y, x] = e[y, x] + min(E[y+1, x-1], E[y+1, x], E[y+1, x+1])`` (the bottom row its error;
+    neighbours beyond the strip's edges not used), the values of the numba kernel's (the same
+    additions; min is exact). A backtrace from any row follows it down; the numpy quilting engine
+    (its kernel's tie rule) and the fill's cut (lowest column) trace their own.
+
+    The rows are accumulated into a buffer padded with +inf columns, three ufunc calls a row written
+    in place, for the whole stack at once (the run is ``h`` steps of calls on tiny arrays, so the
+    number of calls is the cost).
+    """
+    k, h, w = error.shape
+    accp = np.full((k, h, w + 2), np.inf)
+    accp[:, h - 1, 1:-1] = error[:, h - 1]
+    tmp = np.empty((k, w))
+    for y in range(h - 2, -1, -1):
+        below = accp[:, y + 1]
+        np.minimum(below[:, :-2], below[:, 2:], out=tmp)
+        np.minimum(tmp, below[:, 1:-1], out=tmp)
+        np.add(error[:, y], tmp, out=accp[:, y, 1:-1])
+    return accp[:, :, 1:-1]

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..seams import accumulated_costs
+
 
 def _vertical_paths(err: np.ndarray) -> np.ndarray:
     """Column of the least-error 8-connected top-to-bottom path in every row of each ``err[k]``
@@ -22,11 +24,7 @@ def _vertical_paths(err: np.ndarray) -> np.ndarray:
     the accumulated costs (a strip is a few columns wide: numpy's per-call cost was 60 % of a cut).
     Ties: the lowest column, as ``np.argmin``."""
     k, h, w = err.shape
-    acc = err.astype(np.float64)  # (a copy)
-    side = np.full((k, w + 2), np.inf)
-    for y in range(h - 2, -1, -1):
-        side[:, 1:-1] = acc[:, y + 1]
-        acc[:, y] += np.minimum(np.minimum(side[:, :-2], side[:, 1:-1]), side[:, 2:])
+    acc = accumulated_costs(err)
     path = np.empty((k, h), dtype=np.int64)
     for s, rows in enumerate(acc.tolist()):
         x = min(range(w), key=rows[0].__getitem__)  # the first minimum

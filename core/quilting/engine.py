@@ -18,6 +18,7 @@ import numpy as np
 from . import codes as _K  # the kernel's array codes, without importing numba (a test checks it)
 from ..grid import block_grid
 from ..jobs import CancelToken, ProgressReporter
+from ..seams import accumulated_costs
 
 RULES = ("tol", "epsilon", "sampled")
 
@@ -536,32 +537,14 @@ def _choose_sampled_numpy(cross, sq, const, cost_buf, u: float, seed: int) -> in
     return int(idx[order[min(int(u * k), k - 1)]])
 
 
-def _vertical_acc_numpy(err: np.ndarray) -> np.ndarray:
-    """The kernel's ``_vertical_acc`` for a stack of error surfaces (K, h, w).
-
-    The rows are accumulated into a buffer padded with +inf columns, three ufunc calls a row
-    written in place (the run is ``h`` steps of calls on tiny arrays, so the number of calls is
-    the cost); the values are the kernel's (the same additions, min is exact)."""
-    k, h, w = err.shape
-    accp = np.full((k, h, w + 2), np.inf)
-    accp[:, h - 1, 1:-1] = err[:, h - 1]
-    tmp = np.empty((k, w))
-    for y in range(h - 2, -1, -1):
-        below = accp[:, y + 1]
-        np.minimum(below[:, :-2], below[:, 2:], out=tmp)
-        np.minimum(tmp, below[:, 1:-1], out=tmp)
-        np.add(err[:, y], tmp, out=accp[:, y, 1:-1])
-    return accp[:, :, 1:-1]
-
-
 def _vertical_accs_numpy(strips: list[np.ndarray]) -> list[np.ndarray]:
-    """:func:`_vertical_acc_numpy` of each (K, h, w) stack of ``strips``; stacks of one shape (a
+    """:func:`weft.core.seams.accumulated_costs` of each (K, h, w) stack of ``strips``; stacks of one shape (a
     square block's left and transposed top strips) run as one program."""
     if len(strips) > 1 and all(s.shape == strips[0].shape for s in strips):
-        acc = _vertical_acc_numpy(np.concatenate(strips))
+        acc = accumulated_costs(np.concatenate(strips))
         k = strips[0].shape[0]
         return [acc[i * k:(i + 1) * k] for i in range(len(strips))]
-    return [_vertical_acc_numpy(s) for s in strips]
+    return [accumulated_costs(s) for s in strips]
 
 
 def _trace_scalar(acc: np.ndarray, y_start, x_start) -> np.ndarray:
