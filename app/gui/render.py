@@ -250,17 +250,18 @@ class Renderer(QObject):
     def job_inputs(self, *, preview: bool) -> tuple[dict[str, np.ndarray], Params] | None:
         """Inputs and parameters of a render of the current method, or None if inputs are missing
         (built here and now; a render job builds them on its worker: :meth:`_preparation`)."""
-        prepare = self._preparation(preview=preview)
-        return None if prepare is None else prepare()[:2]
+        prepared = self._preparation(preview=preview)
+        return None if prepared is None else prepared[0]()[:2]
 
-    def _preparation(self, *, preview: bool, around_box=None) -> Callable[[], tuple | None] | None:
+    def _preparation(self, *, preview: bool, around_box=None) -> tuple[Callable[[], tuple | None], Params] | None:
         """What a job of the current method runs on, captured now (the document's inputs and
         parameters) and built by the returned call, on the job's worker: its painted masks as float
         images, a crop to the source region, a preview's reduction (``reduce_for_preview``: 48.5 ms
         at 4096² on the GUI thread before) or a stroke's crop (``crop_around``, with the whole
         image's mask: 0.15-0.57 s per preview at 4096² on the GUI thread before). The call gives
         ``(inputs, params, around)`` (``around``: the stroke's :class:`~weft.core.studio.Around`, or
-        None), or None when there is nothing painted near the stroke. None here: inputs are missing."""
+        None), or None when there is nothing painted near the stroke. Returns ``(that call, the
+        document's run parameters)``, or None when inputs are missing."""
         doc = self.doc
         if doc.missing_inputs():
             return None
@@ -276,7 +277,7 @@ class Renderer(QObject):
                 return (*reduce_for_preview(studio, build(), params, PREVIEW_SIDE), None)
             return build(), params, None
 
-        return prepare
+        return prepare, params
 
     def _submit(self, slot: str, preview: bool) -> int | None:
         if not self.enabled:
@@ -289,10 +290,10 @@ class Renderer(QObject):
             if doc.missing_inputs():
                 return None
             box, self._around_box = self._around_box, None
-        prepare = self._preparation(preview=preview, around_box=box)
-        if prepare is None:
+        prepared = self._preparation(preview=preview, around_box=box)
+        if prepared is None:
             return None
-        params = doc.run_params()
+        prepare, params = prepared
         method, seed = doc.current, doc.seed
         recipe = None if preview else doc.recipe(params)
         masks = None if preview else doc.masks()
