@@ -82,7 +82,8 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
     extend : ``Margins`` or ``(left, top, right, bottom)`` or ``"L,T,R,B"``: pixels added (and filled).
     size, anchor : ``(width, height)`` of a larger canvas, and where the image sits on it
         (:data:`ANCHORS`); not with ``extend``.
-    engine : ``"quilt"``, ``"pixel"``, ``"patchmatch"`` or ``"hybrid"``; default :data:`DEFAULT_ENGINE`.
+    engine : ``"auto"`` (the default, :data:`DEFAULT_ENGINE`: ``patchmatch`` for a hole inside a colour
+        picture, ``quilt`` otherwise), ``"quilt"``, ``"pixel"``, ``"patchmatch"`` or ``"hybrid"``.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
     source_mask : (H, W) (of the texture when one is given): the only pixels to copy from.
     texture : ndarray: copy from this image instead of the rest of ``image``.

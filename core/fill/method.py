@@ -16,8 +16,8 @@ from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
 from .common import neighbourhood, whole_patches
-from .params import ANCHORS, FillParams
-from .quilt import refines
+from .params import ANCHORS, DEFAULT_PATCH, FillParams, auto_engine
+from .quilt import is_colour, refines
 
 
 def _engine(name: str):
@@ -109,9 +109,6 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     """The whole method: ``(filled image, figures)``. See :func:`weft.core.fill.fill`."""
     colour, alpha = _split_alpha(image, "image")
     h, w = colour.shape[:2]
-    patch = params.resolved_patch()
-    if params.engine == "pixel":
-        patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
     hole = np.zeros((h, w), dtype=bool)
     named = None  # what made the hole, for messages
     if mask is not None:
@@ -141,6 +138,17 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         if alpha is not None:
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
+    if params.engine == "auto":  # the figures and messages name the engine that runs
+        on_border = bool(hole[0].any() or hole[-1].any() or hole[:, 0].any() or hole[:, -1].any())
+        # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
+        # large picture (a colour corner far from a hole in a grey region does not make it a photo)
+        known = ~hole & ~transparent
+        near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
+        picture = colour.ndim == 3 and is_colour(colour[near], known[near])
+        params = params.replace(engine=auto_engine(picture, on_border, params.patch))
+    patch = params.resolved_patch()
+    if params.engine == "pixel":
+        patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
     if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
         patch = max(3, min(ch, cw) // 2) | (1 if params.engine == "pixel" else 0)
     if params.patch is None and params.engine == "hybrid":  # its 48-px block: at most a third of a small image
@@ -266,11 +274,8 @@ def _run(inputs: Mapping[str, np.ndarray], params: FillParams, *, rng=None, prog
 
 def warm_up() -> None:
     """Load (or compile) the kernels a fill can use, on tiny inputs, so that no run compiles: the
-    PatchMatch engine's and the pixel engine's (grey and colour). The quilt engine and the blend
-    band run in numpy (:mod:`weft.core.fill.cut`) and have none."""
-    from . import patchmatch
-
-    patchmatch.warm_up()
+    pixel engine's (grey and colour). The quilt and patchmatch engines and the blend band run in
+    numpy (:mod:`weft.core.fill.cut`, :mod:`weft.core.fill.patchmatch`) and have none."""
     rng = np.random.default_rng(0)
     img = rng.random((24, 24), dtype=np.float32)
     hole = np.zeros((24, 24), dtype=bool)

@@ -12,10 +12,12 @@ from ..params import Params, param
 ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-left", "bottom", "bottom-right")
 
 
-#: The engines `--engine` offers (each a function of one signature, see the package docstring).
-ENGINES = ("patchmatch", "quilt", "pixel", "hybrid")
-#: The default engine: the one that measures best on issue 15's cases (see the package docstring for the figures).
-DEFAULT_ENGINE = "quilt"
+#: The engines `--engine` offers (each a function of one signature, see the package docstring), and
+#: ``auto``, which picks one of them for the picture (:func:`auto_engine`).
+ENGINES = ("auto", "patchmatch", "quilt", "pixel", "hybrid")
+#: The default engine: ``auto``, the pick that measures best on each of issue 15's cases (see the
+#: package docstring for the figures).
+DEFAULT_ENGINE = "auto"
 #: Each engine's patch side when ``patch`` is not given.
 DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7, "hybrid": 48}
 
@@ -25,7 +27,9 @@ class FillParams(Params):
     """Parameters of ``weft fill``."""
 
     engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
-                        help="quilt: blocks in fill-front order with min-cut seams (Efros & Freeman); "
+                        help="auto: patchmatch for a hole inside a colour picture, quilt otherwise (grey "
+                             "pictures, holes along the border, uncrop); "
+                             "quilt: blocks in fill-front order with min-cut seams (Efros & Freeman); "
                              "pixel: coherent pixel synthesis (Ashikhmin)"
                              "; patchmatch: multi-scale patch search with voting"
                              "; hybrid: quilt, then full-resolution patch search refines the seams")
@@ -54,4 +58,18 @@ class FillParams(Params):
                                        f"engine", name="patch", value=self.patch)
 
     def resolved_patch(self) -> int:
+        """The patch side the engine runs with (``auto`` resolved first: :func:`auto_engine`)."""
         return self.patch if self.patch is not None else DEFAULT_PATCH[self.engine]
+
+
+def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None) -> str:
+    """The engine ``auto`` runs: ``patchmatch`` for a hole inside a colour picture (removing an
+    object from a photo: coherence 4.69 against quilt's 5.40 on issue 15's photo, seeds 0-4), unless
+    the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.77,
+    brick 1.05 against 1.49) and for holes along the canvas border, an uncrop's (0.72 against 0.95,
+    in a third of the time)."""
+    from .patchmatch import MAX_PATCH
+
+    if colour_picture and not hole_on_border and (patch is None or patch <= MAX_PATCH):
+        return "patchmatch"
+    return "quilt"

@@ -197,7 +197,39 @@ def test_python_api_refusals(gravel):
 
 
 def test_engines_listed():
-    assert {"quilt", "pixel"} <= set(ENGINES)
+    assert {"auto", "quilt", "pixel", "patchmatch", "hybrid"} == set(ENGINES)
+    assert FillParams().engine == "auto"
+
+
+def test_auto_runs_patchmatch_inside_a_colour_picture_and_quilt_otherwise(gravel):
+    """``auto`` (the default) is the engine it names in the figures, and its pixels are that
+    engine's: patchmatch for a hole inside a colour picture; quilt for a grey picture, a colour
+    picture stored grey as RGB, a hole along the border or an uncrop, and a patch beyond 63 px."""
+    big = np.ascontiguousarray(load_image(example("chelsea")).image[:160, :200])
+    photo = big[:96, :120]
+    assert photo.ndim == 3
+    hole = square_hole(photo.shape)
+    grey_rgb = np.repeat(gravel[..., None], 3, axis=2)
+    border = np.zeros(photo.shape[:2], bool)
+    border[:, :20] = True
+    cases = [
+        ("patchmatch", photo, dict(mask=hole)),
+        ("quilt", gravel, dict(mask=square_hole(gravel.shape))),
+        ("quilt", grey_rgb, dict(mask=square_hole(gravel.shape))),
+        ("quilt", photo, dict(mask=border)),
+        ("quilt", photo, dict(extend=(0, 0, 16, 0))),
+        ("quilt", big, dict(mask=square_hole(big.shape, 70, 100, 80, 120), patch=64)),
+    ]
+    from weft.core.fill.method import fill_image
+    from weft.core.geometry import Margins
+
+    for expected, image, kw in cases:
+        mask = kw.pop("mask", None)
+        if "extend" in kw:
+            kw["extend"] = Margins.coerce(kw["extend"])
+        out, figures = fill_image(image, mask, params=FillParams(**kw), rng=2)
+        assert figures["engine"] == expected, (expected, kw)
+        assert np.array_equal(out, fill(image, mask, engine=expected, seed=2, **kw))
 
 
 @pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))

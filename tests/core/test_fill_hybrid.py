@@ -187,11 +187,14 @@ def test_patchmatch_with_a_band_refines_it_and_leaves_every_other_known_pixel(gr
     assert not np.array_equal(a[band], gravel[band])
     assert np.array_equal(plain[~hole], gravel[~hole])
     # through the method: the band is the only place known pixels change, and no Poisson solve smooths it
-    out = fill(gravel, hole, engine="patchmatch", seed=3, band=2)
-    assert np.array_equal(out[~(hole | band)], gravel[~(hole | band)])
+    outs = [fill(gravel, hole, engine="patchmatch", seed=s, band=2) for s in (1, 2, 3)]
+    for out in outs:
+        assert np.array_equal(out[~(hole | band)], gravel[~(hole | band)])
+    # a third of this 96 px crop is the hole: the fill's detail is 0.7-0.85 of the truth's here (0.87-0.93
+    # on the benchmark's 320 px gravel), a smeared fill 0.1-0.5
     truth_detail = metrics.fill_detail(gravel, hole)
-    assert 0.8 * truth_detail <= metrics.fill_detail(out, hole) <= 1.25 * truth_detail
-    assert metrics.fill_coherence(out, hole, gravel) <= 0.75 * metrics.fill_coherence(gravel, hole)
+    assert 0.65 * truth_detail <= np.median([metrics.fill_detail(o, hole) for o in outs]) <= 1.25 * truth_detail
+    assert np.median([metrics.fill_coherence(o, hole, gravel) for o in outs]) <= 0.75 * metrics.fill_coherence(gravel, hole)
 
 
 def test_refine_searching_the_worst_patches_only():

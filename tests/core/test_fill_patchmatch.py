@@ -69,8 +69,14 @@ def test_same_seed_same_pixels_other_seed_other_pixels(gravel):
 
 
 def test_a_gravel_hole_is_detailed_like_the_ground_truth_and_as_coherent(gravel):
+    from weft.core.fill.band import band_region
+
     hole = _square_hole(96, 96, 36, 36, 24)
-    out = fill_patchmatch(_garbled(gravel, hole), hole, rng=1)
+    # as the method runs it: the default 2 px blend band may change (without one the seam is about
+    # +0.16 of the truth's here: the known edge is fixed, the copies meet it as they are)
+    band = band_region(hole, 2) & ~hole
+    out = fill_patchmatch(_garbled(gravel, hole), hole, rng=1, cuttable=band)
+    assert np.array_equal(out[~(hole | band)], gravel[~(hole | band)])
     truth_detail = fill_detail(gravel, hole)
     assert 0.7 <= fill_detail(out, hole) / truth_detail <= 1.3
     assert abs(fill_seam(out, hole) - fill_seam(gravel, hole)) <= 0.15
@@ -190,69 +196,45 @@ def test_a_source_without_a_whole_patch_is_refused(gravel):
 
 @pytest.mark.parametrize("bias, takes_neighbours_offset", [(0.0, False), (1.0, True)])
 def test_a_coherence_bias_lets_propagation_take_a_neighbours_offset_within_the_margin(bias, takes_neighbours_offset):
-    from weft.core._kernels import fill as kf
+    from weft.core.fill.patchmatch import _Flat, _try
 
     p = 3
-    img = np.random.default_rng(5).random((20, 20, 1))
-    img[10:13, 10:13] = img[2:5, 2:5]  # target 0 at (10, 10) is an exact copy of source (2, 2)
-    img[10:13, 13] = img[2:5, 5] + 0.1  # and target 1 at (10, 11) nearly one of source (2, 3)
-    conf = np.ones((20, 20), np.float32)
-    valid = np.zeros((18, 18), bool)
-    valid[2, 2:4] = True  # the only allowed sources: target 0's match and its right neighbour
-    tpos = np.array([[10, 10], [10, 11]], np.int64)
-    tmap = np.full((18, 18), -1, np.int64)
-    tmap[10, 10], tmap[10, 11] = 0, 1
-    # target 1's current match (outside the source, as a stale match may be) is 1.5x closer than the
-    # offset target 0 propagates to it: only a bias above 0.5 takes the neighbour's offset
-    d_prop = kf._dist(img, conf, 10, 11, 2, 3, p, np.inf)
-    assert d_prop > 0 and kf._dist(img, conf, 10, 11, 2, 2, p, np.inf) > d_prop
-    nnf = np.array([[2, 2], [15, 15]], np.int64)
-    dist = np.array([0.0, d_prop / 1.5])
-    kf.patchmatch_pass(img, conf, valid, tpos, tmap, nnf, dist, p, False, np.array([7], np.int64), bias)
-    assert nnf[0].tolist() == [2, 2] and dist[0] == 0.0
+    img = np.random.default_rng(5).random((20, 20, 1)).astype(np.float32)
+    hole = np.zeros((20, 20), bool)
+    hole[10:13, 10:14] = True
+    source = ~hole
+    fl = _Flat(img, hole, source, p)
+    target = fl.gather(np.array([10]), np.array([11]))  # the patch at (10, 11), as its pixels
+    k = np.array([0])  # its candidate (2, 3), its current match (2, 2)
+    d_cand = fl.dist(target, k, np.array([2]), np.array([3]))[0]
+    # the current match is 1.5x closer than the candidate the neighbour's offset proposes: only a
+    # bias above 0.5 takes the neighbour's offset
+    sy, sx, dist = np.array([2]), np.array([2]), np.array([d_cand / 1.5])
+    _try(fl, target, k, sy, sx, dist, np.array([2]), np.array([3]), np.array([True]), bias=bias)
     if takes_neighbours_offset:
-        assert nnf[1].tolist() == [2, 3] and dist[1] == d_prop
+        assert (sy[0], sx[0]) == (2, 3) and dist[0] == d_cand
     else:
-        assert nnf[1].tolist() == [15, 15] and dist[1] == d_prop / 1.5
-
-_COMPILE_SCRIPT = r"""
-import json, sys
-import numpy as np
-from numba.core.registry import CPUDispatcher
-from weft.core._kernels import fill as kf
-from weft.core.fill.patchmatch import fill_patchmatch, warm_up
-
-def signatures():
-    return {name: sorted(str(s) for s in obj.signatures) for name, obj in vars(kf).items()
-            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == kf.__name__}
-
-warm_up()
-before = signatures()
-rng = np.random.default_rng(0)
-hole = np.zeros((80, 90), bool)
-hole[20:50, 30:60] = True
-source = np.ones((80, 90), bool)
-source[:, :10] = False
-for img in (rng.random((80, 90), dtype=np.float32), rng.random((80, 90, 3), dtype=np.float32),
-            rng.random((80, 90, 4), dtype=np.float32)):
-    fill_patchmatch(img, hole, rng=1)
-    fill_patchmatch(img.astype(np.float64), ~source, source, patch=5, rng=2, levels=1)
-print(json.dumps({"before": before, "after": signatures()}))
-"""
+        assert (sy[0], sx[0]) == (2, 2) and dist[0] == d_cand / 1.5
 
 
-def test_warm_up_compiles_every_kernel_a_fill_uses_once():
-    import json
+def test_a_patchmatch_fill_loads_no_numba():
+    """The engine is numpy only: a ``weft fill --engine patchmatch`` process pays no numba import
+    or kernel cache loads (0.4-0.5 s of its whole-process time when it had them)."""
     import subprocess
     import sys
 
-    proc = subprocess.run([sys.executable, "-c", _COMPILE_SCRIPT], capture_output=True, text=True, timeout=600)
+    script = (
+        "import sys, numpy as np\n"
+        "from weft.core.fill.patchmatch import fill_patchmatch\n"
+        "img = np.random.default_rng(0).random((64, 64, 3), dtype=np.float32)\n"
+        "hole = np.zeros((64, 64), bool); hole[20:40, 20:40] = True\n"
+        "out = fill_patchmatch(img, hole, rng=1)\n"
+        "assert np.array_equal(out[~hole], img[~hole])\n"
+        "print(sorted(m for m in sys.modules if m == 'numba' or m.startswith('scipy.ndimage')))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
-    # every public kernel loaded by warm_up() (the private helpers are compiled into their callers)
-    assert out["before"] and all(sigs for name, sigs in out["before"].items() if not name.startswith("_"))
-    assert out["after"] == out["before"]  # a run compiled nothing new
-    assert all(len(sigs) <= 1 for sigs in out["after"].values())
+    assert proc.stdout.strip().splitlines()[-1] == "[]"
 
 
 def test_stable_argsort_is_numpys_stable_argsort():

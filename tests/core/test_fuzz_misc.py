@@ -300,9 +300,11 @@ def test_patch_metrics_fuzz(kind_a, kind_b, ha, wa, hb, wb, colour, patch, strid
         if kind_a in ("flat", "black", "white") and kind_b in ("flat", "black", "white"):
             diff = abs(float(luminance(a).flat[0]) - float(luminance(b).flat[0]))
             assert value == pytest.approx(patch * diff, abs=1e-5)  # every window is the constant
-    if not problems:  # identical images: ~0 (float32 may pick a twin patch a rounding error away)
-        assert 0.0 <= metrics.coherence(a, a, patch=patch, stride=stride) < 1e-5
-        assert 0.0 <= metrics.completeness(b, b, patch=patch, stride=stride) < 1e-5
+    if not problems:  # identical images: ~0. The neighbour is picked in float32 (|b|^2 - 2a.b, an error of
+        # ~1e-7 on squared distances), so a twin patch up to ~sqrt(1e-7) = 3e-4 away may win over the patch
+        # itself (noise, 1x1 patches: 1.3e-5); the reported distance is then exact
+        assert 0.0 <= metrics.coherence(a, a, patch=patch, stride=stride) < 1e-3
+        assert 0.0 <= metrics.completeness(b, b, patch=patch, stride=stride) < 1e-3
 
 
 @fuzz(80)
