@@ -23,24 +23,20 @@ quilt engine's cut may also run through the known pixels of the blend band, when
 ``patchmatch`` and ``hybrid`` are given the band too (``cuttable``) and re-synthesise it with the
 hole; the method then runs no Poisson blend for them.
 
-**The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE` (``quilt``). Measured
-against the others on issue 15's cases and judges (``python -m benchmarks 'fill-*'``, seed 1;
-coherence / detail / seam, the truth's in the README):
-``quilt`` meets every goal on the stochastic texture (gravel 9.01 / 0.94 / 1.05) and the uncrop
-(0.72 / 1.06 / 1.05), all but the seam on brick (0.93 / 1.06 / 0.98), and all but coherence on the
-photo (5.79 / 1.36 / 0.99; its refine, step 7 of :mod:`weft.core.fill.quilt`, took it from 6.53); it
-loads no numba, so its first run costs what the second does, and its whole process is at or under
-G'MIC's on every case (on a quiet machine, interleaved: 0.20 / 0.20 / 0.33-0.35 s against G'MIC's
-0.23 / 0.23 / 0.35-0.36 s on gravel / brick / photo; the uncrop 0.38 s).
-``hybrid`` (quilt with 48-px blocks, then the refine) has a lower coherence than ``quilt`` on
-every hole (7.51 / 0.91 / 5.56) but leaves a red ghost of the spoon's handle on the photo, and its
-refine costs 0.03-0.06 s more than G'MIC's whole process.
-``patchmatch`` is the best on the photo (4.52 / 1.22 / 1.07) but bends brick mortar (1.10) and pays
-numba's fixed cost in every process (0.83-1.14 s; 3.3 s on a first run). ``pixel`` is the least
-coherent everywhere. No engine meets every goal; ``quilt`` misses the fewest and is the quickest.
-The README's "Fill and extend against the peers" has the tables and the pictures.
-
-Switching the default is the one line :data:`~weft.core.fill.params.DEFAULT_ENGINE`.
+**The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE`, ``auto``
+(:func:`~weft.core.fill.params.auto_engine`): ``patchmatch`` for a hole inside a colour picture,
+``quilt`` otherwise; the figures name the engine that ran. Measured on issue 15's cases (seeds 0-4
+medians, ``python -m benchmarks.fill --seeds 0-4``; coherence / detail / seam against the truth's):
+on the photo ``patchmatch`` is the most coherent (4.69 / 1.01 / -0.05 against ``quilt``'s 5.40 /
+1.08 / +0.01; G'MIC's 7.24, 1.2x shift-map's 4.99), in a whole process of 0.37 s against G'MIC's
+0.36 s (interleaved, medians of 9); on the grey textures and the uncrop ``quilt`` is the more
+coherent (gravel 9.01 against 9.77, brick 1.05 against 1.49, uncrop 0.72 against 0.95) and the
+quicker (0.20-0.38 s whole processes), and it keeps brick mortar straight where ``patchmatch``
+bends it. ``hybrid`` (quilt with 48-px blocks, then the refine) is more coherent than ``quilt`` on
+the textures but leaves a red ghost of the spoon's handle on the photo and costs more than G'MIC's
+whole process; ``pixel`` is the least coherent everywhere. Neither ``quilt`` nor ``patchmatch``
+loads numba: a fill's first run costs what the second does. The README's "Fill and extend against
+the peers" has the tables and the pictures.
 
 **Known pixels** are never changed except within the blend band (``--band``, default 2 px): the
 quilting engine's minimum-error cut may run through the known pixels within ``band`` px of the hole,

@@ -307,7 +307,7 @@ STUDIO = Studio(
     preview_inputs=("image", "mask", "source_mask", "texture"),
     examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
     masks_of={"source_mask": ("texture", "image")},
-    figures={"engine": Figure("engine", whole=True), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
+    figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
              "hole_fraction": Figure("filled", "%", "of the image", digits=2),
              "source_pixels": Figure("copied from", "px")})
 
