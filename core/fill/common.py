@@ -68,6 +68,12 @@ def neighbourhood(hole: np.ndarray, source: np.ndarray, patch: int) -> tuple[sli
     return slice(y0, y1), slice(x0, x1)
 
 
+def touches_border(hole: np.ndarray) -> bool:
+    """Whether ``hole`` has a pixel in the picture's first or last row or column (an uncrop's, a
+    transparent border's)."""
+    return bool(hole[0].any() or hole[-1].any() or hole[:, 0].any() or hole[:, -1].any())
+
+
 def whole_patches(region: np.ndarray, patch: int) -> np.ndarray:
     """bool (H - patch + 1, W - patch + 1): the patch with this top-left corner lies inside ``region``."""
     h, w = region.shape

@@ -15,7 +15,7 @@ from ..limits import check_output_size
 from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
-from .common import neighbourhood, whole_patches
+from .common import neighbourhood, touches_border, whole_patches
 from .params import ANCHORS, DEFAULT_PATCH, FillParams, auto_engine
 from .quilt import is_colour, refines
 
@@ -139,13 +139,12 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
     if params.engine == "auto":  # the figures and messages name the engine that runs
-        on_border = bool(hole[0].any() or hole[-1].any() or hole[:, 0].any() or hole[:, -1].any())
         # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
         # large picture (a colour corner far from a hole in a grey region does not make it a photo)
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        params = params.replace(engine=auto_engine(picture, on_border, params.patch))
+        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch))
     patch = params.resolved_patch()
     if params.engine == "pixel":
         patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one

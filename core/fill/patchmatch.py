@@ -4,7 +4,7 @@ Wexler, Shechtman & Irani, "Space-Time Completion of Video" (PAMI 2007), with th
 search of Barnes et al., "PatchMatch" (SIGGRAPH 2009), vectorised (every target patch at once, its
 propagation by jump flooding instead of PatchMatch's scan order), so a fill loads no numba: numba's
 import and its kernels' cache loads were 0.4-0.5 s of every ``weft fill --engine patchmatch``
-process (0.9-1.1 s for a 320 px photo against 0.35-0.4 s now), and ``scipy.ndimage`` (0.1 s) is
+process (0.9-1.1 s for a 320 px photo against 0.37-0.38 s now, with ``weft``'s allocator setting), and ``scipy.ndimage`` (0.1 s) is
 not imported either (OpenCV's exact distance transform gives the depths):
 
 1. An image pyramid, halving until the hole is about two patches deep (one along the image's
@@ -49,9 +49,9 @@ truth's), the numba engine this replaced against this one: gravel 9.55 / 0.84 / 
 grey textures (where the ``quilt`` engine is the better choice and what ``auto`` picks), as good on
 the photo (where ``auto`` picks this engine), with no crema copied from the cup under the spoon,
 at half the whole-process time (in-process 0.20 s against the quilt engine's 0.15 s on the photo).
-Searching the finest level too (one EM iteration on all channels) and three final iterations over
-every inexact patch was more coherent on the textures (gravel 8.38, brick 1.38) at twice the
-computing time, over G'MIC's whole-process time.
+With the one-patch pyramid, searching the finest level too (one EM iteration on all channels) and
+three final iterations over every inexact patch was more coherent on the textures (gravel 8.38,
+brick 1.38) at twice the computing time, over G'MIC's whole-process time.
 
 Every pixel outside the hole (and ``cuttable``) is returned exactly as given.
 """
@@ -65,6 +65,7 @@ import numpy as np
 from ..errors import ImageError, InvalidParameter
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
+from .common import touches_border, whole_patches
 
 __all__ = ["fill_patchmatch", "refine_patchmatch", "MIN_PATCH", "MAX_PATCH"]
 
@@ -83,16 +84,15 @@ _COARSEST_DEPTH = 2.0
 _COARSEST_DEPTH_BORDER = 1.0
 _FEATURE_WEIGHT = 3.0  # weight of Newson's texture features (two extra channels) in the distance
 # default EM iterations per level: the finest level gets none (the final refine follows), the
-# intermediate ones 4, the coarsest 12 (the photo, seeds 0-4: 8 on the coarsest 4.95, 16 4.71 in
-# +10 ms)
+# intermediate ones 4, the coarsest 12 (the photo, seeds 0-4: 4.69; 8 on the coarsest 4.95, 16 4.71
+# in +10 ms)
 _EM_FINEST, _EM_MIDDLE, _EM_COARSEST = 0, 4, 12
-# the vote counts the patches at every this-th corner row and column (and the last), on the pyramid's
-# levels and in the final refine; the final refine's last vote counts every covering patch: with 9 of
-# the 49 votes neighbouring pixels of an incoherent region went through different offsets and the
-# fill was speckled (gravel: |Laplacian| in the hole 1.13x the known region's, the truth's 1.03x, now
-# 1.01-1.05; photo coherence 4.66 -> 4.54, +25 ms). Every vote at every patch: worse (photo 5.29).
-_PYRAMID_STRIDE = 3
-_FINAL_STRIDE = 3
+# the votes count the covering patches at every _VOTE_STRIDE-th corner row and column, but the final
+# refine's last vote counts every one (stride 1): with 9 of the 49 votes neighbouring pixels of an
+# incoherent region went through different offsets and the fill was speckled (gravel: |Laplacian| in
+# the hole 1.13x the known region's, the truth's 1.03x, now 1.01-1.05; photo coherence 4.71 -> 4.54,
+# +25 ms; measured with the one-patch pyramid). Every other row and column (stride 2): 4.79 and the
+# speckle back; every covering patch in the pyramid's votes too: worse (4.71 -> 5.29).
 _LAST_STRIDE = 1
 _PYRAMID_SHRINK = 2  # the pyramid's random search radii: half the level, then / 2 down to 1 px
 # On the intermediate levels PatchMatch's propagation takes a neighbour's offset when its distance is
@@ -102,8 +102,9 @@ _PYRAMID_SHRINK = 2  # the pyramid's random search radii: half the level, then /
 # 4.3 -> 5.1), nor on the finest (no effect).
 _COHERENCE_BIAS = 1.0
 # the final full-resolution refine (step 4): EM iterations, and the percentile of the inexact patches'
-# distances from which they are searched (the photo, seeds 0-4: 3 iterations over all of them 4.52 in
-# 0.205 s, over the worse half 4.53 in 0.188 s, 2 over the worse half 4.66 in 0.165 s)
+# distances from which they are searched (the photo, seeds 0-4, measured with the one-patch pyramid
+# and the sparse last vote: 3 iterations over all of them 4.52 in 0.205 s, over the worse half 4.53 in
+# 0.188 s, 2 over the worse half 4.66 in 0.165 s)
 _FINAL_REFINE, _FINAL_WORST = 2, 50
 
 
@@ -161,7 +162,7 @@ class _Level:
 
     def __init__(self, img, hole, source, p):
         self.img, self.hole, self.source, self.p = img, hole, source, p
-        self.n_valid = int(np.count_nonzero(_box_sum(source, p) >= p * p - 0.5))
+        self.n_valid = int(np.count_nonzero(whole_patches(source, p)))
         depth = _depth_of(hole)
         self.depth = float(depth.max()) if hole.any() else 0.0
         self.conf = np.ascontiguousarray(np.where(hole, _GAMMA ** -depth, 1.0).astype(np.float32))
@@ -233,11 +234,11 @@ def fill_patchmatch(
     cancel : CancelToken, optional
         Checked before every PatchMatch sweep; raises :class:`weft.core.errors.Cancelled`.
     levels : int, optional
-        Pyramid levels (1 = finest only); default: as many as bring the hole to about one patch
-        deep, as long as a level keeps 16 whole source patches and both sides >= 2 patches.
+        Pyramid levels (1 = finest only); default: as many as bring the hole to about two patches
+        deep (one when it touches the image's border), as long as a level keeps 16 whole source patches and both sides >= 2 patches.
     iterations : int, optional
-        EM iterations on every level (all channels, confidence-weighted); default 8 on the coarsest,
-        4 on the intermediate ones, none on the finest (a single level gets 8). Two refine
+        EM iterations on every level (all channels, confidence-weighted); default 12 on the
+        coarsest, 4 on the intermediate ones, none on the finest (a single level gets 12). Two refine
         iterations on the image's own channels always follow (:func:`refine_band`).
     cuttable : bool array (H, W), optional
         Known pixels that may change (the method's blend band): the finished fill, these pixels and
@@ -274,8 +275,7 @@ def fill_patchmatch(
         raise ImageError(f"the source region holds no whole {p}x{p} patch: leave at least a {p}x{p} square "
                          f"of known pixels to copy from (or use a smaller patch)")
     max_levels = 64 if levels is None else int(levels)
-    on_border = bool(hole[0].any() or hole[-1].any() or hole[:, 0].any() or hole[:, -1].any())
-    deep = p * (_COARSEST_DEPTH_BORDER if on_border else _COARSEST_DEPTH)
+    deep = p * (_COARSEST_DEPTH_BORDER if touches_border(hole) else _COARSEST_DEPTH)
     while len(pyramid) < max_levels:
         top = pyramid[-1]
         if levels is None and top.depth <= deep:
@@ -301,16 +301,14 @@ def fill_patchmatch(
         if li == n - 1:
             _onion_fill(im, lv.hole)
             fl = _Flat(im, lv.hole, lv.source, p, conf=lv.conf)
-            vy, vx = np.nonzero(fl.valid)
-            pick = gen.integers(0, len(vy), len(fl.ty))
-            sy, sx = vy[pick].astype(np.int64), vx[pick].astype(np.int64)
+            sy, sx = _random_matches(fl, gen)
         else:
             _upsample_into(im, lv.hole, pyramid[li + 1].img)
             coarse, fl = fl, _Flat(im, lv.hole, lv.source, p, conf=lv.conf)
             sy, sx = _upsample_matches(fl, coarse, sy, sx, gen)
             # the first estimate of this level: the coarse matches, doubled, voted (an upsampled
             # image would be blurred; matched against it, the flattest patches win)
-            _vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)), _PYRAMID_STRIDE)
+            _vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)))
         if schedule[li] > 0:
             everyone = np.arange(len(fl.ty))
             dist = fl.dist(fl.gather(fl.ty, fl.tx), everyone, sy, sx)
@@ -320,8 +318,7 @@ def fill_patchmatch(
                 report.update(done0 + _it + 1)
 
             _em(fl, im, lv.hole, sy, sx, dist, iterations=schedule[li], gen=gen, steps_first=_STEPS_FIRST,
-                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step,
-                stride=_PYRAMID_STRIDE)
+                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step)
             done += schedule[li]
     res = pyramid[0].img[..., :nch]
     if out.ndim == 2:
@@ -336,7 +333,7 @@ def fill_patchmatch(
 
     return refine_band(out, hole, region, source, patch=p, iterations=_FINAL_REFINE, rng=gen,
                        progress=refine_progress if progress is not None else None, cancel=cancel, worst=_FINAL_WORST,
-                       vote_stride=_FINAL_STRIDE, last_vote_stride=_LAST_STRIDE)
+                       last_vote_stride=_LAST_STRIDE)
 
 
 def _texture_features(img: np.ndarray, hole: np.ndarray) -> np.ndarray:
@@ -405,9 +402,15 @@ def _upsample_matches(fl: "_Flat", coarse: "_Flat", sy: np.ndarray, sx: np.ndarr
     ny = np.clip(2 * sy[np.maximum(m, 0)] + fl.ty % 2, 0, hv - 1)
     nx = np.clip(2 * sx[np.maximum(m, 0)] + fl.tx % 2, 0, wv - 1)
     ok = (m >= 0) & fl.valid[ny, nx]
+    ry, rx = _random_matches(fl, gen)
+    return np.where(ok, ny, ry), np.where(ok, nx, rx)
+
+
+def _random_matches(fl: "_Flat", gen: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A whole source patch drawn at random for each of ``fl``'s target patches (int64 corners)."""
     vy, vx = np.nonzero(fl.valid)
     pick = gen.integers(0, len(vy), len(fl.ty))
-    return np.where(ok, ny, vy[pick]).astype(np.int64), np.where(ok, nx, vx[pick]).astype(np.int64)
+    return vy[pick].astype(np.int64), vx[pick].astype(np.int64)
 
 
 def _upsample_into(img: np.ndarray, hole: np.ndarray, coarse: np.ndarray) -> None:
@@ -461,7 +464,7 @@ class _Flat:
         assert img.flags.c_contiguous and s1 == c * s2
         self.windows = as_strided(img, shape=(h - p + 1, w - p + 1, p, p * c), strides=(s0, s1, s0, s2),
                                   writeable=False)
-        self.valid = _box_sum(source, p) >= p * p - 0.5
+        self.valid = whole_patches(source, p)
         touches = _box_sum(hole, p) > 0.5
         ty, tx = np.nonzero(touches)
         self.ty, self.tx = ty.astype(np.int64), tx.astype(np.int64)
@@ -603,21 +606,19 @@ def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight, str
 
 def refine_band(filled: np.ndarray, hole: np.ndarray, region: np.ndarray, source: np.ndarray, *, patch: int,
                 iterations: int, rng=0, progress=None, cancel=None, worst: float = 0.0,
-                vote_stride: int = _VOTE_STRIDE, last_vote_stride: int | None = None) -> np.ndarray:
+                last_vote_stride: int | None = None) -> np.ndarray:
     """:func:`refine_patchmatch` of a finished fill over ``region`` (the hole and the blend band's
     known pixels that may change), copying only from ``source`` pixels outside it, so the band
     becomes a continuation of the copies; over the hole alone, from the whole source, when the band
     took the last whole source patch; ``filled`` as it is when there is none either. What the
     ``quilt`` (colour), ``hybrid`` and ``patchmatch`` engines end with."""
-    from .common import whole_patches
-
     sources = source & ~region
     if not whole_patches(sources, patch).any():
         region, sources = hole, source
         if not whole_patches(sources, patch).any():
             return filled
     return refine_patchmatch(filled, region, sources, filled, patch=patch, iterations=iterations, rng=rng,
-                             progress=progress, cancel=cancel, worst=worst, vote_stride=vote_stride,
+                             progress=progress, cancel=cancel, worst=worst,
                              last_vote_stride=last_vote_stride)
 
 
@@ -633,7 +634,6 @@ def refine_patchmatch(
     progress: Callable[[Progress], None] | None = None,
     cancel: CancelToken | None = None,
     worst: float = 0.0,
-    vote_stride: int = _VOTE_STRIDE,
     last_vote_stride: int | None = None,
 ) -> np.ndarray:
     """EM / PatchMatch iterations at full resolution, started from a given fill ``init`` (no pyramid).
@@ -658,8 +658,10 @@ def refine_patchmatch(
     (1..64, default 3). ``worst``: a percentage 0..100 (default 0): every iteration searches only the
     patches that are not exact copies and whose distance is at least this percentile of theirs (the
     hybrid engine searches the worse half: most of the gain at a fraction of the cost, since the
-    judge's mean distance is dominated by the worst windows). Returns float32, every pixel outside
-    the hole equal to ``image``'s bit for bit.
+    judge's mean distance is dominated by the worst windows). ``last_vote_stride``: the last
+    iteration's vote counts the covering patches at every this-th corner row and column (default:
+    every ``_VOTE_STRIDE``-th, as the others; the ``patchmatch`` engine's final refine counts every
+    one). Returns float32, every pixel outside the hole equal to ``image``'s bit for bit.
     """
     if isinstance(worst, bool) or not isinstance(worst, (int, float, np.integer, np.floating)) or not 0 <= worst < 100:
         raise InvalidParameter(f"parameter 'worst' = {worst!r} must be a percentage 0..100 (below 100)",
@@ -689,7 +691,7 @@ def refine_patchmatch(
         _try(fl, targets, everyone, sy, sx, dist, cy[c], cx[c], np.ones(n, bool))
     _em(fl, img, hole, sy, sx, dist, iterations=iterations, gen=gen, steps_first=_STEPS_FIRST,
         shrink=_SEARCH_SHRINK, bias=0.0, worst=worst, cancel=cancel, on_iteration=lambda it: report.update(it + 1),
-        stride=vote_stride, last_stride=last_vote_stride)
+        last_stride=last_vote_stride)
     if out.ndim == 2:
         out[hole] = img[..., 0][hole]
     else:
@@ -700,7 +702,7 @@ def refine_patchmatch(
 def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.ndarray, dist: np.ndarray, *,
         iterations: int, gen: np.random.Generator, steps_first: tuple[int, ...], shrink: int, bias: float,
         worst: float, cancel: CancelToken | None, on_iteration: Callable[[int], None],
-        stride: int = _VOTE_STRIDE, last_stride: int | None = None) -> None:
+        last_stride: int | None = None) -> None:
     """EM iterations on ``img`` (the array ``fl`` views), improving the matches (``sy``, ``sx``, their
     ``dist``) of ``fl``'s target patches and writing the hole's pixels, in place. Each iteration:
     (E) the inexact patches (a distance above 0; with ``worst``, at least that percentile of their
@@ -744,7 +746,7 @@ def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.nda
         sigma2 = max(_percentile(dn, _SIGMA_PERCENTILE), 1e-12)
         inexact = np.zeros((fl.h + p - 1, fl.w + p - 1), bool)  # pixels covered by a patch that is not an exact copy
         inexact[p - 1 + fl.ty[dist > 0.0], p - 1 + fl.tx[dist > 0.0]] = True
-        vote_stride = stride if last_stride is None or it < iterations - 1 else last_stride
+        stride = _VOTE_STRIDE if last_stride is None or it < iterations - 1 else last_stride
         changed = _vote_mode(img, hole & (_box_sum(inexact, p) > 0.5), fl, sy, sx, np.exp(-dn / (2.0 * sigma2)),
-                             vote_stride)
+                             stride)
         on_iteration(it)
