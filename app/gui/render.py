@@ -115,6 +115,34 @@ def _render(method, inputs, params, seed, report, cancel, *, final: bool):
     return result, max(0.0, seconds), final, prepared + during, bool(said)
 
 
+def preparation(doc, *, side: int | None = None, around_box=None
+                ) -> tuple[Callable[[], tuple | None], Params] | None:
+    """What a job of the document's current method runs on, captured now on the GUI thread (the
+    document's inputs and parameters: references to immutable values) and built by the returned
+    call, on the job's worker: its painted masks as float images, a crop to the source region, a
+    reduction to ``side`` px (``reduce_for_preview``: 48.5 ms at 4096² on the GUI thread before;
+    a preview's, a variations grid's thumbnails) or a stroke's crop around ``around_box``
+    (``crop_around``, with the whole image's mask: 0.15-0.57 s per preview at 4096² on the GUI
+    thread before). The call gives ``(inputs, params, around)`` (``around``: the stroke's
+    :class:`~weft.core.studio.Around`, or None), or None when there is nothing painted near the
+    stroke. Returns ``(that call, the document's run parameters)``, or None when inputs are missing."""
+    if doc.missing_inputs():
+        return None
+    studio = doc.studio
+    build = doc.deferred_inputs(live=around_box is not None)
+    params = doc.run_params()
+
+    def prepare():
+        if around_box is not None:
+            around = crop_around(studio, build(), params, around_box)
+            return None if around is None else (around.inputs, around.params, around)
+        if side is not None:
+            return (*reduce_for_preview(studio, build(), params, side), None)
+        return build(), params, None
+
+    return prepare, params
+
+
 class Renderer(QObject):
     """Preview/final job logic for one document (see the module docstring).
 
@@ -254,30 +282,9 @@ class Renderer(QObject):
         return None if prepared is None else prepared[0]()[:2]
 
     def _preparation(self, *, preview: bool, around_box=None) -> tuple[Callable[[], tuple | None], Params] | None:
-        """What a job of the current method runs on, captured now (the document's inputs and
-        parameters) and built by the returned call, on the job's worker: its painted masks as float
-        images, a crop to the source region, a preview's reduction (``reduce_for_preview``: 48.5 ms
-        at 4096² on the GUI thread before) or a stroke's crop (``crop_around``, with the whole
-        image's mask: 0.15-0.57 s per preview at 4096² on the GUI thread before). The call gives
-        ``(inputs, params, around)`` (``around``: the stroke's :class:`~weft.core.studio.Around`, or
-        None), or None when there is nothing painted near the stroke. Returns ``(that call, the
-        document's run parameters)``, or None when inputs are missing."""
-        doc = self.doc
-        if doc.missing_inputs():
-            return None
-        studio = doc.studio
-        build = doc.deferred_inputs(live=around_box is not None)
-        params = doc.run_params()
-
-        def prepare():
-            if around_box is not None:
-                around = crop_around(studio, build(), params, around_box)
-                return None if around is None else (around.inputs, around.params, around)
-            if preview:
-                return (*reduce_for_preview(studio, build(), params, PREVIEW_SIDE), None)
-            return build(), params, None
-
-        return prepare, params
+        """:func:`preparation` of a render of the current method: a preview's reduction to
+        ``PREVIEW_SIDE``, a stroke's crop around ``around_box``, else the full-size inputs."""
+        return preparation(self.doc, side=PREVIEW_SIDE if preview else None, around_box=around_box)
 
     def _submit(self, slot: str, preview: bool) -> int | None:
         if not self.enabled:

@@ -2,7 +2,11 @@
 
 Clicking a cell adopts its two values (one undo step). Cells render on their own worker pool at
 thumbnail size (the target or output size scaled so its longer side is ``THUMB_SIDE``), so the main
-window's renders are not held up; a cell whose values the method refuses says why.
+window's renders are not held up; a cell whose values the method refuses says why. The thumbnail-size
+inputs are built once per grid on that pool too (the GUI thread only takes a snapshot of the
+document at the click: it never blocks on image work), then the cells are submitted; a new grid or
+closing the dialog cancels the preparation and the cells, and a late result of an earlier grid is
+dropped.
 """
 
 from __future__ import annotations
@@ -27,9 +31,9 @@ from weft.core.errors import WeftError
 from weft.core.image import save_image
 from weft.core.jobs import JobResult, JobRunner
 from weft.core.params import FLOAT, INT, specs
-from weft.core.studio import reduce_for_preview
 
 from .convert import to_qimage
+from .render import preparation
 
 THUMB_SIDE = 192
 
@@ -97,6 +101,9 @@ class VariationsDialog(QDialog):
         controls.addWidget(self.export_button, 2, 3)
         self.images: dict[tuple[int, int], np.ndarray] = {}
         self.side = THUMB_SIDE
+        self._preparing: int | None = None  # the job id of the grid's preparation while it runs
+        self._cell_jobs: dict[tuple[int, int], int] = {}  # the job id of each cell submitted
+        self._pending: set[tuple[int, int]] = set()  # the cells submitted and not yet arrived
         lay.addLayout(controls)
         self.grid_widget = QWidget()
         self.grid = QGridLayout(self.grid_widget)
@@ -149,8 +156,15 @@ class VariationsDialog(QDialog):
         return int(max(48, min(THUMB_SIDE, by_height, by_width)))
 
     def render_grid(self) -> None:
-        """Submit one thumbnail job per cell (replacing any grid being rendered)."""
+        """Lay out the grid's cells and start its preparation (replacing any grid being rendered).
+
+        The document's inputs, parameters and seed are taken now; the thumbnail-size inputs (a
+        painted mask's image, the reduction to ``THUMB_SIDE``) are built once per grid on a worker
+        (:func:`~weft.app.gui.render.preparation`, as the main window's renders do), and only then
+        are the cells' jobs submitted (:meth:`_prepared`)."""
         self.runner.cancel()
+        self._preparing = None  # a preparation or cell of an earlier grid that still arrives is dropped
+        self._cell_jobs, self._pending = {}, set()
         while self.grid.count():
             item = self.grid.takeAt(0)
             if item.widget():
@@ -164,11 +178,11 @@ class VariationsDialog(QDialog):
             return
         rows = grid_values(a, self.lo[0].value(), self.hi[0].value(), n)
         cols = grid_values(b, self.lo[1].value(), self.hi[1].value(), n)
-        built = _thumb_inputs(self.doc)
-        if built is None:
+        prepared = preparation(self.doc, side=THUMB_SIDE)  # (a snapshot: nothing is built here)
+        if prepared is None:
             self.status.setText("open the method's inputs first")
             return
-        inputs, base = built
+        prepare, params = prepared
         method, seed = self.doc.current, self.doc.seed
         self.side = side = self.thumb_side(n)
         for i, va in enumerate(rows):
@@ -183,19 +197,45 @@ class VariationsDialog(QDialog):
                 self.grid.addWidget(button, i, j)
                 self.cells[(i, j)] = button
                 self.values[(i, j)] = ((a.name, va), (b.name, vb))
-                try:
-                    params = base.replace(**{a.name: va, b.name: vb})
-                except WeftError as e:  # refused before any work: not run
+                try:  # values the method refuses at any size: said at once, never run
+                    params.replace(**{a.name: va, b.name: vb})
+                except WeftError as e:
                     self._cell_error(button, str(e))
-                    continue
 
-                def job(*, progress=None, cancel=None, params=params):
-                    return method.run(inputs, params, rng=seed, cancel=cancel).image
+        def prepare_grid(*, progress=None, cancel=None):
+            inputs, base, _ = prepare()
+            cancel.raise_if_cancelled()
+            return inputs, base, method, seed
 
-                self.runner.submit(f"cell-{i}-{j}", job)
+        self._preparing = self.runner.submit("prepare", prepare_grid).id
         self.status.setText("rendering…")
         # the new cells are shown by their layout on the next turn of the event loop: fit then
         QTimer.singleShot(0, self._fit_on_screen)
+
+    def _prepared(self, result: JobResult) -> None:
+        """The grid's thumbnail inputs are built: submit one job per cell not yet refused."""
+        self._preparing = None
+        if result.error is not None:
+            self.status.setText(_one_line(f"could not prepare the grid: {result.error}"))
+            return
+        inputs, base, method, seed = result.value
+        for key, button in self.cells.items():
+            if not button.isEnabled():
+                continue  # refused when laid out
+            (na, va), (nb, vb) = self.values[key]
+            try:
+                params = base.replace(**{na: va, nb: vb})
+            except WeftError as e:  # refused at thumbnail size (e.g. a size reduced below the values)
+                self._cell_error(button, str(e))
+                continue
+
+            def job(*, progress=None, cancel=None, params=params):
+                return method.run(inputs, params, rng=seed, cancel=cancel).image
+
+            self._cell_jobs[key] = self.runner.submit("cell-{}-{}".format(*key), job).id
+            self._pending.add(key)
+        if not self._cell_jobs:
+            self.status.setText("no cell can be rendered: each says why")
 
     def _fit_on_screen(self) -> None:
         """Grow to the new grid, then move (not past the screen's edges) so all of it is visible."""
@@ -210,11 +250,15 @@ class VariationsDialog(QDialog):
         self.move(max(x, free.x()), max(y, free.y()))
 
     def _on_result(self, result: JobResult) -> None:
+        if result.slot == "prepare":
+            if result.job_id == self._preparing:  # (else an earlier grid's: its cells are gone)
+                self._prepared(result)
+            return
         _, i, j = result.slot.split("-")
         key = (int(i), int(j))
         button = self.cells.get(key)
-        if button is None:
-            return
+        if button is None or self._cell_jobs.get(key) != result.job_id:
+            return  # a cell of an earlier grid
         if result.error is not None:
             self._cell_error(button, str(result.error))
         else:
@@ -223,7 +267,8 @@ class VariationsDialog(QDialog):
             self.images[key] = result.value
             self.export_button.setEnabled(True)
         self.cell_done.emit(*key)
-        if not self.runner.busy():
+        self._pending.discard(key)
+        if not self._pending:
             self.status.setText("click a cell to adopt its values")
 
     def _cell_error(self, button: QToolButton, text: str) -> None:
@@ -288,8 +333,7 @@ class VariationsDialog(QDialog):
         super().closeEvent(event)
 
 
-def _thumb_inputs(doc):
-    """Thumbnail-size inputs and the current parameters, or None if inputs are missing."""
-    if doc.missing_inputs():
-        return None
-    return reduce_for_preview(doc.studio, doc.method_inputs(), doc.run_params(), THUMB_SIDE)
+
+def _one_line(text: str) -> str:
+    """``text`` on one line (a status line must not grow)."""
+    return " ".join(text.split())
