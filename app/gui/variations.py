@@ -326,6 +326,7 @@ class VariationsDialog(QDialog):
         self.status.setText(f"adopted {na}={va}, {nb}={vb}")
 
     def shutdown(self) -> None:
+        self._preparing = None  # a preparation delivered (queued) before the close starts no cell
         self.runner.shutdown(wait=True, cancel=True)
 
     def closeEvent(self, event):  # noqa: N802

@@ -205,3 +205,13 @@ def test_a_late_result_of_an_earlier_grid_is_dropped(window, qtbot, monkeypatch)
     QApplication.processEvents()
     assert len(jobs) == count and dialog.images[(0, 0)] is shown
     dialog.close()
+
+
+def test_a_preparation_that_arrives_as_the_dialog_closes_starts_nothing(window, qtbot, monkeypatch):
+    dialog = _dialog(window)
+    jobs = _submits(dialog, monkeypatch)
+    _click(qtbot, dialog)
+    assert jobs[0].result(timeout=30).ok  # done and delivered, its signal not yet handled
+    dialog.close()
+    QApplication.processEvents()  # (a cell submitted to the closed runner would raise here)
+    assert [j.slot for j in jobs] == ["prepare"] and dialog.images == {}
