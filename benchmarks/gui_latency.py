@@ -21,6 +21,13 @@ the picture too), ``open`` File > Open of it as the canvas input, ``result`` the
 result of it (with a small painted mask for a method that fills one) from its arrival until both
 views show it, ``export`` exporting that result. Prints one JSON line with each step's median over
 the runs (ms) and every run's figure.
+
+``--variations [--side 4096] [--runs 5] [--method fill]``: the longest GUI-thread stall (the 5 ms
+heartbeat) from the Variations dialog's Render grid click until its last cell arrives (a 3 x 3 grid
+over the method's first two numeric parameters, its default ranges), on a large picture (``--side``
+px square, with a painted stroke for a method that fills a mask), every method's kernels loaded
+and the main window idle; a fresh dialog per run. Prints one JSON line with the median over the runs
+(ms), every run's figure and the grid's time (click to last cell, s).
 """
 
 from __future__ import annotations
@@ -299,6 +306,61 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
             "each": steps}
 
 
+def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") -> dict:
+    from PySide6.QtCore import Qt
+    from PySide6.QtTest import QTest
+
+    from weft.app.gui.document import DocumentState, read_input
+    from weft.app.gui.main_window import MainWindow
+    from weft.core import registry
+    from weft.core.geometry import Mask
+    from weft.core.studio import MASK
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    registry.warm_up_all(first=method)  # (the studio's background warm-up of every method: not during a grid)
+    stalls: list[float] = []
+    seconds: list[float] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["WEFT_RECOVERY_DIR"] = tmp
+        item = read_input(_picture_file(tmp, side))
+        settings = QSettings(os.path.join(tmp, "weft.ini"), QSettings.Format.IniFormat)
+        window = MainWindow(settings=settings, load_defaults=False)
+        window.resize(1400, 900)
+        window.show()
+        window.renderer.enabled = False  # the main window idle: its full-size render is not measured here
+        doc, studio = window.doc, window.doc.methods[method].studio
+        doc.restore(DocumentState(inputs={studio.canvas: item}, method=method))
+        g = next((g for g in studio.geometry if g.kind == MASK), None)
+        if g is not None:
+            doc.set_mask(g.key, Mask.empty(side, side).painted_line((side * 0.4, side * 0.4), (side * 0.5, side * 0.45),
+                                                                   side / 60, True), "stroke")
+        _wait(app, lambda: not window.renderer.running(), 30)
+        for _run in range(runs):
+            window.open_variations()
+            dialog = window._variations
+            _wait(app, dialog.isVisible, 10)
+            done: set = set()
+            dialog.cell_done.connect(lambda i, j: done.add((i, j)))
+            heartbeat, beats = _heartbeat()
+            _wait(app, lambda: len(beats) > 2, 5)
+            t0 = time.perf_counter()
+            QTest.mouseClick(dialog.render_button, Qt.MouseButton.LeftButton)
+            _wait(app, lambda: dialog.cells and done == {k for k, b in dialog.cells.items() if b.isEnabled()}
+                  and not dialog.runner.busy(), 300)
+            seconds.append(round(time.perf_counter() - t0, 2))
+            _wait(app, lambda: False, 0.1)  # the last thumbnail painted
+            heartbeat.stop()
+            stalls.append(_stall_since(beats, t0))
+            if not done:
+                raise SystemExit(f"no cell of the {method} grid rendered: {dialog.status.text()}")
+            dialog.close()
+            dialog.deleteLater()
+        doc.undo_stack.setClean()
+        window.close()
+    return {"side": side, "method": method, "runs": runs, "grid_stall_ms": round(statistics.median(stalls), 1),
+            "each": stalls, "grid_s": seconds}
+
+
 def _heartbeat() -> tuple[QTimer, list[float]]:
     """A started 5 ms timer and the times it fired at: a gap between two beats is a GUI-thread stall."""
     beats: list[float] = []
@@ -338,12 +400,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--values", type=int, default=None, help="slider values (30) or mouse moves of the stroke (60)")
     ap.add_argument("--hz", type=float, default=60.0)
     ap.add_argument("--paint", action="store_true", help="paint a mask stroke instead of moving a slider")
-    ap.add_argument("--method", default=None, help="with --paint: the method (default: the first that previews strokes)")
-    ap.add_argument("--side", type=int, default=None, help="with --paint (512) or --open (4096): the picture's side")
+    ap.add_argument("--method", default=None, help="the method: with --paint the first that previews strokes, with "
+                    "--open or --variations fill (defaults)")
+    ap.add_argument("--side", type=int, default=None, help="with --paint (512), --open or --variations (4096): the picture's side")
     ap.add_argument("--open", action="store_true", help="open a large picture: the longest GUI-thread stalls")
-    ap.add_argument("--runs", type=int, default=5, help="with --open: the runs (median)")
+    ap.add_argument("--variations", action="store_true",
+                    help="render a Variations grid of a large picture: the longest GUI-thread stall")
+    ap.add_argument("--runs", type=int, default=5, help="with --open or --variations: the runs (median)")
     args = ap.parse_args(argv)
-    if args.open:
+    if args.variations:
+        print(json.dumps(measure_variations(args.side or 4096, args.runs, args.method or "fill")))
+    elif args.open:
         print(json.dumps(measure_opening(args.side or 4096, args.runs, args.method or "fill")))
     elif args.paint:
         print(json.dumps(measure_painting(args.values or 60, args.hz, args.method, args.side or 512)))
