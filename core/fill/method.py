@@ -85,6 +85,19 @@ def _margins(params: FillParams, w: int, h: int) -> Margins | None:
     return Margins(left, top, dx - left, dy - top) if dx or dy else None
 
 
+def _run_patch(params: FillParams, ch: int, cw: int) -> int:
+    """The patch side a run of ``params.engine`` (not ``auto``) uses on a ``cw`` x ``ch`` canvas: the
+    one given, or the engine's default fitted to a small canvas."""
+    patch = params.resolved_patch()
+    if params.engine == "pixel":
+        patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
+    if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
+        patch = max(3, min(ch, cw) // 2) | (1 if params.engine == "pixel" else 0)
+    if params.patch is None and params.engine == "hybrid":  # its 48-px block: at most a third of a small image
+        patch = min(patch, max(3, min(ch, cw) // 3))
+    return patch
+
+
 def _largest_square(region: np.ndarray) -> int:
     """The side of the largest square inside ``region`` (0 if empty), from a chessboard distance."""
     if not region.any():
@@ -145,13 +158,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
         params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch))
-    patch = params.resolved_patch()
-    if params.engine == "pixel":
-        patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
-    if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
-        patch = max(3, min(ch, cw) // 2) | (1 if params.engine == "pixel" else 0)
-    if params.patch is None and params.engine == "hybrid":  # its 48-px block: at most a third of a small image
-        patch = min(patch, max(3, min(ch, cw) // 3))
+    patch = _run_patch(params, ch, cw)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
         raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
@@ -295,6 +302,30 @@ def _memory(shapes: Mapping[str, tuple[int, ...]], params: FillParams) -> float:
     return float(h * w * 120)  # canvas, masks, costs, positions (float32/float64 copies), measured order
 
 
+def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
+    """What an unset ``patch`` resolves to with inputs of these shapes (the studio shows it beside its
+    box, and the variations grid centres its range on it): the patch the run takes (the engine's
+    default, fitted to a small canvas); for ``auto``, that of the engine it runs for a hole inside a
+    picture of this shape (``patchmatch``'s in a colour picture, ``quilt``'s in a grey one or when the
+    canvas is extended). From shapes alone a colour picture whose hole touches its border, or whose
+    hole's surroundings are grey, resolves to ``patchmatch``'s patch where the run takes ``quilt``'s
+    (the run's figures say which). Nothing before an image is open."""
+    shape = shapes.get("image")
+    if params.patch is not None or shape is None:
+        return {}
+    h, w = shape[:2]
+    try:
+        margins = _margins(params, w, h)
+    except WeftError:
+        return {}
+    if margins is not None:
+        h, w = h + margins.top + margins.bottom, w + margins.left + margins.right
+    if params.engine == "auto":
+        colour = len(shape) == 3 and shape[2] >= 3
+        params = params.replace(engine=auto_engine(colour, margins is not None, None))
+    return {"patch": _run_patch(params, h, w)}
+
+
 #: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting
 #: the mask previews the region around the stroke (``preview_around``); the optional ``texture`` is
 #: fill's own (``own_inputs``: the texture the studio has open for quilt and fast is not a source).
@@ -305,7 +336,7 @@ STUDIO = Studio(
               Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas")),
     preview_inputs=("image", "mask", "source_mask", "texture"),
     examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
-    masks_of={"source_mask": ("texture", "image")},
+    masks_of={"source_mask": ("texture", "image")}, auto=_auto,
     figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
              "hole_fraction": Figure("filled", "%", "of the image", digits=2),
              "source_pixels": Figure("copied from", "px")})

@@ -232,6 +232,24 @@ def test_auto_runs_patchmatch_inside_a_colour_picture_and_quilt_otherwise(gravel
         assert np.array_equal(out, fill(image, mask, engine=expected, seed=2, **kw))
 
 
+def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
+    """The studio's "auto" patch (beside its box, and the centre of a variations range) is the patch
+    of the engine that runs: a colour picture's hole gets patchmatch's 7 px, a grey one quilt's 24,
+    an uncrop quilt's; a named engine its own; a patch given is not resolved."""
+    from weft.core.fill.method import STUDIO, fill_image
+
+    colour = np.ascontiguousarray(load_image(example("chelsea")).image[:96, :120])
+    for image, params in ((colour, FillParams()), (gravel, FillParams()), (colour, FillParams(engine="hybrid"))):
+        resolved = STUDIO.resolved(params, {"image": image.shape})
+        _, figures = fill_image(image, square_hole(image.shape), params=params, rng=0)
+        assert resolved == {"patch": figures["patch"]}, (image.shape, params.engine)
+    assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 7}
+    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 24}
+    assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 48}
+    assert STUDIO.resolved(FillParams(patch=9), {"image": (96, 120, 3)}) == {}
+    assert STUDIO.resolved(FillParams(), {}) == {}
+
+
 @pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))
 def test_progress_reaches_the_end_and_cancel_stops(engine, gravel):
     from weft.core.errors import Cancelled
