@@ -31,7 +31,7 @@ from .jsonio import MAX_FILE_BYTES
 
 MAX_SIDE = 16384
 
-__all__ = ["Square", "FeatureLines", "LineDraft", "Mask", "Margins", "read_json_or_file",
+__all__ = ["Square", "FeatureLines", "LineDraft", "Mask", "MaskStroke", "paint_line", "Margins", "read_json_or_file",
            "SQUARE", "LINES", "MASK", "MARGINS", "KINDS"]
 
 #: The kinds of geometry the studio has a tool for (a method's studio description names them per input):
@@ -492,21 +492,11 @@ class Mask:
         """The mask with a round brush stroke from ``p0`` to ``p1`` (pixel coordinates ``(x, y)``,
         pixel centres at whole numbers) set to ``value`` (True paints, False erases): every pixel whose
         centre lies within ``radius`` of the segment. A zero-length stroke is a dot; radius 0 is a
-        one-pixel-wide line."""
-        h, w = self.bits.shape
-        (x0, y0), (x1, y1) = (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))
-        r = max(0.0, float(radius)) + 0.5  # a pixel is hit when its centre is within radius (+ half a pixel)
-        left, right = max(0, int(math.floor(min(x0, x1) - r))), min(w, int(math.ceil(max(x0, x1) + r)) + 1)
-        top, bottom = max(0, int(math.floor(min(y0, y1) - r))), min(h, int(math.ceil(max(y0, y1) + r)) + 1)
-        if left >= right or top >= bottom:
+        one-pixel-wide line. (:func:`paint_line` paints into an array in place: a stroke being drawn.)"""
+        if _line_box(self.bits.shape, p0, p1, radius) is None:
             return self
-        yy, xx = np.mgrid[top:bottom, left:right].astype(np.float64)
-        dx, dy = x1 - x0, y1 - y0
-        length2 = dx * dx + dy * dy
-        t = np.zeros_like(xx) if length2 == 0 else np.clip(((xx - x0) * dx + (yy - y0) * dy) / length2, 0.0, 1.0)
-        hit = (xx - x0 - t * dx) ** 2 + (yy - y0 - t * dy) ** 2 < r * r
         out = self.bits.copy()
-        out[top:bottom, left:right][hit] = value
+        paint_line(out, p0, p1, radius, value)
         return Mask._own(out)
 
     def painted_polygon(self, points, value: bool = True) -> "Mask":
@@ -530,6 +520,100 @@ class Mask:
 
     def __repr__(self) -> str:
         return f"Mask({self.size[0]}x{self.size[1]}, {self.area} px)"
+
+
+def _line_box(shape, p0, p1, radius: float):
+    """``(left, top, right, bottom)`` (exclusive ends) of the pixels a brush line may hit in an
+    image of ``shape``, or None when it misses the image; and the line's float parameters."""
+    h, w = shape
+    (x0, y0), (x1, y1) = (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))
+    r = max(0.0, float(radius)) + 0.5  # a pixel is hit when its centre is within radius (+ half a pixel)
+    left, right = max(0, int(math.floor(min(x0, x1) - r))), min(w, int(math.ceil(max(x0, x1) + r)) + 1)
+    top, bottom = max(0, int(math.floor(min(y0, y1) - r))), min(h, int(math.ceil(max(y0, y1) + r)) + 1)
+    if left >= right or top >= bottom:
+        return None
+    return (left, top, right, bottom), (x0, y0, x1, y1, r)
+
+
+def paint_line(bits: np.ndarray, p0, p1, radius: float, value: bool = True) -> tuple[int, int, int, int] | None:
+    """Paint :meth:`Mask.painted_line`'s brush line into the bool array ``bits`` in place (only the
+    line's box is read and written: a dab on a 4096² mask costs the dab, not a copy of the mask).
+    Returns the box ``(x0, y0, x1, y1)`` (exclusive ends) whose pixels changed, None if none did."""
+    found = _line_box(bits.shape, p0, p1, radius)
+    if found is None:
+        return None
+    (left, top, right, bottom), (x0, y0, x1, y1, r) = found
+    yy, xx = np.mgrid[top:bottom, left:right].astype(np.float64)
+    dx, dy = x1 - x0, y1 - y0
+    length2 = dx * dx + dy * dy
+    t = np.zeros_like(xx) if length2 == 0 else np.clip(((xx - x0) * dx + (yy - y0) * dy) / length2, 0.0, 1.0)
+    hit = (xx - x0 - t * dx) ** 2 + (yy - y0 - t * dy) ** 2 < r * r
+    part = bits[top:bottom, left:right]
+    hit &= part != bool(value)  # the pixels this line changes
+    rows, cols = np.flatnonzero(hit.any(axis=1)), np.flatnonzero(hit.any(axis=0))
+    if not len(rows):
+        return None
+    part[hit] = bool(value)
+    return left + int(cols[0]), top + int(rows[0]), left + int(cols[-1]) + 1, top + int(rows[-1]) + 1
+
+
+class MaskStroke:
+    """A mask being painted, dab by dab (the studio's brush and eraser): its bits change in place
+    (:func:`paint_line`), so a dab costs the dab's pixels, where ``Mask.painted_line`` copies the
+    whole mask (16 MB per dab at 4096²). Not a :class:`Mask` (which is immutable): read it with
+    :meth:`cut` (a copy of a part, what a preview around the stroke needs), :attr:`bits` (a read-only
+    view that changes as the stroke goes on) or :meth:`snapshot`; :meth:`mask` ends the stroke.
+
+    ``changed``: whether any pixel differs from the mask the stroke began on."""
+
+    __slots__ = ("_bits", "changed", "_ended")
+
+    def __init__(self, base: "Mask | None", width: int | None = None, height: int | None = None) -> None:
+        if base is None:
+            if not width or not height or width < 1 or height < 1:
+                raise GeometryError(f"a stroke needs a mask or a size, not {width}x{height}")
+            self._bits = np.zeros((height, width), dtype=bool)  # (calloc: pages are made as painted)
+        else:
+            self._bits = base.bits.copy()
+        self.changed = False
+        self._ended = False
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self._bits.shape
+
+    @property
+    def bits(self) -> np.ndarray:
+        """The bits so far (a read-only view: it changes with the next dab)."""
+        view = self._bits.view()
+        view.flags.writeable = False
+        return view
+
+    def line(self, p0, p1, radius: float, value: bool = True) -> tuple[int, int, int, int] | None:
+        """Paint a brush line (as :meth:`Mask.painted_line`); the box of the pixels it changed, or None."""
+        if self._ended:
+            raise GeometryError("this stroke has ended: it paints no more")
+        box = paint_line(self._bits, p0, p1, radius, value)
+        self.changed = self.changed or box is not None
+        return box
+
+    def cut(self, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
+        """A copy of the bits in ``[y0:y1, x0:x1]`` (clipped to the mask)."""
+        h, w = self._bits.shape
+        return self._bits[max(0, y0):min(h, y1), max(0, x0):min(w, x1)].copy()
+
+    def snapshot(self) -> "Mask":
+        """The mask so far (a copy: the stroke goes on)."""
+        return Mask(self._bits)
+
+    def mask(self) -> "Mask":
+        """The mask painted, ending the stroke: the bits are handed over, not copied."""
+        self._ended = True
+        return Mask._own(self._bits)
+
+    def __repr__(self) -> str:
+        h, w = self._bits.shape
+        return f"MaskStroke({w}x{h}, changed={self.changed})"
 
 
 # --- margins --------------------------------------------------------------------------------------

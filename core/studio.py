@@ -275,6 +275,19 @@ class Around:
     box: tuple[int, int, int, int]
     offset: tuple[int, int]
 
+    def fitted(self, part: np.ndarray) -> np.ndarray | None:
+        """The crop's result ``part`` at the box's size (scaled back when it was rendered smaller), as
+        :meth:`paste` pastes it; None when it cannot be (another channel layout or an empty result)."""
+        from .image import resize
+
+        x0, y0, x1, y1 = self.box
+        w, h = x1 - x0, y1 - y0
+        if part.shape[:2] == (h, w):
+            return part
+        if part.ndim not in (2, 3) or min(part.shape[:2]) < 1:
+            return None
+        return resize(part, (w, h), interpolation="linear")
+
     def paste(self, base: np.ndarray, part: np.ndarray, *, copy: bool = True) -> np.ndarray | None:
         """``base`` (a full result) with ``part`` (the crop's result, scaled back to the box) pasted
         at the box (into a copy, or with ``copy=False`` into ``base`` itself); None when they do not
@@ -296,8 +309,23 @@ class Around:
         return out
 
 
+def around_region(stroke: tuple[float, float, float, float], width: int, height: int, *,
+                  context: int = 16) -> tuple[int, int, int, int]:
+    """The part ``(x0, y0, x1, y1)`` of a ``width`` x ``height`` painted mask that :func:`crop_around`
+    reads for ``stroke`` (same ``context``): the stroke's box grown by ``context``, grown again by
+    ``context`` and a quarter of that box's longer side (the crop never reaches farther), clipped to
+    the mask. Cut that part and pass it as ``crop_around(..., mask_part=)``: a preview around a
+    stroke then never needs the whole mask (64 MB as a float image at 4096²)."""
+    sx0, sy0, sx1, sy1 = stroke
+    wx0, wy0 = int(np.floor(sx0)) - context, int(np.floor(sy0)) - context
+    wx1, wy1 = int(np.ceil(sx1)) + 1 + context, int(np.ceil(sy1)) + 1 + context
+    grow = context + max(wx1 - wx0, wy1 - wy0) // 4 + 1
+    return max(0, wx0 - grow), max(0, wy0 - grow), min(width, wx1 + grow), min(height, wy1 + grow)
+
+
 def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke: tuple[float, float, float, float],
-                *, side: int = AROUND_SIDE, context: int = 16) -> Around | None:
+                *, side: int = AROUND_SIDE, context: int = 16,
+                mask_part: tuple[np.ndarray, tuple[int, int]] | None = None) -> Around | None:
     """What to render while a stroke paints the mask input ``studio.preview_around``: the inputs
     cropped around the painted region near the stroke, so the preview costs a fraction of a full
     render.
@@ -313,6 +341,9 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     margins geometry on that image are reset to their defaults (the crop is not uncropped) and their
     left/top margins give :attr:`Around.offset`. None when the studio previews no mask that way,
     the mask is not open, or there is nothing painted near the stroke (nothing to fill).
+
+    ``mask_part`` = ``(bits, (x, y))``: the painted mask is not in ``inputs``; ``bits`` (bool or
+    float) is its part at ``(x, y)``, covering at least :func:`around_region` of the stroke.
     """
     from .geometry import Margins
     from .image import resize
@@ -320,22 +351,29 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
 
     name = studio.preview_around
     g = next((g for g in studio.geometry if g.kind == MASK and g.input == name), None)
-    if g is None or name not in inputs:
+    if g is None or (name not in inputs and mask_part is None):
         return None
     on = g.input_for(inputs)
     if on not in inputs:
         return None
-    mask = np.asarray(inputs[name])
     h, w = inputs[on].shape[:2]
-    if mask.shape[:2] != (h, w):
-        return None
-    bits = (mask if mask.ndim == 2 else mask[..., 0]) > 0.5
+    if mask_part is None:
+        mask, (px, py) = np.asarray(inputs[name]), (0, 0)
+        if mask.shape[:2] != (h, w):
+            return None
+    else:
+        mask, (px, py) = np.asarray(mask_part[0]), mask_part[1]
+        rx0, ry0, rx1, ry1 = around_region(stroke, w, h, context=context)
+        if px > rx0 or py > ry0 or px + mask.shape[1] < rx1 or py + mask.shape[0] < ry1:
+            raise ValueError(f"the mask's part {mask.shape[1]}x{mask.shape[0]} at ({px}, {py}) does not cover "
+                             f"the stroke's region {(rx0, ry0, rx1, ry1)}")
+    plane = mask if mask.ndim == 2 else mask[..., 0]
     sx0, sy0, sx1, sy1 = stroke
     wx0, wy0 = max(0, int(np.floor(sx0)) - context), max(0, int(np.floor(sy0)) - context)
     wx1, wy1 = min(w, int(np.ceil(sx1)) + 1 + context), min(h, int(np.ceil(sy1)) + 1 + context)
     if wx0 >= wx1 or wy0 >= wy1:
         return None
-    near = bits[wy0:wy1, wx0:wx1]
+    near = plane[wy0 - py:wy1 - py, wx0 - px:wx1 - px] > 0.5
     rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
     if not len(rows):
         return None
@@ -348,10 +386,16 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     small = dict(inputs)
     crop = {on} | {m.input for m in studio.geometry if m.kind == MASK and m.input_for(inputs) == on}
     crop |= {n for n, of in studio.masks_of.items() if next((i for i in of if i in inputs), None) == on}
-    for n, img in inputs.items():
-        if n not in crop or img.shape[:2] != (h, w):  # a mask of another size: the method says so
+    parts = dict(inputs)
+    if mask_part is not None:
+        parts[name] = mask
+    for n, img in parts.items():
+        if n == name and mask_part is not None:
+            part = (plane[y0 - py:y1 - py, x0 - px:x1 - px] > 0.5).astype(np.float32)
+        elif n not in crop or img.shape[:2] != (h, w):  # a mask of another size: the method says so
             continue
-        part = np.ascontiguousarray(img[y0:y1, x0:x1])
+        else:
+            part = np.ascontiguousarray(img[y0:y1, x0:x1])
         if k < 1.0:
             part = resize(part, size, interpolation="area")
             if n != on:  # a mask stays a mask

@@ -27,7 +27,7 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 
 from weft.core import registry
 from weft.core.errors import WeftError
-from weft.core.geometry import LINES, MARGINS, MASK, SQUARE, LineDraft, Margins, Mask, Square
+from weft.core.geometry import LINES, MARGINS, MASK, SQUARE, LineDraft, Margins, Mask, MaskStroke, Square
 from weft.core.params import Params, Recipe, relative_path
 from weft.core.session import SESSION_VERSION, mask_file, read_session  # noqa: F401 (read_session: the studio reads sessions)
 from weft.core.studio import Geometry, Studio
@@ -104,7 +104,8 @@ class Document(QObject):
         self.params: dict[str, Params] = {name: m.params() for name, m in self.methods.items()}
         self.geometry: dict[str, dict[str, Any]] = {name: {} for name in self.methods}
         self.seed = 1
-        # The geometry being dragged (key, value): not an edit yet, no undo step until release.
+        # The geometry being dragged (key, value): not an edit yet, no undo step until release. A mask
+        # being painted is the tool's ``MaskStroke`` (its bits change in place, dab by dab).
         self.live: tuple[str, Any] | None = None
 
     # --- reading -------------------------------------------------------------------------------
@@ -190,6 +191,8 @@ class Document(QObject):
             mask = self.value(g.key)
             if live and self.live is not None and self.live[0] == g.key:
                 mask = self.live[1]
+                if isinstance(mask, MaskStroke):  # a stroke being painted: the mask so far (a copy)
+                    mask = mask.snapshot()
             on = self.image(g.input_for(self.inputs))
             if mask is not None and mask and on is not None and mask.shape == on.shape[:2]:
                 out[g.input] = mask

@@ -573,7 +573,8 @@ class MainWindow(QMainWindow):
     # --- results ---------------------------------------------------------------------------------
     def _on_around_shown(self, shown) -> None:
         self.result_view.set_notice(None)
-        self.result_view.set_image(shown.image, changed=shown.changed)  # (only the part pasted is redrawn)
+        # (only the part pasted is redrawn: the rest is what the view shows already)
+        self.result_view.set_image(shown.image, changed=shown.changed, over=shown.over)
         self.statusBar().showMessage(describe(shown))  # (it says it is around the stroke)
 
     def _on_shown(self, shown) -> None:

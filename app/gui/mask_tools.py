@@ -3,11 +3,14 @@
 * ``MaskTool`` paints a mask geometry (``Geometry(MASK, input=...)``) of the document's current
   method over its image: brush and eraser (round, size with ``[`` / ``]``, shown as a circle of the
   brush's size on screen), lasso (add or subtract a polygon). The mask is drawn over the image in a
-  semi-transparent colour. A stroke is painted with the Qt-free ``Mask.painted_line`` /
-  ``painted_polygon`` and is one undo command, pushed on release; Esc cancels a stroke in progress.
-  While a brush or eraser stroke is drawn, ``on_stroke(mask, box)`` hears the mask so far and the
-  box around the latest dab (the window renders a preview around it); ``on_stroke(None, None)``: the
-  stroke ended without an edit (Esc, or a release that left the mask as it was).
+  semi-transparent colour. A brush or eraser stroke is painted into a Qt-free ``MaskStroke`` (a
+  copy of the mask made at the press, changed in place dab by dab: a dab costs its own pixels, in the
+  mask and in the overlay, not a copy of a 4096² mask), a lasso with ``Mask.painted_polygon``; a
+  stroke is one undo command, pushed on release (the stroke's bits become the mask, not copied); Esc
+  cancels a stroke in progress. While a brush or eraser stroke is drawn, ``on_stroke(stroke, box)``
+  hears the ``MaskStroke`` so far and the box around the latest dab (the window renders a preview
+  around it, cutting from the stroke only the part that preview reads); ``on_stroke(None, None)``:
+  the stroke ended without an edit (Esc, or a release that left the mask as it was).
 * ``MarginsTool`` edits a margins geometry (``Geometry(MARGINS, param=...)``): a press outside the
   image drags the canvas edges on that side outward (the grown frame drawn as a dashed outline);
   one undo command on release; Esc cancels.
@@ -46,7 +49,7 @@ from PySide6.QtWidgets import (
     QToolBar,
 )
 
-from weft.core.geometry import MAX_SIDE, Margins, Mask
+from weft.core.geometry import MAX_SIDE, Margins, Mask, MaskStroke
 
 from .tools import Tool, _cosmetic
 
@@ -66,33 +69,64 @@ class MaskOverlay(QGraphicsItem):
         super().__init__()
         self._rgba: np.ndarray | None = None  # (H, W, 4) uint8: the QImage's pixels (kept alive with it)
         self._image = QImage()
-        self._mask: Mask | None = None  # the mask drawn (masks are immutable: the same one is not redrawn)
+        # what is drawn: a mask (immutable: the same one is not redrawn), or the stroke being painted
+        self._mask: Mask | MaskStroke | None = None
 
     def image(self) -> QImage:
         """What is drawn (a null image when the mask is empty or none)."""
         return self._image
 
-    def set_mask(self, mask: Mask | None) -> None:
-        """Draw ``mask`` (None or empty: nothing); nothing to do if that very mask is drawn already
-        (every parameter change syncs the tools: no rebuild of a large overlay then)."""
+    def set_mask(self, mask: Mask | MaskStroke | None) -> None:
+        """Draw ``mask`` (None or empty: nothing; or a stroke's bits so far); nothing to do if that
+        very mask is drawn already (every parameter change syncs the tools: no rebuild of a large
+        overlay then)."""
         if mask is self._mask:
             return
         self._mask = mask
-        self.prepareGeometryChange()
-        if mask is None or not mask:
-            self._rgba, self._image = None, QImage()
+        if mask is None or (isinstance(mask, Mask) and not mask):
+            self._show(None)
         else:
             h, w = mask.shape
             # one multiply of the bits by the colour as a 32-bit word, not a boolean-indexed assignment:
             # 11.8 against 169.7 ms for a 4096² mask (a GUI-thread stall at each undo, Clear, session open)
             rgba = np.empty((h, w), dtype=np.uint32)
             np.multiply(mask.bits, _MASK_WORD, out=rgba, casting="unsafe")
-            self._rgba = rgba.view(np.uint8).reshape(h, w, 4)
+            self._show(rgba)
+
+    def _show(self, words: np.ndarray | None) -> None:
+        """Draw the (H, W) uint32 colour words ``words`` (None: nothing)."""
+        self.prepareGeometryChange()
+        if words is None:
+            self._rgba, self._image = None, QImage()
+        else:
+            h, w = words.shape
+            self._rgba = words.view(np.uint8).reshape(h, w, 4)
             self._image = QImage(self._rgba.data, w, h, 4 * w, QImage.Format.Format_RGBA8888)
         self.update()
 
-    def update_box(self, mask: Mask, box: tuple[int, int, int, int]) -> None:
-        """Redraw ``box`` = (x0, y0, x1, y1) of ``mask`` (a mask of the same size as the one shown)."""
+    def begin(self, stroke: MaskStroke, start: Mask | None) -> None:
+        """A stroke begins on ``start``, the document's mask (None: nothing painted): draw the stroke
+        from now on. No redraw when ``start`` is what is drawn; with nothing painted, a blank overlay
+        (calloc'd: its pages are made as the stroke paints them, no 64 MB written at 4096²)."""
+        if start is not None and start is self._mask and self._rgba is not None:
+            self._mask = stroke
+        elif start is None:  # (a stroke on no mask starts blank)
+            self._mask = stroke
+            self._show(np.zeros(stroke.shape, dtype=np.uint32))
+        else:
+            self.set_mask(stroke)
+
+    def adopt(self, mask: Mask | None) -> None:
+        """``mask`` has the very bits drawn now (the stroke just ended became it): it is what is drawn,
+        with no redraw (None: the overlay shows nothing painted, and is dropped)."""
+        if mask is None:
+            self.set_mask(None)
+        else:
+            self._mask = mask
+
+    def update_box(self, mask: Mask | MaskStroke, box: tuple[int, int, int, int]) -> None:
+        """Redraw ``box`` = (x0, y0, x1, y1) of ``mask`` (a mask, or the stroke being painted, of the
+        same size as the one shown); ``mask`` is then what is drawn."""
         if self._rgba is None or self._rgba.shape[:2] != mask.shape:
             self.set_mask(mask)
             return
@@ -102,9 +136,8 @@ class MaskOverlay(QGraphicsItem):
         x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
         if x0 >= x1 or y0 >= y1:
             return
-        part = self._rgba[y0:y1, x0:x1]
-        part[:] = 0
-        part[mask.bits[y0:y1, x0:x1]] = MASK_RGBA
+        words = self._rgba.view(np.uint32).reshape(h, w)
+        np.multiply(mask.bits[y0:y1, x0:x1], _MASK_WORD, out=words[y0:y1, x0:x1], casting="unsafe")
         self.update(QRectF(x0, y0, x1 - x0, y1 - y0))
 
     def boundingRect(self) -> QRectF:  # noqa: N802 (Qt naming)
@@ -138,8 +171,10 @@ class MaskTool(Tool):
         self.lasso_item.setBrush(QBrush(QColor(255, 215, 64, 50)))
         self.lasso_item.setZValue(25)
         scene.addItem(self.lasso_item)
-        self.live: Mask | None = None  # the mask with the stroke so far
+        # the stroke so far: a brush's or eraser's MaskStroke (painted in place), a lasso's starting mask
+        self.live: MaskStroke | Mask | None = None
         self.start: Mask | None = None  # the document's mask when the stroke began
+        self.touched: tuple[int, int, int, int] | None = None  # the box of the pixels the stroke changed
         self.last: tuple[float, float] | None = None
         self.points: list[tuple[float, float]] = []
         self.active = False
@@ -248,23 +283,30 @@ class MaskTool(Tool):
 
     def _dab(self, p0, p1) -> None:
         value = self.mode == BRUSH
-        self.live = self.live.painted_line(p0, p1, self.radius, value)
+        changed = self.live.line(p0, p1, self.radius, value)  # (in place: only the dab's pixels)
         self.last = p1
         r = self.radius + 1
         box = (min(p0[0], p1[0]) - r, min(p0[1], p1[1]) - r, max(p0[0], p1[0]) + r, max(p0[1], p1[1]) + r)
-        self.overlay.update_box(self.live, (int(np.floor(box[0])), int(np.floor(box[1])),
-                                            int(np.ceil(box[2])) + 1, int(np.ceil(box[3])) + 1))
+        if changed is not None:
+            self.overlay.update_box(self.live, changed)
+            t = self.touched
+            self.touched = changed if t is None else (min(t[0], changed[0]), min(t[1], changed[1]),
+                                                      max(t[2], changed[2]), max(t[3], changed[3]))
         if self.on_stroke is not None:  # the eraser's strokes too: erased pixels are previewed unfilled
             self.on_stroke(self.live, box)
 
     def press(self, view, pos, event):
         self.active = True
         self.start = self.mask()
-        self.live = self.base()
+        self.touched = None
         p = self._pixel(pos)
         if self.mode in (BRUSH, ERASER):
+            w, h = self.view.image_size()
+            self.live = MaskStroke(self.start, max(w, 1), max(h, 1))
+            self.overlay.begin(self.live, self.start)
             self._dab(p, p)
         else:
+            self.live = self.base()
             self.points = [p]
             self._draw_lasso()
 
@@ -299,13 +341,18 @@ class MaskTool(Tool):
         if self.mode in (BRUSH, ERASER):
             if self.last is not None and self._pixel(pos) != self.last:
                 self._dab(self.last, self._pixel(pos))
-            mask, text = self.live, "Brush stroke" if self.mode == BRUSH else "Erase"
+            stroke, text = self.live, "Brush stroke" if self.mode == BRUSH else "Erase"
+            # (a stroke of one mode only paints or only erases: it changed a pixel iff its mask differs)
+            changed, mask = stroke.changed, stroke.mask()  # (its bits, not a copy)
+            if changed:
+                self.overlay.adopt(mask)  # (drawn dab by dab already)
         else:
             self.points.append(self._pixel(pos))
             mask = self.live.painted_polygon(self.points, self.mode == LASSO_ADD)
             text = "Lasso" if self.mode == LASSO_ADD else "Lasso subtract"
+            changed = mask != self.base()
         self._end()
-        if mask != self.base():
+        if changed:
             self.doc.set_mask(self.geometry_key, mask, text)  # (the document's live stroke ends with it)
             self.refresh()
         else:  # nothing changed: no undo step, and the stroke's previews go as with Esc
@@ -327,6 +374,13 @@ class MaskTool(Tool):
         return True
 
     def _cancelled(self) -> None:
+        start, touched = self.start, self.touched
+        if start is not None and start is self.mask() and self.overlay.image().size() == QSize(*start.size):
+            # the overlay differs from the mask the stroke began on only where the stroke changed pixels
+            if touched is not None:
+                self.overlay.update_box(start, touched)
+            self.overlay.adopt(start)
+        self.touched = None
         self.refresh()
         if self.on_stroke is not None:
             self.on_stroke(None, None)

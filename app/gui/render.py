@@ -17,10 +17,19 @@
   a render of the region around the stroke only, when the method's studio description asks for it
   (``Studio.preview_around``; ``weft.core.studio.crop_around`` crops the inputs to at most
   ``AROUND_SIDE`` px): its result is pasted into the last full result and shown; the release renders
-  full size. A preview around a stroke that fails says nothing (the release's render will).
+  full size. A preview around a stroke that fails says nothing (the release's render will). A dab
+  while no preview runs starts one at once; dabs while one runs are coalesced into the next (the
+  latest wins), started when it is done.
 * A job captures the document's inputs and parameters when it is submitted and builds what it runs
   on (painted masks as images, the preview's reduction, the stroke's crop) on its worker: the GUI
-  thread only takes references (``Document.deferred_inputs``).
+  thread only takes references (``Document.deferred_inputs``). A preview around a stroke gets only
+  the part of the stroke's mask its crop can reach (``weft.core.studio.around_region``, cut from the
+  tool's ``MaskStroke`` on the GUI thread: a few hundred pixels, never the 4096² mask), its result
+  comes back already scaled to the crop's box, and the stroke's first one also brings the copy of
+  the full result its crops are pasted into (200 MB at 4096² in colour: 110 ms on the GUI thread
+  before); later ones are pasted into that copy in place, and the result view redraws only the part.
+  While a stroke is painted, no whole-image preview is made (a preview asked for with no stroke box
+  left waits for the next box).
 * A job running longer than ``PROGRESS_DELAY_MS`` shows its progress (with partial previews where the
   method gives them) and can be cancelled; after a cancel or an error the last good result stays.
 """
@@ -38,7 +47,8 @@ from weft.core import registry
 from weft.core.jobs import JobResult, JobRunner, Progress
 from weft.core.params import Params, Recipe
 from weft.core.errors import WeftError
-from weft.core.studio import crop_around, describe_figures, reduce_for_preview
+from weft.core.geometry import Mask, MaskStroke
+from weft.core.studio import around_region, crop_around, describe_figures, reduce_for_preview
 
 PREVIEW_SIDE = 400
 PROGRESS_DELAY_MS = 300
@@ -79,9 +89,11 @@ class Shown:
     # a preview around a stroke: (width, height) of the crop in the image and as rendered (its figures are the
     # crop's: only those of the whole image are stated, ``describe``)
     crop: tuple[int, int, int, int] | None = None
-    # a preview around a stroke: (x0, y0, x1, y1) of ``image`` it changed since the stroke's previous preview
-    # (``image`` is the same array: pasted into in place); None: all of it (the stroke's first preview)
+    # a preview around a stroke: (x0, y0, x1, y1) of ``image`` it changed: ``image`` equals ``over`` elsewhere,
+    # ``over`` being the stroke's previous preview (the same array: pasted into in place) or, for its first
+    # preview, the full result (or canvas input) it is a copy of; None: a new image
     changed: tuple[int, int, int, int] | None = None
+    over: np.ndarray | None = None
 
 
 def _render(method, inputs, params, seed, report, cancel, *, final: bool):
@@ -115,6 +127,23 @@ def _render(method, inputs, params, seed, report, cancel, *, final: bool):
     return result, max(0.0, seconds), final, prepared + during, bool(said)
 
 
+def stroke_part(doc, box) -> tuple[np.ndarray, tuple[int, int]] | None:
+    """The part of the document's stroke being painted (``Document.live``: the mask tool's
+    ``MaskStroke``) that a preview around ``box`` reads (``around_region``), copied now, with its
+    place; None when the live geometry is not the previewed mask painted on the open image (a job
+    then reads the document's live masks whole)."""
+    g = doc.mask_geometry(doc.studio.preview_around) if doc.studio.preview_around else None
+    live = doc.live
+    if g is None or live is None or live[0] != g.key or not isinstance(live[1], (MaskStroke, Mask)):
+        return None
+    on = doc.image(g.input_for(doc.inputs))
+    h, w = live[1].shape
+    if on is None or on.shape[:2] != (h, w):
+        return None
+    x0, y0, x1, y1 = around_region(box, w, h)
+    return live[1].bits[y0:y1, x0:x1].copy(), (x0, y0)
+
+
 def preparation(doc, *, side: int | None = None, around_box=None
                 ) -> tuple[Callable[[], tuple | None], Params] | None:
     """What a job of the document's current method runs on, captured now on the GUI thread (the
@@ -125,16 +154,20 @@ def preparation(doc, *, side: int | None = None, around_box=None
     (``crop_around``, with the whole image's mask: 0.15-0.57 s per preview at 4096² on the GUI
     thread before). The call gives ``(inputs, params, around)`` (``around``: the stroke's
     :class:`~weft.core.studio.Around`, or None), or None when there is nothing painted near the
-    stroke. Returns ``(that call, the document's run parameters)``, or None when inputs are missing."""
+    stroke. Returns ``(that call, the document's run parameters)``, or None when inputs are missing.
+    A stroke's crop gets only the part of the stroke's mask it can reach (:func:`stroke_part`, cut
+    here), never the whole mask as an image (64 MB at 4096², per preview)."""
     if doc.missing_inputs():
         return None
     studio = doc.studio
-    build = doc.deferred_inputs(live=around_box is not None)
+    part = None if around_box is None else stroke_part(doc, around_box)
+    build = doc.deferred_inputs(live=around_box is not None and part is None)
     params = doc.run_params()
+    names = None if part is None else [i.name for i in doc.current.inputs if i.name != studio.preview_around]
 
     def prepare():
         if around_box is not None:
-            around = crop_around(studio, build(), params, around_box)
+            around = crop_around(studio, build(names), params, around_box, mask_part=part)
             return None if around is None else (around.inputs, around.params, around)
         if side is not None:
             return (*reduce_for_preview(studio, build(), params, side), None)
@@ -181,6 +214,8 @@ class Renderer(QObject):
         self._around_box: tuple[float, float, float, float] | None = None  # stroke region not previewed yet
         self._around_jobs: set[int] = set()
         self._around_image: np.ndarray | None = None  # the last full result with the stroke's previews pasted
+        self._around_bases: dict[int, np.ndarray] = {}  # a job copying the base -> that base (the array copied)
+        self._stroking = False  # a stroke's previews are asked for: no whole-image preview meanwhile
         self.last: Shown | None = None
         # The window shows the canvas input instead of ``last`` (the method had nothing to do, e.g.
         # nothing painted): ``last`` is older than the document, no base for a stroke's previews.
@@ -207,17 +242,22 @@ class Renderer(QObject):
 
     def preview_around(self, box) -> bool:
         """A mask stroke is being painted (``box`` the region of its latest dab, in the painted image's
-        pixels): preview the region around it soon (coalesced with the dabs that follow). False if
-        the method previews no stroke that way."""
+        pixels): preview the region around it at once when no preview is running (no frame's wait:
+        the stroke's crop is small), else as soon as the running one is done, coalesced with the dabs
+        that follow (the latest wins). False if the method previews no stroke that way."""
         if self.doc.studio.preview_around is None:
             return False
+        self._stroking = True
         if self._around_box is None:
             self._around_box = tuple(box)
         else:
             a = self._around_box
             self._around_box = (min(a[0], box[0]), min(a[1], box[1]), max(a[2], box[2]), max(a[3], box[3]))
-        if not self._preview_timer.isActive():
-            self._preview_timer.start()
+        if self._preview_running is not None:
+            self._preview_dirty = True  # (started when the running preview is done)
+        else:
+            self._preview_timer.stop()
+            self._submit("preview", preview=True)
         return True
 
     def stroke_cancelled(self) -> bool:
@@ -226,6 +266,8 @@ class Renderer(QObject):
         self._preview_timer.stop()
         self._around_box = None
         self._around_image = None
+        self._stroking = False
+        self._around_bases.clear()  # (a cancelled job delivers nothing)
         self.runner.cancel("preview")
         self._preview_running, self._preview_dirty = None, False
         if self._current_final() is not None:
@@ -255,6 +297,7 @@ class Renderer(QObject):
         self._final_timer.stop()
         self._preview_running, self._preview_dirty = None, False
         self._final_running = False
+        self._around_bases.clear()
         self.runner.cancel("preview")
         self.runner.cancel("final")
         self._busy_timer.stop()
@@ -297,6 +340,9 @@ class Renderer(QObject):
             if doc.missing_inputs():
                 return None
             box, self._around_box = self._around_box, None
+            self._preview_timer.stop()  # (asked for by the dabs this job covers)
+        elif slot == "preview" and self._stroking:
+            return None  # a stroke is painted: its next dab asks for its preview (no whole image meanwhile)
         prepared = self._preparation(preview=preview, around_box=box)
         if prepared is None:
             return None
@@ -305,6 +351,8 @@ class Renderer(QObject):
         recipe = None if preview else doc.recipe(params)
         masks = None if preview else doc.masks()
         before = doc.image(doc.studio.compare_input(doc.inputs))
+        # a stroke's first preview copies the image its crops are pasted into, on the worker
+        base = self._around_base() if box is not None and self._around_image is None else None
 
         def job(*, progress=None, cancel=None):
             # Previews report nothing; a final render's partial images are built at most every
@@ -314,16 +362,25 @@ class Renderer(QObject):
                 return None  # nothing painted near the stroke: the release renders
             inputs, run_params, around = prepared
             report = None if preview or progress is None else _Partial(progress)
-            return (*_render(method, inputs, run_params, seed, report, cancel, final=not preview), recipe, before,
-                    masks, around, method.name)
+            out = _render(method, inputs, run_params, seed, report, cancel, final=not preview)
+            fitted = copied = None
+            if around is not None:  # (scaled back to its box here, not on the GUI thread)
+                fitted = around.fitted(out[0].image)
+                copied = None if base is None or fitted is None else base.copy()
+            return (*out, recipe, before, masks, around, method.name, fitted, copied)
 
         if slot == "final":
             self.runner.cancel("preview")
             self._preview_running, self._preview_dirty = None, False
             self._around_box = None
+            self._around_bases.clear()
+        if slot == "final":
+            self._stroking = False
         handle = self.runner.submit(slot, job)
         if box is not None:
             self._around_jobs.add(handle.id)
+            if base is not None:
+                self._around_bases[handle.id] = base
         if slot == "preview":
             self._preview_running = handle.id
             handle.future.add_done_callback(lambda _f, jid=handle.id: self._preview_finished.emit(jid))
@@ -335,6 +392,8 @@ class Renderer(QObject):
         return handle.id
 
     def _submit_preview(self) -> None:
+        if self._stroking and self._around_box is None:
+            return  # (the box it was started for went with the job that ended meanwhile)
         if self._preview_running is not None:
             self._preview_dirty = True  # started when the running preview is done
             return
@@ -364,6 +423,7 @@ class Renderer(QObject):
             self._start_warm_up()  # the first result (or error) is in: the other methods' turn
         around = result.job_id in self._around_jobs
         self._around_jobs.discard(result.job_id)
+        base = self._around_bases.pop(result.job_id, None)
         if result.error is not None:
             if not around and (self.last is None or result.job_id > self.last.job_id):
                 self.failed.emit(f"render failed: {result.error}")
@@ -372,9 +432,9 @@ class Renderer(QObject):
             return  # a stroke's preview with nothing painted near it
         if self.last is not None and result.job_id < self.last.job_id:
             return  # older than what is shown: stale
-        res, seconds, final, prepared, compiled, recipe, before, masks, crop, name = result.value
+        res, seconds, final, prepared, compiled, recipe, before, masks, crop, name, fitted, copied = result.value
         if crop is not None:
-            self._show_around(res, crop, result.job_id, seconds, name)
+            self._show_around(res, crop, result.job_id, seconds, name, fitted, copied, base)
             return
         if final:
             self._around_image = None
@@ -390,23 +450,32 @@ class Renderer(QObject):
         canvas = self.doc.studio.canvas
         return last.image if last is not None else self.doc.deferred_inputs()(names=(canvas,)).get(canvas)
 
-    def _show_around(self, res, crop, job_id: int, seconds: float, method: str) -> None:
-        """Paste a preview around a stroke into the full result (and the stroke's earlier ones)."""
-        fresh = self._around_image is None
-        base = self._around_base() if fresh else self._around_image
-        if base is None:
-            return
-        pasted = crop.paste(base, res.image, copy=fresh)
-        if pasted is None:
+    def _show_around(self, res, crop, job_id: int, seconds: float, method: str, fitted, copied, base) -> None:
+        """Paste a preview around a stroke (``fitted``: its result scaled to its box) into the stroke's
+        copy of the full result: ``copied``, the copy of ``base`` its job made, for the stroke's first."""
+        if fitted is None:
             return  # the crop's result does not fit the full one (another size): the release renders
-        self._around_image = pasted
+        over = self._around_image
+        if over is None:
+            if not self._stroking:
+                return  # (the stroke has ended: its full render is on its way)
+            if copied is None or base is not self._around_base():
+                # no copy, or one of what is no longer the base (a full result came meanwhile): the next
+                # job copies the base again and covers this crop too
+                self.preview_around(crop.box)
+                return
+            self._around_image, over = copied, base
+        if crop.paste(self._around_image, fitted, copy=False) is None:
+            if over is base:
+                self._around_image = None
+            return
         x0, y0, x1, y1 = crop.box
         dx, dy = crop.offset
         rh, rw = res.image.shape[:2]
-        self.around_shown.emit(Shown(pasted, job_id, seconds, dict(res.figures), False, recipe=None,
+        self.around_shown.emit(Shown(self._around_image, job_id, seconds, dict(res.figures), False, recipe=None,
                                      before=None if self.last is None else self.last.before, method=method,
                                      crop=(x1 - x0, y1 - y0, rw, rh),
-                                     changed=None if fresh else (x0 + dx, y0 + dy, x1 + dx, y1 + dy)))
+                                     changed=(x0 + dx, y0 + dy, x1 + dx, y1 + dy), over=over))
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
         if slot != "final" or job_id != self.latest_final:

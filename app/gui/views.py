@@ -33,6 +33,9 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
 #: Images of more pixels than this are converted for display on a worker thread (display_qimage:
 #: 0.4 ms for 512², 10 ms for 1024², 39 ms for 2048², 145 ms for 4096², median of 7, loaded machine).
 ASYNC_PIXELS = 512 * 512
+#: A part of the image on screen changed in place of at most this many pixels is converted on the GUI
+#: thread (``set_image(changed=)``: a stroke's preview; 1024² in 10 ms), not the whole image on a worker.
+PART_PIXELS = 1024 * 1024
 
 _converters = ThreadPoolExecutor(max_workers=2, thread_name_prefix="weft-display")
 
@@ -173,32 +176,37 @@ class ImageView(QGraphicsView):
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
 
     # --- image ---------------------------------------------------------------------------------
-    def set_image(self, image: np.ndarray | None, *, fit: bool = False, changed=None) -> None:
+    def set_image(self, image: np.ndarray | None, *, fit: bool = False, changed=None, over=None) -> None:
         """Show ``image`` (float32 [0, 1]); ``fit`` also fits it to the window, as does an image of
         another size while the view is fitting (the user has not zoomed). A large image is shown
         once converted on a worker thread (module docstring); the previous one stays until then.
 
-        ``changed`` = ``(x0, y0, x1, y1)``: ``image`` is the very array on screen, changed in place
-        only there since it was shown (a stroke's preview pasted into the result): only that part
-        is converted and redrawn, at once when it is small."""
-        if changed is not None and self._redraw_part(image, changed):
+        ``changed`` = ``(x0, y0, x1, y1)``: ``image`` differs from ``over`` (default: ``image`` itself,
+        changed in place) only there; when ``over`` is the array on screen (a stroke's preview pasted
+        into the result, or into a copy of it), only that part is converted and redrawn, at once
+        (a part of at most ``PART_PIXELS``)."""
+        if changed is not None and self._redraw_part(image, changed, image if over is None else over):
             return
         self._fit_wanted = self._fit_wanted or fit
         self._converter.request(image)
 
-    def _redraw_part(self, image: np.ndarray | None, box) -> bool:
-        """Redraw ``box`` of the array on screen (see :meth:`set_image`); False when that does not
-        apply (another array, one being converted, or a part too large to convert here)."""
+    def _redraw_part(self, image: np.ndarray | None, box, over) -> bool:
+        """Show ``image``, which is the array on screen ``over`` but for ``box``, by redrawing ``box``
+        (see :meth:`set_image`); False when that does not apply (not what is on screen, one being
+        converted, or a part too large to convert here)."""
         pixels = self._item.pixels()
-        if image is None or image is not self.image or self.converting or pixels is None:
+        if image is None or over is not self.image or self.converting or pixels is None:
             return False
         h, w = image.shape[:2]
+        if over.shape != image.shape or pixels.shape[:2] != (h, w):
+            return False
         x0, y0, x1, y1 = (int(v) for v in box)
         x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
+        if (x1 - x0) * (y1 - y0) > PART_PIXELS:
+            return False
+        self.image = image  # (the same pixels as ``over`` outside ``box``)
         if x0 >= x1 or y0 >= y1:
             return True  # nothing on screen changed
-        if (x1 - x0) * (y1 - y0) > ASYNC_PIXELS or pixels.shape[:2] != (h, w):
-            return False
         _q, part = display_qimage(image[y0:y1, x0:x1])
         pixels[y0:y1, x0:x1] = part
         self._converter.shown_now()  # (a conversion still running is older: dropped)

@@ -76,3 +76,33 @@ def test_a_mask_geometry_is_an_input():
         Geometry(MASK, on=("image",), param="mask")
     with pytest.raises(ValueError, match="only a mask"):
         Geometry("square", on=("image",), param="p", input="mask")
+
+
+def test_a_stroke_paints_in_place_what_painted_line_paints_and_knows_if_it_changed_anything():
+    from weft.core.geometry import MaskStroke
+
+    base = Mask.empty(40, 30).painted_line((5, 5), (20, 5), radius=2)
+    stroke = MaskStroke(base)
+    assert stroke.shape == (30, 40) and not stroke.changed
+    assert stroke.line((6, 5), (12, 5), 1) is None and not stroke.changed  # over painted pixels only
+    box = stroke.line((10, 10), (30, 20), 3)
+    expected = base.painted_line((10, 10), (30, 20), 3)
+    assert stroke.changed and np.array_equal(stroke.bits, expected.bits)
+    changed = expected.bits != base.bits
+    rows, cols = np.flatnonzero(changed.any(axis=1)), np.flatnonzero(changed.any(axis=0))
+    assert box == (cols[0], rows[0], cols[-1] + 1, rows[-1] + 1)  # exactly the pixels it changed
+    assert base == Mask.empty(40, 30).painted_line((5, 5), (20, 5), radius=2)  # the base is untouched
+    assert not stroke.bits.flags.writeable
+    snap = stroke.snapshot()
+    stroke.line((0, 29), (0, 29), 0, value=True)
+    erased = stroke.line((12, 12), (12, 12), 1, value=False)  # the eraser
+    assert erased is not None and not stroke.bits[12, 12] and snap.bits[12, 12]  # the snapshot stays
+    assert np.array_equal(stroke.cut(8, 9, 15, 14), stroke.bits[9:14, 8:15])
+    assert stroke.cut(-5, -5, 3, 2).shape == (2, 3)  # clipped to the mask
+    final = stroke.mask()
+    assert final == Mask(stroke.bits) and not final.bits.flags.writeable
+    with pytest.raises(GeometryError, match="ended"):
+        stroke.line((1, 1), (2, 2), 1)
+    fresh = MaskStroke(None, 7, 5)
+    assert fresh.shape == (5, 7) and not fresh.bits.any()
+    assert fresh.line((100, 100), (120, 100), 2) is None  # outside the mask: nothing

@@ -161,3 +161,42 @@ def test_a_texture_the_size_of_the_painted_image_is_kept_whole_and_a_source_mask
     del inputs["texture"]
     around = crop_around(STUDIO, inputs, HoleParams(), (205, 105, 215, 115))
     assert np.array_equal(around.inputs["source"], source[y0:y1, x0:x1])  # goes with the image
+
+
+@pytest.mark.parametrize("stroke", [(205, 105, 215, 115), (0, 0, 6, 4), (380, 280, 399, 299), (150, 20, 260, 60)])
+def test_a_part_of_the_mask_around_the_stroke_gives_the_crop_the_whole_mask_gives(stroke):
+    """The studio cuts only ``around_region`` of a stroke's mask (not the whole mask, 64 MB as a
+    float image at 4096²): the crop, its inputs and its box are those of the whole mask."""
+    from weft.core.studio import around_region
+
+    rng = np.random.default_rng(3)
+    hole = np.zeros((300, 400), np.float32)
+    hole[100:120, 200:230] = 1.0
+    hole[0:10, 0:9] = 1.0
+    hole[270:300, 370:400] = 1.0
+    hole[30:50, 140:270] = rng.random((20, 130)) > 0.5
+    inputs = _inputs(hole=hole)
+    whole = crop_around(STUDIO, inputs, HoleParams(grow=Margins(3, 4, 0, 0)), stroke)
+    x0, y0, x1, y1 = around_region(stroke, 400, 300)
+    assert 0 <= x0 < x1 <= 400 and 0 <= y0 < y1 <= 300 and (x1 - x0) * (y1 - y0) < 400 * 300
+    part = (hole[y0:y1, x0:x1] > 0.5).copy()
+    without = {k: v for k, v in inputs.items() if k != "hole"}
+    cut = crop_around(STUDIO, without, HoleParams(grow=Margins(3, 4, 0, 0)), stroke, mask_part=(part, (x0, y0)))
+    assert whole is not None and cut is not None
+    assert cut.box == whole.box and cut.offset == whole.offset == (3, 4) and cut.params == whole.params
+    assert set(cut.inputs) == set(whole.inputs)
+    for name in whole.inputs:
+        assert cut.inputs[name].dtype == whole.inputs[name].dtype
+        assert np.array_equal(cut.inputs[name], whole.inputs[name]), name
+    # a part that does not cover the region is refused, not read past its edge
+    with pytest.raises(ValueError, match="does not cover"):
+        crop_around(STUDIO, without, HoleParams(), stroke, mask_part=(part[1:], (x0, y0 + 1)))
+
+
+def test_a_part_with_nothing_painted_near_the_stroke_gives_no_crop():
+    from weft.core.studio import around_region
+
+    x0, y0, x1, y1 = around_region((100, 100, 110, 110), 400, 300)
+    part = np.zeros((y1 - y0, x1 - x0), bool)
+    inputs = {k: v for k, v in _inputs().items() if k != "hole"}
+    assert crop_around(STUDIO, inputs, HoleParams(), (100, 100, 110, 110), mask_part=(part, (x0, y0))) is None

@@ -901,7 +901,7 @@ def test_an_eraser_stroke_is_previewed_live(studio, qtbot):
     qtbot.mouseClick(bar.mode_buttons["eraser"], Qt.MouseButton.LeftButton)
     tool.set_size(5)
     around = _previewed(studio, qtbot, view, [(35.5, 24.5), (35.5, 36.5)])
-    live = doc.live[1]
+    live = doc.live[1].snapshot()  # (the tool's MaskStroke: the mask so far, copied)
     assert not live.bits[28:33, 34:37].any() and live.bits[30, 30]
     source = doc.image("picture")
     # erased pixels show the picture again, the rest of the hole stays filled
@@ -1106,17 +1106,35 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
 
 
 def test_a_strokes_later_previews_name_the_part_they_changed(studio, qtbot):
-    """A stroke's first preview is a new image (the last result with the crop pasted: the result view
-    converts it whole); each later one is pasted into that same image and names the part it changed,
-    so the view converts only that part (a 4096² result is not converted again per preview)."""
+    """A stroke's first preview is a new image (a copy of what the result view shows, made on the
+    job's worker, with the crop pasted) that names the part it changed and what it is a copy of
+    (``over``); each later one is pasted into that same image and names the part it changed. So the
+    view converts only that part (a 4096² result is neither copied on the GUI thread nor converted
+    again per preview)."""
     view = studio.canvas_view
+    shown_before = studio.result_view.image
+    picture = studio.doc.image("picture")
+    assert np.array_equal(shown_before, picture)  # (nothing painted yet: the picture)
     studio.inputs_pane.mask_tool().set_size(5)
     around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
-    assert around[0].changed is None
+    first = around[0]
+    assert first.over is shown_before and first.image is not shown_before and first.changed is not None
+    x0, y0, x1, y1 = first.changed
+    assert x0 < 10 < x1 and y0 < 10 < y1 and (x1 - x0) * (y1 - y0) < W * H
+    outside = np.ones((H, W), bool)
+    outside[y0:y1, x0:x1] = False
+    assert np.array_equal(first.image[outside], picture[outside])  # the copy, changed only in its part
+    assert not np.array_equal(first.image[y0:y1, x0:x1], picture[y0:y1, x0:x1])  # the stroke, filled
+    assert np.array_equal(picture, shown_before) and shown_before is picture  # the picture is not touched
     mouse(view, "move", (40.5, 40.5))
-    qtbot.waitUntil(lambda: len(around) > 1, timeout=10000)
+
+    def covers_the_latest_dab() -> bool:  # (a preview of the earlier dabs may come first: dabs coalesce)
+        box = around[-1].changed if len(around) > 1 else None
+        return box is not None and box[0] < 40 < box[2] and box[1] < 40 < box[3]
+
+    qtbot.waitUntil(covers_the_latest_dab, timeout=10000)
     last = around[-1]
-    assert last.image is around[0].image and last.changed is not None
+    assert last.image is around[0].image and last.changed is not None and last.over is last.image
     x0, y0, x1, y1 = last.changed
     assert x0 < 40 < x1 and y0 < 40 < y1 and (x1 - x0) * (y1 - y0) < W * H
     assert studio.result_view.image is last.image
