@@ -36,6 +36,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import dataclass
 from typing import Callable
@@ -54,6 +55,13 @@ PREVIEW_SIDE = 400
 PROGRESS_DELAY_MS = 300
 PARTIAL_INTERVAL = 0.25
 WARM_UP_DELAY_MS = 3000  # no render at start: warm the kernels up after this long anyway
+#: Python's GIL switch interval (s) in a process with a renderer: a worker running Python (a numpy fill,
+#: a stroke's crop) hands the GIL over to a waiting GUI thread after at most this long, not the default
+#: 5 ms, and a GUI event handler enters Python several times (the tool, the QGraphicsItems' paint and
+#: boundingRect). Painting a 4096² mask, median of 3: longest stall 50.4 -> 30.1 ms, latency 70.5 ->
+#: 51.7 ms (``python -m benchmarks.gui_latency --paint --side 4096``); a long C call holding the GIL
+#: (an import, numba loading its typing tables) is not cut short by it.
+GIL_SWITCH_INTERVAL = 0.001
 
 
 class _Partial:
@@ -203,6 +211,8 @@ class Renderer(QObject):
 
     def __init__(self, doc, parent=None, *, workers: int = 2):
         super().__init__(parent)
+        if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
+            sys.setswitchinterval(GIL_SWITCH_INTERVAL)
         self.doc = doc
         self.runner = JobRunner(max_workers=workers, on_result=self._delivered.emit,
                                 on_progress=lambda jid, slot, p: self._progressed.emit(jid, slot, p))
@@ -283,8 +293,10 @@ class Renderer(QObject):
         return last if last.recipe.method == self.doc.method else None
 
     def final(self, *, now: bool = False) -> None:
-        """Ask for the full-size render (coalesced; ``now`` skips the short delay)."""
+        """Ask for the full-size render (coalesced; ``now`` skips the short delay). A stroke being
+        previewed has ended (released, or the document changed under it)."""
         self._preview_timer.stop()
+        self._stroking = False
         if now:
             self._final_timer.stop()
             self._submit_final()
@@ -374,8 +386,6 @@ class Renderer(QObject):
             self._preview_running, self._preview_dirty = None, False
             self._around_box = None
             self._around_bases.clear()
-        if slot == "final":
-            self._stroking = False
         handle = self.runner.submit(slot, job)
         if box is not None:
             self._around_jobs.add(handle.id)
@@ -457,9 +467,10 @@ class Renderer(QObject):
             return  # the crop's result does not fit the full one (another size): the release renders
         over = self._around_image
         if over is None:
-            if not self._stroking:
-                return  # (the stroke has ended: its full render is on its way)
-            if copied is None or base is not self._around_base():
+            current = self._around_base()
+            if not self._stroking or current is None:
+                return  # the stroke has ended (its full render is on its way), or nothing to paste into
+            if copied is None or base is not current:
                 # no copy, or one of what is no longer the base (a full result came meanwhile): the next
                 # job copies the base again and covers this crop too
                 self.preview_around(crop.box)

@@ -1139,3 +1139,139 @@ def test_a_strokes_later_previews_name_the_part_they_changed(studio, qtbot):
     assert x0 < 40 < x1 and y0 < 40 < y1 and (x1 - x0) * (y1 - y0) < W * H
     assert studio.result_view.image is last.image
     _final_after(studio, qtbot, lambda: mouse(view, "release", (40.5, 40.5)))
+
+
+def _large_picture(studio, qtbot, tmp_path, w=480, h=360, at=(105, 102)):
+    """Open a ``w`` x ``h`` picture in the studio (nothing painted), zoomed 4x around ``at``."""
+    path = tmp_path / "large.png"
+    save_image(path, np.random.default_rng(5).random((h, w, 3)).astype(np.float32))
+    with qtbot.waitSignal(studio.renderer.failed, timeout=10000):  # nothing to fill yet
+        studio.open_input("picture", str(path))
+    view = studio.canvas_view
+    qtbot.waitUntil(lambda: view.image is not None and view.image.shape[:2] == (h, w), timeout=10000)
+    view.actual_size()
+    view.zoom_by(4.0)
+    view.centerOn(*at)
+    return view
+
+
+def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole_mask(studio, qtbot, tmp_path,
+                                                                                   monkeypatch):
+    """The job of a preview around a stroke is given the part of the stroke's mask its crop can reach
+    (``around_region``), cut on the GUI thread, never the whole mask (at 4096² a 64 MB float image per
+    preview); the whole mask is made into an image only for the full render on release."""
+    import weft.app.gui.render as render
+    from weft.core.studio import around_region
+
+    w, h = 480, 360
+    view = _large_picture(studio, qtbot, tmp_path, w, h)
+    calls, images = [], []
+
+    def recorded_crop(studio_, inputs, params, stroke, **kwargs):
+        calls.append((set(inputs), stroke, kwargs.get("mask_part")))
+        return crop_around(studio_, inputs, params, stroke, **kwargs)
+
+    crop_around = render.crop_around
+    monkeypatch.setattr(render, "crop_around", recorded_crop)
+    to_image = Mask.to_image
+    monkeypatch.setattr(Mask, "to_image", lambda self: images.append(self.shape) or to_image(self))
+    studio.inputs_pane.mask_tool().set_size(9)  # radius 4
+    CALLS.clear()
+    around = _previewed(studio, qtbot, view, [(100.5, 100.5), (110.5, 104.5)])
+    names, stroke, part = calls[0]
+    assert "hole" not in names and "picture" in names  # the mask is not among the job's whole inputs
+    bits, (x0, y0) = part
+    rx0, ry0, rx1, ry1 = around_region(stroke, w, h)
+    assert (x0, y0) == (rx0, ry0) and bits.shape == (ry1 - ry0, rx1 - rx0)
+    assert bits.size * 10 < w * h  # a part, not the mask
+    # the first preview's part is the press's dab, exactly
+    dab = Mask.empty(w, h).painted_line((100, 100), (100, 100), 4)
+    assert np.array_equal(bits, dab.bits[ry0:ry1, rx0:rx1])
+    assert CALLS and max(CALLS[0]) < max(bits.shape)  # the method ran on a crop inside that part
+    assert images == []  # no mask was made into a whole image for a preview
+    shown = around[-1]
+    x0, y0, x1, y1 = shown.changed
+    assert x0 <= 96 and y0 <= 96 and x1 >= 105 and y1 >= 105 and (x1 - x0) * (y1 - y0) * 10 < w * h
+    result = _final_after(studio, qtbot, lambda: mouse(view, "release", (110.5, 104.5)))
+    assert images == [(h, w)]  # the full render's mask, once (on its worker)
+    expected = Mask.empty(w, h).painted_line((100, 100), (100, 100), 4).painted_line((100, 100), (110, 104), 4)
+    assert _mask(studio) == expected
+    assert result.figures["hole_pixels"] == expected.area
+
+
+def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the_latest(studio, qtbot, tmp_path,
+                                                                                     monkeypatch):
+    """While a stroke's preview is computed, the dabs that follow wait in one box: when it is done, one
+    preview of all of them follows (the latest dab wins), not one per mouse move."""
+    import threading
+
+    import weft.app.gui.render as render
+
+    w, h = 480, 360
+    view = _large_picture(studio, qtbot, tmp_path, w, h, at=(130, 102))
+    gate = threading.Event()
+    crop_around = render.crop_around
+    entered = []
+
+    def held(*args, **kwargs):
+        entered.append(True)
+        assert gate.wait(20)  # the first preview's job waits here until the moves are made
+        return crop_around(*args, **kwargs)
+
+    monkeypatch.setattr(render, "crop_around", held)
+    submitted = []
+    studio.renderer.submitted.connect(lambda job, slot: submitted.append(job) if slot == "preview" else None)
+    around = []
+    studio.renderer.around_shown.connect(around.append)
+    studio.inputs_pane.mask_tool().set_size(7)  # radius 3
+    points = [(100.5 + 10 * i, 100.5) for i in range(7)]
+    try:
+        mouse(view, "press", points[0])
+        qtbot.waitUntil(lambda: bool(entered), timeout=10000)  # the press's preview runs
+        for p in points[1:]:
+            mouse(view, "move", p)
+        assert len(submitted) == 1  # the moves wait for it
+    finally:
+        gate.set()
+
+    def covers_the_last_dab() -> bool:
+        box = around[-1].changed if around else None
+        return box is not None and box[0] <= 157 and box[2] >= 164 and box[1] <= 97 and box[3] >= 104
+
+    qtbot.waitUntil(covers_the_last_dab, timeout=10000)
+    assert len(submitted) == 2 and len(around) == 2  # the six moves: one preview
+    x0, y0, x1, y1 = around[-1].changed
+    assert x0 <= 107 and x1 >= 164  # it covers every dab since the first preview
+    picture = studio.doc.image("picture")
+    image = around[-1].image
+    assert not np.allclose(image[100, 160], picture[100, 160]) and not np.allclose(image[100, 110], picture[100, 110])
+    assert np.array_equal(image[150:, :], picture[150:, :])  # nothing else changed
+    _final_after(studio, qtbot, lambda: mouse(view, "release", points[-1]))
+    expected = Mask.empty(w, h)
+    for p0, p1 in zip([points[0]] + points[:-1], points):
+        expected = expected.painted_line((p0[0] - 0.5, p0[1] - 0.5), (p1[0] - 0.5, p1[1] - 0.5), 3)
+    assert _mask(studio) == expected and np.array_equal(_painted(studio.inputs_pane.mask_tool().overlay), expected.bits)
+
+
+def test_esc_restores_the_overlay_of_the_mask_a_stroke_began_on(studio, qtbot):
+    """A stroke over a painted mask draws its dabs into the overlay; Esc puts back exactly the mask's
+    pixels where the stroke changed them (the rest was not redrawn), brush and eraser alike."""
+    view, doc = studio.canvas_view, studio.doc
+    tool, bar = studio.inputs_pane.mask_tool(), studio.inputs_pane.bar()
+    tool.set_size(7)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 20.5), (60.5, 20.5)]))
+    start = _mask(studio)
+    for mode, points in (("brush", [(30.5, 10.5), (30.5, 40.5), (50.5, 40.5)]), ("eraser", [(20.5, 20.5), (40.5, 22.5)])):
+        qtbot.mouseClick(bar.mode_buttons[mode], Qt.MouseButton.LeftButton)
+        _stroke(view, points, release=False)
+        drawn = _painted(tool.overlay)
+        assert not np.array_equal(drawn, start.bits) and np.array_equal(drawn, doc.live[1].bits)
+        view.setFocus()
+        qtbot.keyClick(view, Qt.Key.Key_Escape)
+        mouse(view, "release", points[-1])
+        assert np.array_equal(_painted(tool.overlay), start.bits) and _mask(studio) is start
+    # and a stroke released: the overlay is the new mask, drawn dab by dab (not rebuilt)
+    qtbot.mouseClick(bar.mode_buttons["brush"], Qt.MouseButton.LeftButton)
+    _final_after(studio, qtbot, lambda: _stroke(view, [(30.5, 50.5), (70.5, 50.5)]))
+    assert _mask(studio) == start.painted_line((30, 50), (70, 50), 3)
+    assert np.array_equal(_painted(tool.overlay), _mask(studio).bits)
