@@ -55,6 +55,7 @@ PREVIEW_SIDE = 400
 PROGRESS_DELAY_MS = 300
 PARTIAL_INTERVAL = 0.25
 WARM_UP_DELAY_MS = 3000  # no render at start: warm the kernels up after this long anyway
+WARM_UP_AFTER_RESULT_MS = 1000  # the first result is in: warm the others up this long after it (not mid-stroke)
 #: Python's GIL switch interval (s) in a process with a renderer: a worker running Python (a numpy fill,
 #: a stroke's crop) hands the GIL over to a waiting GUI thread after at most this long, not the default
 #: 5 ms, and a GUI event handler enters Python several times (the tool, the QGraphicsItems' paint and
@@ -430,7 +431,7 @@ class Renderer(QObject):
             self._final_running = False
             self._busy_timer.stop()
             self.busy.emit(False)
-            self._start_warm_up()  # the first result (or error) is in: the other methods' turn
+            self._warm_up_after_result()  # the first result (or error) is in: the other methods' turn
         around = result.job_id in self._around_jobs
         self._around_jobs.discard(result.job_id)
         base = self._around_bases.pop(result.job_id, None)
@@ -504,16 +505,23 @@ class Renderer(QObject):
 
     # --- kernels warm-up -----------------------------------------------------------------------
     def warm_up_soon(self, delay_ms: int = WARM_UP_DELAY_MS) -> None:
-        """Load (or compile) the other methods' kernels in the background — after the first full
-        result is shown, or after ``delay_ms`` if no render is running then — so that they never
-        make the visible render wait: numba compiles under one process-wide lock, and a warm-up
-        that went first held the first result back behind every other method's compile."""
+        """Load (or compile) the other methods' kernels in the background — a moment
+        (``WARM_UP_AFTER_RESULT_MS``) after the first full result is shown, or after ``delay_ms`` if no
+        render is running then, and never while a stroke is previewed — so that they never make the
+        visible render wait: numba compiles under one process-wide lock, and a warm-up that went
+        first held the first result back behind every other method's compile. Nor do they stall
+        painting: loading them holds Python's GIL up to 40-66 ms at a time (imports, numba's typing
+        tables), and an artist often starts a stroke as soon as the picture is there."""
         self._warm_up_wanted = True
         self._warm_up_timer.start(delay_ms)
 
+    def _warm_up_after_result(self) -> None:
+        if self._warm_up_wanted and not self._warm_up_started:
+            self._warm_up_timer.start(WARM_UP_AFTER_RESULT_MS)
+
     def _warm_up_due(self) -> None:
-        if self._final_running:
-            self._warm_up_timer.start()  # that render's result starts it (or the next timeout)
+        if self._final_running or self._stroking:
+            self._warm_up_timer.start()  # that render's result (or the next timeout) starts it
         else:
             self._start_warm_up()
 
