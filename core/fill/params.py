@@ -64,9 +64,9 @@ class FillParams(Params):
 
 def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None) -> str:
     """The engine ``auto`` runs: ``patchmatch`` for a hole inside a colour picture (removing an
-    object from a photo: coherence 4.69 against quilt's 5.40 on issue 15's photo, seeds 0-4), unless
-    the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.77,
-    brick 1.05 against 1.49) and for holes along the canvas border, an uncrop's (0.72 against 0.95,
+    object from a photo: coherence 4.45 against quilt's 5.40 on issue 15's photo, seeds 0-4), unless
+    the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.24,
+    brick 1.05 against 1.35) and for holes along the canvas border, an uncrop's (0.72 against 0.85,
     in a third of the time)."""
     from .patchmatch import MAX_PATCH
 

@@ -50,8 +50,9 @@ grey textures (where the ``quilt`` engine is the better choice and what ``auto``
 the photo (where ``auto`` picks this engine), with no crema copied from the cup under the spoon,
 at half the whole-process time. Then the distance and the vote were made quicker (0.22 -> 0.145 s
 of CPU time in-process on the photo) and part of the gain spent on 6 intermediate EM iterations
-instead of 4 and 3 final ones instead of 2 (0.172 s): gravel 9.36 / 0.89 / -0.11, brick 1.42 / 0.92
-/ +0.00, photo 4.45 / 1.01 / -0.07, uncrop 0.87 / 0.95 / +0.06.
+instead of 4 and 3 final ones instead of 2 (0.172 s), then 8 intermediate ones (0.19 s): gravel
+9.24 / 0.87 / -0.10, brick 1.35 / 0.92 / +0.01, photo 4.45 / 1.02 / -0.04, uncrop 0.85 / 0.96 /
++0.05.
 With the one-patch pyramid, searching the finest level too (one EM iteration on all channels) and
 three final iterations over every inexact patch was more coherent on the textures (gravel 8.38,
 brick 1.38) at twice the computing time, over G'MIC's whole-process time.
@@ -87,10 +88,13 @@ _COARSEST_DEPTH = 2.0
 _COARSEST_DEPTH_BORDER = 1.0
 _FEATURE_WEIGHT = 3.0  # weight of Newson's texture features (two extra channels) in the distance
 # default EM iterations per level: the finest level gets none (the final refine follows), the
-# intermediate ones 6, the coarsest 12. The photo, seeds 0-4 medians, with 2 final refine iterations:
-# 4 intermediate 4.69 (8 on the coarsest 4.95, 16 4.71 in +10 ms), 5 4.65, 6 4.62, 8 4.51 in +40 ms;
-# with 3 final iterations: 4 intermediate 4.58, 6 4.45 (see _FINAL_REFINE)
-_EM_FINEST, _EM_MIDDLE, _EM_COARSEST = 0, 6, 12
+# intermediate ones 8, the coarsest 12. The photo, seeds 0-4 medians, with 2 final refine iterations:
+# 4 intermediate 4.69 (8 on the coarsest 4.95, 16 4.71 in +10 ms), 5 4.65, 6 4.62, 8 4.51; with 3
+# final iterations (see _FINAL_REFINE): 4 intermediate 4.58, 6 4.45, 8 4.45 with the seam nearer the
+# truth's (median -0.04 against -0.07; seed 1, the benchmark's, -0.13 against -0.15) and the grey
+# cases more coherent (gravel 9.36 -> 9.24, brick 1.42 -> 1.35, uncrop 0.87 -> 0.85), for +0.015 s of
+# CPU time (0.175 -> 0.19 s in-process on the photo)
+_EM_FINEST, _EM_MIDDLE, _EM_COARSEST = 0, 8, 12
 # the votes count the covering patches at every _VOTE_STRIDE-th corner row and column, but the final
 # refine's last vote counts every one (stride 1): with 9 of the 49 votes neighbouring pixels of an
 # incoherent region went through different offsets and the fill was speckled (gravel: |Laplacian| in
@@ -245,7 +249,7 @@ def fill_patchmatch(
         deep (one when it touches the image's border), as long as a level keeps 16 whole source patches and both sides >= 2 patches.
     iterations : int, optional
         EM iterations on every level (all channels, confidence-weighted); default 12 on the
-        coarsest, 6 on the intermediate ones, none on the finest (a single level gets 12). Three refine
+        coarsest, 8 on the intermediate ones, none on the finest (a single level gets 12). Three refine
         iterations on the image's own channels always follow (:func:`refine_band`).
     cuttable : bool array (H, W), optional
         Known pixels that may change (the method's blend band): the finished fill, these pixels and
