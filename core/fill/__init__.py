@@ -27,15 +27,15 @@ hole; the method then runs no Poisson blend for them.
 (:func:`~weft.core.fill.params.auto_engine`): ``patchmatch`` for a hole inside a colour picture,
 ``quilt`` otherwise; the figures name the engine that ran. Measured on issue 15's cases (seeds 0-4
 medians, ``python -m benchmarks.fill --seeds 0-4``; coherence / detail / seam against the truth's):
-on the photo ``patchmatch`` is the most coherent of weft's engines (4.69 / 1.01 / -0.05 against
-``quilt``'s 5.40 / 1.08 / +0.01; at the benchmark's seed 5.01 against G'MIC's 6.72 and 1.2x
-shift-map's 4.99), in a whole process of 0.37-0.38 s against G'MIC's 0.35-0.36 s (interleaved,
-medians of 9); on the grey textures and the uncrop ``quilt`` is the more coherent (gravel 9.01
-against 9.77, brick 1.05 against 1.49, uncrop 0.72 against 0.95) and the quicker (0.20-0.39 s
+on the photo ``patchmatch`` is the most coherent of weft's engines (4.45 / 1.02 / -0.04 against
+``quilt``'s 5.40 / 1.08 / +0.01; at the benchmark's seed 4.42 against G'MIC's 6.42 and 1.2x
+shift-map's 4.99), in a whole process of 0.30 s against G'MIC's 0.33 s (interleaved, medians of
+9); on the grey textures and the uncrop ``quilt`` is the more coherent (gravel 9.01 against 9.24,
+brick 1.05 against 1.35, uncrop 0.72 against 0.85) and the quicker (0.19-0.37 s
 whole processes), and it keeps brick mortar straight where ``patchmatch`` bends it. ``hybrid``
 (quilt with 48-px blocks, then the refine) is more coherent than ``quilt`` on the textures but
-leaves a red ghost of the spoon's handle on the photo (coherence 5.56 there, in 0.30 s against
-G'MIC's 0.37 s in the benchmark run); ``pixel`` is the least coherent everywhere. Neither ``quilt`` nor ``patchmatch``
+leaves a red ghost of the spoon's handle on the photo (coherence 5.56 there, in 0.28 s against
+G'MIC's 0.38 s in the benchmark run); ``pixel`` is the least coherent everywhere. Neither ``quilt`` nor ``patchmatch``
 loads numba: a fill's first run costs what the second does. The README's "Fill and extend against
 the peers" has the tables and the pictures.
 
