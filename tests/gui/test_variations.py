@@ -8,6 +8,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QApplication
 
 import weft.app.gui.render as render
+import weft.core.jobs as jobs_module
 from weft.app.gui.document import Document, DocumentState
 from weft.app.gui.variations import THUMB_SIDE
 from weft.core.errors import WeftError
@@ -162,8 +163,15 @@ def test_closing_during_the_preparation_cancels_it_and_starts_no_cell(window, qt
     jobs = _submits(dialog, monkeypatch)
     _click(qtbot, dialog)
     qtbot.waitUntil(started.is_set, timeout=10000)
-    # the close waits for the running preparation (it cannot be interrupted inside the reduction)
-    threading.Timer(0.2, release.set).start()
+    # the close waits for the running preparation (it cannot be interrupted inside the reduction):
+    # the held reduction goes on once the close has cancelled its job, not after a guessed delay
+    real_cancel = jobs_module.Job.cancel
+
+    def cancel_then_release(job):
+        real_cancel(job)
+        release.set()
+
+    monkeypatch.setattr(jobs_module.Job, "cancel", cancel_then_release)
     dialog.close()
     assert jobs[0].done() and jobs[0].result().cancelled
     QApplication.processEvents()
