@@ -316,11 +316,17 @@ def around_region(stroke: tuple[float, float, float, float], width: int, height:
     ``context`` and a quarter of that box's longer side (the crop never reaches farther), clipped to
     the mask. Cut that part and pass it as ``crop_around(..., mask_part=)``: a preview around a
     stroke then never needs the whole mask (64 MB as a float image at 4096²)."""
-    sx0, sy0, sx1, sy1 = stroke
-    wx0, wy0 = int(np.floor(sx0)) - context, int(np.floor(sy0)) - context
-    wx1, wy1 = int(np.ceil(sx1)) + 1 + context, int(np.ceil(sy1)) + 1 + context
+    wx0, wy0, wx1, wy1 = _stroke_window(stroke, context)
     grow = context + max(wx1 - wx0, wy1 - wy0) // 4 + 1
     return max(0, wx0 - grow), max(0, wy0 - grow), min(width, wx1 + grow), min(height, wy1 + grow)
+
+
+def _stroke_window(stroke: tuple[float, float, float, float], context: int) -> tuple[int, int, int, int]:
+    """The stroke's box in whole pixels grown by ``context`` (exclusive ends, not clipped): where
+    :func:`crop_around` looks for painted pixels."""
+    sx0, sy0, sx1, sy1 = stroke
+    return (int(np.floor(sx0)) - context, int(np.floor(sy0)) - context,
+            int(np.ceil(sx1)) + 1 + context, int(np.ceil(sy1)) + 1 + context)
 
 
 def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke: tuple[float, float, float, float],
@@ -368,9 +374,8 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
             raise ValueError(f"the mask's part {mask.shape[1]}x{mask.shape[0]} at ({px}, {py}) does not cover "
                              f"the stroke's region {(rx0, ry0, rx1, ry1)}")
     plane = mask if mask.ndim == 2 else mask[..., 0]
-    sx0, sy0, sx1, sy1 = stroke
-    wx0, wy0 = max(0, int(np.floor(sx0)) - context), max(0, int(np.floor(sy0)) - context)
-    wx1, wy1 = min(w, int(np.ceil(sx1)) + 1 + context), min(h, int(np.ceil(sy1)) + 1 + context)
+    wx0, wy0, wx1, wy1 = _stroke_window(stroke, context)
+    wx0, wy0, wx1, wy1 = max(0, wx0), max(0, wy0), min(w, wx1), min(h, wy1)
     if wx0 >= wx1 or wy0 >= wy1:
         return None
     near = plane[wy0 - py:wy1 - py, wx0 - px:wx1 - px] > 0.5
@@ -386,16 +391,13 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     small = dict(inputs)
     crop = {on} | {m.input for m in studio.geometry if m.kind == MASK and m.input_for(inputs) == on}
     crop |= {n for n, of in studio.masks_of.items() if next((i for i in of if i in inputs), None) == on}
-    parts = dict(inputs)
-    if mask_part is not None:
-        parts[name] = mask
-    for n, img in parts.items():
-        if n == name and mask_part is not None:
+    for n in dict.fromkeys([*inputs, name] if mask_part is not None else inputs):  # (each input once)
+        if n == name and mask_part is not None:  # (the painted mask's part, as a 0/1 image)
             part = (plane[y0 - py:y1 - py, x0 - px:x1 - px] > 0.5).astype(np.float32)
-        elif n not in crop or img.shape[:2] != (h, w):  # a mask of another size: the method says so
+        elif n not in crop or inputs[n].shape[:2] != (h, w):  # a mask of another size: the method says so
             continue
         else:
-            part = np.ascontiguousarray(img[y0:y1, x0:x1])
+            part = np.ascontiguousarray(inputs[n][y0:y1, x0:x1])
         if k < 1.0:
             part = resize(part, size, interpolation="area")
             if n != on:  # a mask stays a mask
