@@ -548,3 +548,23 @@ def test_a_grey_neighbourhood_of_a_colour_picture_is_blended_as_the_engine_fille
     out = fill(img, hole, seed=2)
     assert np.array_equal(out[near], fill(img[near], hole[near], seed=2))
 
+
+def test_quilt_draws_no_mortar_line_into_a_thin_gap(monkeypatch):
+    """The quilt's step 5 on a thin gap: the benchmark's brick box ends 5 px above a mortar line,
+    so its last row of blocks fills an 8-px gap between filled rows and the dark rows above that
+    line; the overlap constrains nothing there, and at seeds 1 and 9 a continued copy drew a second
+    mortar line into it (the seam figure 0.26 over the truth's). A copy is now continued into a thin
+    gap only if it agrees with the gap's diffusion from its sides."""
+    from benchmarks.fill import build_brick
+    from weft.core.fill import quilt
+
+    case = build_brick()
+    image = case.known_part.astype(np.float32) / 255.0
+    truth = metrics.fill_seam(case.truth.astype(np.float32) / 255.0, case.hole)
+
+    def excess(seed):
+        return metrics.fill_seam(fill(image, case.hole, seed=seed, engine="quilt"), case.hole) - truth
+
+    assert all(abs(excess(s)) <= 0.15 for s in (1, 9))
+    monkeypatch.setattr(quilt, "GAP", 0.0)
+    assert excess(1) > 0.15  # without the term, the second line is back
