@@ -568,3 +568,42 @@ def test_quilt_draws_no_mortar_line_into_a_thin_gap(monkeypatch):
     assert all(abs(excess(s)) <= 0.15 for s in (1, 9))
     monkeypatch.setattr(quilt, "GAP", 0.0)
     assert excess(1) > 0.15  # without the term, the second line is back
+
+
+def _parity_halves(seed=0, h=400, w=900, split=300):
+    """A blurred-noise picture whose columns left of ``split`` hold even 8-bit levels and the others
+    odd ones: the same texture to the SSD (1/255 apart), told apart by the parity of a copied pixel."""
+    rng = np.random.default_rng(seed)
+    noise = cv2.GaussianBlur(rng.standard_normal((h, w)).astype(np.float32), (0, 0), 2.0)
+    levels = np.clip(np.rint(128 + 60 * noise / noise.std()), 2, 252).astype(np.int32) // 2 * 2
+    levels[:, split:] += 1
+    return levels.astype(np.float32) / 255.0
+
+
+def test_quilt_copies_from_the_nearest_reach_that_has_a_block():
+    """A hole wider than twice the quilt's REACH: a window in its middle has no whole source block
+    within REACH; its blocks now come from the nearest reach that has one (the odd levels around the
+    hole), not from anywhere in the picture (the even ones, 220 px left of the hole)."""
+    img = _parity_halves()
+    hole = np.zeros(img.shape, dtype=bool)
+    hole[70:330, 520:780] = True
+    out = fill_quilt(img, hole, patch=16, rng=3)
+    levels = np.rint(out[hole] * 255).astype(np.int32)
+    assert np.all(levels % 2 == 1)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_quilt_front_finds_numpys_first_maximum(seed):
+    """The fill front's strip maxima give ``np.argmax``'s answer (the first maximum in scan order,
+    ties included) after any run of updates."""
+    from weft.core.fill import quilt
+
+    rng = np.random.default_rng(seed)
+    score = rng.integers(-1, 4, size=(97, 61)).astype(np.float32)  # many ties
+    front = quilt._Front(score)
+    for _ in range(50):
+        assert front.first_max() == np.unravel_index(int(np.argmax(score)), score.shape)
+        y0 = int(rng.integers(0, 97))
+        y1 = int(rng.integers(y0 + 1, 98))
+        score[y0:y1, int(rng.integers(0, 61)):] = rng.integers(-1, 6, size=1)[0]
+        front.update(y0, y1)
