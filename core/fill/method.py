@@ -16,7 +16,7 @@ from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
 from .common import neighbourhood, touches_border, whole_patches
-from .params import ANCHORS, DEFAULT_PATCH, FillParams, auto_engine
+from .params import ANCHORS, BORDER_BLOCK, DEFAULT_PATCH, FillParams, auto_engine
 from .quilt import is_colour, refines
 
 
@@ -85,10 +85,13 @@ def _margins(params: FillParams, w: int, h: int) -> Margins | None:
     return Margins(left, top, dx - left, dy - top) if dx or dy else None
 
 
-def _run_patch(params: FillParams, ch: int, cw: int) -> int:
+def _run_patch(params: FillParams, ch: int, cw: int, border: bool = False) -> int:
     """The patch side a run of ``params.engine`` (not ``auto``) uses on a ``cw`` x ``ch`` canvas: the
-    one given, or the engine's default fitted to a small canvas."""
+    one given, or the engine's default fitted to a small canvas (the quilt's :data:`BORDER_BLOCK`
+    when the hole runs along the ``border``, at most a third of the canvas)."""
     patch = params.resolved_patch()
+    if params.patch is None and params.engine == "quilt" and border:
+        patch = max(patch, min(BORDER_BLOCK, min(ch, cw) // 3))
     if params.engine == "pixel":
         patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
     if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
@@ -151,14 +154,15 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         if alpha is not None:
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
+    border = touches_border(hole)
     if params.engine == "auto":  # the figures and messages name the engine that runs
         # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
         # large picture (a colour corner far from a hole in a grey region does not make it a photo)
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch))
-    patch = _run_patch(params, ch, cw)
+        params = params.replace(engine=auto_engine(picture, border, params.patch))
+    patch = _run_patch(params, ch, cw, border)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
         raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
@@ -323,7 +327,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     if params.engine == "auto":
         colour = len(shape) == 3 and shape[2] >= 3
         params = params.replace(engine=auto_engine(colour, margins is not None, None))
-    return {"patch": _run_patch(params, h, w)}
+    return {"patch": _run_patch(params, h, w, margins is not None)}
 
 
 #: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting

@@ -235,16 +235,20 @@ def test_auto_runs_patchmatch_inside_a_colour_picture_and_quilt_otherwise(gravel
 def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
     """The studio's "auto" patch (beside its box, and the centre of a variations range) is the patch
     of the engine that runs: a colour picture's hole gets patchmatch's 7 px, a grey one quilt's 24,
-    an uncrop quilt's; a named engine its own; a patch given is not resolved."""
+    an uncrop quilt's border block (48, at most a third of the canvas); a named engine its own; a
+    patch given is not resolved."""
     from weft.core.fill.method import STUDIO, fill_image
 
     colour = np.ascontiguousarray(load_image(example("chelsea")).image[:96, :120])
-    for image, params in ((colour, FillParams()), (gravel, FillParams()), (colour, FillParams(engine="hybrid"))):
+    for image, params in ((colour, FillParams()), (gravel, FillParams()), (colour, FillParams(engine="hybrid")),
+                          (gravel, FillParams(extend=(0, 0, 16, 0)))):
         resolved = STUDIO.resolved(params, {"image": image.shape})
-        _, figures = fill_image(image, square_hole(image.shape), params=params, rng=0)
+        mask = None if params.extend is not None else square_hole(image.shape)
+        _, figures = fill_image(image, mask, params=params, rng=0)
         assert resolved == {"patch": figures["patch"]}, (image.shape, params.engine)
+    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": gravel.shape}) == {"patch": 32}
     assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 7}
-    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 24}
+    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 48}
     assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 48}
     assert STUDIO.resolved(FillParams(patch=9), {"image": (96, 120, 3)}) == {}
     assert STUDIO.resolved(FillParams(), {}) == {}
@@ -607,3 +611,29 @@ def test_quilt_front_finds_numpys_first_maximum(seed):
         y1 = int(rng.integers(y0 + 1, 98))
         score[y0:y1, int(rng.integers(0, 61)):] = rng.integers(-1, 6, size=1)[0]
         front.update(y0, y1)
+
+
+def test_an_extension_along_the_border_is_quilted_with_larger_blocks():
+    """A hole along the canvas border gets the quilt's BORDER_BLOCK (48 px), not its 24: the bundled
+    brick's right third grown back from the rest, its edge with the known part is about the truth's
+    (24-px blocks drift from the bricks' joints block by block: a visible edge, +1.75 over it)."""
+    from weft.core.fill.params import BORDER_BLOCK
+
+    full = load_image(example("brick")).image
+    h, w = full.shape[:2]
+    cut = int(w * 0.68)
+    hole = np.zeros((h, w), dtype=bool)
+    hole[:, cut:] = True
+    truth = metrics.fill_seam(full, hole)
+    out, figures = fill_image_figures(full[:, :cut], extend=(0, 0, w - cut, 0), seed=0)
+    assert figures["patch"] == BORDER_BLOCK and out.shape == full.shape
+    assert abs(metrics.fill_seam(out, hole) - truth) <= 0.3
+    small, _ = fill_image_figures(full[:, :cut], extend=(0, 0, w - cut, 0), seed=0, patch=24)
+    assert metrics.fill_seam(small, hole) - truth > 1.0
+
+
+def fill_image_figures(image, seed, **params):
+    """``fill_image`` with these parameters: (output, figures)."""
+    from weft.core.fill.method import fill_image
+
+    return fill_image(image, None, params=FillParams(**params), rng=seed)
