@@ -193,8 +193,11 @@ class MethodPanel(QWidget):
         self.show_square()
 
     def show_params(self) -> None:
+        """The current parameters, each unset ("auto") one with the value a run resolves it to: resolved
+        with the parameters a run takes, the geometry's among them (an extended canvas can change it)."""
         doc = self.doc
-        self.params_panel.show_params(doc.current_params, doc.studio.resolved(doc.current_params, doc.input_shapes()))
+        self.params_panel.show_params(doc.current_params,
+                                      doc.studio.resolved(doc.run_params(live=False), doc.input_shapes()))
 
     def show_seed(self) -> None:
         self.seed_box.blockSignals(True)

@@ -1275,3 +1275,54 @@ def test_esc_restores_the_overlay_of_the_mask_a_stroke_began_on(studio, qtbot):
     _final_after(studio, qtbot, lambda: _stroke(view, [(30.5, 50.5), (70.5, 50.5)]))
     assert _mask(studio) == start.painted_line((30, 50), (70, 50), 3)
     assert np.array_equal(_painted(tool.overlay), _mask(studio).bits)
+
+
+@dataclass(frozen=True)
+class SpreadFillParams(MeanFillParams):
+    spread: int = param(None, kind="int", lo=1, hi=99, optional=True, help="auto: 3 px, more on an extended canvas")
+
+
+SPREAD_FILL = Method(
+    name="spread-fill", summary="mean fill whose auto spread grows with the canvas's margins", params=SpreadFillParams,
+    inputs=MEAN_FILL.inputs, run=_mean_fill,
+    studio=Studio(title="Spread fill", canvas="picture", preview_around="hole",
+                  auto=lambda params, shapes: {"spread": 3 + (params.grow.right if params.grow else 0)},
+                  geometry=MEAN_FILL.studio.geometry),
+)
+
+
+def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, qtbot, settings, tmp_path):
+    """An unset parameter shows the value a run resolves it to, the canvas's margins (a geometry
+    parameter, edited with the mouse) included: fill's patch is 48 along an extended border, not
+    the 24 it showed (or a colour picture's 7) while its run took 48. Its tooltip and the variations'
+    range follow an edge drag."""
+    from weft.app.gui.main_window import MainWindow
+    from weft.app.gui.variations import VariationsDialog
+
+    registry.register(SPREAD_FILL)
+    try:
+        window = MainWindow(settings=settings, load_defaults=False)
+        qtbot.addWidget(window)
+        window.resize(1300, 820)
+        window.show()
+        box = window.method_panel.method_box
+        box.setCurrentIndex(box.findData(SPREAD_FILL.name))
+        with qtbot.waitSignal(window.renderer.failed, timeout=10000):  # nothing to fill yet
+            window.open_input("picture", str(_picture(tmp_path / "picture.png")))
+        row = window.params_panel.row("spread")
+        assert "(now 3)" in row.editor.toolTip()
+        view = window.canvas_view
+        view.fit()
+        window.inputs_pane.mask_tool().set_size(1)  # a press 1 px outside the image drags the edge
+        k = view.scale_factor()
+        _final_after(window, qtbot, lambda: _screen_drag(view, (W + 1.0, H / 2), [(10 * k, 0), (20 * k, 0)]))
+        assert window.doc.value("grow") == Margins(0, 0, 20, 0)
+        assert "(now 23)" in row.editor.toolTip()
+        dialog = VariationsDialog(window.doc, parent=window)
+        qtbot.addWidget(dialog)
+        dialog.combo[1].setCurrentIndex(dialog.combo[1].findText("spread"))
+        assert dialog.lo[1].value() < 23 < dialog.hi[1].value()  # the grid's range centres on the resolved value
+        dialog.close()
+        window.shutdown()
+    finally:
+        registry.unregister(SPREAD_FILL.name)
