@@ -88,7 +88,7 @@ def _margins(params: FillParams, w: int, h: int) -> Margins | None:
 def _run_patch(params: FillParams, ch: int, cw: int, border: bool = False) -> int:
     """The patch side a run of ``params.engine`` (not ``auto``) uses on a ``cw`` x ``ch`` canvas: the
     one given, or the engine's default fitted to a small canvas (the quilt's :data:`BORDER_BLOCK`
-    when the hole runs along the ``border``, at most a third of the canvas)."""
+    for a ``border`` hole, :func:`_deep_border`, at most a third of the canvas)."""
     patch = params.resolved_patch()
     if params.patch is None and params.engine == "quilt" and border:
         patch = max(patch, min(BORDER_BLOCK, min(ch, cw) // 3))
@@ -99,6 +99,17 @@ def _run_patch(params: FillParams, ch: int, cw: int, border: bool = False) -> in
     if params.patch is None and params.engine == "hybrid":  # its 48-px block: at most a third of a small image
         patch = min(patch, max(3, min(ch, cw) // 3))
     return patch
+
+
+def _deep_border(hole: np.ndarray) -> bool:
+    """Whether ``hole`` runs along the canvas border and reaches more than the quilt's default block
+    (24 px) from the known pixels (chessboard distance, so that margins of L, T, R, B reach their
+    largest): an uncrop or an extended canvas, whose quilt takes :data:`BORDER_BLOCK`; a small hole
+    that touches the border keeps 24."""
+    if not touches_border(hole):
+        return False
+    d = cv2.distanceTransform(hole.astype(np.uint8), cv2.DIST_C, 3)
+    return float(d.max()) > DEFAULT_PATCH["quilt"]
 
 
 def _largest_square(region: np.ndarray) -> int:
@@ -162,7 +173,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
         params = params.replace(engine=auto_engine(picture, border, params.patch))
-    patch = _run_patch(params, ch, cw, border)
+    patch = _run_patch(params, ch, cw, params.engine == "quilt" and params.patch is None and _deep_border(hole))
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
         raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
@@ -327,7 +338,8 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     if params.engine == "auto":
         colour = len(shape) == 3 and shape[2] >= 3
         params = params.replace(engine=auto_engine(colour, margins is not None, None))
-    return {"patch": _run_patch(params, h, w, margins is not None)}
+    deep = margins is not None and max(margins) > DEFAULT_PATCH["quilt"]  # as _deep_border finds it
+    return {"patch": _run_patch(params, h, w, deep)}
 
 
 #: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting

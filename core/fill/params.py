@@ -20,9 +20,9 @@ ENGINES = ("auto", "patchmatch", "quilt", "pixel", "hybrid")
 DEFAULT_ENGINE = "auto"
 #: Each engine's patch side when ``patch`` is not given.
 DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7, "hybrid": 48}
-#: The quilt's block when ``patch`` is not given and the hole runs along the canvas border (an
-#: uncrop, an extended canvas, a rectification's transparent border): at most a third of the canvas's
-#: smaller side. With 24-px blocks an extension a few blocks deep drifts from the picture's structure
+#: The quilt's block when ``patch`` is not given and the hole runs along the canvas border more than
+#: 24 px deep (an uncrop, an extended canvas, a rectification's wide transparent border): at most a
+#: third of the canvas's smaller side. With 24-px blocks an extension a few blocks deep drifts from the picture's structure
 #: block by block (the bundled brick's right 82 px grown back, seeds 0-5: bricks without joints,
 #: coherence 1.38, seam +1.75 over the truth's); with 48: 0.76 and +0.13, in 57 ms against 136. On
 #: the benchmark's 256 -> 384 uncrop 0.73 -> 0.81 (G'MIC's 1.55), seam -0.08..+0.09 from the truth's,
@@ -45,7 +45,7 @@ class FillParams(Params):
                        help="patch side in pixels (quilt, hybrid: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
                             "default per engine, smaller on a small image: "
                             + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items())
-                            + f" ({BORDER_BLOCK} for a hole along the border, an uncrop's)")
+                            + f" ({BORDER_BLOCK} for an uncrop more than 24 px deep)")
     extend: Margins = param(None, kind="geometry", type=Margins, optional=True,
                             help="uncrop: pixels added on the left, top, right and bottom, filled like the hole")
     size: tuple = param(None, kind="size", lo=1, hi=MAX_SIDE, optional=True,

@@ -235,20 +235,21 @@ def test_auto_runs_patchmatch_inside_a_colour_picture_and_quilt_otherwise(gravel
 def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
     """The studio's "auto" patch (beside its box, and the centre of a variations range) is the patch
     of the engine that runs: a colour picture's hole gets patchmatch's 7 px, a grey one quilt's 24,
-    an uncrop quilt's border block (48, at most a third of the canvas); a named engine its own; a
-    patch given is not resolved."""
+    an uncrop more than 24 px deep quilt's border block (48, at most a third of the canvas), a
+    narrower one 24; a named engine its own; a patch given is not resolved."""
     from weft.core.fill.method import STUDIO, fill_image
 
     colour = np.ascontiguousarray(load_image(example("chelsea")).image[:96, :120])
     for image, params in ((colour, FillParams()), (gravel, FillParams()), (colour, FillParams(engine="hybrid")),
-                          (gravel, FillParams(extend=(0, 0, 16, 0)))):
+                          (gravel, FillParams(extend=(0, 0, 30, 0))), (gravel, FillParams(extend=(0, 0, 16, 0)))):
         resolved = STUDIO.resolved(params, {"image": image.shape})
         mask = None if params.extend is not None else square_hole(image.shape)
         _, figures = fill_image(image, mask, params=params, rng=0)
         assert resolved == {"patch": figures["patch"]}, (image.shape, params.engine)
-    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": gravel.shape}) == {"patch": 32}
+    assert STUDIO.resolved(FillParams(extend=(0, 0, 30, 0)), {"image": gravel.shape}) == {"patch": 32}
     assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 7}
-    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 48}
+    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 24}
+    assert STUDIO.resolved(FillParams(extend=(0, 0, 40, 0)), {"image": (300, 400, 3)}) == {"patch": 48}
     assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 48}
     assert STUDIO.resolved(FillParams(patch=9), {"image": (96, 120, 3)}) == {}
     assert STUDIO.resolved(FillParams(), {}) == {}
@@ -614,9 +615,10 @@ def test_quilt_front_finds_numpys_first_maximum(seed):
 
 
 def test_an_extension_along_the_border_is_quilted_with_larger_blocks():
-    """A hole along the canvas border gets the quilt's BORDER_BLOCK (48 px), not its 24: the bundled
-    brick's right third grown back from the rest, its edge with the known part is about the truth's
-    (24-px blocks drift from the bricks' joints block by block: a visible edge, +1.75 over it)."""
+    """A hole along the canvas border more than 24 px deep gets the quilt's BORDER_BLOCK (48 px): the
+    bundled brick's right third grown back from the rest meets the known part about as the truth
+    does (24-px blocks drift from the bricks' joints block by block: a visible edge, +1.75 over it).
+    A small hole that touches the border keeps 24."""
     from weft.core.fill.params import BORDER_BLOCK
 
     full = load_image(example("brick")).image
@@ -630,6 +632,11 @@ def test_an_extension_along_the_border_is_quilted_with_larger_blocks():
     assert abs(metrics.fill_seam(out, hole) - truth) <= 0.3
     small, _ = fill_image_figures(full[:, :cut], extend=(0, 0, w - cut, 0), seed=0, patch=24)
     assert metrics.fill_seam(small, hole) - truth > 1.0
+    from weft.core.fill.method import fill_image
+
+    dab = np.zeros((h, w), dtype=bool)
+    dab[:12, 100:130] = True  # a small hole on the border keeps the 24-px block
+    assert fill_image(full, dab, params=FillParams(), rng=0)[1]["patch"] == 24
 
 
 def fill_image_figures(image, seed, **params):
