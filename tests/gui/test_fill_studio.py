@@ -101,21 +101,27 @@ def _picture(path, seed=3, alpha=None):
     return path
 
 
-@pytest.fixture
-def studio(plugin, qtbot, settings, tmp_path):
-    """The window on the mean-fill method with a picture open, its first result shown, zoomed 4x."""
+def _window_on(method: str, qtbot, settings, picture):
+    """The main window on ``method`` with ``picture`` open as its picture (nothing to fill yet)."""
     from weft.app.gui.main_window import MainWindow
 
-    CALLS.clear()
     window = MainWindow(settings=settings, load_defaults=False)
     qtbot.addWidget(window)
     window.resize(1300, 820)
     window.show()
     box = window.method_panel.method_box
-    box.setCurrentIndex(box.findData(plugin.name))
-    picture = _picture(tmp_path / "picture.png")
+    box.setCurrentIndex(box.findData(method))
     with qtbot.waitSignal(window.renderer.failed, timeout=10000):  # nothing to fill yet
         window.open_input("picture", str(picture))
+    return window
+
+
+@pytest.fixture
+def studio(plugin, qtbot, settings, tmp_path):
+    """The window on the mean-fill method with a picture open, its first result shown, zoomed 4x."""
+    CALLS.clear()
+    picture = _picture(tmp_path / "picture.png")
+    window = _window_on(plugin.name, qtbot, settings, picture)
     assert window.doc.image("picture") is not None
     view = window.canvas_view
     view.actual_size()
@@ -1296,19 +1302,11 @@ def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, 
     parameter, edited with the mouse) included: fill's patch is 48 along an extended border, not
     the 24 it showed (or a colour picture's 7) while its run took 48. Its tooltip and the variations'
     range follow an edge drag."""
-    from weft.app.gui.main_window import MainWindow
     from weft.app.gui.variations import VariationsDialog
 
     registry.register(SPREAD_FILL)
     try:
-        window = MainWindow(settings=settings, load_defaults=False)
-        qtbot.addWidget(window)
-        window.resize(1300, 820)
-        window.show()
-        box = window.method_panel.method_box
-        box.setCurrentIndex(box.findData(SPREAD_FILL.name))
-        with qtbot.waitSignal(window.renderer.failed, timeout=10000):  # nothing to fill yet
-            window.open_input("picture", str(_picture(tmp_path / "picture.png")))
+        window = _window_on(SPREAD_FILL.name, qtbot, settings, _picture(tmp_path / "picture.png"))
         row = window.params_panel.row("spread")
         assert "(now 3)" in row.editor.toolTip()
         view = window.canvas_view
