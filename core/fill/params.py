@@ -28,7 +28,7 @@ DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7, "hybrid": 48}
 #: the benchmark's 256 -> 384 uncrop 0.73 -> 0.81 (G'MIC's 1.55), seam -0.08..+0.09 from the truth's,
 #: 300 -> 189 ms; one-sided extensions of gravel 4.03 -> 2.67 and grass 4.86 -> 4.13. On colour
 #: pictures (the quilt and its refine) the right third of the bundled chelsea grown back: seam
-#: +0.33 -> 0.00 over the truth's (medians of seeds 0-5), perspective-frontal coherence 0.87 -> 0.55;
+#: +0.34 -> -0.06 over the truth's (medians of seeds 0-5), perspective-frontal coherence 0.87 -> 0.55;
 #: wood-grain (112 px wide: a 37-px block) lost the visible seam at the join, though its coherence
 #: went 2.38 -> 3.66.
 BORDER_BLOCK = 48
