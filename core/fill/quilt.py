@@ -42,7 +42,6 @@ One block at a time, until no pixel of the hole is left:
    saucer's red or the coffee), not its texture, which the known pixels' SSD matches. Grey images
    have no chroma and no guide (a grey guide pulled blocks towards flat ones: brick coherence
    1.07 -> 1.28).
-
 5. **Continuing a copy.** Where earlier blocks already wrote into the window, the blocks that
    continue their copies (same source offset; the ``CONTINUE`` most frequent in the window) are
    candidates too, and the cheapest is taken when it costs at most ``(1 + COHERE)`` times the
@@ -50,10 +49,11 @@ One block at a time, until no pixel of the hole is left:
    shift-map's labels do. The judge ``fill_coherence`` (distance of every 7x7 window to the
    nearest known one) is ~0 inside a copy and high across a seam: on gravel's hole interior
    (windows 6+ px inside) the quilt without it scored 8.8, shift-map 0.9.
-   On grey images a copy is not continued into a **thin gap** without a check: where none of the
-   window's unknown pixels lies more than ``GAP_WIDTH`` px from a valued one (the last row of
-   blocks, between filled rows and the hole's edge), the overlap says nothing about the gap, and
-   a continued copy drew a whole mortar line into it, beside the real one a few px below the hole.
+   On grey pictures (a grey one stored as RGB too) a copy is not continued into a **thin gap**
+   without a check: where none of the window's unknown pixels lies more than ``GAP_WIDTH`` px from
+   a valued one (the last row of blocks, between filled rows and the hole's edge), the overlap
+   says nothing about the gap, and a continued copy drew a whole mortar line into it, beside the
+   real one a few px below the hole.
    There the gap is filled by diffusion (``cv2.inpaint``, Telea) from the window's own pixels,
    ``GAP`` times the SSD between that and the source block blurred by ``GAP_SIGMA`` (over the
    gap's pixels) is added to every cost, and the continuation is taken only if it still costs at
@@ -134,7 +134,7 @@ REFINE = 1
 REFINE_WORST = 50.0
 #: The refine's patch side (the judge ``fill_coherence``'s window).
 REFINE_PATCH = 7
-#: Weight of the thin-gap cost on a continued copy (step 5; grey images only); 0 = none.
+#: Weight of the thin-gap cost on a continued copy (step 5; grey pictures only); 0 = none.
 GAP = 3.0
 #: A window's unknown pixels form a thin gap when none is farther than this (px) from a valued one.
 GAP_WIDTH = 5.0
@@ -435,7 +435,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
                 if conts:
                     c_cost, ty, tx = min(conts)
                     bound = best
-                    if GAP > 0 and not guided and un.any():  # a continued copy must not draw into a thin gap what its sides lack
+                    if GAP > 0 and not colour and un.any():  # a continued copy must not draw into a thin gap what its sides lack
                         gap = _gap_cost(template, un, search, crop, gap_search)
                         if gap is not None:
                             with_gap = cost + GAP * gap

@@ -644,3 +644,20 @@ def fill_image_figures(image, seed, **params):
     from weft.core.fill.method import fill_image
 
     return fill_image(image, None, params=FillParams(**params), rng=seed)
+
+
+def test_a_grey_picture_stored_as_rgb_gets_the_thin_gap_check_too(monkeypatch):
+    """The thin-gap check is for pictures without colour, however they are stored: the benchmark's
+    brick as RGB fills as the grey one does, and without the check its seed 1 draws the line again."""
+    from benchmarks.fill import build_brick
+    from weft.core.fill import quilt
+
+    case = build_brick()
+    grey = case.known_part.astype(np.float32) / 255.0
+    rgb = np.repeat(grey[..., None], 3, axis=2)
+    out = fill(rgb, case.hole, seed=1, engine="quilt")
+    assert np.allclose(out, fill(grey, case.hole, seed=1, engine="quilt")[..., None], atol=1e-5)
+    truth = metrics.fill_seam(case.truth.astype(np.float32) / 255.0, case.hole)
+    assert abs(metrics.fill_seam(out, case.hole) - truth) <= 0.15
+    monkeypatch.setattr(quilt, "GAP", 0.0)
+    assert metrics.fill_seam(fill(rgb, case.hole, seed=1, engine="quilt"), case.hole) - truth > 0.15
