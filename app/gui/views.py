@@ -34,8 +34,12 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
 #: 0.4 ms for 512², 10 ms for 1024², 39 ms for 2048², 145 ms for 4096², median of 7, loaded machine).
 ASYNC_PIXELS = 512 * 512
 #: A part of the image on screen changed in place of at most this many pixels is converted on the GUI
-#: thread (``set_image(changed=)``: a stroke's preview; 1024² in 10 ms), not the whole image on a worker.
-PART_PIXELS = 1024 * 1024
+#: thread (``set_image(changed=)``: a stroke's preview), not the whole image on a worker: 2048² in 9 ms
+#: grey, 14 ms RGB (1024² in 3 and 2.4 ms; medians of 5, a quiet machine). At 1024², the part a 4096²
+#: picture's preview changes (its crop, up to ~1100x1200 px once dabs coalesced) outgrew it; the whole
+#: picture then went to the worker (~150 ms), every later preview waited behind that conversion, and
+#: previews reached the screen in bursts: medians 86-130 ms instead of ~31 ms in such runs.
+PART_PIXELS = 2048 * 2048
 
 _converters = ThreadPoolExecutor(max_workers=2, thread_name_prefix="weft-display")
 
@@ -160,6 +164,10 @@ class ImageView(QGraphicsView):
         self.scene().addItem(self._item)
         self.image: np.ndarray | None = None  # the image on screen
         self._converter = DisplayConverter(self._show_image, self)
+        # parts of the array on its way to the screen changed in place since its conversion was asked
+        # for: redrawn from it once it is shown (:meth:`_defer_part`)
+        self._late_parts: list[tuple[int, int, int, int]] = []
+        self._late_of: np.ndarray | None = None
         self._fit_wanted = False
         self.tool = None
         self.auto_fit = True  # keep fitting the image to the window until the user zooms
@@ -185,8 +193,10 @@ class ImageView(QGraphicsView):
         changed in place) only there; when ``over`` is the array on screen (a stroke's preview pasted
         into the result, or into a copy of it), only that part is converted and redrawn, at once
         (a part of at most ``PART_PIXELS``)."""
-        if changed is not None and self._redraw_part(image, changed, image if over is None else over):
-            return
+        if changed is not None:
+            over = image if over is None else over
+            if self._defer_part(image, changed, over) or self._redraw_part(image, changed, over):
+                return
         self._fit_wanted = self._fit_wanted or fit
         self._converter.request(image)
 
@@ -201,18 +211,39 @@ class ImageView(QGraphicsView):
         if over.shape != image.shape or pixels.shape[:2] != (h, w):
             return False
         x0, y0, x1, y1 = (int(v) for v in box)
-        x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
-        if (x1 - x0) * (y1 - y0) > PART_PIXELS:
+        if (min(w, x1) - max(0, x0)) * (min(h, y1) - max(0, y0)) > PART_PIXELS:
             return False
         self.image = image  # (the same pixels as ``over`` outside ``box``)
-        if x0 >= x1 or y0 >= y1:
-            return True  # nothing on screen changed
+        self._converter.shown_now()  # (a conversion still running is older: dropped)
+        self._paint_part(image, box)
+        return True
+
+    def _defer_part(self, image: np.ndarray | None, box, over) -> bool:
+        """``image``, changed in place only in ``box`` (``over`` is ``image``), is the array whose
+        conversion for the screen is on its way (the whole picture went to the worker: the first
+        preview of a stroke came before the picture itself was on screen, or its part was too large):
+        ``box`` is redrawn from it once that conversion is shown, instead of converting it all again.
+        Else every later preview of the stroke waited behind a whole-picture conversion (~150 ms at
+        4096²) and they reached the screen in bursts."""
+        if image is None or over is not image or not self.converting or self._converter.latest is not image:
+            return False
+        if self._late_of is not image:
+            self._late_of, self._late_parts = image, []
+        self._late_parts.append(tuple(int(v) for v in box))
+        return True
+
+    def _paint_part(self, image: np.ndarray, box) -> None:
+        """Convert ``box`` of ``image`` (the array on screen) and redraw it."""
+        pixels = self._item.pixels()
+        h, w = image.shape[:2]
+        x0, y0, x1, y1 = box
+        x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
+        if x0 >= x1 or y0 >= y1 or pixels is None:
+            return  # nothing on screen changed
         _q, part = display_qimage(image[y0:y1, x0:x1])
         pixels[y0:y1, x0:x1] = part
-        self._converter.shown_now()  # (a conversion still running is older: dropped)
         self._item.update(QRectF(x0, y0, x1 - x0, y1 - y0))
         self.image_shown.emit()
-        return True
 
     @property
     def converting(self) -> bool:
@@ -236,6 +267,11 @@ class ImageView(QGraphicsView):
         self._image_changed()
         self.viewport().update()
         self.image_shown.emit()
+        late, self._late_parts = self._late_parts, []
+        if image is self._late_of and not self.converting:
+            for box in late:  # changed in place since this conversion was asked for
+                self._paint_part(image, box)
+        self._late_of = None
 
     def _image_changed(self) -> None:
         """(For subclasses: what follows the image on screen.)"""

@@ -242,3 +242,42 @@ def test_a_part_changed_in_place_is_redrawn_at_once_and_alone(qtbot, monkeypatch
     held.release()
     qtbot.waitUntil(lambda: view.image is other, timeout=10000)
     assert held.sizes[-1] == (BIG, BIG)
+
+
+def test_parts_changed_while_their_array_converts_are_redrawn_once_it_is_shown(qtbot, monkeypatch):
+    """A stroke's previews pasted into an array whose whole conversion is on its way (the first
+    preview came before the picture was on screen): each part waits for that one conversion and is
+    then redrawn alone, so the view draws the array as it is now, the parts pasted after the worker
+    read it included; no second whole conversion is asked for (before, every part asked for one, and
+    the previews reached the screen in bursts)."""
+    view = ImageView()
+    qtbot.addWidget(view)
+    view.resize(300, 240)
+    view.show()
+    held = _Held(monkeypatch)
+    real = held.real
+    read = threading.Event()
+
+    def convert_then_wait(image):  # the worker reads the array first, then waits
+        held.on_gui_thread.append(threading.current_thread() is threading.main_thread())
+        held.sizes.append(image.shape[:2])
+        out = real(image)
+        if image.shape[0] * image.shape[1] > views.ASYNC_PIXELS:
+            read.set()
+            assert held.gate.wait(20), "never released"
+        return out
+
+    monkeypatch.setattr(views, "display_qimage", convert_then_wait)
+    image = _picture(BIG, 4)
+    view.set_image(image, fit=True)
+    assert read.wait(10)  # converted as it was; not shown yet
+    image[10:30, 20:60] = _picture(40, 5)[:20]  # two previews pasted in place meanwhile
+    view.set_image(image, changed=(20, 10, 60, 30), over=image)
+    image[300:340, 400:420] = _picture(40, 6)[:, :20]
+    view.set_image(image, changed=(400, 300, 420, 340), over=image)
+    assert view.converting and held.sizes == [(BIG, BIG)]  # nothing else converted yet
+    held.release()
+    qtbot.waitUntil(lambda: not view.converting, timeout=10000)
+    assert held.sizes == [(BIG, BIG), (20, 40), (40, 20)] and held.on_gui_thread[1:] == [True, True]
+    assert view.image is image
+    assert view.viewport().grab().toImage() == _reference_grab(image, view)
