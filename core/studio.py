@@ -292,16 +292,10 @@ class Around:
         """``base`` (a full result) with ``part`` (the crop's result, scaled back to the box) pasted
         at the box (into a copy, or with ``copy=False`` into ``base`` itself); None when they do not
         fit together (another size or channel count)."""
-        from .image import resize
-
         x0, y0, x1, y1 = self.box
         dx, dy = self.offset
-        w, h = x1 - x0, y1 - y0
-        if part.shape[:2] != (h, w):
-            if part.ndim != base.ndim or min(part.shape[:2]) < 1:
-                return None
-            part = resize(part, (w, h), interpolation="linear")
-        if (part.ndim != base.ndim or (part.ndim == 3 and part.shape[2] != base.shape[2])
+        part = self.fitted(part)
+        if (part is None or part.ndim != base.ndim or (part.ndim == 3 and part.shape[2] != base.shape[2])
                 or y0 + dy < 0 or x0 + dx < 0 or y1 + dy > base.shape[0] or x1 + dx > base.shape[1]):
             return None
         out = base.copy() if copy else base
