@@ -48,7 +48,7 @@ from weft.core import registry
 from weft.core.jobs import JobResult, JobRunner, Progress
 from weft.core.params import Params, Recipe
 from weft.core.errors import WeftError
-from weft.core.geometry import Mask, MaskStroke
+from weft.core.geometry import MaskStroke
 from weft.core.studio import around_region, crop_around, describe_figures, reduce_for_preview
 
 PREVIEW_SIDE = 400
@@ -143,14 +143,14 @@ def stroke_part(doc, box) -> tuple[np.ndarray, tuple[int, int]] | None:
     then reads the document's live masks whole)."""
     g = doc.mask_geometry(doc.studio.preview_around) if doc.studio.preview_around else None
     live = doc.live
-    if g is None or live is None or live[0] != g.key or not isinstance(live[1], (MaskStroke, Mask)):
+    if g is None or live is None or live[0] != g.key or not isinstance(live[1], MaskStroke):
         return None
     on = doc.image(g.input_for(doc.inputs))
     h, w = live[1].shape
     if on is None or on.shape[:2] != (h, w):
         return None
     x0, y0, x1, y1 = around_region(box, w, h)
-    return live[1].bits[y0:y1, x0:x1].copy(), (x0, y0)
+    return live[1].cut(x0, y0, x1, y1), (x0, y0)
 
 
 def preparation(doc, *, side: int | None = None, around_box=None
