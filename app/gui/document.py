@@ -231,6 +231,12 @@ class Document(QObject):
                 out[on] = (region.side, region.side) + tuple(shape[2:])
         return out
 
+    def auto_values(self) -> dict[str, Any]:
+        """What the current method's unset ("auto") parameters resolve to now (``Studio.resolved``),
+        as a run resolves them: with the parameters a run takes, the geometry's among them (an
+        extended canvas can change them), and the shapes of its inputs."""
+        return self.studio.resolved(self.run_params(live=False), self.input_shapes())
+
     def _input_parts(self, live: bool):
         """What the current method's inputs are made of: the open images it gets (name -> array, with
         alpha where its ``InputSpec`` asks), its painted masks (name -> ``Mask``), and its source region

@@ -193,11 +193,8 @@ class MethodPanel(QWidget):
         self.show_square()
 
     def show_params(self) -> None:
-        """The current parameters, each unset ("auto") one with the value a run resolves it to: resolved
-        with the parameters a run takes, the geometry's among them (an extended canvas can change it)."""
-        doc = self.doc
-        self.params_panel.show_params(doc.current_params,
-                                      doc.studio.resolved(doc.run_params(live=False), doc.input_shapes()))
+        """The current parameters, each unset ("auto") one with the value a run resolves it to."""
+        self.params_panel.show_params(self.doc.current_params, self.doc.auto_values())
 
     def show_seed(self) -> None:
         self.seed_box.blockSignals(True)

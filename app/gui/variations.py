@@ -133,9 +133,8 @@ class VariationsDialog(QDialog):
             box.setSingleStep(1 if spec.kind == INT else (spec.step or (spec.hi - spec.lo) / 20))
         params = self.doc.params[self.method]
         current = getattr(params, spec.name)
-        if current is None:  # resolved as a run resolves it, with the geometry's parameters (an extended canvas)
-            run = self.doc.run_params(live=False) if self.method == self.doc.method else params
-            current = self.doc.studio.resolved(run, self.doc.input_shapes()).get(spec.name)
+        if current is None and self.method == self.doc.method:  # what "auto" resolves to, as a run resolves it
+            current = self.doc.auto_values().get(spec.name)
         if current is None:
             current = spec.default if spec.default is not None else spec.lo
         span = (spec.hi - spec.lo) / 4
