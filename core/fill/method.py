@@ -85,12 +85,14 @@ def _margins(params: FillParams, w: int, h: int) -> Margins | None:
     return Margins(left, top, dx - left, dy - top) if dx or dy else None
 
 
-def _run_patch(params: FillParams, ch: int, cw: int, border: bool = False) -> int:
+def _run_patch(params: FillParams, ch: int, cw: int, *, hole: np.ndarray | None = None,
+               margins: Margins | None = None) -> int:
     """The patch side a run of ``params.engine`` (not ``auto``) uses on a ``cw`` x ``ch`` canvas: the
-    one given, or the engine's default fitted to a small canvas (the quilt's :data:`BORDER_BLOCK`
-    for a ``border`` hole, :func:`_deep_border`, at most a third of the canvas)."""
+    one given, or the engine's default fitted to a small canvas; the quilt's :data:`BORDER_BLOCK`
+    (at most a third of the canvas) for a hole along the border deeper than its 24-px block
+    (:func:`_deep_border`, of the canvas's ``hole``, or of the ``margins`` when only shapes are known)."""
     patch = params.resolved_patch()
-    if params.patch is None and params.engine == "quilt" and border:
+    if params.patch is None and params.engine == "quilt" and _deep_border(hole, margins):
         patch = max(patch, min(BORDER_BLOCK, min(ch, cw) // 3))
     if params.engine == "pixel":
         patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
@@ -101,11 +103,13 @@ def _run_patch(params: FillParams, ch: int, cw: int, border: bool = False) -> in
     return patch
 
 
-def _deep_border(hole: np.ndarray) -> bool:
-    """Whether ``hole`` runs along the canvas border and reaches more than the quilt's default block
-    (24 px) from the known pixels (chessboard distance, so that margins of L, T, R, B reach their
-    largest): an uncrop or an extended canvas, whose quilt takes :data:`BORDER_BLOCK`; a small hole
-    that touches the border keeps 24."""
+def _deep_border(hole: np.ndarray | None, margins: Margins | None) -> bool:
+    """Whether the hole runs along the canvas border and reaches more than the quilt's default block
+    (24 px) from the known pixels: an uncrop or an extended canvas, whose quilt takes
+    :data:`BORDER_BLOCK`; a small hole that touches the border keeps 24. Of ``hole`` when given (a
+    chessboard distance, so that margins of L, T, R, B reach their largest), else of ``margins``."""
+    if hole is None:
+        return margins is not None and max(margins) > DEFAULT_PATCH["quilt"]
     if not touches_border(hole):
         return False
     d = cv2.distanceTransform(hole.astype(np.uint8), cv2.DIST_C, 3)
@@ -173,7 +177,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
         params = params.replace(engine=auto_engine(picture, border, params.patch))
-    patch = _run_patch(params, ch, cw, params.engine == "quilt" and params.patch is None and _deep_border(hole))
+    patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
         raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
@@ -320,7 +324,7 @@ def _memory(shapes: Mapping[str, tuple[int, ...]], params: FillParams) -> float:
 def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     """What an unset ``patch`` resolves to with inputs of these shapes (the studio shows it beside its
     box, and the variations grid centres its range on it): the patch the run takes (the engine's
-    default, fitted to a small canvas); for ``auto``, that of the engine it runs for a hole inside a
+    default, fitted to a small canvas; the quilt's border block for margins over 24 px); for ``auto``, that of the engine it runs for a hole inside a
     picture of this shape (``patchmatch``'s in a colour picture, ``quilt``'s in a grey one or when the
     canvas is extended). From shapes alone a colour picture whose hole touches its border, or whose
     hole's surroundings are grey, resolves to ``patchmatch``'s patch where the run takes ``quilt``'s
@@ -338,8 +342,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     if params.engine == "auto":
         colour = len(shape) == 3 and shape[2] >= 3
         params = params.replace(engine=auto_engine(colour, margins is not None, None))
-    deep = margins is not None and max(margins) > DEFAULT_PATCH["quilt"]  # as _deep_border finds it
-    return {"patch": _run_patch(params, h, w, deep)}
+    return {"patch": _run_patch(params, h, w, margins=margins)}
 
 
 #: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting
