@@ -194,14 +194,19 @@ def _coarse_guide(canvas: np.ndarray, hole: np.ndarray, scale: int) -> np.ndarra
     cover = cv2.resize(hole.astype(np.float32), (sw, sh), interpolation=cv2.INTER_AREA)
     known_share = np.maximum(1.0 - cover, 1e-6)[..., None]
     small = small / known_share  # the mean of the known pixels alone (the hole is 0 in the canvas)
-    shole = (cover > 0.5).astype(np.uint8)
-    out = np.empty_like(small)
-    for k in range(c):
-        ch8 = np.clip(np.rint(small[..., k] * 255), 0, 255).astype(np.uint8)
-        out[..., k] = cv2.inpaint(ch8, shole, 3, cv2.INPAINT_TELEA).astype(np.float32) / 255.0 if shole.any() \
-            else ch8 / 255.0
-    up = cv2.resize(out, (w, h), interpolation=cv2.INTER_LINEAR).reshape(h, w, c)
+    up = cv2.resize(_telea(small, cover > 0.5), (w, h), interpolation=cv2.INTER_LINEAR).reshape(h, w, c)
     return np.ascontiguousarray(up, dtype=np.float32)
+
+
+def _telea(img: np.ndarray, unknown: np.ndarray) -> np.ndarray:
+    """(H, W, C) float32: ``img`` in 8-bit levels, its ``unknown`` pixels (bool (H, W)) filled by
+    diffusion from the others (``cv2.inpaint``, Telea, radius 3, channel by channel)."""
+    mask = unknown.astype(np.uint8)
+    out = np.empty(img.shape, dtype=np.float32)
+    for k in range(img.shape[2]):
+        ch8 = np.clip(np.rint(img[..., k] * 255), 0, 255).astype(np.uint8)
+        out[..., k] = (cv2.inpaint(ch8, mask, 3, cv2.INPAINT_TELEA) if mask.any() else ch8).astype(np.float32) / 255.0
+    return out
 
 
 def _gap_cost(template: np.ndarray, unknown: np.ndarray, search: np.ndarray, crop: tuple[slice, slice],
@@ -218,10 +223,7 @@ def _gap_cost(template: np.ndarray, unknown: np.ndarray, search: np.ndarray, cro
         soft = cv2.GaussianBlur(search, (0, 0), GAP_SIGMA).reshape(search.shape)
         blurred.extend(_planes(soft))
         blurred.append(np.ascontiguousarray((soft * soft).sum(axis=2)))
-    est = np.empty(template.shape, dtype=np.float32)
-    for k in range(template.shape[2]):
-        ch8 = np.clip(np.rint(template[..., k] * 255), 0, 255).astype(np.uint8)
-        est[..., k] = cv2.inpaint(ch8, gap.astype(np.uint8), 3, cv2.INPAINT_TELEA).astype(np.float32) / 255.0
+    est = _telea(template, gap)
     g = np.ascontiguousarray(est * unknown[..., None])
     out = cv2.matchTemplate(blurred[-1][crop], unknown, cv2.TM_CCORR) - 2.0 * _ccorr(blurred[:-1], crop, g)
     out += float((g * est).sum())
