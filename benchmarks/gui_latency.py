@@ -57,19 +57,26 @@ class _PaintWatch(QObject):
         return False
 
 
+def _window(tmp: str, ini: str = "weft.ini"):
+    """A shown 1400x900 main window with its settings in ``tmp`` and its recovery file there too
+    (never the user's)."""
+    from weft.app.gui.main_window import MainWindow
+
+    os.environ["WEFT_RECOVERY_DIR"] = tmp
+    window = MainWindow(settings=QSettings(os.path.join(tmp, ini), QSettings.Format.IniFormat), load_defaults=False)
+    window.resize(1400, 900)
+    window.show()
+    return window
+
+
 def measure(values: int = 30, hz: float = 60.0) -> dict:
     from weft.app.gui.document import DocumentState, InputImage
-    from weft.app.gui.main_window import MainWindow
     from weft.core.examples import example
     from weft.core.image import load_image, resize
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     with tempfile.TemporaryDirectory() as tmp:
-        settings = QSettings(os.path.join(tmp, "weft.ini"), QSettings.Format.IniFormat)
-        os.environ["WEFT_RECOVERY_DIR"] = tmp  # never touch the user's recovery file
-        window = MainWindow(settings=settings, load_defaults=False)
-        window.resize(1400, 900)
-        window.show()
+        window = _window(tmp)
         doc = window.doc
         doc.restore(DocumentState(inputs={
             "texture": InputImage(None, load_image(example("gravel")).image[:192, :192]),
@@ -126,7 +133,6 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
     from PySide6.QtGui import QMouseEvent
 
     from weft.app.gui.document import DocumentState, InputImage
-    from weft.app.gui.main_window import MainWindow
     from weft.core import registry
     from weft.core.errors import WeftError
     from weft.core.examples import example
@@ -140,11 +146,7 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
         raise SystemExit(f"no studio method previews a painted stroke ({method or 'none registered'})")
     studio = offered[method].studio
     with tempfile.TemporaryDirectory() as tmp:
-        settings = QSettings(os.path.join(tmp, "weft.ini"), QSettings.Format.IniFormat)
-        os.environ["WEFT_RECOVERY_DIR"] = tmp
-        window = MainWindow(settings=settings, load_defaults=False)
-        window.resize(1400, 900)
-        window.show()
+        window = _window(tmp)
         doc = window.doc
         try:
             picture = load_image(example(studio.examples.get(studio.canvas, "gravel"))).image
@@ -229,10 +231,7 @@ def _stall_since(beats: list[float], t0: float) -> float:
 
 
 def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> dict:
-    import numpy as np
-
     from weft.app.gui.document import DocumentState, read_input
-    from weft.app.gui.main_window import MainWindow
     from weft.core import registry
     from weft.core.geometry import Mask
     from weft.core.studio import MASK
@@ -241,15 +240,11 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
     registry.warm_up(method)  # (the studio loads them at start: no kernel loading in the figures)
     steps: dict[str, list[float]] = {"session": [], "open": [], "result": [], "export": []}
     with tempfile.TemporaryDirectory() as tmp:
-        os.environ["WEFT_RECOVERY_DIR"] = tmp
         picture = _picture_file(tmp, side)
         item = read_input(picture)
         session = os.path.join(tmp, "big.weft.json")
         for run in range(runs):
-            settings = QSettings(os.path.join(tmp, f"weft{run}.ini"), QSettings.Format.IniFormat)
-            window = MainWindow(settings=settings, load_defaults=False)
-            window.resize(1400, 900)
-            window.show()
+            window = _window(tmp, f"weft{run}.ini")
             doc, studio = window.doc, window.doc.methods[method].studio
             canvas = studio.canvas
             doc.restore(DocumentState(inputs={canvas: item}, method=method))
@@ -311,7 +306,6 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
     from PySide6.QtTest import QTest
 
     from weft.app.gui.document import DocumentState, read_input
-    from weft.app.gui.main_window import MainWindow
     from weft.core import registry
     from weft.core.geometry import Mask
     from weft.core.studio import MASK
@@ -321,12 +315,8 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
     stalls: list[float] = []
     seconds: list[float] = []
     with tempfile.TemporaryDirectory() as tmp:
-        os.environ["WEFT_RECOVERY_DIR"] = tmp
         item = read_input(_picture_file(tmp, side))
-        settings = QSettings(os.path.join(tmp, "weft.ini"), QSettings.Format.IniFormat)
-        window = MainWindow(settings=settings, load_defaults=False)
-        window.resize(1400, 900)
-        window.show()
+        window = _window(tmp)
         window.renderer.enabled = False  # the main window idle: its full-size render is not measured here
         doc, studio = window.doc, window.doc.methods[method].studio
         doc.restore(DocumentState(inputs={studio.canvas: item}, method=method))
