@@ -4,8 +4,8 @@ Wexler, Shechtman & Irani, "Space-Time Completion of Video" (PAMI 2007), with th
 search of Barnes et al., "PatchMatch" (SIGGRAPH 2009), vectorised (every target patch at once, its
 propagation by jump flooding instead of PatchMatch's scan order), so a fill loads no numba: numba's
 import and its kernels' cache loads were 0.4-0.5 s of every ``weft fill --engine patchmatch``
-process (0.9-1.1 s for a 320 px photo against 0.37-0.38 s now, with ``weft``'s allocator setting), and ``scipy.ndimage`` (0.1 s) is
-not imported either (OpenCV's exact distance transform gives the depths):
+process (0.9-1.1 s for a 320 px photo; 0.30 s in the last interleaved measurement, 0.37 s in the
+benchmark's run, with ``weft``'s allocator setting), and ``scipy.ndimage`` (0.1 s) is not imported either (OpenCV's exact distance transform gives the depths):
 
 1. An image pyramid, halving until the hole is about two patches deep (one along the image's
    border: an uncrop; see ``_COARSEST_DEPTH``) (a coarse pixel is in the hole when any of its four
@@ -246,7 +246,8 @@ def fill_patchmatch(
         Checked before every PatchMatch sweep; raises :class:`weft.core.errors.Cancelled`.
     levels : int, optional
         Pyramid levels (1 = finest only); default: as many as bring the hole to about two patches
-        deep (one when it touches the image's border), as long as a level keeps 16 whole source patches and both sides >= 2 patches.
+        deep (one when it touches the image's border), as long as a level keeps 16 whole source
+        patches and both sides >= 2 patches.
     iterations : int, optional
         EM iterations on every level (all channels, confidence-weighted); default 12 on the
         coarsest, 8 on the intermediate ones, none on the finest (a single level gets 12). Three refine
