@@ -493,11 +493,8 @@ class Mask:
         pixel centres at whole numbers) set to ``value`` (True paints, False erases): every pixel whose
         centre lies within ``radius`` of the segment. A zero-length stroke is a dot; radius 0 is a
         one-pixel-wide line. (:func:`paint_line` paints into an array in place: a stroke being drawn.)"""
-        if _line_box(self.bits.shape, p0, p1, radius) is None:
-            return self
         out = self.bits.copy()
-        paint_line(out, p0, p1, radius, value)
-        return Mask._own(out)
+        return self if paint_line(out, p0, p1, radius, value) is None else Mask._own(out)
 
     def painted_polygon(self, points, value: bool = True) -> "Mask":
         """The mask with the polygon ``points`` [(x, y), ...] (a lasso, closed) set to ``value``."""
@@ -522,27 +519,17 @@ class Mask:
         return f"Mask({self.size[0]}x{self.size[1]}, {self.area} px)"
 
 
-def _line_box(shape, p0, p1, radius: float):
-    """``(left, top, right, bottom)`` (exclusive ends) of the pixels a brush line may hit in an
-    image of ``shape``, or None when it misses the image; and the line's float parameters."""
-    h, w = shape
+def paint_line(bits: np.ndarray, p0, p1, radius: float, value: bool = True) -> tuple[int, int, int, int] | None:
+    """Paint :meth:`Mask.painted_line`'s brush line into the bool array ``bits`` in place (only the
+    line's box is read and written: a dab on a 4096² mask costs the dab, not a copy of the mask).
+    Returns the box ``(x0, y0, x1, y1)`` (exclusive ends) whose pixels changed, None if none did."""
+    h, w = bits.shape
     (x0, y0), (x1, y1) = (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))
     r = max(0.0, float(radius)) + 0.5  # a pixel is hit when its centre is within radius (+ half a pixel)
     left, right = max(0, int(math.floor(min(x0, x1) - r))), min(w, int(math.ceil(max(x0, x1) + r)) + 1)
     top, bottom = max(0, int(math.floor(min(y0, y1) - r))), min(h, int(math.ceil(max(y0, y1) + r)) + 1)
     if left >= right or top >= bottom:
-        return None
-    return (left, top, right, bottom), (x0, y0, x1, y1, r)
-
-
-def paint_line(bits: np.ndarray, p0, p1, radius: float, value: bool = True) -> tuple[int, int, int, int] | None:
-    """Paint :meth:`Mask.painted_line`'s brush line into the bool array ``bits`` in place (only the
-    line's box is read and written: a dab on a 4096² mask costs the dab, not a copy of the mask).
-    Returns the box ``(x0, y0, x1, y1)`` (exclusive ends) whose pixels changed, None if none did."""
-    found = _line_box(bits.shape, p0, p1, radius)
-    if found is None:
-        return None
-    (left, top, right, bottom), (x0, y0, x1, y1, r) = found
+        return None  # the line misses the image
     yy, xx = np.mgrid[top:bottom, left:right].astype(np.float64)
     dx, dy = x1 - x0, y1 - y0
     length2 = dx * dx + dy * dy
