@@ -9,8 +9,9 @@ the GUI thread measures the longest stall. Prints one JSON line:
 ``{"median_ms", "p95_ms", "max_stall_ms", "previews", "values"}``.
 
 ``--paint``: the first studio method whose description previews a stroke (``Studio.preview_around``;
-or ``--method``) on its bundled example (or gravel) resized to ``--side`` px; a brush stroke of
-``--values`` mouse moves at ``--hz`` is painted on the canvas with real mouse events. For every
+or ``--method``) on its bundled example (or gravel; ``--example NAME``: that one, e.g. coffee, a colour
+photo) resized to ``--side`` px; a brush stroke of ``--values`` mouse moves at ``--hz`` is painted on
+the canvas with real mouse events. For every
 preview around the stroke that reaches the screen, the latency is the time from the mouse move of the
 latest dab it includes to the end of the result view's next paint. Same JSON line, plus ``"method"``.
 
@@ -128,7 +129,8 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
     return _summary(latencies, beats, values)
 
 
-def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = None, side: int = 512) -> dict:
+def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = None, side: int = 512,
+                     picture_name: str | None = None) -> dict:
     from PySide6.QtCore import QEvent, QPointF, Qt
     from PySide6.QtGui import QMouseEvent
 
@@ -149,7 +151,7 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
         window = _window(tmp)
         doc = window.doc
         try:
-            picture = load_image(example(studio.examples.get(studio.canvas, "gravel"))).image
+            picture = load_image(example(picture_name or studio.examples.get(studio.canvas, "gravel"))).image
         except WeftError:
             picture = load_image(example("gravel")).image
         picture = resize(picture, (side, side))
@@ -397,13 +399,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--variations", action="store_true",
                     help="render a Variations grid of a large picture: the longest GUI-thread stall")
     ap.add_argument("--runs", type=int, default=5, help="with --open or --variations: the runs (median)")
+    ap.add_argument("--example", default=None, help="with --paint: the bundled example painted on (default: the "
+                    "method's own; coffee: a colour photo)")
     args = ap.parse_args(argv)
     if args.variations:
         print(json.dumps(measure_variations(args.side or 4096, args.runs, args.method or "fill")))
     elif args.open:
         print(json.dumps(measure_opening(args.side or 4096, args.runs, args.method or "fill")))
     elif args.paint:
-        print(json.dumps(measure_painting(args.values or 60, args.hz, args.method, args.side or 512)))
+        print(json.dumps(measure_painting(args.values or 60, args.hz, args.method, args.side or 512, args.example)))
     else:
         print(json.dumps(measure(args.values or 30, args.hz)))
     return 0
