@@ -67,6 +67,16 @@ One block at a time, until no pixel of the hole is left:
    brick crop's fill less coherent (median 3.07 -> 3.52, against 3.15 for the continuation
    alone; ``hybrid``'s 2.50 -> 3.36, with a mortar stub of its own); weight 10 pulled blocks
    towards flat ones; a sigma of 0.75 or 3 did as well as 1.5.
+   Where the short courses left come from (seed 5): a chain of continued copies 93 px up the wall
+   carries a mortar line to 15 px above the real one (rows 194-200), and the last row's windows hold
+   only the 5 brick rows between the box and that line, so no cost sees the two lines together.
+   Not kept (seeds 0-14 brick, 0-4 gravel and uncrop): also matching 4 or 8 px of the known and
+   filled pixels around the block (its SSD only, the block pasted as before): gravel 9.01 -> 8.5-8.6
+   but brick 1.06 -> 1.19-1.29 (the goal's bound 1.27) with short courses still at 2-4 seeds;
+   blocks of 32, 40 or 48 px: brick 1.14 / 0.96 / 1.13, short courses at 1-3 seeds, and at 48
+   mortar stubs in the right column at 6; the texture's dominant offsets (peaks of the masked
+   autocorrelation of its gradients) as continuation candidates: brick unchanged (the hand-laid
+   courses are no lattice: peak 0.17), uncrop 0.81 -> 0.76.
 6. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
    overlap strip of ``B // 3`` pixels), E&F's dynamic-programming cut
    runs over the squared difference between those pixels and the new block (one path per side, in
