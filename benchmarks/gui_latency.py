@@ -11,9 +11,9 @@ the GUI thread measures the longest stall. Prints one JSON line:
 ``--paint``: the first studio method whose description previews a stroke (``Studio.preview_around``;
 or ``--method``) on its bundled example (or gravel; ``--example NAME``: that one, e.g. coffee, a colour
 photo) resized to ``--side`` px; a brush stroke of ``--values`` mouse moves at ``--hz`` is painted on
-the canvas with real mouse events. For every
-preview around the stroke that reaches the screen, the latency is the time from the mouse move of the
-latest dab it includes to the end of the result view's next paint. Same JSON line, plus ``"method"``.
+the canvas with real mouse events. For every preview around the stroke that reaches the screen, the
+latency is the time from the mouse move of the latest dab it includes to the end of the result view's
+next paint. Same JSON line, plus ``"method"``.
 
 ``--open [--side 4096] [--runs 5] [--method fill]``: the longest GUI-thread stall (the 5 ms heartbeat)
 while a large picture (``--side`` px square) reaches the views, each step in a fresh window with the
@@ -152,7 +152,9 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
         doc = window.doc
         try:
             picture = load_image(example(picture_name or studio.examples.get(studio.canvas, "gravel"))).image
-        except WeftError:
+        except WeftError as e:
+            if picture_name is not None:  # asked for by name: say so, never measure another picture
+                raise SystemExit(f"--example {picture_name}: {e}") from None
             picture = load_image(example("gravel")).image
         picture = resize(picture, (side, side))
         answered: list = []  # the first render: a result, or "nothing to fill" with nothing painted yet
