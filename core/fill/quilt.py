@@ -58,25 +58,25 @@ One block at a time, until no pixel of the hole is left:
    ``GAP`` times the SSD between that and the source block blurred by ``GAP_SIGMA`` (over the
    gap's pixels) is added to every cost, and the continuation is taken only if it still costs at
    most ``(1 + COHERE)`` times the best of those; the block picked otherwise is E&F's as before.
-   On the benchmark's brick box (ending 5 px above a mortar line), seeds 0-14, the seam figure
-   less the truth's was +0.26 at seeds 1 and 9 (a second mortar line along the box's lower edge)
-   and -0.03..+0.06 elsewhere; now -0.04..+0.05 at every seed, and such a line is left at 4 of
-   the 15 seeds (7 before), drawn by blocks whose gap is not thin. Seeds 0-5 medians: brick
-   coherence 1.06, gravel 9.02, uncrop 0.73, all unchanged. Adding the gap cost to every block's
-   choice, not only the continuation's, did as well on the benchmark's brick but made a 96 px
-   brick crop's fill less coherent (median 3.07 -> 3.52, against 3.15 for the continuation
-   alone; ``hybrid``'s 2.50 -> 3.36, with a mortar stub of its own); weight 10 pulled blocks
-   towards flat ones; a sigma of 0.75 or 3 did as well as 1.5.
+   On the benchmark's brick box (ending 5 px above a mortar line), seeds 0-14, the seam figure less
+   the truth's was +0.26 at seeds 1 and 9 (a second mortar line along the box's lower edge) and
+   -0.03..+0.06 elsewhere; now -0.04..+0.05 at every seed, and such a line is left at 5 of the 15
+   seeds (5, 8, 11, 13, 14; 7 before, by eye), a stub of one at 6 and 12, drawn by blocks whose
+   gap is not thin. Seeds 0-5 medians: brick coherence 1.06, gravel 9.02, uncrop 0.73, all unchanged. Adding
+   the gap cost to every block's choice, not only the continuation's, did as well on the benchmark's
+   brick but made a 96 px brick crop's fill less coherent (median 3.07 -> 3.52, against 3.15 for the
+   continuation alone; ``hybrid``'s 2.50 -> 3.36, with a mortar stub of its own); weight 10 pulled
+   blocks towards flat ones; a sigma of 0.75 or 3 did as well as 1.5.
    Where the short courses left come from (seed 5): a chain of continued copies 93 px up the wall
    carries a mortar line to 15 px above the real one (rows 194-200), and the last row's windows hold
-   only the 5 brick rows between the box and that line, so no cost sees the two lines together.
-   Not kept (seeds 0-14 brick, 0-4 gravel and uncrop): also matching 4 or 8 px of the known and
-   filled pixels around the block (its SSD only, the block pasted as before): gravel 9.01 -> 8.5-8.6
-   but brick 1.06 -> 1.19-1.29 (the goal's bound 1.27) with short courses still at 2-4 seeds;
-   blocks of 32, 40 or 48 px: brick 1.14 / 0.96 / 1.13, short courses at 1-3 seeds, and at 48
-   mortar stubs in the right column at 6; the texture's dominant offsets (peaks of the masked
-   autocorrelation of its gradients) as continuation candidates: brick unchanged (the hand-laid
-   courses are no lattice: peak 0.17), uncrop 0.81 -> 0.76.
+   only the 5 brick rows between the box and that line, so no cost sees the two lines together. Not
+   kept (seeds 0-14 brick, 0-4 gravel and uncrop): also matching 4 or 8 px of the known and filled
+   pixels around the block (its SSD only, the block pasted as before): gravel 9.01 -> 8.5-8.6 but
+   brick 1.06 -> 1.19-1.29 (the goal's bound 1.27), short courses still drawn (by eye); blocks of
+   32, 40 or 48 px: brick 1.14 / 0.96 / 1.13, but at 40 short courses at 5 seeds and floating mortar
+   stubs at 6 more, at 48 stubs in the right column at 6 seeds; the texture's dominant offsets
+   (peaks of the masked autocorrelation of its gradients) as continuation candidates: brick
+   unchanged (the hand-laid courses are no lattice: peak 0.17), uncrop 0.81 -> 0.76.
 6. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
    overlap strip of ``B // 3`` pixels), E&F's dynamic-programming cut
    runs over the squared difference between those pixels and the new block (one path per side, in
