@@ -61,12 +61,12 @@ One block at a time, until no pixel of the hole is left:
    On the benchmark's brick box (ending 5 px above a mortar line), seeds 0-14, the seam figure less
    the truth's was +0.26 at seeds 1 and 9 (a second mortar line along the box's lower edge) and
    -0.03..+0.06 elsewhere; now -0.04..+0.05 at every seed, and such a line is left at 5 of the 15
-   seeds (5, 8, 11, 13, 14; 7 before, by eye), a stub of one at 6 and 12, drawn by blocks whose
-   gap is not thin. Seeds 0-5 medians: brick coherence 1.06, gravel 9.02, uncrop 0.73, all
-   unchanged. Adding the gap cost to every block's choice, not only the continuation's, did as well
-   on the benchmark's brick but made a 96 px brick crop's fill less coherent (median 3.07 -> 3.52, against 3.15 for the
-   continuation alone; ``hybrid``'s 2.50 -> 3.36, with a mortar stub of its own); weight 10 pulled
-   blocks towards flat ones; a sigma of 0.75 or 3 did as well as 1.5.
+   seeds (5, 8, 11, 13, 14; 7 before, by eye), a stub of one at 6 and 12, drawn by blocks whose gap
+   is not thin. Seeds 0-5 medians: brick coherence 1.06, gravel 9.02, uncrop 0.73, all unchanged.
+   Adding the gap cost to every block's choice, not only the continuation's, did as well on the
+   benchmark's brick but made a 96 px brick crop's fill less coherent (median 3.07 -> 3.52, against
+   3.15 for the continuation alone; ``hybrid``'s 2.50 -> 3.36, with a mortar stub of its own);
+   weight 10 pulled blocks towards flat ones; a sigma of 0.75 or 3 did as well as 1.5.
    Where the short courses left come from (seed 5): a chain of continued copies 93 px up the wall
    carries a mortar line to 15 px above the real one (rows 194-200), and the last row's windows hold
    only the 5 brick rows between the box and that line, so no cost sees the two lines together. Not
