@@ -58,26 +58,28 @@ three final iterations over every inexact patch was more coherent on the texture
 brick 1.38) at twice the computing time, over G'MIC's whole-process time.
 
 Not solved: the photo's saucer rim, where the spoon's bowl hid it, bulges or drips red into the
-shadow at every one of seeds 0-4. Where that comes from: the coarsest level (80 px) lays the rim
-out cleanly at seeds 0, 1 and 3, and the first estimate of the next level (its doubled matches,
-voted, at 160 px) draws the bulge back; at seeds 2 and 4 it is there at 80 px already. Tried on
-seeds 0-4 (coherence medians against 4.45) and not kept: full confidence in the hole on the finer
-levels (their estimate is no longer a diffusion guess) 4.46, the drip gone at seed 1 only, this
-engine's uncrop 0.85 -> 0.92; the finer levels' first estimate upsampled instead of voted 5.36,
-smeared (seam -0.27..-0.44 from the truth's); each doubled match weighted in that first vote by
-its agreement with the upsampled coarser result (sigma^2 the 25th-75th percentile) 4.30-4.46, the
-drip gone at seed 1 only and a red blob made on another photo's hole (on 18 random holes in six
-photos 9 better, 7 worse, the mean 1 % lower); a random search only near the doubled matches 4.51,
-the bulges kept; a two-colour k-means segmentation of the known pixels, closed across the hole by
-cubic Hermite curves, as the coarsest level's start (each side diffused from its own colour) 4.61,
-bulges at seeds 1 and 4 and the shadow cut off square at 0 and 2, or as a guide channel matched at
-every level 5.3-5.6, the rim continued at every seed but its shadow cut off square, and on a disc
-hole by the saucer's edge over the wood the saucer copied into the wood (7.22 -> 11.96); the strong
-edges entering the hole, paired by direction and side colours and joined by Hermite curves (the
-curve lies where the rim truly runs), as a guide of the distance to them (signed by side or not,
-5-24 px) 4.6-5.7, thin red slivers beside the rim or a square shadow, or as Sun et al.'s structure
-propagation (patches along the curve chosen by dynamic programming, the rest filled after)
-4.98-5.44, red blocks beside the rim.
+shadow at every one of seeds 0-4. Where that comes from: the coarsest level (80 px) lays the rim out
+cleanly at seeds 0, 1 and 3, and the first estimate of the next level (its doubled matches, voted,
+at 160 px) draws the bulge back; at seeds 2 and 4 it is there at 80 px already. Tried on seeds 0-4
+(coherence medians against 4.45) and not kept: full confidence in the hole on the finer levels
+(their estimate is no longer a diffusion guess) 4.46, the drip gone at seed 1 only, this engine's
+uncrop 0.85 -> 0.92; the finer levels' first estimate upsampled instead of voted 5.36, smeared (seam
+-0.27..-0.44 from the truth's); each doubled match weighted in that first vote by its agreement with
+the upsampled coarser result (sigma^2 the 25th-75th percentile) 4.30-4.46, the drip gone at seed 1
+only and a red blob made on another photo's hole (on 18 random holes in six photos 9 better, 7
+worse, the mean 1 % lower); a random search only near the doubled matches 4.51, the bulges kept; the
+coarsest level run 3 or 5 times from different random matches, the lowest summed patch distance kept
+(with that weighted vote too) 4.36-4.53, bulges at 3-4 seeds: at that level the patch distance seems
+to prefer the bulging layout, so a better search alone does not remove it; a two-colour k-means
+segmentation of the known pixels, closed across the hole by cubic Hermite curves, as the coarsest
+level's start (each side diffused from its own colour) 4.61, bulges at seeds 1 and 4 and the shadow
+cut off square at 0 and 2, or as a guide channel matched at every level 5.3-5.6, the rim continued
+at every seed but its shadow cut off square, and on a disc hole by the saucer's edge over the wood
+the saucer copied into the wood (7.22 -> 11.96); the strong edges entering the hole, paired by
+direction and side colours and joined by Hermite curves (the curve lies where the rim truly runs),
+as a guide of the distance to them (signed by side or not, 5-24 px) 4.6-5.7, thin red slivers beside
+the rim or a square shadow, or as Sun et al.'s structure propagation (patches along the curve chosen
+by dynamic programming, the rest filled after) 4.98-5.44, red blocks beside the rim.
 
 Every pixel outside the hole (and ``cuttable``) is returned exactly as given.
 """
