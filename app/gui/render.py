@@ -264,11 +264,7 @@ class Renderer(QObject):
         else:
             a = self._around_box
             self._around_box = (min(a[0], box[0]), min(a[1], box[1]), max(a[2], box[2]), max(a[3], box[3]))
-        if self._preview_running is not None:
-            self._preview_dirty = True  # (started when the running preview is done)
-        else:
-            self._preview_timer.stop()
-            self._submit("preview", preview=True)
+        self._submit_preview()
         return True
 
     def stroke_cancelled(self) -> bool:
@@ -403,8 +399,6 @@ class Renderer(QObject):
         return handle.id
 
     def _submit_preview(self) -> None:
-        if self._stroking and self._around_box is None:
-            return  # (the box it was started for went with the job that ended meanwhile)
         if self._preview_running is not None:
             self._preview_dirty = True  # started when the running preview is done
             return

@@ -169,14 +169,13 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         if alpha is not None:
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
-    border = touches_border(hole)
     if params.engine == "auto":  # the figures and messages name the engine that runs
         # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
         # large picture (a colour corner far from a hole in a grey region does not make it a photo)
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        params = params.replace(engine=auto_engine(picture, border, params.patch))
+        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch))
     patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
@@ -326,9 +325,10 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     box, and the variations grid centres its range on it): the patch the run takes (the engine's
     default, fitted to a small canvas; the quilt's border block for margins over 24 px); for
     ``auto``, that of the engine it runs for a hole inside a picture of this shape (``patchmatch``'s
-    in a colour picture, ``quilt``'s in a grey one or when the canvas is extended). From shapes alone a colour picture whose hole touches its border, or whose
-    hole's surroundings are grey, resolves to ``patchmatch``'s patch where the run takes ``quilt``'s
-    (the run's figures say which). Nothing before an image is open."""
+    in a colour picture, ``quilt``'s in a grey one or when the canvas is extended). From shapes
+    alone a colour picture whose hole touches its border, or whose hole's surroundings are grey,
+    resolves to ``patchmatch``'s patch where the run takes ``quilt``'s (the run's figures say which).
+    Nothing before an image is open."""
     shape = shapes.get("image")
     if params.patch is not None or shape is None:
         return {}

@@ -274,6 +274,10 @@ def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: in
     score[y0:y1, x0:x1] = part[y0 - ya:y1 - ya, x0 - xa:x1 - xa]
 
 
+#: Rows per strip of :class:`_Front`.
+_STRIP = 32
+
+
 class _Front:
     """The first maximum of ``score`` in scan order (``np.argmax``'s answer), found through the
     maxima of its strips of :data:`_STRIP` rows: ``update(y0, y1)`` after rows ``[y0, y1)`` of it
@@ -292,10 +296,6 @@ class _Front:
         k = int(np.argmax(self.maxima))  # the first strip holding the maximum, then its first in scan order
         y, x = divmod(int(np.argmax(self.score[k * _STRIP:(k + 1) * _STRIP])), self.score.shape[1])
         return k * _STRIP + y, x
-
-
-#: Rows per strip of :class:`_Front`.
-_STRIP = 32
 
 
 def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0,
