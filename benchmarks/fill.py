@@ -17,8 +17,8 @@ ground truth:
   grow a canvas, get the 384x384 canvas with a black border and the border as their mask.
 
 Each tool is a separate process (its whole-process time and peak resident memory, ``ru_maxrss`` of
-the child from ``wait4``, are its own): ``weft fill`` with its default engine and with each
-``--engine``; G'MIC's ``inpaint_matchpatch`` (``gmic`` on the PATH); OpenCV's shift-map
+the child from ``wait4``, are its own): ``weft fill`` with its default engine, with each
+``--engine`` and with ``--structure yes``; G'MIC's ``inpaint_matchpatch`` (``gmic`` on the PATH); OpenCV's shift-map
 (``cv2.xphoto``), Telea and Navier-Stokes (``cv2.inpaint``, the smear reference) run by
 ``benchmarks/fill_peers.py``; ``pypatchmatch`` and the PyPI ``resynthesizer`` run by the same script
 under ``$WEFT_PEERS_PYTHON`` (default: this interpreter) when that environment has them. The peers
@@ -208,7 +208,7 @@ def _importable(python: str, module: str) -> str | None:
     return _IMPORTABLE[key]
 
 
-def _weft_command(engine: str | None):
+def _weft_command(engine: str | None, *options: str):
     def command(files, out, case, inputs):
         cmd = [sys.executable, "-m", "weft.app.cli", "fill", str(files["image"])]
         if inputs.extend is None:
@@ -217,7 +217,7 @@ def _weft_command(engine: str | None):
             cmd += ["--extend", ",".join(str(v) for v in inputs.extend)]
         if engine is not None:
             cmd += ["--engine", engine]
-        return cmd + ["-o", str(out), "--seed", str(case.seed), "--quiet"]
+        return cmd + [*options, "-o", str(out), "--seed", str(case.seed), "--quiet"]
     return command
 
 
@@ -245,6 +245,7 @@ def _cv2_missing() -> str | None:
 TOOLS: list[Tool] = [
     Tool("weft", _weft_command(None), weft=True),
     *[Tool(f"weft --engine {e}", _weft_command(e), weft=True, engine=e) for e in WEFT_ENGINES],
+    Tool("weft --structure yes", _weft_command(None, "--structure", "yes"), weft=True, engine="patchmatch"),
     Tool("G'MIC inpaint_matchpatch", _gmic_command,
          lambda: None if shutil.which("gmic") else "gmic is not on the PATH (Debian: apt-get install gmic)"),
     Tool("OpenCV xphoto shift-map", _peer_command("shiftmap", lambda: sys.executable), _cv2_missing),

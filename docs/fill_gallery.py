@@ -4,8 +4,9 @@
 
 One picture per case of ``python -m benchmarks 'fill-*'`` (``benchmarks/fill.py`` builds them from
 scikit-image's data): the input with the hole outlined in red, the ground truth, weft's fill (the
-default engine, seed 1), then G'MIC ``inpaint_matchpatch``, OpenCV's shift-map, ``pypatchmatch``,
-the PyPI Resynthesizer and OpenCV Telea, each captioned with its coherence / detail / seam (the
+default engine, seed 1; on the photo also with ``--structure yes``), then G'MIC
+``inpaint_matchpatch``, OpenCV's shift-map, ``pypatchmatch``, the PyPI Resynthesizer and (but on
+the photo) OpenCV Telea, each captioned with its coherence / detail / seam (the
 truth's own under the truth) and, when it changed known pixels, the largest change within 2 px of the
 hole and beyond. Every tool runs as in the benchmark, as its own process on the same files; a tool
 that is not installed gets a grey panel that says so.
@@ -31,7 +32,10 @@ from weft.core.image import save_image  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 SHOWN = ["weft", bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyPI)", "OpenCV Telea"]
-SHORT = {"weft": "weft fill (default engine)", bench.GMIC: "G'MIC inpaint_matchpatch",
+# on the photo, weft's --structure takes the place of Telea (the smear reference; its figures stay in the table)
+SHOWN_OBJECT = ["weft", "weft --structure yes", bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyPI)"]
+SHORT = {"weft": "weft fill (default engine)", "weft --structure yes": "weft fill --structure yes",
+         bench.GMIC: "G'MIC inpaint_matchpatch",
          bench.SHIFTMAP: "OpenCV shift-map", "pypatchmatch": "pypatchmatch",
          "Resynthesizer (PyPI)": "Resynthesizer", "OpenCV Telea": "OpenCV Telea"}
 
@@ -68,7 +72,7 @@ def render(case: bench.FillCase, tools: dict[str, bench.Tool]) -> np.ndarray:
                     f"ground truth|coh {truth['coherence']:.1f}  detail {truth['detail']:.2f}  seam {truth['seam']:.2f}")]
     with tempfile.TemporaryDirectory(prefix="weft-fill-gallery-") as tmp:
         files = bench.write_inputs(inputs, Path(tmp))
-        for name in SHOWN:
+        for name in SHOWN_OBJECT if case.name == "fill-object" else SHOWN:
             tool = tools[name]
             why = tool.missing()
             if why:

@@ -68,7 +68,7 @@ __all__ = ["ANCHORS", "DEFAULT_ENGINE", "DEFAULT_PATCH", "ENGINES", "FillParams"
 
 
 def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=None, patch=None, band=2,
-         source_mask=None, texture=None, seed=0, progress=None, cancel=None) -> np.ndarray:
+         structure=False, source_mask=None, texture=None, seed=0, progress=None, cancel=None) -> np.ndarray:
     """Fill the hole of ``image`` and/or extend its canvas; returns the filled float32 image.
 
     Parameters
@@ -82,6 +82,8 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
     engine : ``"auto"`` (the default, :data:`DEFAULT_ENGINE`: ``patchmatch`` for a hole inside a colour
         picture, ``quilt`` otherwise), ``"quilt"``, ``"pixel"``, ``"patchmatch"`` or ``"hybrid"``.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
+    structure : continue the strong edges that cross the hole along smooth curves
+        (:mod:`weft.core.fill.structure`; the ``patchmatch`` engine, which ``auto`` then runs).
     source_mask : (H, W) (of the texture when one is given): the only pixels to copy from.
     texture : ndarray: copy from this image instead of the rest of ``image``.
     seed : int or ``np.random.Generator``: the same seed gives the same pixels.
@@ -93,7 +95,7 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
 
     Raises ``WeftError`` (one line) for nothing to fill, a mask of another size, too little to copy from.
     """
-    params = FillParams(engine=engine or DEFAULT_ENGINE, patch=patch, band=band,
+    params = FillParams(engine=engine or DEFAULT_ENGINE, patch=patch, band=band, structure=structure,
                         extend=None if extend is None else Margins.coerce(extend),
                         size=None if size is None else tuple(size), anchor=anchor)
     out, _figures = fill_image(image, mask, params=params, source_mask=source_mask, texture=texture, rng=seed,

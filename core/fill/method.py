@@ -175,12 +175,16 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch))
+        engine = "patchmatch" if params.structure else auto_engine(picture, touches_border(hole), params.patch)
+        params = params.replace(engine=engine)
     patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
         raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
                      f"is {w}x{h}{grown})", "image", name="patch", value=patch)
+    if params.structure and texture is not None:
+        raise _error(InvalidParameter, "parameter 'structure' continues the picture's own edges across the hole: it "
+                     "cannot copy from a second texture", "texture", name="structure", value=True)
     # the source: where blocks are copied from
     if texture is not None:
         tex, _talpha = _split_alpha(texture, "texture")
@@ -252,8 +256,13 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     # a small hole in a large picture: the engine fills the hole's neighbourhood alone
     near = neighbourhood(work_hole, work_src, patch) if texture is None else None
     part = (slice(None), slice(None)) if near is None else near
+    if params.structure:  # the edges entering the hole, continued across it (None: none pair up)
+        from .structure import structure_guide
+
+        extra["guide"], continued = structure_guide(work[part], work_hole[part], ~work_hole[part] & ~transparent[part])
     filled = _engine(params.engine)(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
-                                    progress=engine_report, cancel=cancel, **{k: v[part] for k, v in extra.items()})
+                                    progress=engine_report, cancel=cancel,
+                                    **{k: v if k == "guide" else v[part] for k, v in extra.items()})
     if near is not None:
         whole = np.array(work, dtype=np.float32)
         whole[near] = filled
@@ -280,6 +289,8 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     figures = {"engine": params.engine, "patch": patch, "hole_pixels": int(hole.sum()),
                "hole_fraction": round(float(hole.mean()), 4), "canvas": [int(cw), int(ch)],
                "source_pixels": int(src_region.sum())}
+    if params.structure:
+        figures["edges_continued"] = continued
     if margins:
         figures["extend"] = margins.to_json()
     return np.ascontiguousarray(out, dtype=np.float32), figures
@@ -325,7 +336,8 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     box, and the variations grid centres its range on it): the patch the run takes (the engine's
     default, fitted to a small canvas; the quilt's border block for margins over 24 px); for
     ``auto``, that of the engine it runs for a hole inside a picture of this shape (``patchmatch``'s
-    in a colour picture, ``quilt``'s in a grey one or when the canvas is extended). From shapes
+    in a colour picture or with ``structure``, ``quilt``'s in a grey one or when the canvas is
+    extended). From shapes
     alone a colour picture whose hole touches its border, or whose hole's surroundings are grey,
     resolves to ``patchmatch``'s patch where the run takes ``quilt``'s (the run's figures say which).
     Nothing before an image is open."""
@@ -341,7 +353,8 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
         h, w = h + margins.top + margins.bottom, w + margins.left + margins.right
     if params.engine == "auto":
         colour = len(shape) == 3 and shape[2] >= 3
-        params = params.replace(engine=auto_engine(colour, margins is not None, None))
+        params = params.replace(engine="patchmatch" if params.structure
+                                else auto_engine(colour, margins is not None, None))
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 
@@ -358,7 +371,7 @@ STUDIO = Studio(
     masks_of={"source_mask": ("texture", "image")}, auto=_auto,
     figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
              "hole_fraction": Figure("filled", "%", "of the image", digits=2),
-             "source_pixels": Figure("copied from", "px")})
+             "source_pixels": Figure("copied from", "px"), "edges_continued": Figure("edges continued")})
 
 
 METHOD = Method(

@@ -58,17 +58,25 @@ class FillParams(Params):
     band: int = param(2, lo=0, hi=32,
                       help="blend band: known pixels up to this many px from the hole may change (Poisson "
                            "seam band); 0 = they never change")
+    structure: bool = param(False,
+                            help="continue the strong edges that cross the hole (a rim, a horizon) along smooth "
+                                 "curves, where patches alone run them on straight or drip; for an object removed "
+                                 "from a photo, not for textures (patchmatch engine)")
 
     def check(self) -> None:
         if self.extend is not None and self.size is not None:
             raise InvalidParameter("parameters 'extend' and 'size' cannot be given together (both set the canvas)",
                                    name="size", value=self.size)
-        if self.engine == "patchmatch" and self.patch is not None:
+        if self.structure and self.engine not in ("auto", "patchmatch"):
+            raise InvalidParameter(f"parameter 'structure' needs the patchmatch engine (or auto), not '{self.engine}'",
+                                   name="structure", value=self.structure)
+        if (self.engine == "patchmatch" or self.structure) and self.patch is not None:
             from .patchmatch import MAX_PATCH
 
             if self.patch > MAX_PATCH:
-                raise InvalidParameter(f"parameter 'patch' = {self.patch} is outside 3..{MAX_PATCH} for the patchmatch "
-                                       f"engine", name="patch", value=self.patch)
+                what = "for the patchmatch engine" if self.engine == "patchmatch" else "with 'structure' (patchmatch)"
+                raise InvalidParameter(f"parameter 'patch' = {self.patch} is outside 3..{MAX_PATCH} {what}",
+                                       name="patch", value=self.patch)
 
     def resolved_patch(self) -> int:
         """The patch side the engine runs with (``auto`` resolved first: :func:`auto_engine`)."""

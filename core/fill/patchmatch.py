@@ -57,10 +57,11 @@ With the one-patch pyramid, searching the finest level too (one EM iteration on 
 three final iterations over every inexact patch was more coherent on the textures (gravel 8.38,
 brick 1.38) at twice the computing time, over G'MIC's whole-process time.
 
-Not solved: the photo's saucer rim, where the spoon's bowl hid it, bulges or drips red into the
-shadow at every one of seeds 0-4. Where that comes from: the coarsest level (80 px) lays the rim out
-cleanly at seeds 0, 1 and 3, and the first estimate of the next level (its doubled matches, voted,
-at 160 px) draws the bulge back; at seeds 2 and 4 it is there at 80 px already. Tried on seeds 0-4
+Not solved without a guide: the photo's saucer rim, where the spoon's bowl hid it, bulges or drips
+red into the shadow at every one of seeds 0-4. Where that comes from: the coarsest level (80 px)
+runs the rim on straight and turns it in a corner at seeds 0 and 3, lays it out near the truth's at
+seed 1 (where the first estimate of the next level, its doubled matches voted at 160 px, draws the
+bulge back), and drips at seeds 2 and 4 already. Tried on seeds 0-4
 (coherence medians against 4.45) and not kept: full confidence in the hole on the finer levels
 (their estimate is no longer a diffusion guess) 4.46, the drip gone at seed 1 only, this engine's
 uncrop 0.85 -> 0.92; the finer levels' first estimate upsampled instead of voted 5.36, smeared (seam
@@ -79,7 +80,19 @@ the saucer copied into the wood (7.22 -> 11.96); the strong edges entering the h
 direction and side colours and joined by Hermite curves (the curve lies where the rim truly runs),
 as a guide of the distance to them (signed by side or not, 5-24 px) 4.6-5.7, thin red slivers beside
 the rim or a square shadow, or as Sun et al.'s structure propagation (patches along the curve chosen
-by dynamic programming, the rest filled after) 4.98-5.44, red blocks beside the rim.
+by dynamic programming, the rest filled after) 4.98-5.44, red blocks beside the rim. Then: rotated
+copies of the picture as more sources (Darabi et al.'s image melding; +-10, +-15 with a penalty,
++-20 degrees) 4.91-9.38, the wood's grain turned and the cup's white copied in, the drips kept;
+Wexler's gamma 1.1 / 1.5 / 2.0 (1.3 above) 4.58 / 4.78 / 5.09, a drip or a square corner at every
+seed; the coarsest level restarted 4 times, the layout kept by its patches' distance without the
+confidence weights 4.46, drips at 4 seeds; an 11 or 15 px patch on the coarsest level 4.28 / 4.50,
+the rim curved but the saucer swollen past it; the finished fill re-solved in the gradient domain
+from each pixel's copy's own gradients (Poisson) 6.69, the drips smeared into tinted ghosts; the
+guide below with the low-pass colours instead of a signed nearness (diffused into the hole on each
+side of the curve) 7.10-8.66, the shadow lost. What continues the rim is a guide of where the edge
+runs, matched at every level: :mod:`weft.core.fill.structure` (``weft fill --structure yes``), at
+coherence 5.50 (the curved rim's patches are no verbatim copies; the measure prefers the drip) and
+an edge detection's time, so an option, not the default.
 
 Every pixel outside the hole (and ``cuttable``) is returned exactly as given.
 """
@@ -133,6 +146,9 @@ _PYRAMID_SHRINK = 2  # the pyramid's random search radii: half the level, then /
 # the coarsest level (there it copies whole wrong objects into a photo's hole: astronaut coherence
 # 4.3 -> 5.1), nor on the finest (no effect).
 _COHERENCE_BIAS = 1.0
+# the guide's weight in the distance (its values are in [-1, 1]; the colours in [0, 1]): 1 continued
+# the photo's rim at seeds 0-4; 0.3 and 0.5 let the drip back as thin slivers at 2-3 of them
+_GUIDE_WEIGHT = 1.0
 # the final full-resolution refine (step 4): EM iterations, and the percentile of the inexact patches'
 # distances from which they are searched (the photo, seeds 0-4, measured with the one-patch pyramid
 # and the sparse last vote: 3 iterations over all of them 4.52 in 0.205 s, over the worse half 4.53 in
@@ -246,6 +262,7 @@ def fill_patchmatch(
     levels: int | None = None,
     iterations: int | None = None,
     cuttable: np.ndarray | None = None,
+    guide: np.ndarray | None = None,
 ) -> np.ndarray:
     """Fill the ``hole`` of ``image`` with patches of its ``source`` region (see the module text).
 
@@ -281,6 +298,13 @@ def fill_patchmatch(
         the hole are then refined together by :func:`refine_patchmatch`, copying only from source
         pixels outside them, so the band becomes a continuation of the copies (and the method runs
         no Poisson blend for this engine).
+    guide : float array (H, W) or (H, W, K), K = 1..8, optional
+        Channels known everywhere, the hole included (:func:`weft.core.fill.structure.structure_guide`:
+        for each edge continued across the hole, the side of it and the nearness to it). On every
+        pyramid level they are matched like colours (weight ``_GUIDE_WEIGHT``), at full confidence
+        in the hole, and never filled: each level has their 2x2 means, put back after every vote.
+        The final refine does not see them (the layout is made; the refine only mends the copies'
+        seams).
 
     Returns
     -------
@@ -289,12 +313,20 @@ def fill_patchmatch(
     Raises
     ------
     ImageError
-        Wrong image or mask shape, an image smaller than the patch, or a source region without a
-        single whole patch.
+        Wrong image, mask or guide shape, a guide with NaN or infinite values, an image smaller than
+        the patch, or a source region without a single whole patch.
     InvalidParameter
         ``patch``, ``levels`` or ``iterations`` out of range.
     """
     arr, hole, source, p = _check(image, hole, source, patch, levels, iterations)
+    if guide is not None:
+        given = np.asarray(guide, dtype=np.float32)
+        guide = given[..., None] if given.ndim == 2 else given
+        if guide.ndim != 3 or guide.shape[:2] != hole.shape or not 1 <= guide.shape[2] <= 8:
+            raise ImageError(f"the guide has shape {given.shape}; it must be (H, W) or (H, W, 1..8) with the "
+                             f"image's {hole.shape[1]}x{hole.shape[0]}")
+        if not np.isfinite(guide).all():
+            raise ImageError("the guide holds NaN or infinite values")
     out = np.array(arr, dtype=np.float32, copy=True)
     if not hole.any():
         return out
@@ -305,6 +337,10 @@ def fill_patchmatch(
     nch = img.shape[2]
     if _FEATURE_WEIGHT > 0:
         img = np.ascontiguousarray(np.concatenate([img, _FEATURE_WEIGHT * _texture_features(img, hole)], axis=2))
+    fixed = None  # the guide's channels: never filled, matched at full confidence
+    if guide is not None:
+        fixed = slice(img.shape[2], img.shape[2] + guide.shape[2])
+        img = np.ascontiguousarray(np.concatenate([img, _GUIDE_WEIGHT * guide], axis=2))
 
     pyramid = [_Level(img.copy(), hole, source, p)]
     if pyramid[0].n_valid == 0:
@@ -321,6 +357,8 @@ def fill_patchmatch(
         nxt = _Level(*_halve(top.img, top.hole, top.source), p)
         if nxt.n_valid < min(_MIN_SOURCES, top.n_valid) or not nxt.hole.any():
             break
+        if fixed is not None:  # the guide is known in the hole too: the plain 2x2 means
+            nxt.img[..., fixed] = _halve_plain(top.img[..., fixed])
         pyramid.append(nxt)
 
     n = len(pyramid)
@@ -334,17 +372,22 @@ def fill_patchmatch(
     for li in range(n - 1, -1, -1):
         lv = pyramid[li]
         im = lv.img
+        keep = None if fixed is None else _Keep(im, lv.hole, fixed)
         if li == n - 1:
             _onion_fill(im, lv.hole)
-            fl = _Flat(im, lv.hole, lv.source, p, conf=lv.conf)
+            if keep is not None:
+                keep()
+            fl = _Flat(im, lv.hole, lv.source, p, conf=lv.conf, fixed=fixed)
             sy, sx = _random_matches(fl, gen)
         else:
             _upsample_into(im, lv.hole, pyramid[li + 1].img)
-            coarse, fl = fl, _Flat(im, lv.hole, lv.source, p, conf=lv.conf)
+            coarse, fl = fl, _Flat(im, lv.hole, lv.source, p, conf=lv.conf, fixed=fixed)
             sy, sx = _upsample_matches(fl, coarse, sy, sx, gen)
             # the first estimate of this level: the coarse matches, doubled, voted (an upsampled
             # image would be blurred; matched against it, the flattest patches win)
             _vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)))
+            if keep is not None:
+                keep()
         if schedule[li] > 0:
             everyone = np.arange(len(fl.ty))
             dist = fl.dist(fl.gather(fl.ty, fl.tx), everyone, sy, sx)
@@ -354,7 +397,7 @@ def fill_patchmatch(
                 report.update(done0 + _it + 1)
 
             _em(fl, im, lv.hole, sy, sx, dist, iterations=schedule[li], gen=gen, steps_first=_STEPS_FIRST,
-                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step)
+                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step, after_vote=keep)
             done += schedule[li]
     res = pyramid[0].img[..., :nch]
     if out.ndim == 2:
@@ -370,6 +413,27 @@ def fill_patchmatch(
     return refine_band(out, hole, region, source, patch=p, iterations=_FINAL_REFINE, rng=gen,
                        progress=refine_progress if progress is not None else None, cancel=cancel, worst=_FINAL_WORST,
                        last_vote_stride=_LAST_STRIDE)
+
+
+def _halve_plain(a: np.ndarray) -> np.ndarray:
+    """The 2x2 means of (H, W, K) channels known everywhere (an odd last row/column padded by its
+    edge, as :func:`_halve` pads), float32."""
+    h, w = a.shape[:2]
+    a = np.pad(a, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+    return a.reshape(a.shape[0] // 2, 2, a.shape[1] // 2, 2, -1).mean(axis=(1, 3), dtype=np.float32)
+
+
+class _Keep:
+    """Puts a level's fixed channels (the guide) back into its hole after a vote or an estimate
+    wrote them."""
+
+    def __init__(self, img: np.ndarray, hole: np.ndarray, channels: slice):
+        self.img, self.channels = img, channels
+        self.ys, self.xs = np.nonzero(hole)
+        self.values = img[self.ys, self.xs, channels].copy()
+
+    def __call__(self) -> None:
+        self.img[self.ys, self.xs, self.channels] = self.values
 
 
 def _texture_features(img: np.ndarray, hole: np.ndarray) -> np.ndarray:
@@ -485,9 +549,11 @@ class _Flat:
     """An image as the patch search sees it: target patches (those touching the hole), the allowed
     source corners, gathering of p x p patches by their top-left corner, and the distance of target
     patches to candidates: the plain SSD, or with ``conf`` (H, W) each target pixel's squared
-    difference weighted by its confidence (the pyramid's levels)."""
+    difference weighted by its confidence (the pyramid's levels), except on the ``fixed`` channels
+    (the guide, known in the hole), weighted 1."""
 
-    def __init__(self, img: np.ndarray, hole: np.ndarray, source: np.ndarray, p: int, conf: np.ndarray | None = None):
+    def __init__(self, img: np.ndarray, hole: np.ndarray, source: np.ndarray, p: int, conf: np.ndarray | None = None,
+                 fixed: slice | None = None):
         from numpy.lib.stride_tricks import as_strided
 
         h, w, c = img.shape
@@ -512,6 +578,8 @@ class _Flat:
             cw = as_strided(conf, shape=(h - p + 1, w - p + 1, p, p), strides=conf.strides * 2, writeable=False)
             c_ = cw[self.ty, self.tx].reshape(len(ty), p * p)
             self.weights = np.ascontiguousarray(np.repeat(c_, c, axis=1), dtype=np.float32)
+            if fixed is not None:  # channels known in the hole (the guide) count in full there
+                self.weights.reshape(len(ty), p * p, c)[:, :, fixed] = 1.0
             self.mean_conf = c_.mean(axis=1, dtype=np.float64)
 
     def gather(self, ys: np.ndarray, xs: np.ndarray) -> np.ndarray:
@@ -747,7 +815,7 @@ def refine_patchmatch(
 def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.ndarray, dist: np.ndarray, *,
         iterations: int, gen: np.random.Generator, steps_first: tuple[int, ...], shrink: int, bias: float,
         worst: float, cancel: CancelToken | None, on_iteration: Callable[[int], None],
-        last_stride: int | None = None) -> None:
+        last_stride: int | None = None, after_vote: Callable[[], None] | None = None) -> None:
     """EM iterations on ``img`` (the array ``fl`` views), improving the matches (``sy``, ``sx``, their
     ``dist``) of ``fl``'s target patches and writing the hole's pixels, in place. Each iteration:
     (E) the inexact patches (a distance above 0; with ``worst``, at least that percentile of their
@@ -757,7 +825,8 @@ def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.nda
     covered by an inexact patch is copied through the offset its covering patches agree on most
     (:func:`_vote_mode`, weights ``exp(-d / 2 sigma^2)``). A patch that is an exact copy of its
     match is not searched again, and a pixel only such patches cover keeps its value (any of their
-    offsets gives it). ``on_iteration(it)`` after each."""
+    offsets gives it). ``after_vote()`` after each vote (puts the guide back), ``on_iteration(it)``
+    after each iteration."""
     p = fl.p
     hv, wv = fl.valid.shape
     changed = None
@@ -794,4 +863,6 @@ def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.nda
         stride = _VOTE_STRIDE if last_stride is None or it < iterations - 1 else last_stride
         changed = _vote_mode(img, hole & (_box_sum(inexact, p) > 0.5), fl, sy, sx, np.exp(-dn / (2.0 * sigma2)),
                              stride)
+        if after_vote is not None:
+            after_vote()
         on_iteration(it)
