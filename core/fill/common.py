@@ -19,6 +19,22 @@ def as_channels(image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(img)
 
 
+def percentile(values: np.ndarray, q: float) -> float:
+    """``np.percentile(values, q)`` (linear interpolation) of a non-empty vector, in float64, by
+    ``np.partition``: np.percentile imports numpy.ma (~7 ms of a fill's process start) on first use.
+    Equal to np.percentile on float64 input; on float32 within a float32 rounding (numpy computes
+    in the input's precision)."""
+    a = np.asarray(values, dtype=np.float64).ravel()
+    virtual = q / 100.0 * (len(a) - 1)
+    lo = int(np.floor(virtual))
+    hi = min(lo + 1, len(a) - 1)
+    part = np.partition(a, [lo, hi]) if hi != lo else np.partition(a, lo)
+    x0, x1 = float(part[lo]), float(part[hi])
+    t = virtual - lo
+    d = x1 - x0
+    return x1 - d * (1.0 - t) if t >= 0.5 else x0 + d * t  # numpy's _lerp
+
+
 def check_engine_args(image, hole, source, patch: int, name: str):
     """``(image (H, W, C) float32, hole bool, source bool)`` or a one-line ``WeftError``."""
     img = as_channels(image)

@@ -106,7 +106,7 @@ import numpy as np
 from ..errors import ImageError, InvalidParameter
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
-from .common import touches_border, whole_patches
+from .common import percentile, touches_border, whole_patches
 
 __all__ = ["fill_patchmatch", "refine_patchmatch", "MIN_PATCH", "MAX_PATCH"]
 
@@ -157,22 +157,6 @@ _GUIDE_WEIGHT = 1.0
 # brick 1.49 -> 1.42, uncrop 0.93 -> 0.87 against 4 and 2 iterations) for +0.027 s of CPU time
 # (0.145 -> 0.172 s in-process on the photo; 0.22 s before the faster distance and vote)
 _FINAL_REFINE, _FINAL_WORST = 3, 50
-
-
-def _percentile(values: np.ndarray, q: float) -> float:
-    """``np.percentile(values, q)`` (linear interpolation) of a non-empty vector, in float64, by
-    ``np.partition``: np.percentile imports numpy.ma (~7 ms of a fill's process start) on first use.
-    Equal to np.percentile on float64 input; on float32 within a float32 rounding (numpy computes
-    in the input's precision)."""
-    a = np.asarray(values, dtype=np.float64).ravel()
-    virtual = q / 100.0 * (len(a) - 1)
-    lo = int(np.floor(virtual))
-    hi = min(lo + 1, len(a) - 1)
-    part = np.partition(a, [lo, hi]) if hi != lo else np.partition(a, lo)
-    x0, x1 = float(part[lo]), float(part[hi])
-    t = virtual - lo
-    d = x1 - x0
-    return x1 - d * (1.0 - t) if t >= 0.5 else x0 + d * t  # numpy's _lerp
 
 
 def _box_sum(a: np.ndarray, p: int) -> np.ndarray:
@@ -302,7 +286,7 @@ def fill_patchmatch(
         Channels known everywhere, the hole included (:func:`weft.core.fill.structure.structure_guide`:
         for each edge continued across the hole, the side of it and the nearness to it). On every
         pyramid level they are matched like colours (weight ``_GUIDE_WEIGHT``), at full confidence
-        in the hole, and never filled: each level has their 2x2 means, put back after every vote.
+        in the hole, and never filled: each level has their 2x2 means, which the votes leave alone.
         The final refine does not see them (the layout is made; the refine only mends the copies'
         seams).
 
@@ -381,13 +365,13 @@ def fill_patchmatch(
             sy, sx = _random_matches(fl, gen)
         else:
             _upsample_into(im, lv.hole, pyramid[li + 1].img)
+            if keep is not None:
+                keep()
             coarse, fl = fl, _Flat(im, lv.hole, lv.source, p, conf=lv.conf, fixed=fixed)
             sy, sx = _upsample_matches(fl, coarse, sy, sx, gen)
             # the first estimate of this level: the coarse matches, doubled, voted (an upsampled
             # image would be blurred; matched against it, the flattest patches win)
-            _vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)))
-            if keep is not None:
-                keep()
+            _vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)), fixed=fixed)
         if schedule[li] > 0:
             everyone = np.arange(len(fl.ty))
             dist = fl.dist(fl.gather(fl.ty, fl.tx), everyone, sy, sx)
@@ -397,7 +381,7 @@ def fill_patchmatch(
                 report.update(done0 + _it + 1)
 
             _em(fl, im, lv.hole, sy, sx, dist, iterations=schedule[li], gen=gen, steps_first=_STEPS_FIRST,
-                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step, after_vote=keep)
+                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step, fixed=fixed)
             done += schedule[li]
     res = pyramid[0].img[..., :nch]
     if out.ndim == 2:
@@ -424,8 +408,8 @@ def _halve_plain(a: np.ndarray) -> np.ndarray:
 
 
 class _Keep:
-    """Puts a level's fixed channels (the guide) back into its hole after a vote or an estimate
-    wrote them."""
+    """Puts a level's fixed channels (the guide) back into its hole after its first estimate (the
+    onion peel, the upsampled coarser level) wrote them."""
 
     def __init__(self, img: np.ndarray, hole: np.ndarray, channels: slice):
         self.img, self.channels = img, channels
@@ -666,11 +650,13 @@ def _stable_argsort(values: np.ndarray) -> np.ndarray:
     return keys & np.int64(0xFFFFFFFF)
 
 
-def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight, stride: int = _VOTE_STRIDE) -> np.ndarray:
+def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight, stride: int = _VOTE_STRIDE,
+               fixed: slice | None = None) -> np.ndarray:
     """Every pixel of ``hole`` is copied through the offset (match minus target corner) that the
     target patches covering it agree on most (those at every ``stride``-th row and column of
     corners, and the last), each counted with its ``weight`` (0..1). numpy; writes ``img`` in place
-    and returns the pixels whose value changed (bool (H, W)).
+    (but its ``fixed`` channels, the guide's, the last ones) and returns the pixels whose value
+    changed (bool (H, W)).
 
     Each covering patch is one int64 key: its offset's code in the high bits, its weight as an
     integer (``weight * 2**(bits - 6)``, at least 1: a pixel whose votes all weigh nearly nothing
@@ -711,9 +697,10 @@ def _vote_mode(img: np.ndarray, hole: np.ndarray, fl: _Flat, sy, sx, weight, str
     bc = cs[np.arange(len(hy)), np.argmax(total, axis=1)]
     has = bc != none
     py, px = hy[has], hx[has]
-    new = img[py + bc[has] // span - h, px + bc[has] % span - w]
-    changed[py, px] = (new != img[py, px]).any(axis=1)
-    img[py, px] = new
+    cols = slice(None) if fixed is None else slice(0, fixed.start)
+    new = img[py + bc[has] // span - h, px + bc[has] % span - w, cols]
+    changed[py, px] = (new != img[py, px, cols]).any(axis=1)
+    img[py, px, cols] = new
     return changed
 
 
@@ -815,7 +802,7 @@ def refine_patchmatch(
 def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.ndarray, dist: np.ndarray, *,
         iterations: int, gen: np.random.Generator, steps_first: tuple[int, ...], shrink: int, bias: float,
         worst: float, cancel: CancelToken | None, on_iteration: Callable[[int], None],
-        last_stride: int | None = None, after_vote: Callable[[], None] | None = None) -> None:
+        last_stride: int | None = None, fixed: slice | None = None) -> None:
     """EM iterations on ``img`` (the array ``fl`` views), improving the matches (``sy``, ``sx``, their
     ``dist``) of ``fl``'s target patches and writing the hole's pixels, in place. Each iteration:
     (E) the inexact patches (a distance above 0; with ``worst``, at least that percentile of their
@@ -825,8 +812,8 @@ def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.nda
     covered by an inexact patch is copied through the offset its covering patches agree on most
     (:func:`_vote_mode`, weights ``exp(-d / 2 sigma^2)``). A patch that is an exact copy of its
     match is not searched again, and a pixel only such patches cover keeps its value (any of their
-    offsets gives it). ``after_vote()`` after each vote (puts the guide back), ``on_iteration(it)``
-    after each iteration."""
+    offsets gives it). The votes leave the ``fixed`` channels (the guide) as they are.
+    ``on_iteration(it)`` after each."""
     p = fl.p
     hv, wv = fl.valid.shape
     changed = None
@@ -837,7 +824,7 @@ def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.nda
             stale = np.nonzero(_box_sum(changed, p)[fl.ty, fl.tx] > 0.5)[0]
             dist[stale] = fl.dist(fl.gather(fl.ty[stale], fl.tx[stale]), stale, sy[stale], sx[stale])
         inexact_d = dist[dist > 0.0]
-        floor = _percentile(inexact_d, worst) if worst > 0 and len(inexact_d) else 0.0
+        floor = percentile(inexact_d, worst) if worst > 0 and len(inexact_d) else 0.0
         act = np.nonzero(dist > 0.0)[0] if floor <= 0.0 else np.nonzero(dist >= floor)[0]
         if len(act) == 0:
             break
@@ -857,12 +844,10 @@ def _em(fl: _Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.nda
             _try(fl, targets, act, sy, sx, dist, ry, rx, np.ones(len(act), bool))
             r //= shrink
         dn = fl.normalized(dist)
-        sigma2 = max(_percentile(dn, _SIGMA_PERCENTILE), 1e-12)
+        sigma2 = max(percentile(dn, _SIGMA_PERCENTILE), 1e-12)
         inexact = np.zeros((fl.h + p - 1, fl.w + p - 1), bool)  # pixels covered by a patch that is not an exact copy
         inexact[p - 1 + fl.ty[dist > 0.0], p - 1 + fl.tx[dist > 0.0]] = True
         stride = _VOTE_STRIDE if last_stride is None or it < iterations - 1 else last_stride
         changed = _vote_mode(img, hole & (_box_sum(inexact, p) > 0.5), fl, sy, sx, np.exp(-dn / (2.0 * sigma2)),
-                             stride)
-        if after_vote is not None:
-            after_vote()
+                             stride, fixed)
         on_iteration(it)

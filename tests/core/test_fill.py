@@ -472,9 +472,10 @@ def test_quilt_refines_colour_pictures_only():
 
 
 def test_default_fill_loads_neither_numba_nor_numpy_ma():
-    """The default engine's whole path (quilt, its refine on colour, the band) runs in numpy and
-    OpenCV: a ``weft fill`` process loads no numba (0.4-0.7 s of import and cache loads) and no
-    numpy.ma (np.percentile imports it: ~7 ms of every process, for two percentiles)."""
+    """The default engine's whole path (quilt, its refine on colour, the band), and ``--structure``'s
+    (its edges and patchmatch), run in numpy and OpenCV: a ``weft fill`` process loads no numba
+    (0.4-0.7 s of import and cache loads) and no numpy.ma (np.percentile imports it: ~7 ms of every
+    process, for two percentiles)."""
     import subprocess
     import sys
 
@@ -486,8 +487,9 @@ img = np.random.default_rng(0).random((64, 64, 3), dtype=np.float32)
 hole = np.zeros((64, 64), bool)
 hole[20:40, 24:44] = True
 for image in (img, img[..., 0]):
-    out = fill(image, hole, seed=1)
-    assert np.array_equal(out[:10], image[:10])
+    for structure in (False, True):
+        out = fill(image, hole, seed=1, structure=structure)
+        assert np.array_equal(out[:10], image[:10])
 print(" ".join(m for m in ("numba", "numpy.ma", "scipy.sparse", "weft.core._kernels") if m in sys.modules) or "none")
 """
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
@@ -496,13 +498,13 @@ print(" ".join(m for m in ("numba", "numpy.ma", "scipy.sparse", "weft.core._kern
 
 
 def test_refine_percentile_is_numpys():
-    from weft.core.fill.patchmatch import _percentile
+    from weft.core.fill.common import percentile
 
     rng = np.random.default_rng(2)
     for n in (1, 2, 3, 10, 999):
         a = np.round(rng.random(n) * 10, 1)
         for q in (0, 25, 50, 75, 99.5):
-            assert _percentile(a, q) == float(np.percentile(a, q))
+            assert percentile(a, q) == float(np.percentile(a, q))
 
 
 @pytest.mark.parametrize("engine", ["quilt", "hybrid"])
