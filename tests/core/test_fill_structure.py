@@ -166,6 +166,10 @@ def test_the_command_line_option(tmp_path, capsys):
     expected = fill(load_image(tmp_path / "disc.png").image, hole, structure=True, seed=1)
     as8 = lambda a: np.clip(np.rint(a * 255), 0, 255).astype(np.uint8)  # noqa: E731
     assert np.array_equal(as8(load_image(out).image), as8(expected))
+    # the recipe beside the output records the option: weft run reproduces the pixels
+    again = tmp_path / "again.png"
+    assert main(["run", str(out), "-o", str(again), "-q"]) == 0, capsys.readouterr().err
+    assert np.array_equal(load_image(again).image, load_image(out).image)
     # with the quilt engine: one line naming the parameter, exit 2, nothing written
     out2 = tmp_path / "out2.png"
     code = main(["fill", str(tmp_path / "disc.png"), "--mask", str(tmp_path / "mask.png"), "--structure",
