@@ -43,7 +43,8 @@ patch beside the curve must come from beside the edge, on the same side (:func:`
    One channel per edge, not one for all: a side is only a convention of each edge's curve, and
    near two parallel edges (a rim and its shadow's edge) one channel flipped sign half-way between
    them, a band that no source beside the edges matched (a red piece of rim left floating in the
-   shadow on one of the 18 random holes below).
+   shadow, on one of 18 random holes in six of scikit-image's photos; with a channel per edge the
+   rim ran on).
 
 ``reach`` 48 px: the measured trade on issue 15's photo (seeds 0-4, the guide matched on the
 pyramid's levels with weight 1 at full confidence; without the guide coherence 4.45 and the drip at
@@ -54,8 +55,9 @@ highlights into the wood (seeds 1 and 4), 36 one such highlight (seed 4), 48 non
 guide, the more of the hole knows which side of the rim it lies on. A weight of 0.3 or 0.5 brought
 the slivers back at 2-3 seeds. No peer continues this rim either (G'MIC ends it
 in a blob, shift-map in a vertical bar, pypatchmatch in a red smear). Not for textures: on issue
-15's gravel and brick the guide pairs the texture's own edges at random (coherence 9.24 -> 12.02,
-1.35 -> 3.02), which is why it is an option and not the default.
+15's gravel and brick the guide pairs the texture's own edges at random (the benchmark's seed:
+coherence 9.24 -> 11.02 and 1.28 -> 2.47 against ``patchmatch`` alone), which is why it is an
+option and not the default.
 """
 
 from __future__ import annotations
@@ -125,7 +127,6 @@ def structure_guide(image: np.ndarray, hole: np.ndarray, known: np.ndarray | Non
     jyy = cv2.GaussianBlur(gy * gy, (0, 0), _TENSOR)
     angle = 0.5 * np.arctan2(2.0 * jxy, jxx - jyy)  # the dominant gradient direction, unsigned
     depth = cv2.distanceTransform((~hole).astype(np.uint8), cv2.DIST_L2, 3)
-    yy, xx = np.mgrid[:h, :w]
     channels = []
     for a, b in pairs[:_MAX_EDGES]:
         # the structure: the curve, and the paired edges near the hole
@@ -147,13 +148,17 @@ def structure_guide(image: np.ndarray, hole: np.ndarray, known: np.ndarray | Non
         reached = _orient(struct, nx_, ny_, list(zip(ys.tolist(), xs.tolist())))
         d, labels = cv2.distanceTransformWithLabels((~reached).astype(np.uint8), cv2.DIST_L2, 5,
                                                     labelType=cv2.DIST_LABEL_PIXEL)
-        # label k (from 1) is the k-th structure pixel in row-major order
+        # within reach only (beyond it the guide is 0): label k (from 1) is the k-th structure
+        # pixel in row-major order
         zy, zx = np.nonzero(reached)
-        ly = np.concatenate([[0], zy])[labels]
-        lx = np.concatenate([[0], zx])[labels]
-        side = np.where((xx - lx) * nx_[ly, lx] + (yy - ly) * ny_[ly, lx] >= 0, 1.0, -1.0)
-        channels.append(side * np.maximum(0.0, 1.0 - d / float(reach)))
-    return np.stack(channels, axis=2).astype(np.float32), len(channels)
+        by, bx = np.nonzero(d < reach)
+        k = labels[by, bx] - 1
+        qy, qx = zy[k], zx[k]
+        side = np.where((bx - qx) * nx_[qy, qx] + (by - qy) * ny_[qy, qx] >= 0, 1.0, -1.0)
+        channel = np.zeros((h, w), np.float32)
+        channel[by, bx] = side * (1.0 - d[by, bx] / float(reach))
+        channels.append(channel)
+    return np.stack(channels, axis=2), len(channels)
 
 
 def _smooth_known(lum: np.ndarray, known: np.ndarray) -> np.ndarray:
