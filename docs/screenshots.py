@@ -1,4 +1,4 @@
-"""Render the README's screenshots from the real app: ``.venv/bin/python docs/screenshots.py``.
+"""Render the README's screenshots from the real app: ``.venv/bin/python docs/screenshots.py [NAME ...]``.
 
 Runs offscreen (``QT_QPA_PLATFORM=offscreen``); each shot opens the real main window with private
 settings, sets up a method the way a user would (inputs, parameters, prototype, lines), waits for the
@@ -91,6 +91,24 @@ def nfpt(window) -> None:
     window.input_tabs.setCurrentIndex(0)
 
 
+def fill(window) -> None:
+    """Fill and extend on issue 15's photo (``benchmarks/fill.py``: the spoon pasted over the saucer's
+    rim), its silhouette painted as the mask, with *structure* ticked: the rim continued."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    from benchmarks.fill import by_name
+
+    from weft.core.geometry import Mask
+    from weft.core.image import save_image
+
+    case = by_name()["fill-object"].build()
+    path = Path(tempfile.mkdtemp(prefix="weft-shot-")) / "saucer.png"
+    save_image(path, case.known_part.astype("float32") / 255.0)
+    doc = window.doc
+    doc.restore(DocumentState(inputs={"image": InputImage(str(path), load_image(path).image)}, method="fill"))
+    doc.set_mask(doc.mask_geometry("mask").key, Mask(case.hole), "Brush")
+    doc.set_param("structure", True)
+
+
 def affine(window) -> None:
     doc = window.doc
     doc.restore(DocumentState(inputs={"texture": _input("cat-fur")}, method="affine"))
@@ -98,15 +116,21 @@ def affine(window) -> None:
     doc.set_param("block", 16)
 
 
-SHOTS = {"fast": fast, "quilt": quilt, "affine": affine, "nfpt": nfpt}
+SHOTS = {"fast": fast, "quilt": quilt, "affine": affine, "nfpt": nfpt, "fill": fill}
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    """Every shot, or those named: ``docs/screenshots.py fill``."""
+    names = list(sys.argv[1:] if argv is None else argv) or list(SHOTS)
+    unknown = [n for n in names if n not in SHOTS]
+    if unknown:
+        print(f"screenshots.py: no shot named {', '.join(unknown)} (shots: {', '.join(SHOTS)})", file=sys.stderr)
+        return 2
     app = QApplication.instance() or QApplication(sys.argv[:1])
     OUT.mkdir(parents=True, exist_ok=True)
-    for name, setup in SHOTS.items():
+    for name in names:
         if name in registry.methods():
-            print(shoot(app, name, setup))
+            print(shoot(app, name, SHOTS[name]))
     return 0
 
 
