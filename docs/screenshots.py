@@ -100,8 +100,13 @@ def fill(window) -> None:
     from weft.core.geometry import Mask
     from weft.core.image import save_image
 
+    import atexit
+    import shutil
+
     case = by_name()["fill-object"].build()
-    path = Path(tempfile.mkdtemp(prefix="weft-shot-")) / "saucer.png"
+    folder = tempfile.mkdtemp(prefix="weft-shot-")  # the image's file, while the window reads it
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    path = Path(folder) / "saucer.png"
     save_image(path, case.known_part.astype("float32") / 255.0)
     doc = window.doc
     doc.restore(DocumentState(inputs={"image": InputImage(str(path), load_image(path).image)}, method="fill"))
