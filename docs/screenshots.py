@@ -25,6 +25,7 @@ from weft.core.examples import RESOURCES, example  # noqa: E402
 from weft.core.image import load_image  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "images"
+sys.path.insert(0, str(OUT.parent.parent))  # the fill shot builds its photo with benchmarks/fill.py
 
 
 def _wait(app, condition, timeout: float = 60.0) -> None:
@@ -94,7 +95,6 @@ def nfpt(window) -> None:
 def fill(window) -> None:
     """Fill and extend on issue 15's photo (``benchmarks/fill.py``: the spoon pasted over the saucer's
     rim), its silhouette painted as the mask, with *structure* ticked: the rim continued."""
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
     from benchmarks.fill import by_name
 
     from weft.core.geometry import Mask

@@ -175,8 +175,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        engine = "patchmatch" if params.structure else auto_engine(picture, touches_border(hole), params.patch)
-        params = params.replace(engine=engine)
+        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch, params.structure))
     patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
@@ -256,13 +255,14 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     # a small hole in a large picture: the engine fills the hole's neighbourhood alone
     near = neighbourhood(work_hole, work_src, patch) if texture is None else None
     part = (slice(None), slice(None)) if near is None else near
+    engine_kw = {k: v[part] for k, v in extra.items()}
     if params.structure:  # the edges entering the hole, continued across it (None: none pair up)
         from .structure import structure_guide
 
-        extra["guide"], continued = structure_guide(work[part], work_hole[part], ~work_hole[part] & ~transparent[part])
+        engine_kw["guide"], continued = structure_guide(work[part], work_hole[part],
+                                                        ~work_hole[part] & ~transparent[part])
     filled = _engine(params.engine)(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
-                                    progress=engine_report, cancel=cancel,
-                                    **{k: v if k == "guide" else v[part] for k, v in extra.items()})
+                                    progress=engine_report, cancel=cancel, **engine_kw)
     if near is not None:
         whole = np.array(work, dtype=np.float32)
         whole[near] = filled
@@ -352,8 +352,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
         h, w = h + margins.top + margins.bottom, w + margins.left + margins.right
     if params.engine == "auto":
         colour = len(shape) == 3 and shape[2] >= 3
-        params = params.replace(engine="patchmatch" if params.structure
-                                else auto_engine(colour, margins is not None, None))
+        params = params.replace(engine=auto_engine(colour, margins is not None, None, params.structure))
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 

@@ -147,7 +147,8 @@ _PYRAMID_SHRINK = 2  # the pyramid's random search radii: half the level, then /
 # 4.3 -> 5.1), nor on the finest (no effect).
 _COHERENCE_BIAS = 1.0
 # the guide's weight in the distance (its values are in [-1, 1]; the colours in [0, 1]): 1 continued
-# the photo's rim at seeds 0-4; 0.3 and 0.5 let the drip back as thin slivers at 2-3 of them
+# the photo's rim at seeds 0-4; 0.3 and 0.5 (at a reach of 24 and 16 px) let the drip back as thin
+# slivers at 2-3 of them
 _GUIDE_WEIGHT = 1.0
 # the final full-resolution refine (step 4): EM iterations, and the percentile of the inexact patches'
 # distances from which they are searched (the photo, seeds 0-4, measured with the one-patch pyramid
