@@ -90,9 +90,13 @@ the rim curved but the saucer swollen past it; the finished fill re-solved in th
 from each pixel's copy's own gradients (Poisson) 6.69, the drips smeared into tinted ghosts; the
 guide below with the low-pass colours instead of a signed nearness (diffused into the hole on each
 side of the curve) 7.10-8.66, the shadow lost. What continues the rim is a guide of where the edge
-runs, matched at every level: :mod:`weft.core.fill.structure` (``weft fill --structure yes``), at
-coherence 5.50 (the curved rim's patches are no verbatim copies; the measure prefers the drip) and
-an edge detection's time, so an option, not the default.
+runs: :mod:`weft.core.fill.structure` (``weft fill --structure yes``), matched on the coarsest level
+(see ``guide`` below), at coherence 4.92 (seeds 0-9; 4.62 without it; 5.43 when it was matched on
+every level) and an edge detection's and a refine iteration's time. Not the default: on 18 random
+holes in six photos it changes 5 (the others pair no edge), all less coherent (mean 5.36 -> 5.52),
+and looking at them, better on two (a saucer rim's red chunk, a retina's broken vessel continued),
+worse on one (a hole on the saucer's rim where the plain fill turns the rim in a clean corner: three
+parallel edges paired, the rim broken into pieces), the same on two.
 
 Every pixel outside the hole (and ``cuttable``) is returned exactly as given.
 """
@@ -147,8 +151,9 @@ _PYRAMID_SHRINK = 2  # the pyramid's random search radii: half the level, then /
 # 4.3 -> 5.1), nor on the finest (no effect).
 _COHERENCE_BIAS = 1.0
 # the guide's weight in the distance (its values are in [-1, 1]; the colours in [0, 1]): 1 continued
-# the photo's rim at seeds 0-4; 0.3 and 0.5 (at a reach of 24 and 16 px) let the drip back as thin
-# slivers at 2-3 of them
+# the photo's rim at seeds 0-4; 0.3 and 0.5 (at a reach of 24 and 16 px, matched on every level) let
+# the drip back as thin slivers at 2-3 of them. Matched on the coarsest level only (seeds 0-9
+# coherence medians): 0.5 5.06, 0.7 5.12, 1.0 4.92, 1.5 5.19
 _GUIDE_WEIGHT = 1.0
 # the final full-resolution refine (step 4): EM iterations, and the percentile of the inexact patches'
 # distances from which they are searched (the photo, seeds 0-4, measured with the one-patch pyramid
@@ -158,6 +163,10 @@ _GUIDE_WEIGHT = 1.0
 # brick 1.49 -> 1.42, uncrop 0.93 -> 0.87 against 4 and 2 iterations) for +0.027 s of CPU time
 # (0.145 -> 0.172 s in-process on the photo; 0.22 s before the faster distance and vote)
 _FINAL_REFINE, _FINAL_WORST = 3, 50
+# ... with a guide (its layout is mended from a level coarser than without one). The photo with its
+# rim's guide, seeds 0-9 coherence medians: 3 iterations 5.01, 4 4.92 (each seed 0.05-0.11 lower but
+# seed 0's), 5 4.85, 6 4.81; +15-20 ms of CPU time each
+_FINAL_REFINE_GUIDED = 4
 
 
 def _box_sum(a: np.ndarray, p: int) -> np.ndarray:
@@ -285,11 +294,15 @@ def fill_patchmatch(
         no Poisson blend for this engine).
     guide : float array (H, W) or (H, W, K), K = 1..8, optional
         Channels known everywhere, the hole included (:func:`weft.core.fill.structure.structure_guide`:
-        for each edge continued across the hole, the side of it and the nearness to it). On every
-        pyramid level they are matched like colours (weight ``_GUIDE_WEIGHT``), at full confidence
-        in the hole, and never filled: each level has their 2x2 means, which the votes leave alone.
-        The final refine does not see them (the layout is made; the refine only mends the copies'
-        seams).
+        for each edge continued across the hole, the side of it and the nearness to it). On the
+        coarsest pyramid level (their 2x2 means) they are matched like colours (weight
+        ``_GUIDE_WEIGHT``), at full confidence in the hole, and never filled: the votes leave them
+        alone. They lay the fill out; the finer levels and the final refine (``_FINAL_REFINE_GUIDED``
+        iterations) do not see them, and mend the copies' seams from that layout. (Matched on every
+        level, as first built, they continued the rim the same but held the whole fill to sources
+        at the same distance from the edge: issue 15's photo, seeds 0-9, coherence median 5.43,
+        against 4.92 now and 4.62 without a guide; windows within 12 px of the edge 6.56 -> 6.80,
+        beyond them 5.26 -> 4.72, seeds 0-4 medians.)
 
     Returns
     -------
@@ -322,10 +335,6 @@ def fill_patchmatch(
     nch = img.shape[2]
     if _FEATURE_WEIGHT > 0:
         img = np.ascontiguousarray(np.concatenate([img, _FEATURE_WEIGHT * _texture_features(img, hole)], axis=2))
-    fixed = None  # the guide's channels: never filled, matched at full confidence
-    if guide is not None:
-        fixed = slice(img.shape[2], img.shape[2] + guide.shape[2])
-        img = np.ascontiguousarray(np.concatenate([img, _GUIDE_WEIGHT * guide], axis=2))
 
     pyramid = [_Level(img.copy(), hole, source, p)]
     if pyramid[0].n_valid == 0:
@@ -342,37 +351,42 @@ def fill_patchmatch(
         nxt = _Level(*_halve(top.img, top.hole, top.source), p)
         if nxt.n_valid < min(_MIN_SOURCES, top.n_valid) or not nxt.hole.any():
             break
-        if fixed is not None:  # the guide is known in the hole too: the plain 2x2 means
-            nxt.img[..., fixed] = _halve_plain(top.img[..., fixed])
         pyramid.append(nxt)
 
     n = len(pyramid)
+    fixed = None  # the guide's channels on the coarsest level: never filled, matched at full confidence
+    if guide is not None:
+        top = pyramid[-1]
+        for _ in range(n - 1):  # the guide is known in the hole too: the plain 2x2 means
+            guide = _halve_plain(guide)
+        fixed = slice(top.img.shape[2], top.img.shape[2] + guide.shape[2])
+        top.img = np.ascontiguousarray(np.concatenate([top.img, _GUIDE_WEIGHT * guide], axis=2))
     if iterations is not None:
         schedule = [int(iterations)] * n
     else:  # by level, finest first (a single level is the coarsest)
         schedule = ([_EM_FINEST] + [_EM_MIDDLE] * (n - 2) + [_EM_COARSEST]) if n > 1 else [_EM_COARSEST]
-    report = ProgressReporter(progress, "fill", sum(schedule) + _FINAL_REFINE)
+    final = _FINAL_REFINE if guide is None else _FINAL_REFINE_GUIDED
+    report = ProgressReporter(progress, "fill", sum(schedule) + final)
     done = 0
     fl = sy = sx = None
     for li in range(n - 1, -1, -1):
         lv = pyramid[li]
         im = lv.img
-        keep = None if fixed is None else _Keep(im, lv.hole, fixed)
         if li == n - 1:
+            keep = None if fixed is None else _Keep(im, lv.hole, fixed)
             _onion_fill(im, lv.hole)
             if keep is not None:
                 keep()
             fl = _Flat(im, lv.hole, lv.source, p, conf=lv.conf, fixed=fixed)
             sy, sx = _random_matches(fl, gen)
         else:
-            _upsample_into(im, lv.hole, pyramid[li + 1].img)
-            if keep is not None:
-                keep()
-            coarse, fl = fl, _Flat(im, lv.hole, lv.source, p, conf=lv.conf, fixed=fixed)
+            fixed = None  # the guide steers the coarsest level's layout only
+            _upsample_into(im, lv.hole, pyramid[li + 1].img[..., :im.shape[2]])
+            coarse, fl = fl, _Flat(im, lv.hole, lv.source, p, conf=lv.conf)
             sy, sx = _upsample_matches(fl, coarse, sy, sx, gen)
             # the first estimate of this level: the coarse matches, doubled, voted (an upsampled
             # image would be blurred; matched against it, the flattest patches win)
-            _vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)), fixed=fixed)
+            _vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)))
         if schedule[li] > 0:
             everyone = np.arange(len(fl.ty))
             dist = fl.dist(fl.gather(fl.ty, fl.tx), everyone, sy, sx)
@@ -393,9 +407,9 @@ def fill_patchmatch(
     units = sum(schedule)
 
     def refine_progress(pr: Progress, done0=units) -> None:
-        report.update(done0 + int(round(pr.fraction * _FINAL_REFINE)))
+        report.update(done0 + int(round(pr.fraction * final)))
 
-    return refine_band(out, hole, region, source, patch=p, iterations=_FINAL_REFINE, rng=gen,
+    return refine_band(out, hole, region, source, patch=p, iterations=final, rng=gen,
                        progress=refine_progress if progress is not None else None, cancel=cancel, worst=_FINAL_WORST,
                        last_vote_stride=_LAST_STRIDE)
 
