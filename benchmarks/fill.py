@@ -18,7 +18,7 @@ ground truth:
 
 Each tool is a separate process (its whole-process time and peak resident memory, ``ru_maxrss`` of
 the child from ``wait4``, are its own): ``weft fill`` with its default engine, with each
-``--engine`` and with ``--structure yes``; G'MIC's ``inpaint_matchpatch`` (``gmic`` on the PATH); OpenCV's shift-map
+``--engine`` and with ``--engine patchmatch --structure no`` (the engine without its edge guide); G'MIC's ``inpaint_matchpatch`` (``gmic`` on the PATH); OpenCV's shift-map
 (``cv2.xphoto``), Telea and Navier-Stokes (``cv2.inpaint``, the smear reference) run by
 ``benchmarks/fill_peers.py``; ``pypatchmatch`` and the PyPI ``resynthesizer`` run by the same script
 under ``$WEFT_PEERS_PYTHON`` (default: this interpreter) when that environment has them. The peers
@@ -245,7 +245,8 @@ def _cv2_missing() -> str | None:
 TOOLS: list[Tool] = [
     Tool("weft", _weft_command(None), weft=True),
     *[Tool(f"weft --engine {e}", _weft_command(e), weft=True, engine=e) for e in WEFT_ENGINES],
-    Tool("weft --structure yes", _weft_command(None, "--structure", "yes"), weft=True, engine="patchmatch"),
+    Tool("weft --engine patchmatch --structure no", _weft_command("patchmatch", "--structure", "no"), weft=True,
+         engine="patchmatch"),
     Tool("G'MIC inpaint_matchpatch", _gmic_command,
          lambda: None if shutil.which("gmic") else "gmic is not on the PATH (Debian: apt-get install gmic)"),
     Tool("OpenCV xphoto shift-map", _peer_command("shiftmap", lambda: sys.executable), _cv2_missing),

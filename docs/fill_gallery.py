@@ -4,7 +4,8 @@
 
 One picture per case of ``python -m benchmarks 'fill-*'`` (``benchmarks/fill.py`` builds them from
 scikit-image's data): the input with the hole outlined in red, the ground truth, weft's fill (the
-default engine, seed 1; on the photo also with ``--structure yes``), then G'MIC
+default engine, seed 1; on the photo also ``--engine patchmatch --structure no``, the default
+without its edge guide), then G'MIC
 ``inpaint_matchpatch``, OpenCV's shift-map, ``pypatchmatch``, the PyPI Resynthesizer and (but on
 the photo) OpenCV Telea, each captioned with its coherence / detail / seam (the
 truth's own under the truth) and, when it changed known pixels, the largest change within 2 px of the
@@ -32,9 +33,11 @@ from weft.core.image import save_image  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 SHOWN = ["weft", bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyPI)", "OpenCV Telea"]
-# on the photo, weft's --structure takes the place of Telea (the smear reference; its figures stay in the table)
-SHOWN_OBJECT = ["weft", "weft --structure yes", bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyPI)"]
-SHORT = {"weft": "weft fill (default engine)", "weft --structure yes": "weft fill --structure yes",
+# on the photo, weft without its edge guide takes the place of Telea (the smear reference; its figures stay in
+# the table)
+NO_GUIDE = "weft --engine patchmatch --structure no"
+SHOWN_OBJECT = ["weft", NO_GUIDE, bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyPI)"]
+SHORT = {"weft": "weft fill (default engine)", NO_GUIDE: "weft fill --structure no",
          bench.GMIC: "G'MIC inpaint_matchpatch",
          bench.SHIFTMAP: "OpenCV shift-map", "pypatchmatch": "pypatchmatch",
          "Resynthesizer (PyPI)": "Resynthesizer", "OpenCV Telea": "OpenCV Telea"}

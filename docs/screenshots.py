@@ -94,7 +94,7 @@ def nfpt(window) -> None:
 
 def fill(window) -> None:
     """Fill and extend on issue 15's photo (``benchmarks/fill.py``: the spoon pasted over the saucer's
-    rim), its silhouette painted as the mask, with *structure* ticked: the rim continued."""
+    rim), its silhouette painted as the mask (*structure* auto: the rim continued)."""
     from benchmarks.fill import by_name
 
     from weft.core.geometry import Mask
@@ -111,7 +111,6 @@ def fill(window) -> None:
     doc = window.doc
     doc.restore(DocumentState(inputs={"image": InputImage(str(path), load_image(path).image)}, method="fill"))
     doc.set_mask(doc.mask_geometry("mask").key, Mask(case.hole), "Brush")
-    doc.set_param("structure", True)
 
 
 def affine(window) -> None:

@@ -232,7 +232,7 @@ def test_fill_weft_rows_run_the_command_line_on_a_hole_and_an_uncrop():
     rows = fill.run_fill_case(hole_case, repeats=1, quick=True, tools=fill.tools_named(["weft"]))
     weft_rows = [r for r in rows if r["tool"].startswith("weft")]
     assert [r["tool"] for r in weft_rows] == ["weft", *(f"weft --engine {e}" for e in fill.WEFT_ENGINES),
-                                              "weft --structure yes"]
+                                              "weft --engine patchmatch --structure no"]
     for row in weft_rows:
         assert "error" not in row, row
         assert row["known_max"] == 0 and row["reach_px"] <= fill.BAND and row["unfilled"] < 0.05

@@ -68,7 +68,7 @@ __all__ = ["ANCHORS", "DEFAULT_ENGINE", "DEFAULT_PATCH", "ENGINES", "FillParams"
 
 
 def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=None, patch=None, band=2,
-         structure=False, source_mask=None, texture=None, seed=0, progress=None, cancel=None) -> np.ndarray:
+         structure="auto", source_mask=None, texture=None, seed=0, progress=None, cancel=None) -> np.ndarray:
     """Fill the hole of ``image`` and/or extend its canvas; returns the filled float32 image.
 
     Parameters
@@ -83,7 +83,9 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
         picture, ``quilt`` otherwise), ``"quilt"``, ``"pixel"``, ``"patchmatch"`` or ``"hybrid"``.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
     structure : continue the strong edges that cross the hole along smooth curves
-        (:mod:`weft.core.fill.structure`; the ``patchmatch`` engine, which ``auto`` then runs).
+        (:mod:`weft.core.fill.structure`): ``"auto"`` (the default) whenever the ``patchmatch`` engine
+        fills from the picture itself, ``"yes"`` always (``auto`` then runs ``patchmatch``), ``"no"``
+        never; ``True`` / ``False`` are read as ``"yes"`` / ``"no"``.
     source_mask : (H, W) (of the texture when one is given): the only pixels to copy from.
     texture : ndarray: copy from this image instead of the rest of ``image``.
     seed : int or ``np.random.Generator``: the same seed gives the same pixels.
@@ -95,6 +97,8 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
 
     Raises ``WeftError`` (one line) for nothing to fill, a mask of another size, too little to copy from.
     """
+    if isinstance(structure, (bool, np.bool_)):
+        structure = "yes" if structure else "no"
     params = FillParams(engine=engine or DEFAULT_ENGINE, patch=patch, band=band, structure=structure,
                         extend=None if extend is None else Margins.coerce(extend),
                         size=None if size is None else tuple(size), anchor=anchor)

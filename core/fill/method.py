@@ -175,15 +175,17 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch, params.structure))
+        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch,
+                                                   params.structure == "yes"))
     patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
         raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
                      f"is {w}x{h}{grown})", "image", name="patch", value=patch)
-    if params.structure and texture is not None:
-        raise _error(InvalidParameter, "parameter 'structure' continues the picture's own edges across the hole: it "
-                     "cannot copy from a second texture", "texture", name="structure", value=True)
+    if params.structure == "yes" and texture is not None:
+        raise _error(InvalidParameter, "parameter 'structure' = yes continues the picture's own edges across the "
+                     "hole: it cannot copy from a second texture", "texture", name="structure", value="yes")
+    structure = params.continues_edges(texture is not None)
     # the source: where blocks are copied from
     if texture is not None:
         tex, _talpha = _split_alpha(texture, "texture")
@@ -256,7 +258,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     near = neighbourhood(work_hole, work_src, patch) if texture is None else None
     part = (slice(None), slice(None)) if near is None else near
     engine_kw = {k: v[part] for k, v in extra.items()}
-    if params.structure:  # the edges entering the hole, continued across it (None: none pair up)
+    if structure:  # the edges entering the hole, continued across it (None: none pair up)
         from .structure import structure_guide
 
         engine_kw["guide"], continued = structure_guide(work[part], work_hole[part],
@@ -289,7 +291,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     figures = {"engine": params.engine, "patch": patch, "hole_pixels": int(hole.sum()),
                "hole_fraction": round(float(hole.mean()), 4), "canvas": [int(cw), int(ch)],
                "source_pixels": int(src_region.sum())}
-    if params.structure:
+    if structure:
         figures["edges_continued"] = continued
     if margins:
         figures["extend"] = margins.to_json()
@@ -336,7 +338,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     box, and the variations grid centres its range on it): the patch the run takes (the engine's
     default, fitted to a small canvas; the quilt's border block for margins over 24 px); for
     ``auto``, that of the engine it runs for a hole inside a picture of this shape (``patchmatch``'s
-    in a colour picture or with ``structure``, ``quilt``'s in a grey one or when the canvas is
+    in a colour picture or with ``structure`` = yes, ``quilt``'s in a grey one or when the canvas is
     extended). From shapes alone a colour picture whose hole touches its border, or whose hole's
     surroundings are grey, resolves to ``patchmatch``'s patch where the run takes ``quilt``'s (the
     run's figures say which). Nothing before an image is open."""
@@ -352,7 +354,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
         h, w = h + margins.top + margins.bottom, w + margins.left + margins.right
     if params.engine == "auto":
         colour = len(shape) == 3 and shape[2] >= 3
-        params = params.replace(engine=auto_engine(colour, margins is not None, None, params.structure))
+        params = params.replace(engine=auto_engine(colour, margins is not None, None, params.structure == "yes"))
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 

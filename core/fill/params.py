@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from ..errors import InvalidParameter
@@ -32,6 +33,10 @@ DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7, "hybrid": 48}
 #: wood-grain (112 px wide: a 37-px block) lost the visible seam at the join, though its coherence
 #: went 2.38 -> 3.66.
 BORDER_BLOCK = 48
+#: ``structure``'s values (:mod:`weft.core.fill.structure`): the edges a hole cuts are continued
+#: whenever ``patchmatch`` fills from the picture itself (``auto``, the default), always (``yes``:
+#: ``auto`` then runs ``patchmatch``) or never (``no``).
+STRUCTURE = ("auto", "yes", "no")
 
 
 @dataclass(frozen=True)
@@ -58,19 +63,20 @@ class FillParams(Params):
     band: int = param(2, lo=0, hi=32,
                       help="blend band: known pixels up to this many px from the hole may change (Poisson "
                            "seam band); 0 = they never change")
-    structure: bool = param(False,
-                            help="continue the strong edges that cross the hole (a rim, a horizon) along smooth "
-                                 "curves, where patches alone run them on straight or drip; for an object removed "
-                                 "from a photo, not for textures (patchmatch engine)")
+    structure: str = param("auto", choices=STRUCTURE,
+                           help="continue the strong edges that cross the hole (a rim, a horizon) along smooth "
+                                "curves, where patches alone run them on straight or drip; auto: whenever the "
+                                "patchmatch engine runs on the picture's own pixels (no --texture); yes: always "
+                                "(auto then runs patchmatch); no: never")
 
     def check(self) -> None:
         if self.extend is not None and self.size is not None:
             raise InvalidParameter("parameters 'extend' and 'size' cannot be given together (both set the canvas)",
                                    name="size", value=self.size)
-        if self.structure and self.engine not in ("auto", "patchmatch"):
-            raise InvalidParameter(f"parameter 'structure' needs the patchmatch engine (or auto), not '{self.engine}'",
-                                   name="structure", value=self.structure)
-        if (self.engine == "patchmatch" or self.structure) and self.patch is not None:
+        if self.structure == "yes" and self.engine not in ("auto", "patchmatch"):
+            raise InvalidParameter(f"parameter 'structure' = yes needs the patchmatch engine (or auto), not "
+                                   f"'{self.engine}'", name="structure", value=self.structure)
+        if (self.engine == "patchmatch" or self.structure == "yes") and self.patch is not None:
             from .patchmatch import MAX_PATCH
 
             if self.patch > MAX_PATCH:
@@ -78,13 +84,29 @@ class FillParams(Params):
                 raise InvalidParameter(f"parameter 'patch' = {self.patch} is outside 3..{MAX_PATCH} {what}",
                                        name="patch", value=self.patch)
 
+    @classmethod
+    def from_dict(cls, data, *, base=None) -> "FillParams":
+        """As :meth:`Params.from_dict`; ``structure`` written as ``true`` / ``false`` (recipes and
+        sessions of the round in which it was an on/off switch, off by default) reads as ``yes`` /
+        ``no``, so they reproduce their pixels."""
+        if isinstance(data, Mapping) and isinstance(data.get("structure"), bool):
+            data = {**data, "structure": "yes" if data["structure"] else "no"}
+        return super().from_dict(data, base=base)
+
+    def continues_edges(self, texture: bool = False) -> bool:
+        """Whether the structure guide runs: ``yes``, or ``auto`` when the engine that runs (``auto``
+        resolved first) is ``patchmatch`` and the hole is filled from the picture itself."""
+        if self.structure == "yes":
+            return True
+        return self.structure == "auto" and self.engine == "patchmatch" and not texture
+
     def resolved_patch(self) -> int:
         """The patch side the engine runs with (``auto`` resolved first: :func:`auto_engine`)."""
         return self.patch if self.patch is not None else DEFAULT_PATCH[self.engine]
 
 
 def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: bool = False) -> str:
-    """The engine ``auto`` runs: ``patchmatch`` with ``structure`` (its guide is that engine's), and
+    """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (its guide is that engine's), and
     for a hole inside a colour picture (removing an
     object from a photo: coherence 4.45 against quilt's 5.40 on issue 15's photo, seeds 0-4), unless
     the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.24,

@@ -63,8 +63,10 @@ then the guide's fill redone within 12 or 24 px of the edge 5.08 / 5.43, with th
 the 12-px band. No peer continues this rim either (G'MIC ends it in a blob, shift-map in a vertical
 bar, pypatchmatch in a red smear). On textures the guide pairs the texture's own edges at random
 (issue 15's gravel and brick, the benchmark's seed, against ``patchmatch`` alone: 9.24 -> 9.51 and
-1.28 -> 1.61; 11.02 and 2.47 when it was matched on every level). It is an option, not the default:
-see :mod:`weft.core.fill.patchmatch` for what it does to other photos.
+1.28 -> 1.61; 11.02 and 2.47 when it was matched on every level); ``auto`` fills grey pictures with
+the quilt, which does not run it. ``weft fill --structure auto`` (the default) runs it whenever the
+``patchmatch`` engine fills from the picture itself: see :mod:`weft.core.fill.patchmatch` for what
+it does to other photos.
 """
 
 from __future__ import annotations

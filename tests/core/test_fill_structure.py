@@ -88,8 +88,8 @@ def test_no_edges_to_pair_no_guide_and_the_same_pixels_as_without():
     hole = np.zeros((96, 96), bool)
     hole[30:60, 35:65] = True
     assert structure_guide(img, hole) == (None, 0)
-    a, fa = fill_image(img, hole, params=FillParams(structure=True), rng=2)
-    b, fb = fill_image(img, hole, params=FillParams(engine="patchmatch"), rng=2)
+    a, fa = fill_image(img, hole, params=FillParams(structure="yes"), rng=2)
+    b, fb = fill_image(img, hole, params=FillParams(engine="patchmatch", structure="no"), rng=2)
     assert np.array_equal(a, b)
     assert fa["edges_continued"] == 0 and fa["engine"] == "patchmatch" and "edges_continued" not in fb
 
@@ -97,15 +97,15 @@ def test_no_edges_to_pair_no_guide_and_the_same_pixels_as_without():
 def test_a_structure_fill_keeps_the_circles_edge_known_pixels_and_its_seed():
     img, region = _picture()
     hole = _hole_on(80, 225, 16)
-    out, figures = fill_image(img, hole, params=FillParams(structure=True), rng=1)
+    out, figures = fill_image(img, hole, params=FillParams(structure="yes"), rng=1)
     assert figures["edges_continued"] == 1 and figures["engine"] == "patchmatch"
     red = out[..., 1] < 0.35  # the disc's pixels (green 0.12; the ground's 0.65)
     wrong = (red != (region > 0)) & hole
     assert wrong.sum() <= 0.03 * hole.sum()
     keep = ~hole & ~band_region(hole, 2)
     assert np.array_equal(out[keep], img[keep])
-    again, _ = fill_image(img, hole, params=FillParams(structure=True), rng=1)
-    other, _ = fill_image(img, hole, params=FillParams(structure=True), rng=2)
+    again, _ = fill_image(img, hole, params=FillParams(structure="yes"), rng=1)
+    other, _ = fill_image(img, hole, params=FillParams(structure="yes"), rng=2)
     assert np.array_equal(out, again) and not np.array_equal(out, other)
 
 
@@ -141,14 +141,45 @@ def test_the_guide_is_checked_by_the_engine():
         fill_patchmatch(img, hole, guide=bad)
 
 
-def test_structure_with_another_engine_or_a_texture_is_refused():
-    with pytest.raises(InvalidParameter, match="parameter 'structure' needs the patchmatch engine .or auto., not 'quilt'"):
-        FillParams(engine="quilt", structure=True)
+def test_structure_yes_with_another_engine_or_a_texture_is_refused():
+    with pytest.raises(InvalidParameter,
+                       match="parameter 'structure' = yes needs the patchmatch engine .or auto., not 'quilt'"):
+        FillParams(engine="quilt", structure="yes")
     with pytest.raises(InvalidParameter, match=r"parameter 'patch' = 64 is outside 3..63 with 'structure'"):
-        FillParams(structure=True, patch=64)
+        FillParams(structure="yes", patch=64)
+    with pytest.raises(InvalidParameter, match=r"parameter 'structure' = 'on' is not one of auto, yes, no"):
+        FillParams(structure="on")
     img, _ = _picture()
     with pytest.raises(InvalidParameter, match="cannot copy from a second texture"):
         fill(img, _hole_on(80, 225, 16), structure=True, texture=img)
+
+
+def test_auto_continues_the_edges_whenever_patchmatch_runs_on_the_picture_itself():
+    """The default, ``auto``: on a colour picture ``auto`` runs patchmatch and the guide with it (the
+    same pixels as ``yes``); with ``no`` the edge is not continued; the quilt (``--engine quilt``, a grey
+    picture) and a fill from a second texture run without it, and say nothing of edges."""
+    img, region = _picture()
+    hole = _hole_on(80, 225, 16)
+    auto, fa = fill_image(img, hole, params=FillParams(), rng=1)
+    yes, _ = fill_image(img, hole, params=FillParams(structure="yes"), rng=1)
+    no, fn = fill_image(img, hole, params=FillParams(structure="no"), rng=1)
+    assert fa["engine"] == "patchmatch" and fa["edges_continued"] == 1 and np.array_equal(auto, yes)
+    assert fn["engine"] == "patchmatch" and "edges_continued" not in fn and not np.array_equal(auto, no)
+    # fill(..., structure=True / False) reads as yes / no
+    assert np.array_equal(fill(img, hole, seed=1, structure=False), no)
+    _, fq = fill_image(img, hole, params=FillParams(engine="quilt"), rng=1)
+    _, fg = fill_image(img[..., 0], hole, params=FillParams(), rng=1)
+    _, ft = fill_image(img, hole, params=FillParams(engine="patchmatch"), texture=img, rng=1)
+    assert fq["engine"] == "quilt" and fg["engine"] == "quilt" and ft["engine"] == "patchmatch"
+    assert all("edges_continued" not in f for f in (fq, fg, ft))
+
+
+def test_recipes_of_the_on_off_switch_read_as_yes_and_no():
+    """``structure`` was an on/off switch (off by default) for one round: its recipes and sessions
+    wrote true / false, and reproduce their pixels as yes / no."""
+    assert FillParams.from_dict({"structure": True}).structure == "yes"
+    assert FillParams.from_dict({"structure": False, "engine": "quilt"}).structure == "no"
+    assert FillParams.from_dict({}).structure == "auto"
 
 
 def test_the_command_line_option(tmp_path, capsys):
@@ -173,16 +204,16 @@ def test_the_command_line_option(tmp_path, capsys):
     # with the quilt engine: one line naming the parameter, exit 2, nothing written
     out2 = tmp_path / "out2.png"
     code = main(["fill", str(tmp_path / "disc.png"), "--mask", str(tmp_path / "mask.png"), "--structure",
-                 "on", "--engine", "quilt", "-o", str(out2), "-q"])
+                 "yes", "--engine", "quilt", "-o", str(out2), "-q"])
     err = capsys.readouterr().err
     assert code == 2 and not out2.exists()
-    assert err.strip().count("\n") == 0 and "parameter 'structure' needs the patchmatch engine" in err
+    assert err.strip().count("\n") == 0 and "parameter 'structure' = yes needs the patchmatch engine" in err
 
 
 def test_the_studio_shows_the_patch_the_structure_run_takes():
-    """With ``structure``, ``auto`` runs patchmatch whatever the picture: its 7 px patch, not the
+    """With ``structure`` = yes, ``auto`` runs patchmatch whatever the picture: its 7 px patch, not the
     quilt's 24 a grey picture would get."""
     from weft.core.fill.method import STUDIO
 
     assert STUDIO.auto(FillParams(), {"image": (96, 96)}) == {"patch": 24}
-    assert STUDIO.auto(FillParams(structure=True), {"image": (96, 96)}) == {"patch": 7}
+    assert STUDIO.auto(FillParams(structure="yes"), {"image": (96, 96)}) == {"patch": 7}
