@@ -91,7 +91,7 @@ from each pixel's copy's own gradients (Poisson) 6.69, the drips smeared into ti
 guide below with the low-pass colours instead of a signed nearness (diffused into the hole on each
 side of the curve) 7.10-8.66, the shadow lost. What continues the rim is a guide of where the edge
 runs: :mod:`weft.core.fill.structure` (``weft fill --structure yes``), matched on the coarsest level
-(see ``guide`` below), at coherence 4.92 (seeds 0-9; 4.62 without it; 5.43 when it was matched on
+(see ``guide`` below), at coherence 5.01 (seeds 0-9; 4.62 without it; 5.43 when it was matched on
 every level) and an edge detection's and a refine iteration's time. ``weft fill`` runs it whenever
 this engine fills from the picture itself (``--structure auto``, the default; ``no`` turns it off).
 On 18 random holes in six photos it changes 5 (the others pair no edge), all less coherent (mean
@@ -139,6 +139,12 @@ _FEATURE_WEIGHT = 3.0  # weight of Newson's texture features (two extra channels
 # cases more coherent (gravel 9.36 -> 9.24, brick 1.42 -> 1.35, uncrop 0.87 -> 0.85), for +0.015 s of
 # CPU time (0.175 -> 0.19 s in-process on the photo)
 _EM_FINEST, _EM_MIDDLE, _EM_COARSEST = 0, 8, 12
+# ... with a guide, which steers the coarsest level's layout: the photo with its rim's guide, seeds
+# 0-19 coherence medians, 12 and 8 iterations 5.10 / 5.08 on the coarsest level (6: 5.27, 17 ms less
+# CPU time for 8), then 8 and 6 on the intermediate one 5.08 / 5.08 (7: 4.98; 22 ms less for 6): the
+# seeds differ by up to 1.0, so these medians differ by noise; the guided fill's time is the one near
+# G'MIC's (the whole process 0.35-0.37 s against 0.35-0.36 s)
+_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED = 6, 8
 # the votes count the covering patches at every _VOTE_STRIDE-th corner row and column, but the final
 # refine's last vote counts every one (stride 1): with 9 of the 49 votes neighbouring pixels of an
 # incoherent region went through different offsets and the fill was speckled (gravel: |Laplacian| in
@@ -156,7 +162,7 @@ _COHERENCE_BIAS = 1.0
 # the guide's weight in the distance (its values are in [-1, 1]; the colours in [0, 1]): 1 continued
 # the photo's rim at seeds 0-4; 0.3 and 0.5 (at a reach of 24 and 16 px, matched on every level) let
 # the drip back as thin slivers at 2-3 of them. Matched on the coarsest level only (seeds 0-9
-# coherence medians): 0.5 5.06, 0.7 5.12, 1.0 4.92, 1.5 5.19
+# coherence medians, with 12 / 8 EM iterations and 4 final ones): 0.5 5.06, 0.7 5.12, 1.0 4.92, 1.5 5.19
 _GUIDE_WEIGHT = 1.0
 # the final full-resolution refine (step 4): EM iterations, and the percentile of the inexact patches'
 # distances from which they are searched (the photo, seeds 0-4, measured with the one-patch pyramid
@@ -167,8 +173,8 @@ _GUIDE_WEIGHT = 1.0
 # (0.145 -> 0.172 s in-process on the photo; 0.22 s before the faster distance and vote)
 _FINAL_REFINE, _FINAL_WORST = 3, 50
 # ... with a guide (its layout is mended from a level coarser than without one). The photo with its
-# rim's guide, seeds 0-9 coherence medians: 3 iterations 5.01, 4 4.92 (each seed 0.05-0.11 lower but
-# seed 0's), 5 4.85, 6 4.81; +15-20 ms of CPU time each
+# rim's guide, seeds 0-9 coherence medians (with 12 / 8 EM iterations): 3 iterations 5.01, 4 4.92
+# (each seed 0.05-0.11 lower but seed 0's), 5 4.85, 6 4.81; +10-20 ms of CPU time each
 _FINAL_REFINE_GUIDED = 4
 
 
@@ -288,8 +294,9 @@ def fill_patchmatch(
         patches and both sides >= 2 patches.
     iterations : int, optional
         EM iterations on every level (all channels, confidence-weighted); default 12 on the
-        coarsest, 8 on the intermediate ones, none on the finest (a single level gets 12). Three refine
-        iterations on the image's own channels always follow (:func:`refine_band`).
+        coarsest, 8 on the intermediate ones (with a ``guide`` 8 and 6), none on the finest (a single
+        level gets the coarsest's). Three refine iterations on the image's own channels always follow (four
+        with a ``guide``: :func:`refine_band`).
     cuttable : bool array (H, W), optional
         Known pixels that may change (the method's blend band): the finished fill, these pixels and
         the hole are then refined together by :func:`refine_patchmatch`, copying only from source
@@ -304,8 +311,8 @@ def fill_patchmatch(
         iterations) do not see them, and mend the copies' seams from that layout. (Matched on every
         level, as first built, they continued the rim the same but held the whole fill to sources
         at the same distance from the edge: issue 15's photo, seeds 0-9, coherence median 5.43,
-        against 4.92 now and 4.62 without a guide; windows within 12 px of the edge 6.56 -> 6.80,
-        beyond them 5.26 -> 4.72, seeds 0-4 medians.)
+        against 5.01 now and 4.62 without a guide; windows within 12 px of the edge 6.56 -> 6.80,
+        beyond them 5.26 -> 4.72, seeds 0-4 medians, with 12 / 8 EM iterations.)
 
     Returns
     -------
@@ -367,7 +374,8 @@ def fill_patchmatch(
     if iterations is not None:
         schedule = [int(iterations)] * n
     else:  # by level, finest first (a single level is the coarsest)
-        schedule = ([_EM_FINEST] + [_EM_MIDDLE] * (n - 2) + [_EM_COARSEST]) if n > 1 else [_EM_COARSEST]
+        middle, coarsest = (_EM_MIDDLE, _EM_COARSEST) if guide is None else (_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED)
+        schedule = ([_EM_FINEST] + [middle] * (n - 2) + [coarsest]) if n > 1 else [coarsest]
     final = _FINAL_REFINE if guide is None else _FINAL_REFINE_GUIDED
     report = ProgressReporter(progress, "fill", sum(schedule) + final)
     done = 0
