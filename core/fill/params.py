@@ -88,7 +88,8 @@ class FillParams(Params):
     def from_dict(cls, data, *, base=None) -> "FillParams":
         """As :meth:`Params.from_dict`; ``structure`` written as ``true`` / ``false`` (recipes and
         sessions of the round in which it was an on/off switch, off by default) reads as ``yes`` /
-        ``no``, so they reproduce their pixels."""
+        ``no`` (a ``false`` one reproduces its pixels; a ``true`` one gets this round's guide, which
+        lays out the coarsest level only)."""
         if isinstance(data, Mapping) and isinstance(data.get("structure"), bool):
             data = {**data, "structure": "yes" if data["structure"] else "no"}
         return super().from_dict(data, base=base)
