@@ -95,9 +95,11 @@ runs: :mod:`weft.core.fill.structure` (``weft fill --structure yes``), matched o
 every level) and an edge detection's and a refine iteration's time. ``weft fill`` runs it whenever
 this engine fills from the picture itself (``--structure auto``, the default; ``no`` turns it off).
 On 18 random holes in six photos it changes 5 (the others pair no edge), all less coherent (mean
-5.36 -> 5.52), and looking at them, better on two (a saucer rim's red chunk, a retina's broken
-vessel continued), worse on one (a hole on the saucer's rim where the plain fill turns the rim in a
-clean corner: three parallel edges paired, the rim broken into pieces), the same on two; on the
+5.36 -> 5.51), and looking at them, better on two (a saucer rim's red chunk, a retina's broken
+vessel continued), the same on two, and on a hole over the saucer's rim where the plain fill turns
+the rim in a clean corner the rim runs on in a curve, with a paler patch of wood below it (three
+edges along the rim paired: with their channels at full weight each, the rim came out broken; see
+``_GUIDE_WEIGHT``); on the
 coffee photo enlarged 6x, of three 90-px holes one pairs an edge (the rim) and gets a dark blob
 beside it where the plain fill made a small bump.
 
@@ -162,7 +164,13 @@ _COHERENCE_BIAS = 1.0
 # the guide's weight in the distance (its values are in [-1, 1]; the colours in [0, 1]): 1 continued
 # the photo's rim at seeds 0-4; 0.3 and 0.5 (at a reach of 24 and 16 px, matched on every level) let
 # the drip back as thin slivers at 2-3 of them. Matched on the coarsest level only (seeds 0-9
-# coherence medians, with 12 / 8 EM iterations and 4 final ones): 0.5 5.06, 0.7 5.12, 1.0 4.92, 1.5 5.19
+# coherence medians, with 12 / 8 EM iterations and 4 final ones): 0.5 5.06, 0.7 5.12, 1.0 4.92, 1.5 5.19.
+# Several continued edges share it, each channel scaled by 1 / their number: on a hole over the rim
+# of scikit-image's coffee (coffee()[100:400, 0:300], three edges along the rim paired) the rim came
+# out broken, with dark or pale pieces where it enters the hole, at every seed 0-4 with weight 1 per
+# channel; with 1 / sqrt(their number) a dark blob there (seed 0); with 1 / their number it ran on
+# whole at 2 seeds, with a small step or notch at 3 (coherence medians 6.20 / 6.32: the same). One
+# edge (the benchmark photo): as before
 _GUIDE_WEIGHT = 1.0
 # the final full-resolution refine (step 4): EM iterations, and the percentile of the inexact patches'
 # distances from which they are searched (the photo, seeds 0-4, measured with the one-patch pyramid
@@ -306,7 +314,7 @@ def fill_patchmatch(
         Channels known everywhere, the hole included (:func:`weft.core.fill.structure.structure_guide`:
         for each edge continued across the hole, the side of it and the nearness to it). On the
         coarsest pyramid level (their 2x2 means) they are matched like colours (weight
-        ``_GUIDE_WEIGHT``), at full confidence in the hole, and never filled: the votes leave them
+        ``_GUIDE_WEIGHT`` / K), at full confidence in the hole, and never filled: the votes leave them
         alone. They lay the fill out; the finer levels and the final refine (``_FINAL_REFINE_GUIDED``
         iterations) do not see them, and mend the copies' seams from that layout. (Matched on every
         level, as first built, they continued the rim the same but held the whole fill to sources
@@ -370,7 +378,8 @@ def fill_patchmatch(
         for _ in range(n - 1):  # the guide is known in the hole too: the plain 2x2 means
             guide = _halve_plain(guide)
         fixed = slice(top.img.shape[2], top.img.shape[2] + guide.shape[2])
-        top.img = np.ascontiguousarray(np.concatenate([top.img, _GUIDE_WEIGHT * guide], axis=2))
+        # several edges share the weight: each channel is scaled by 1 / their number
+        top.img = np.ascontiguousarray(np.concatenate([top.img, (_GUIDE_WEIGHT / guide.shape[2]) * guide], axis=2))
     if iterations is not None:
         schedule = [int(iterations)] * n
     else:  # by level, finest first (a single level is the coarsest)
