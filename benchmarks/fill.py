@@ -18,11 +18,12 @@ ground truth:
 
 Each tool is a separate process (its whole-process time and peak resident memory, ``ru_maxrss`` of
 the child from ``wait4``, are its own): ``weft fill`` with its default engine, with each
-``--engine`` and with ``--engine patchmatch --structure no`` (the engine without its edge guide); G'MIC's ``inpaint_matchpatch`` (``gmic`` on the PATH); OpenCV's shift-map
-(``cv2.xphoto``), Telea and Navier-Stokes (``cv2.inpaint``, the smear reference) run by
-``benchmarks/fill_peers.py``; ``pypatchmatch`` and the PyPI ``resynthesizer`` run by the same script
-under ``$WEFT_PEERS_PYTHON`` (default: this interpreter) when that environment has them. The peers
-are never dependencies of weft: a peer that is not installed gets a row saying so.
+``--engine`` and with ``--engine patchmatch --structure no`` (the engine without its edge guide);
+G'MIC's ``inpaint_matchpatch`` (``gmic`` on the PATH); OpenCV's shift-map (``cv2.xphoto``), Telea
+and Navier-Stokes (``cv2.inpaint``, the smear reference) run by ``benchmarks/fill_peers.py``;
+``pypatchmatch`` and the PyPI ``resynthesizer`` run by the same script under ``$WEFT_PEERS_PYTHON``
+(default: this interpreter) when that environment has them. The peers are never dependencies of
+weft: a peer that is not installed gets a row saying so.
 
 Per case: one untimed warm-up run per tool (numba's and the OS's caches), then ``repeats`` rounds
 that run every tool once each, in turn, so that machine noise hits them alike; the table gives the

@@ -379,11 +379,13 @@ def fill_patchmatch(
             guide = _halve_plain(guide)
         fixed = slice(top.img.shape[2], top.img.shape[2] + guide.shape[2])
         # several edges share the weight: each channel is scaled by 1 / their number
-        top.img = np.ascontiguousarray(np.concatenate([top.img, (_GUIDE_WEIGHT / guide.shape[2]) * guide], axis=2))
+        weight = _GUIDE_WEIGHT / guide.shape[2]
+        top.img = np.ascontiguousarray(np.concatenate([top.img, weight * guide], axis=2))
     if iterations is not None:
         schedule = [int(iterations)] * n
     else:  # by level, finest first (a single level is the coarsest)
-        middle, coarsest = (_EM_MIDDLE, _EM_COARSEST) if guide is None else (_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED)
+        middle, coarsest = ((_EM_MIDDLE, _EM_COARSEST) if guide is None
+                            else (_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED))
         schedule = ([_EM_FINEST] + [middle] * (n - 2) + [coarsest]) if n > 1 else [coarsest]
     final = _FINAL_REFINE if guide is None else _FINAL_REFINE_GUIDED
     report = ProgressReporter(progress, "fill", sum(schedule) + final)
