@@ -59,7 +59,7 @@ import numpy as np
 
 from ..geometry import Margins
 from .method import METHOD, fill_image, warm_up
-from .params import ANCHORS, DEFAULT_ENGINE, DEFAULT_PATCH, ENGINES, FillParams
+from .params import ANCHORS, DEFAULT_ENGINE, DEFAULT_PATCH, ENGINES, FillParams, structure_value
 from .pixel import fill_pixel
 from .quilt import fill_quilt
 
@@ -97,9 +97,7 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
 
     Raises ``WeftError`` (one line) for nothing to fill, a mask of another size, too little to copy from.
     """
-    if isinstance(structure, (bool, np.bool_)):
-        structure = "yes" if structure else "no"
-    params = FillParams(engine=engine or DEFAULT_ENGINE, patch=patch, band=band, structure=structure,
+    params = FillParams(engine=engine or DEFAULT_ENGINE, patch=patch, band=band, structure=structure_value(structure),
                         extend=None if extend is None else Margins.coerce(extend),
                         size=None if size is None else tuple(size), anchor=anchor)
     out, _figures = fill_image(image, mask, params=params, source_mask=source_mask, texture=texture, rng=seed,

@@ -175,8 +175,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch,
-                                                   params.structure == "yes"))
+        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch, params.structure))
     patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
@@ -354,7 +353,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
         h, w = h + margins.top + margins.bottom, w + margins.left + margins.right
     if params.engine == "auto":
         colour = len(shape) == 3 and shape[2] >= 3
-        params = params.replace(engine=auto_engine(colour, margins is not None, None, params.structure == "yes"))
+        params = params.replace(engine=auto_engine(colour, margins is not None, None, params.structure))
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 

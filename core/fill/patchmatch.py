@@ -372,9 +372,10 @@ def fill_patchmatch(
         pyramid.append(nxt)
 
     n = len(pyramid)
+    top = pyramid[-1]
+    _onion_fill(top.img, top.hole)  # the coarsest level's start
     fixed = None  # the guide's channels on the coarsest level: never filled, matched at full confidence
     if guide is not None:
-        top = pyramid[-1]
         for _ in range(n - 1):  # the guide is known in the hole too: the plain 2x2 means
             guide = _halve_plain(guide)
         fixed = slice(top.img.shape[2], top.img.shape[2] + guide.shape[2])
@@ -395,10 +396,6 @@ def fill_patchmatch(
         lv = pyramid[li]
         im = lv.img
         if li == n - 1:
-            keep = None if fixed is None else _Keep(im, lv.hole, fixed)
-            _onion_fill(im, lv.hole)
-            if keep is not None:
-                keep()
             fl = _Flat(im, lv.hole, lv.source, p, conf=lv.conf, fixed=fixed)
             sy, sx = _random_matches(fl, gen)
         else:
@@ -442,19 +439,6 @@ def _halve_plain(a: np.ndarray) -> np.ndarray:
     h, w = a.shape[:2]
     a = np.pad(a, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
     return a.reshape(a.shape[0] // 2, 2, a.shape[1] // 2, 2, -1).mean(axis=(1, 3), dtype=np.float32)
-
-
-class _Keep:
-    """Puts a level's fixed channels (the guide) back into its hole after its first estimate (the
-    onion peel, the upsampled coarser level) wrote them."""
-
-    def __init__(self, img: np.ndarray, hole: np.ndarray, channels: slice):
-        self.img, self.channels = img, channels
-        self.ys, self.xs = np.nonzero(hole)
-        self.values = img[self.ys, self.xs, channels].copy()
-
-    def __call__(self) -> None:
-        self.img[self.ys, self.xs, self.channels] = self.values
 
 
 def _texture_features(img: np.ndarray, hole: np.ndarray) -> np.ndarray:
