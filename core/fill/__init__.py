@@ -25,13 +25,16 @@ hole; the method then runs no Poisson blend for them.
 
 **The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE`, ``auto``
 (:func:`~weft.core.fill.params.auto_engine`): ``patchmatch`` for a hole inside a colour picture,
-``quilt`` otherwise; the figures name the engine that ran. Measured on issue 15's cases (seeds 0-4
-medians, ``python -m benchmarks.fill --seeds 0-4``; coherence / detail / seam against the truth's):
-on the photo ``patchmatch`` is the most coherent of weft's engines (4.45 / 1.02 / -0.04 against
-``quilt``'s 5.40 / 1.08 / +0.01; at the benchmark's seed 4.42 against G'MIC's 6.42 and 1.2x
-shift-map's 4.99), in a whole process of 0.30 s against G'MIC's 0.33 s (interleaved, medians of
-9); on the grey textures and the uncrop ``quilt`` is the more coherent (gravel 9.01 against 9.24,
-brick 1.05 against 1.35, uncrop 0.81 against 0.85) and the quicker (0.19-0.27 s whole processes),
+with the edge guide of :mod:`weft.core.fill.structure` (``structure`` ``auto``), ``quilt``
+otherwise; the figures name the engine that ran. Measured on issue 15's cases (seeds 0-4 medians,
+``python -m benchmarks.fill --seeds 0-4``; coherence / detail / seam against the truth's): on the
+photo ``patchmatch`` is the most coherent of weft's engines (without the guide 4.45 / 1.02 / -0.04
+against ``quilt``'s 5.40 / 1.08 / +0.01); with the guide, which continues the saucer's rim where
+patch search alone drips it, 5.05 / 1.00 / +0.05 (at the benchmark's seed 4.78 against G'MIC's
+6.58 and 1.2x shift-map's 4.99), in a whole process of 0.34-0.35 s against G'MIC's 0.36-0.37 s
+(interleaved, medians of 15, two rounds); on the grey textures and the uncrop ``quilt`` is the
+more coherent (gravel 9.01 against 9.24, brick 1.05 against 1.35, uncrop 0.81 against 0.85) and
+the quicker (0.19-0.27 s whole processes),
 and it keeps brick mortar straight where ``patchmatch`` bends it. ``hybrid`` (quilt with 48-px
 blocks, then the refine) is more coherent than ``quilt`` on the textures but leaves a red ghost of
 the spoon's handle on the photo (coherence 5.56 there, in 0.28 s against G'MIC's 0.38 s in the
@@ -42,10 +45,11 @@ the peers" has the tables and the pictures.
 **Known pixels** are never changed except within the blend band (``--band``, default 2 px): the
 quilting engine's minimum-error cut may run through the known pixels within ``band`` px of the hole,
 and then (on grey pictures) the pixels within ``band`` px (8-connected) of the hole's edge, on both
-sides, are re-solved by a Poisson equation whose guidance is the image's own gradients except across the hole's edge, where the
-step beyond twice the texture's own is replaced by the continued slope of both sides
-(:mod:`weft.core.fill.band`; ``patchmatch``, ``hybrid`` and ``quilt`` on colour pictures
-re-synthesise the band instead); every pixel further away is bit-identical to the input. ``--band 0``: no known pixel changes.
+sides, are re-solved by a Poisson equation whose guidance is the image's own gradients except
+across the hole's edge, where the step beyond twice the texture's own is replaced by the continued
+slope of both sides (:mod:`weft.core.fill.band`; ``patchmatch``, ``hybrid`` and ``quilt`` on colour
+pictures re-synthesise the band instead); every pixel further away is bit-identical to the input.
+``--band 0``: no known pixel changes.
 
 **Alpha.** The image keeps its alpha channel (``InputSpec.alpha``): with no mask its transparent pixels
 are the hole; transparent pixels are never copied from; the output is RGBA (grey+alpha is written

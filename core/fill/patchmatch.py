@@ -144,8 +144,10 @@ _EM_FINEST, _EM_MIDDLE, _EM_COARSEST = 0, 8, 12
 # ... with a guide, which steers the coarsest level's layout: the photo with its rim's guide, seeds
 # 0-19 coherence medians, 12 and 8 iterations 5.10 / 5.08 on the coarsest level (6: 5.27, 17 ms less
 # CPU time for 8), then 8 and 6 on the intermediate one 5.08 / 5.08 (7: 4.98; 22 ms less for 6): the
-# seeds differ by up to 1.0, so these medians differ by noise; the guided fill's time is the one near
-# G'MIC's (the whole process 0.35-0.37 s against 0.35-0.36 s)
+# seeds differ by up to 1.0, so these medians differ by noise. The guided fill is the default's on a
+# photo, and its time is near G'MIC's: whole processes on the benchmark photo, interleaved, two rounds
+# of 9, medians: 12 / 8 iterations 0.38 / 0.40 s against G'MIC's 0.36 / 0.36; 8 / 8 0.37 / 0.35
+# against 0.36 / 0.35; 8 / 6 0.33 / 0.32 against 0.33 / 0.34
 _EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED = 6, 8
 # the votes count the covering patches at every _VOTE_STRIDE-th corner row and column, but the final
 # refine's last vote counts every one (stride 1): with 9 of the 49 votes neighbouring pixels of an
@@ -182,7 +184,8 @@ _GUIDE_WEIGHT = 1.0
 _FINAL_REFINE, _FINAL_WORST = 3, 50
 # ... with a guide (its layout is mended from a level coarser than without one). The photo with its
 # rim's guide, seeds 0-9 coherence medians (with 12 / 8 EM iterations): 3 iterations 5.01, 4 4.92
-# (each seed 0.05-0.11 lower but seed 0's), 5 4.85, 6 4.81; +10-20 ms of CPU time each
+# (each seed 0.05-0.11 lower but seed 0's), 5 4.85, 6 4.81; the fourth costs ~10 ms (refine_band
+# 55 -> 66 ms in-process, medians of 7); with 8 / 6 EM iterations, seeds 0-19, 3 iterations 5.15, 4 5.08
 _FINAL_REFINE_GUIDED = 4
 
 

@@ -53,20 +53,20 @@ every seed): 12 px left thin red slivers beside the rim at every seed (the drip 
 guide's reach); 24, 36 and 48 px continued the rim at every seed (coherence medians 5.34, 5.42,
 5.50), but 24 left a red fleck at the shadow's corner (seed 1) and copied the saucer's white
 highlights into the wood (seeds 1 and 4), 36 one such highlight (seed 4), 48 none: the wider the
-guide, the more of the hole knows which side of the rim it lies on. A weight of 0.3 or 0.5
-(measured at a reach of 24 and 16 px) brought the slivers back at 2-3 seeds. Since the guide is
-matched on the coarsest level only (seeds 0-9 medians, 3 final refine iterations): 32 px 5.13, 48
-5.01, 64 5.28, 96 5.56. Other shapes of the channel, matched on every level, seeds 0-4 medians
-against the ramp's 5.50: a side step of 0.5 or 0.3 with a ramp over the last 8-24 px 5.35-5.85; the
-ramp squared 5.35; the guide ignored in target pixels beyond the reach 5.38; the plain fill first,
-then the guide's fill redone within 12 or 24 px of the edge 5.08 / 5.43, with the drip left beyond
-the 12-px band. No peer continues this rim either (G'MIC ends it in a blob, shift-map in a vertical
-bar, pypatchmatch in a red smear). On textures the guide pairs the texture's own edges at random
-(issue 15's gravel and brick, the benchmark's seed, against ``patchmatch`` alone: 9.24 -> 9.51 and
-1.28 -> 1.61; 11.02 and 2.47 when it was matched on every level); ``auto`` fills grey pictures with
-the quilt, which does not run it. ``weft fill --structure auto`` (the default) runs it whenever the
-``patchmatch`` engine fills from the picture itself: see :mod:`weft.core.fill.patchmatch` for what
-it does to other photos.
+guide, the more of the hole knows which side of the rim it lies on. A weight of 0.3 or 0.5 (measured
+at a reach of 24 and 16 px) brought the slivers back at 2-3 seeds. Since the guide is matched on the
+coarsest level only (seeds 0-9 medians, 12 / 8 EM iterations, 3 final refine iterations): 32 px
+5.13, 48 5.01, 64 5.28, 96 5.56. Other shapes of the channel, matched on every level, seeds 0-4
+medians against the ramp's 5.50: a side step of 0.5 or 0.3 with a ramp over the last 8-24 px
+5.35-5.85; the ramp squared 5.35; the guide ignored in target pixels beyond the reach 5.38; the
+plain fill first, then the guide's fill redone within 12 or 24 px of the edge 5.08 / 5.43, with the
+drip left beyond the 12-px band. No peer continues this rim either (G'MIC ends it in a blob,
+shift-map in a vertical bar, pypatchmatch in a red smear). On textures the guide pairs the texture's
+own edges at random (issue 15's gravel and brick, the benchmark's seed, against ``patchmatch``
+alone: 9.24 -> 9.38 and 1.28 -> 1.76, 4 and 3 edges continued; 11.02 and 2.47 when it was matched on
+every level); ``auto`` fills grey pictures with the quilt, which does not run it. ``weft fill
+--structure auto`` (the default) runs it whenever the ``patchmatch`` engine fills from the picture
+itself: see :mod:`weft.core.fill.patchmatch` for what it does to other photos.
 """
 
 from __future__ import annotations
