@@ -36,13 +36,13 @@ from weft.core.jobs import JobResult, JobRunner
 from weft.core.studio import MASK, SQUARE
 from weft.core.image import atomic_write_bytes, save_image
 
+from . import recovery
 from .document import DocumentState, InputImage, read_input, read_session
 
 T = TypeVar("T")
 
 SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
 AUTOSAVE_MS = 2000  # unsaved edits reach the recovery file at most this long after they are made
-RECOVERY_FILE = "recovery.weft.json"
 
 
 def _write_masks(masks: dict) -> None:
@@ -52,13 +52,6 @@ def _write_masks(masks: dict) -> None:
             mask.save(file)
         except OSError as e:
             raise WeftError(f"{file}: cannot write the {name.replace('_', ' ')} ({e.strerror or e})") from None
-
-
-def recovery_path() -> Path:
-    """The crash-recovery session file: in ``WEFT_RECOVERY_DIR`` if set, else the app data folder."""
-    folder = os.environ.get("WEFT_RECOVERY_DIR") or QStandardPaths.writableLocation(
-        QStandardPaths.StandardLocation.AppDataLocation) or str(Path.home() / ".weft")
-    return Path(folder) / RECOVERY_FILE
 
 
 def off_gui_thread(fn: Callable[[], T]) -> T:
@@ -99,7 +92,10 @@ class FileActions(QObject):
         self.settings = window.settings
         # Crash recovery: while the document has unsaved edits, it is autosaved (atomically) at most
         # every AUTOSAVE_MS; a clean document has no recovery file.
-        self.recovery_file = recovery_path()
+        # (one file per window, with a lock naming its owner: see recovery.py)
+        self._me = recovery.Owner.me(recovery.settings_id(self.settings))
+        self.recovery_file = recovery.new_recovery_file(recovery.recovery_folder())
+        self.session_path: str | None = None  # the session file Ctrl+S saves to (saved, opened or restored)
         self._autosave_timer = QTimer(window, singleShot=True, interval=AUTOSAVE_MS)
         self._autosave_timer.timeout.connect(lambda: self.autosave(wait=False))
         self._owns_recovery = False  # only a file this window wrote (or restored) is removed by it
@@ -229,9 +225,21 @@ class FileActions(QObject):
             inputs[name] = str(file.resolve())
         return dataclasses.replace(recipe, inputs=inputs), masks
 
+    def save_session_quick(self) -> bool:
+        """Save to the session file last saved, opened or restored (Ctrl+S); ask where if none."""
+        if self.session_path:
+            return self.save_session(self.session_path)
+        return self.save_session_dialog()
+
     def save_session_dialog(self) -> bool:
         """Ask where, then save; True if the session was saved."""
-        path = self._ask_save("Save session", ".weft.json", "weft session (*.weft.json *.json)")
+        if self.session_path:
+            path, _ = QFileDialog.getSaveFileName(self.window, "Save session as", self.session_path,
+                                                  "weft session (*.weft.json *.json)")
+            if path:
+                self.settings.setValue("last_dir", str(Path(path).parent))
+        else:
+            path = self._ask_save("Save session", ".weft.json", "weft session (*.weft.json *.json)")
         return bool(path) and self.save_session(path)
 
     def save_session(self, path: str) -> bool:
@@ -240,6 +248,7 @@ class FileActions(QObject):
         except WeftError as e:
             self.show_message(str(e))
             return False
+        self.session_path = str(path)
         self.doc.undo_stack.setClean()
         self.statusBar().showMessage(f"session saved to {path}", 4000)
         return True
@@ -263,6 +272,7 @@ class FileActions(QObject):
             self.show_message(" ".join(str(e).split()))
             return False
         self._apply_session(data, images)
+        self.session_path = str(path)
         self.statusBar().showMessage(f"session {Path(path).name} opened", 4000)
         return True
 
@@ -346,6 +356,8 @@ class FileActions(QObject):
             return False
         data = self.doc.session_dict(session=self.recovery_file)
         data["inputs"] = {name: os.path.abspath(p) for name, p in data["inputs"].items()}
+        if self.session_path:
+            data["saved_as"] = os.path.abspath(self.session_path)  # (Ctrl+S after a recovery saves there)
         text = json.dumps(data, indent=1) + "\n"
         masks = self.doc.session_masks(self.recovery_file)
         with self._recovery_lock:
@@ -369,6 +381,7 @@ class FileActions(QObject):
             if generation != self._recovery_generation:
                 return False
             self.recovery_file.parent.mkdir(parents=True, exist_ok=True)
+            recovery.write_lock(self.recovery_file, self._me)  # (first: a file without its lock is nobody's)
             for file, data in pngs.items():
                 atomic_write_bytes(file, data)
             atomic_write_bytes(self.recovery_file, text.encode("utf-8"))
@@ -391,29 +404,58 @@ class FileActions(QObject):
                 self.recovery_file.unlink(missing_ok=True)
                 for mask in self.recovery_file.parent.glob(f"{stem}.*.png"):  # its masks (Document.session_masks)
                     mask.unlink(missing_ok=True)
+                recovery.lock_path(self.recovery_file).unlink(missing_ok=True)
             except OSError:
                 pass
         self._owns_recovery = False
 
     def offer_recovery(self) -> bool:
-        """If a recovery file exists (the last run ended with unsaved edits), ask to restore it.
+        """Offer to restore the unsaved session of a window that did not close normally.
 
-        Restores inputs, method, parameters, prototype, feature lines and seed; the restored document
-        counts as unsaved. Declined: the file is removed. Unreadable: said in one line, and kept.
+        Only orphans are offered (recovery.py: written with these settings, their window no longer
+        running), the newest first, one question each (Restore is the default button). Restored:
+        this window takes the file over (inputs, method, parameters, geometry, seed and the session
+        file Ctrl+S saves to; the document counts as unsaved). Declined: that file is removed and the
+        next orphan, if any, is offered. Unreadable: said in one line, and kept.
         """
-        path = self.recovery_file
-        if not path.is_file():
-            return False
-        if not self._confirm("weft did not close normally. Restore the unsaved session?"):
-            self.discard_recovery()
-            return False
+        for path in recovery.orphans(self.recovery_file.parent, self._me.settings):
+            if not recovery.claim(path, self._me):
+                continue
+            when = recovery.modified(path)
+            if not self.window._ask_restore(f"A weft window did not close normally{f' ({when})' if when else ''}. "
+                                            f"Restore its unsaved session?"):
+                self._discard_file(path)
+                continue
+            try:
+                data, images = self._read_session_files(path)
+            except WeftError as e:
+                self.show_message(f"could not restore the session: {' '.join(str(e).split())}")
+                return False
+            self._apply_session(data, images)
+            self.recovery_file = path  # this window's from now (its lock names this window)
+            self._owns_recovery = True
+            self.session_path = _saved_as(path)
+            self.doc.undo_stack.resetClean()  # the restored edits are still unsaved
+            self.statusBar().showMessage("unsaved session restored", 4000)
+            return True
+        return False
+
+    def _discard_file(self, path: Path) -> None:
+        """Remove another window's recovery file (declined), its masks and its lock."""
+        stem = path.name[:-5]
         try:
-            data, images = self._read_session_files(path)
-        except WeftError as e:
-            self.show_message(f"could not restore the session: {' '.join(str(e).split())}")
-            return False
-        self._apply_session(data, images)
-        self._owns_recovery = True
-        self.doc.undo_stack.resetClean()  # the restored edits are still unsaved
-        self.statusBar().showMessage("unsaved session restored", 4000)
-        return True
+            path.unlink(missing_ok=True)
+            for mask in path.parent.glob(f"{stem}.*.png"):
+                mask.unlink(missing_ok=True)
+            recovery.lock_path(path).unlink(missing_ok=True)
+        except OSError:
+            pass
+
+
+def _saved_as(recovery_file: Path) -> str | None:
+    """The session file a recovery file's window saved to (its ``saved_as``), or None."""
+    try:
+        value = json.loads(recovery_file.read_text(encoding="utf-8")).get("saved_as")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return value if isinstance(value, str) and value else None

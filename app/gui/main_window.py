@@ -250,6 +250,17 @@ class MainWindow(QMainWindow):
                                       QMessageBox.StandardButton.No)
         return answer == QMessageBox.StandardButton.Yes
 
+    def _ask_restore(self, question: str) -> bool:
+        """Ask whether to restore a recovered session: Restore (the default: Enter restores) or
+        Discard; True for Restore (tests replace it)."""
+        box = QMessageBox(QMessageBox.Icon.Question, "weft", question, QMessageBox.StandardButton.NoButton, self)
+        restore = box.addButton("Restore", QMessageBox.ButtonRole.AcceptRole)
+        box.addButton("Discard", QMessageBox.ButtonRole.DestructiveRole)
+        box.setDefaultButton(restore)
+        box.setEscapeButton(restore)  # (closing the box keeps the work: Esc never discards it)
+        box.exec()
+        return box.clickedButton() is restore
+
     def _ask_unsaved(self, doing: str) -> str:
         """The document has unsaved edits and the user is about to ``doing`` (e.g. "quit"): ask
         Save / Discard / Cancel in a modal box; returns "save", "discard" or "cancel"."""
@@ -344,7 +355,9 @@ class MainWindow(QMainWindow):
         self.clear_input_menu = m.addMenu("&Clear Input")  # the current method's optional inputs
         m.addSeparator()
         self._action(m, "Open &Session…", self.files.open_session_dialog, "Ctrl+Shift+L")
-        self._action(m, "&Save Session…", self.files.save_session_dialog, QKeySequence.StandardKey.Save)
+        self._action(m, "&Save Session", self.files.save_session_quick, QKeySequence.StandardKey.Save,
+                     tip="save to the session file last saved or opened (asks where the first time)")
+        self._action(m, "Save Session &As…", self.files.save_session_dialog, QKeySequence.StandardKey.SaveAs)
         m.addSeparator()
         self.save_result_action = self._action(m, "&Export Result…", self.files.save_result_dialog, "Ctrl+E")
         self._action(m, "Export &Recipe…", self.files.export_recipe_dialog, "Ctrl+Shift+E")

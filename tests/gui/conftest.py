@@ -9,11 +9,12 @@ from weft.app.gui.main_window import MainWindow
 @pytest.fixture(autouse=True)
 def private_recovery(tmp_path, monkeypatch):
     """Every GUI test autosaves into its own folder, and the window's questions are answered yes,
-    and "discard" to unsaved edits (a test that cares replaces ``MainWindow._confirm`` or
+    "restore" to a recovered session, and "discard" to unsaved edits (a test that cares replaces ``MainWindow._confirm`` or
     ``MainWindow._ask_unsaved`` itself)."""
     folder = tmp_path / "recovery"
     monkeypatch.setenv("WEFT_RECOVERY_DIR", str(folder))
     monkeypatch.setattr(MainWindow, "_confirm", lambda self, question: True)
+    monkeypatch.setattr(MainWindow, "_ask_restore", lambda self, question: True)
     monkeypatch.setattr(MainWindow, "_ask_unsaved", lambda self, doing: "discard")
     return folder
 

@@ -30,3 +30,40 @@ def drag(view, start, end, steps: int = 4):
 
 def no_job_threads() -> bool:
     return not [t for t in threading.enumerate() if t.name.startswith("weft-job") and t.is_alive()]
+
+
+def dead_pid() -> int:
+    """The process id of a process that has ended."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    return int(proc.stdout)
+
+
+def pretend_crashed(window) -> None:
+    """Make ``window``'s recovery file look like one left by a window that died (its lock names a
+    process that has ended): as after a crash, a new window may offer it."""
+    import json
+
+    from weft.app.gui import recovery
+
+    window.files._autosave_timer.stop()
+    lock = recovery.lock_path(window.recovery_file)
+    owner = json.loads(lock.read_text(encoding="utf-8"))
+    owner.update(pid=dead_pid(), started=None)
+    lock.write_text(json.dumps(owner), encoding="utf-8")
+    window.files._owns_recovery = False  # (the "dead" window removes nothing)
+
+
+def orphan_recovery(folder, settings, text: str):
+    """A recovery file (``text``) with a lock naming an ended process that ran with ``settings``: what a
+    crashed window leaves. Returns its path."""
+    from weft.app.gui import recovery
+
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"recovery-crashed-{dead_pid()}-0000abcd.weft.json"
+    path.write_text(text, encoding="utf-8")
+    owner = recovery.Owner(dead_pid(), recovery._host(), None, recovery.settings_id(settings))
+    recovery.write_lock(path, owner)
+    return path

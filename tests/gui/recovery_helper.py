@@ -32,7 +32,8 @@ def main() -> int:
     target, ini = sys.argv[1], sys.argv[2]
     app = QApplication(sys.argv[:1])
     window = MainWindow(settings=QSettings(ini, QSettings.Format.IniFormat))
-    window._confirm = lambda question: False  # nothing to restore in a fresh folder; never block
+    window._confirm = lambda question: False  # never block
+    window._ask_restore = lambda question: False
     window.show()
     window.open_input("target", target)
     state = {"edited": False}

@@ -23,7 +23,7 @@ from weft.core.params import Params, param
 from weft.core.registry import InputSpec, Method, Result
 from weft.core.studio import MARGINS, MASK, Figure, Geometry, Studio
 
-from .helpers import mouse
+from .helpers import mouse, pretend_crashed
 from .test_artist_session import _click_menu_item
 
 W, H = 80, 64
@@ -418,8 +418,8 @@ def test_mask_pngs_are_encoded_and_decoded_off_the_gui_thread(studio, qtbot, tmp
     # the autosave (its timer's): off the GUI thread, and nothing waits for it
     doc.set_margins("grow", Margins(0, 0, 2, 0))
     studio.files._autosave_timer.setInterval(10)
-    recovery = private_recovery / "recovery.weft.mean-fill.hole.png"
-    qtbot.waitUntil(lambda: (private_recovery / "recovery.weft.json").is_file() and recovery.is_file(), timeout=10000)
+    recovery = studio.recovery_file.with_name(studio.recovery_file.name[:-5] + ".mean-fill.hole.png")
+    qtbot.waitUntil(lambda: studio.recovery_file.is_file() and recovery.is_file(), timeout=10000)
     assert len(threads["encode"]) == 4 and not any(threads["encode"])
     doc.set_mask("hole", None, "Clear mask")
     assert studio.open_session(str(session))
@@ -647,8 +647,11 @@ def test_unsaved_masks_and_margins_reach_the_recovery_file(studio, qtbot, settin
     doc.set_margins("grow", Margins(0, 2, 0, 0))
     painted = _mask(studio)
     assert studio.autosave()
-    assert (private_recovery / "recovery.weft.mean-fill.hole.png").is_file()
+    file = studio.recovery_file
+    hole = file.with_name(file.name[:-5] + ".mean-fill.hole.png")
+    assert hole.is_file()
     # a new window (the first one "crashed") offers the recovery and gets the mask back
+    pretend_crashed(studio)
     again = MainWindow(settings=settings, load_defaults=False)
     qtbot.addWidget(again)
     try:
@@ -656,8 +659,7 @@ def test_unsaved_masks_and_margins_reach_the_recovery_file(studio, qtbot, settin
         assert again.doc.value("grow") == Margins(0, 2, 0, 0)
         again.doc.undo_stack.setClean()  # saved: the recovery file and its mask go
         again.files._schedule_autosave()
-        assert not (private_recovery / "recovery.weft.json").exists()
-        assert not (private_recovery / "recovery.weft.mean-fill.hole.png").exists()
+        assert not file.exists() and not hole.exists()
     finally:
         again.shutdown()
 
@@ -1020,7 +1022,7 @@ def test_a_background_autosave_that_fails_says_so_in_one_line(studio, qtbot, pri
                           check_params_cb=lambda text: "autosave failed" in text) as said:
         _stroke(studio.canvas_view, [(20.5, 20.5), (30.5, 25.5)])
     text = said.args[0]
-    assert text.startswith(f"{private_recovery / 'recovery.weft.json'}: autosave failed (") and "\n" not in text
+    assert text.startswith(f"{studio.recovery_file}: autosave failed (") and "\n" not in text
     assert _mask(studio) is not None  # the edit stands
 
 

@@ -16,10 +16,11 @@ from PySide6.QtCore import QSettings
 from weft.app.gui.main_window import MainWindow
 from weft.core.image import save_image
 
-from .helpers import no_job_threads
+from .helpers import no_job_threads, orphan_recovery, pretend_crashed
 from .recovery_helper import EDITS
 
 ROOT = Path(__file__).resolve().parents[2]
+REAL_ASK_RESTORE = MainWindow._ask_restore  # (before the conftest replaces it)
 
 
 def answer(monkeypatch, reply: bool) -> list[str]:
@@ -92,7 +93,8 @@ def test_open_session_with_unsaved_edits_asks(window, tmp_path, monkeypatch):
 
 def test_autosave_while_edited_and_removed_when_clean(window, qtbot, private_recovery):
     window._autosave_timer.setInterval(20)
-    recovery = private_recovery / "recovery.weft.json"
+    recovery = window.recovery_file
+    assert recovery.parent == private_recovery
     assert not recovery.exists()
     window.doc.set_param("p", 0.25)
     qtbot.waitUntil(recovery.exists, timeout=5000)
@@ -104,24 +106,125 @@ def test_autosave_while_edited_and_removed_when_clean(window, qtbot, private_rec
     window.doc.set_param("p", 0.75)
     qtbot.waitUntil(recovery.exists, timeout=5000)
     window.close()  # the conftest answers "discard" to the question
-    assert not recovery.exists()
+    assert not recovery.exists() and list(private_recovery.iterdir()) == []  # (its lock too)
+
+
+def answer_restore(monkeypatch, reply: bool) -> list[str]:
+    """Make the question "restore a recovered session?" answer ``reply``; returns the questions asked."""
+    asked = []
+
+    def ask(self, question):
+        asked.append(question)
+        return reply
+
+    monkeypatch.setattr(MainWindow, "_ask_restore", ask)
+    return asked
 
 
 def test_recovery_declined_is_removed(qtbot, settings, private_recovery, monkeypatch):
-    private_recovery.mkdir()
-    recovery = private_recovery / "recovery.weft.json"
-    recovery.write_text("{}", encoding="utf-8")
-    asked = answer(monkeypatch, False)
+    recovery = orphan_recovery(private_recovery, settings, "{}")
+    asked = answer_restore(monkeypatch, False)
     w = MainWindow(settings=settings, load_defaults=False)
     qtbot.addWidget(w)
     assert len(asked) == 1 and not recovery.exists()
+    assert list(private_recovery.iterdir()) == []  # its lock too
     w.shutdown()
 
 
+def test_a_second_window_never_offers_or_removes_the_first_windows_work(window, qtbot, settings, private_recovery,
+                                                                          monkeypatch):
+    """Two studios at once: the second does not offer the first one's recovery file (its window
+    runs), so declining cannot remove it; each window autosaves to a file of its own."""
+    window.doc.set_param("p", 0.25)
+    assert window.autosave()
+    first = window.recovery_file
+    assert first.is_file()
+    asked = answer_restore(monkeypatch, False)
+    second = MainWindow(settings=settings)
+    qtbot.addWidget(second)
+    assert asked == [] and first.is_file()
+    second.doc.set_param("p", 0.75)
+    assert second.autosave()
+    assert second.recovery_file != first and second.recovery_file.is_file()
+    assert json.loads(first.read_text(encoding="utf-8"))["params"]["fast"]["p"] == 0.25
+    # the first window "crashes": a third window offers its work (and only its: the second runs)
+    pretend_crashed(window)
+    asked = answer_restore(monkeypatch, True)
+    third = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(third)
+    assert len(asked) == 1 and third.doc.params["fast"].p == 0.25 and third.recovery_file == first
+    assert second.recovery_file.is_file()
+    for w in (second, third):
+        w.shutdown()
+
+
+def test_a_first_launch_offers_no_strangers_recovery_file(qtbot, tmp_path, settings, private_recovery, monkeypatch):
+    """A recovery file left by a weft that ran with other settings (another user of the account, an
+    earlier setup) is a stranger's: a first launch (new settings) neither offers nor removes it."""
+    theirs = QSettings(str(tmp_path / "theirs.ini"), QSettings.Format.IniFormat)
+    stranger = orphan_recovery(private_recovery, theirs, "{}")
+    asked = answer_restore(monkeypatch, True)
+    w = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(w)
+    assert asked == [] and stranger.is_file()
+    w.shutdown()
+
+
+def test_the_restore_question_restores_on_enter(qtbot, settings, private_recovery, monkeypatch, tmp_path):
+    """The question's default button is Restore: Enter keeps the work."""
+    from PySide6.QtCore import Qt, QTimer
+    from PySide6.QtWidgets import QApplication, QMessageBox
+
+    monkeypatch.setattr(MainWindow, "_ask_restore", REAL_ASK_RESTORE)
+    target = tmp_path / "t.png"
+    save_image(target, np.random.default_rng(1).random((40, 48, 3), dtype=np.float32))
+    session = {"weft_session": 1, "method": "fast", "params": {"fast": {"p": 0.31}}, "inputs": {"target": str(target)},
+               "geometry": {}, "seed": 5}
+    orphan_recovery(private_recovery, settings, json.dumps(session))
+    seen = []
+
+    def press_enter():
+        box = QApplication.activeModalWidget()
+        if not isinstance(box, QMessageBox):
+            QTimer.singleShot(20, press_enter)
+            return
+        seen.append(box.text())
+        qtbot.keyClick(box, Qt.Key.Key_Return)
+
+    QTimer.singleShot(0, press_enter)
+    w = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(w)
+    assert seen and "Restore" in seen[0]
+    assert w.doc.params["fast"].p == 0.31 and w.doc.seed == 5
+    w.shutdown()
+
+
+def test_ctrl_s_after_a_recovery_saves_to_the_sessions_file(window, qtbot, settings, private_recovery, tmp_path,
+                                                            monkeypatch):
+    from PySide6.QtCore import Qt
+    from PySide6.QtWidgets import QFileDialog
+
+    session = tmp_path / "mine.weft.json"
+    assert window.save_session(str(session))
+    window.doc.set_param("p", 0.4)
+    assert window.autosave()
+    pretend_crashed(window)
+    again = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(again)
+    asked = []
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: asked.append(a) or ("", ""))
+    again.show()
+    again.activateWindow()
+    qtbot.waitUntil(again.isActiveWindow, timeout=5000)
+    qtbot.keyClick(again, Qt.Key.Key_S, Qt.KeyboardModifier.ControlModifier)
+    assert asked == []  # saved where the session was, no dialog
+    assert json.loads(session.read_text(encoding="utf-8"))["params"]["fast"]["p"] == 0.4
+    assert again.doc.undo_stack.isClean()
+    again.shutdown()
+
+
 def test_unreadable_recovery_file_says_so_in_one_line(qtbot, settings, private_recovery):
-    private_recovery.mkdir()
-    recovery = private_recovery / "recovery.weft.json"
-    recovery.write_text("{not json", encoding="utf-8")
+    recovery = orphan_recovery(private_recovery, settings, "{not json")
     messages = []
     w = MainWindow(settings=settings, load_defaults=False)
     qtbot.addWidget(w)
@@ -145,19 +248,25 @@ def test_kill_9_then_restart_offers_to_restore(qtbot, tmp_path, private_recovery
     reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)
     reader.start()
     reader.join(60)
+    ini = QSettings(str(tmp_path / "first.ini"), QSettings.Format.IniFormat)  # the same user's settings
     try:
         assert line and line[0].strip() == "AUTOSAVED", (line, proc.poll())
+        # while the first studio runs, a second one started does not offer (nor remove) its work
+        asked = answer_restore(monkeypatch, False)
+        w = MainWindow(settings=ini, load_defaults=False)
+        qtbot.addWidget(w)
+        assert asked == []
+        w.shutdown()
     finally:
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait(10)
         proc.stdout.close()
         proc.stderr.close()
     assert proc.returncode == -signal.SIGKILL
-    recovery = private_recovery / "recovery.weft.json"
-    assert recovery.is_file()
+    (recovery,) = private_recovery.glob("recovery-*.weft.json")
 
-    asked = answer(monkeypatch, True)
-    w = MainWindow(settings=QSettings(str(tmp_path / "second.ini"), QSettings.Format.IniFormat))
+    asked = answer_restore(monkeypatch, True)
+    w = MainWindow(settings=ini)
     qtbot.addWidget(w)
     doc = w.doc
     assert len(asked) == 1 and "Restore" in asked[0]
