@@ -87,6 +87,8 @@ class FeatureLinesPanel(QWidget):
         self.rectify_status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         self.rectify_status.setWordWrap(True)
         self.rectify_status.setContentsMargins(4, 0, 4, 0)
+        # room for two lines always: a hint that changes length does not move the frame below it
+        self.rectify_status.setMinimumHeight(2 * self.rectify_status.fontMetrics().lineSpacing() + 2)
         lay.addWidget(self.rectify_status)
         lay.addWidget(self.frontal_view, 1)
         self._sync_frontal_size()

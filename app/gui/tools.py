@@ -7,7 +7,8 @@ overlay in the view's scene, and pushes one undo command on release. Esc cancels
   a square parameter); the side snaps to even pixels; drag inside to move it, drag a corner handle to
   resize it.
 * ``LineTool``: feature lines on the photo or on the frontal frame; click-drag draws a line, dragging an
-  end point edits it, a click on a line selects it and Delete removes the pair. Lines are numbered
+  end point edits it (and the ends of other lines at the same point, such as Quad…'s corners; Alt
+  moves it alone), a click on a line selects it and Delete removes the pair. Lines are numbered
   and coloured alike in both views (line i of the photo goes with line i of the frontal frame).
 * ``QuadTool``: four clicks on the corners of the textured plane, clockwise from its top-left corner,
   give four photo lines and the
@@ -25,6 +26,7 @@ from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsLineItem, QGraphics
 from weft.core.geometry import Square
 
 HANDLE_PX = 8  # grab distance of handles and end points, in screen pixels
+LINKED = 0.5  # end points of feature lines this close (image pixels) are one point: they move together
 
 
 def _screen_sized(item, x: float, y: float):
@@ -203,7 +205,7 @@ class LineTool(Tool):
     def __init__(self, view, doc, which: str, on_drag: Callable[[list, list], None] | None = None):
         self.view, self.doc, self.which, self.on_drag = view, doc, which, on_drag
         self.items: list = []
-        self.drag = None  # ("new", start) or ("end", index, 0|1)
+        self.drag = None  # ("new", start) or ("end", index, 0|1, [(index, 0|1), ...] the ends moved together)
         self.selected: int | None = None
         self.refresh()
 
@@ -280,8 +282,16 @@ class LineTool(Tool):
     def press(self, view, pos, event):
         end = self._near_end(pos)
         if end is not None:
-            self.drag = ("end", *end)
-            self.selected = end[0]
+            # ends at the same point move together (Quad…'s corners: two lines meet at each), unless
+            # Alt is held (then only the end grabbed moves)
+            i, k = end
+            ends = [(i, k)]
+            if not event.modifiers() & Qt.KeyboardModifier.AltModifier:
+                x, y = self.lines()[i][2 * k:2 * k + 2]
+                ends += [(j, e) for j, line in enumerate(self.lines()) for e in (0, 1)
+                         if (j, e) != (i, k) and abs(line[2 * e] - x) < LINKED and abs(line[2 * e + 1] - y) < LINKED]
+            self.drag = ("end", i, k, ends)
+            self.selected = i
         else:
             hit = self._near_line(pos)
             if hit is not None:
@@ -298,8 +308,8 @@ class LineTool(Tool):
             sx, sy = self.drag[1]
             lines.append([sx, sy, x, y])
         else:
-            _, i, end = self.drag
-            lines[i][2 * end:2 * end + 2] = [x, y]
+            for i, end in self.drag[3]:
+                lines[i][2 * end:2 * end + 2] = [x, y]
         return lines
 
     def move(self, view, pos, event):

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
-from PySide6.QtCore import QObject, QPointF, QRectF, Qt, Signal
+from PySide6.QtCore import QObject, QPoint, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QImage, QPainter, QPen
 from PySide6.QtWidgets import QGraphicsItem, QGraphicsLineItem, QGraphicsRectItem, QGraphicsScene, QGraphicsView, QLabel
 
@@ -174,6 +174,9 @@ class ImageView(QGraphicsView):
         self._frame: QRectF | None = None  # a tool's frame around the image (an uncrop's grown canvas)
         self._pan_from = None
         self._space = False
+        self._tool_drag = False  # a tool's left-button drag is in progress: the view must not move under it
+        self._refit_after_drag = False
+        self._scroll_unlocked = False  # (during a drag whose view was moved: see _unlock_scroll)
         self.setTransformationAnchor(QGraphicsView.ViewportAnchor.NoAnchor)
         self.setResizeAnchor(QGraphicsView.ViewportAnchor.AnchorViewCenter)
         self.setDragMode(QGraphicsView.DragMode.NoDrag)
@@ -263,7 +266,10 @@ class ImageView(QGraphicsView):
         self._item.set_qimage(q)
         self._set_scene_rect()
         if fit or first or (resized and self.auto_fit):
-            self.fit()
+            if self._tool_drag and not first:
+                self._refit_after_drag = True  # (fitted when the drag ends: nothing moves under the mouse)
+            else:
+                self.fit()
         self._image_changed()
         self.viewport().update()
         self.image_shown.emit()
@@ -287,6 +293,8 @@ class ImageView(QGraphicsView):
             self.fit()
 
     def _set_scene_rect(self) -> None:
+        if self._scroll_unlocked:
+            return  # (mid-drag: the view holds still; set when the drag ends)
         rect = self._item.boundingRect()
         if self._frame is not None and not rect.isEmpty():
             room = 0.12 * max(rect.width(), rect.height())
@@ -315,10 +323,66 @@ class ImageView(QGraphicsView):
         self.zoomed.emit(1.0)
 
     def resizeEvent(self, event):  # noqa: N802
+        if self._tool_drag:
+            # the layout changed mid-drag (a hint above the view shrank): keep the image where it is
+            # on the screen under the mouse; it is fitted again when the drag ends
+            self._hold_under_drag(lambda: super(ImageView, self).resizeEvent(event))
+            self._refit_after_drag = self._refit_after_drag or self.auto_fit
+            return
         super().resizeEvent(event)
         if self.auto_fit and self.image is not None:
             self.fitInView(self._fitted(), Qt.AspectRatioMode.KeepAspectRatio)
             self.zoomed.emit(self.scale_factor())  # the % label follows a refit on resize
+
+    def moveEvent(self, event):  # noqa: N802
+        if self._tool_drag:
+            self._hold_under_drag(lambda: super(ImageView, self).moveEvent(event), moved=event.pos() - event.oldPos())
+            return
+        super().moveEvent(event)
+
+    def _hold_under_drag(self, handle, moved=None) -> None:
+        """Let Qt handle a resize or move of the view (``handle``), then scroll so that the image
+        point under a fixed place on the screen stays there (a drag's line ends where the mouse went)."""
+        self._unlock_scroll()
+        origin = self.viewport().mapToGlobal(QPoint(0, 0))
+        anchor = self.mapToScene(QPoint(0, 0))
+        handle()
+        shift = (self.viewport().mapToGlobal(QPoint(0, 0)) - origin) if moved is None else moved
+        self._scroll_to(anchor, -shift)
+
+    def _scroll_to(self, scene_point, at: QPoint) -> None:
+        """Scroll so that ``scene_point`` is at view position ``at``."""
+        off = self.mapFromScene(scene_point) - at
+        self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() + off.x())
+        self.verticalScrollBar().setValue(self.verticalScrollBar().value() + off.y())
+
+    def _unlock_scroll(self) -> None:
+        """Give the scene room around the image so that the view can be scrolled anywhere (an image
+        smaller than the view is otherwise held centred), keeping what is on screen where it is;
+        undone when the drag ends."""
+        if self._scroll_unlocked:
+            return
+        anchor = self.mapToScene(QPoint(0, 0))
+        rect = self.sceneRect() if self._frame is not None else self._item.sceneBoundingRect()
+        room = 2 * max(self.viewport().width(), self.viewport().height()) / max(self.scale_factor(), 1e-6)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.scene().setSceneRect(rect.adjusted(-room, -room, room, room))
+        self._scroll_unlocked = True
+        self._scroll_to(anchor, QPoint(0, 0))
+
+    def _end_tool_drag(self) -> None:
+        """The drag ended: the scene's own rect again, and the fit the layout asked for meanwhile."""
+        self._tool_drag = False
+        if self._scroll_unlocked:
+            self._scroll_unlocked = False
+            self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAsNeeded)
+            self.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAsNeeded)
+            self._set_scene_rect()
+        if self._refit_after_drag:
+            self._refit_after_drag = False
+            if self.auto_fit and self.image is not None:
+                self.fit()
 
     def zoom_by(self, factor: float, at=None) -> None:
         """Zoom by ``factor`` keeping the image point under view position ``at`` (default: centre) fixed."""
@@ -367,6 +431,7 @@ class ImageView(QGraphicsView):
         if (self.tool is not None and event.button() == Qt.MouseButton.LeftButton and self.image is not None
                 and not self.converting):  # (not on the image being replaced: its geometry is the new one's)
             self.setFocus()
+            self._tool_drag = True
             self.tool.press(self, self.mapToScene(event.position().toPoint()), event)
             event.accept()
             return
@@ -393,9 +458,13 @@ class ImageView(QGraphicsView):
             event.accept()
             return
         if self.tool is not None and event.button() == Qt.MouseButton.LeftButton and self.image is not None:
-            self.tool.release(self, self.mapToScene(event.position().toPoint()), event)
+            try:
+                self.tool.release(self, self.mapToScene(event.position().toPoint()), event)
+            finally:
+                self._end_tool_drag()
             event.accept()
             return
+        self._end_tool_drag()
         super().mouseReleaseEvent(event)
 
     def leaveEvent(self, event):  # noqa: N802

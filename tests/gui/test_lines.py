@@ -129,3 +129,90 @@ def test_affine_prototype_by_mouse_and_live_swap(window, qtbot):
     mouse(view, "release", (40.0, 30.0))
     assert doc.square == (30, 24, 32)
     qtbot.waitUntil(lambda: shown[-1].final and shown[-1].figures.get("prototype") == [30, 24, 32], timeout=30000)
+
+
+def _at_global(view, kind, global_pos, buttons=Qt.MouseButton.LeftButton):
+    """A real mouse event at a fixed place on the screen, wherever the view has moved meanwhile."""
+    from PySide6.QtCore import QPointF
+    from PySide6.QtGui import QMouseEvent
+
+    local = QPointF(view.viewport().mapFromGlobal(global_pos))
+    etype = {"press": QEvent.Type.MouseButtonPress, "move": QEvent.Type.MouseMove,
+             "release": QEvent.Type.MouseButtonRelease}[kind]
+    button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
+    held = buttons if kind != "release" else Qt.MouseButton.NoButton
+    QApplication.sendEvent(view.viewport(), QMouseEvent(etype, local, QPointF(global_pos), button, held,
+                                                        Qt.KeyboardModifier.NoModifier))
+
+
+def test_the_frontal_frame_does_not_move_under_a_drag(nfpt, qtbot):
+    """After Quad… and one pair deleted, the hint above the frontal frame says why it cannot rectify
+    (two lines); drawing the 4th frontal line makes it rectify mid-drag. The frame must not move or
+    zoom under the mouse: the line ends where the mouse went."""
+    from PySide6.QtCore import QPointF
+
+    data = json.loads((RESOURCES / "perspective-lines.json").read_text())
+    doc, panel = nfpt.doc, nfpt.lines_panel
+    nfpt.resize(1100, 760)
+    panel.quad_button.setChecked(True)
+    for x, y in [line[:2] for line in data["image_lines"][:4]]:
+        mouse(nfpt.canvas_view, "press", (x, y))
+        mouse(nfpt.canvas_view, "release", (x, y))
+    image_lines, frontal_lines = [list(x) for x in doc.image_lines], [list(x) for x in doc.frontal_lines]
+    doc.set_lines(image_lines[:3], frontal_lines[:3], text="Delete line 4")
+    qtbot.waitUntil(lambda: "needs at least 4" in panel.rectify_status.text(), timeout=10000)
+    doc.set_lines(image_lines, frontal_lines[:3], text="Draw line 4")  # the 4th line on the photo
+    qtbot.wait(50)
+    frontal = panel.frontal_view
+    qtbot.waitUntil(lambda: not frontal.converting, timeout=5000)
+    w, h = doc.frontal_size
+    start, end = (0.3 * w, 0.2 * h), (0.3 * w, 0.8 * h)  # straight down
+    to_global = lambda p: QPointF(frontal.viewport().mapToGlobal(frontal.mapFromScene(QPointF(*p))))  # noqa: E731
+    g0, g1 = to_global(start), to_global(end)
+    scale = frontal.scale_factor()
+    _at_global(frontal, "press", g0)
+    for i in range(1, 21):
+        t = i / 20
+        _at_global(frontal, "move", g0 + (g1 - g0) * t)
+        qtbot.wait(15)  # (the live rectification comes back meanwhile and changes the hint)
+        if i == 10:
+            qtbot.waitUntil(lambda: panel.rectify_status.text() == "rectified", timeout=10000)
+    assert frontal.scale_factor() == pytest.approx(scale)  # no zoom mid-drag ...
+    assert frontal.mapToScene(frontal.viewport().mapFromGlobal(g1.toPoint())).y() == pytest.approx(end[1], abs=1.0)
+    _at_global(frontal, "release", g1)
+    assert len(doc.frontal_lines) == 4
+    assert doc.frontal_lines[3] == pytest.approx([*start, *end], abs=1.0)
+
+
+def test_quad_corners_move_together(nfpt, qtbot):
+    """Dragging a corner of Quad…'s lines moves both lines that meet there (the quad stays closed),
+    on the photo and in the frontal frame; Alt-drag moves one end alone."""
+    from PySide6.QtCore import Qt as _Qt
+
+    data = json.loads((RESOURCES / "perspective-lines.json").read_text())
+    corners = [line[:2] for line in data["image_lines"][:4]]
+    doc, panel = nfpt.doc, nfpt.lines_panel
+    panel.quad_button.setChecked(True)
+    for x, y in corners:
+        mouse(nfpt.canvas_view, "press", (x, y))
+        mouse(nfpt.canvas_view, "release", (x, y))
+    x, y = corners[1]  # the top-right corner: the end of line 1 and the start of line 2
+    drag(nfpt.canvas_view, (x, y), (x + 12, y + 9))
+    assert doc.image_lines[0][2:] == pytest.approx([x + 12, y + 9], abs=0.6)
+    assert doc.image_lines[1][:2] == pytest.approx([x + 12, y + 9], abs=0.6)
+    assert doc.undo_stack.undoText().startswith("Move end")
+    frontal = panel.frontal_view
+    qtbot.waitUntil(lambda: frontal.image is not None and not frontal.converting, timeout=10000)
+    w, h = doc.frontal_size
+    corner = (w - 1.0, h - 1.0)  # lines 2 and 3 meet there
+    drag(frontal, corner, (w - 40.0, h - 30.0))
+    assert doc.frontal_lines[1][2:] == pytest.approx([w - 40, h - 30], abs=1.0)
+    assert doc.frontal_lines[2][:2] == pytest.approx([w - 40, h - 30], abs=1.0)
+    before = [list(v) for v in doc.image_lines]
+    x, y = before[2][:2]
+    mouse(nfpt.canvas_view, "press", (x, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
+    mouse(nfpt.canvas_view, "move", (x - 10, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
+    mouse(nfpt.canvas_view, "release", (x - 10, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
+    moved = [doc.image_lines[2][:2], doc.image_lines[1][2:]]  # the two ends that met there
+    assert sorted(abs(m[0] - (x - 10)) < 0.6 for m in moved) == [False, True]  # Alt: one alone
+    assert before[2][:2] in moved or before[1][2:] in moved
