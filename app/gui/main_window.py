@@ -313,6 +313,11 @@ class MainWindow(QMainWindow):
         self.status_label = ElidedLabel()
         self.statusBar().messageChanged.connect(self.status_label.set_full_text)
         self.statusBar().addPermanentWidget(self.status_label, 1)
+        # the shown result's figures stay in a widget of their own: a menu's or a tooltip's status
+        # tip replaces (then clears) the status message, never them
+        self.result_label = ElidedLabel()
+        self.result_label.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+        self.statusBar().addPermanentWidget(self.result_label, 1)
         self.pixel_label = QLabel("")
         # the read-out keeps its own room (a typical read-out's width), so moving the mouse does not
         # shift the message, and a longer read-out is elided rather than pushed into it
@@ -321,6 +326,8 @@ class MainWindow(QMainWindow):
         self.zoom_label = QLabel("")
         self.progress_bar = QProgressBar()
         self.progress_bar.setMaximumWidth(320)
+        # room for a stage, its percentage and the time left (longer text is shortened to fit)
+        self.progress_bar.setMinimumWidth(self.progress_bar.fontMetrics().horizontalAdvance("synthesis 100% · 10 min 5 s") + 24)
         self._work_started: float | None = None  # when the running render's counted work began
         self._last_fraction = 0.0
         self.progress_bar.setRange(0, 1000)
@@ -588,7 +595,7 @@ class MainWindow(QMainWindow):
         self.result_view.set_notice(None)
         # (only the part pasted is redrawn: the rest is what the view shows already)
         self.result_view.set_image(shown.image, changed=shown.changed, over=shown.over)
-        self.statusBar().showMessage(describe(shown))  # (it says it is around the stroke)
+        self.result_label.set_full_text(describe(shown))  # (it says it is around the stroke)
 
     def _on_shown(self, shown) -> None:
         self._input_shown = None
@@ -597,7 +604,7 @@ class MainWindow(QMainWindow):
         self.result_view.set_image(shown.image)
         if shown.before is not None and shown.before is not self.result_view.compare_image:
             self.result_view.set_compare(shown.before)  # the input of this result, not of the panel
-        self.statusBar().showMessage(describe(shown))
+        self.result_label.set_full_text(describe(shown))
 
     def _on_progress(self, fraction: float, stage: str) -> None:
         self._end_preparing()
@@ -607,7 +614,20 @@ class MainWindow(QMainWindow):
         self._last_fraction = fraction
         self.progress_bar.setValue(int(fraction * 1000))
         left = _time_left(now - self._work_started, fraction)
-        self.progress_bar.setFormat(f"{stage} %p%" + (f" — about {left} left" if left else ""))
+        self._set_progress_text(stage, left)
+
+    def _set_progress_text(self, stage: str, left: str) -> None:
+        """The bar's text: the longest of a few wordings that fits in the bar (the whole in its tooltip)."""
+        bar = self.progress_bar
+        full = f"{stage} %p%" + (f" — about {left} left" if left else "")
+        room = bar.contentsRect().width() - 8
+        percent = f"{round(100 * bar.value() / max(bar.maximum(), 1))}%"
+        metrics = bar.fontMetrics()
+        for text in (full, f"{stage} %p%" + (f" · {left}" if left else ""), f"{stage} %p%", "%p%" + (f" · {left}" if left else ""), "%p%"):
+            if metrics.horizontalAdvance(text.replace("%p%", percent)) <= room:
+                break
+        bar.setFormat(text)
+        bar.setToolTip(full.replace("%p%", percent))
 
     def _on_preparing(self, words: str) -> None:
         """A first run: the method's kernels compile before any work can be counted — say so in
@@ -664,11 +684,13 @@ class MainWindow(QMainWindow):
         the canvas input and what to draw on it while nothing is drawn, else the last result."""
         if self._input_shown is not None:
             self.result_view.set_stale(None)
+            self.result_label.set_full_text("")  # (no result is shown)
             self.result_view.set_image(self.doc.image(self.doc.studio.canvas))
             self.result_view.set_notice(self._input_shown)
             self.statusBar().showMessage(self._input_shown, 8000)
         elif self.renderer.last is not None:
             self.result_view.set_image(self.renderer.last.image)
+            self.result_label.set_full_text(describe(self.renderer.last))
 
     def nothing_to_export(self, doing: str = "export") -> str | None:
         """Why there is no result to export or copy now (one line), or None: none rendered in full

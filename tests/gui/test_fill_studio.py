@@ -615,12 +615,12 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
-    text = studio.statusBar().currentMessage()
+    text = studio.result_label.full_text()
     # (a count of pixels describes the crop, not the picture: only the full result states it)
     assert re.fullmatch(r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?; "
                         r"the image's figures on release", text), text
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
-    assert studio.statusBar().currentMessage().endswith(f"— filled {result.figures['hole_pixels']} px")
+    assert studio.result_label.full_text().endswith(f"— filled {result.figures['hole_pixels']} px")
     previews, text = _slider_previewed(studio, qtbot, "amount")  # a slider's preview
     assert re.fullmatch(rf"preview {W}x{H} in \d+ ms — filled {previews[-1].figures['hole_pixels']} px", text), text
     qtbot.waitUntil(lambda: not studio.renderer.running(), timeout=10000)  # (its release render ends the test)
@@ -720,7 +720,7 @@ def _slider_previewed(studio, qtbot, name: str):
     slider.setSliderDown(True)
     slider.setValue(slider.value() - max(1, (slider.maximum() - slider.minimum()) // 4))
     qtbot.waitUntil(lambda: len(previews) > 0, timeout=10000)
-    text = studio.statusBar().currentMessage()
+    text = studio.result_label.full_text()
     slider.setSliderDown(False)
     slider.sliderReleased.emit()
     return previews, text
@@ -1041,7 +1041,7 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, setting
         window.inputs_pane.mask_tool().set_size(9)
         y = h / 2 + 0.5
         around = _previewed(window, qtbot, view, [(w * 0.4, y), (w * 0.5, y)], timeout=30000)
-        text = window.statusBar().currentMessage()
+        text = window.result_label.full_text()
         assert text.startswith("preview around the stroke") and "crop" in text, text
         assert "of the image" not in text, text  # the crop's hole fraction is not the image's
         studio = doc.studio
@@ -1055,7 +1055,7 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, setting
         assert doc.current_params.engine == "auto" and "engine" not in text, text
         result = _final_after(window, qtbot, lambda: mouse(view, "release", (w * 0.5, y)))
         hole = doc.value("mask").bits
-        text = window.statusBar().currentMessage()
+        text = window.result_label.full_text()
         assert studio.figures["hole_fraction"].render(round(float(hole.mean()), 4)) in text, text  # the image's
         assert result.figures["hole_pixels"] == int(hole.sum())
 

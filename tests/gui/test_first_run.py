@@ -70,7 +70,7 @@ def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest
     result = shown.args[0]
     assert result.final and result.image.shape == (40, 48, 3)
     assert result.compiled and result.prepared >= held  # the compile, measured apart ...
-    message = window.statusBar().currentMessage()
+    message = window.result_label.full_text()
     assert message.startswith(f"result 48x40 in {result.seconds * 1000:.0f} ms (after preparing its kernels for ")
     assert message.split(" — ")[0].endswith(" s, first run only)")  # ... and not counted as render time
     qtbot.waitUntil(lambda: not window.result_view.notice.isVisible(), timeout=5000)
@@ -82,7 +82,7 @@ def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest
     with qtbot.waitSignal(window.renderer.shown, timeout=30000) as again:
         window.renderer.final(now=True)
     assert again.args[0].prepared == 0.0 and not again.args[0].compiled
-    assert "preparing" not in window.statusBar().currentMessage()
+    assert "preparing" not in window.result_label.full_text()
     window.doc.undo_stack.setClean()
     window.shutdown()
 
@@ -130,6 +130,6 @@ def test_waiting_behind_another_methods_compile_says_preparing_at_once(qtbot, se
     finally:
         registry.compile_ended()
     assert shown.args[0].compiled and shown.args[0].prepared > 0
-    assert "(after preparing its kernels for " in window.statusBar().currentMessage()
+    assert "(after preparing its kernels for " in window.result_label.full_text()
     window.doc.undo_stack.setClean()
     window.shutdown()

@@ -2,6 +2,7 @@
 
 import dataclasses
 import json
+import re
 import threading
 
 import numpy as np
@@ -26,7 +27,7 @@ def test_opens_on_the_examples_with_a_result(window):
     assert shown.final and shown.image.shape == window.doc.image("target").shape
     assert window.result_view.image is shown.image
     assert window.example_list.count() >= 10
-    assert "result" in window.statusBar().currentMessage()
+    assert "result" in window.result_label.full_text()
 
 
 @pytest.mark.parametrize("zoom", [2.0, 0.5])
@@ -322,3 +323,49 @@ def test_slow_stand_in_is_cancellable_directly():
     token.cancel()
     t.join(5)
     assert not t.is_alive()
+
+
+def test_result_figures_stay_while_a_menu_shows_status_tips(window, qtbot):
+    """Hovering a menu entry shows its status tip and closing the menu clears the status message:
+    the shown result's figures stay on the status line all along."""
+    from PySide6.QtCore import Qt
+    from PySide6.QtWidgets import QLabel
+    from PySide6.QtTest import QTest
+
+    def figures_shown() -> bool:
+        return any(label.isVisible() and re.match(r"result \d+x\d+ in \d+ ms", label.text())
+                   for label in window.statusBar().findChildren(QLabel))
+
+    assert figures_shown()
+    menu = window.view_menu
+    action = window.reset_layout_action  # (has a status tip)
+    menu.popup(window.mapToGlobal(window.rect().center()))
+    qtbot.waitUntil(menu.isVisible, timeout=5000)
+    QTest.mouseMove(menu, menu.actionGeometry(action).center())
+    qtbot.waitUntil(lambda: window.statusBar().currentMessage() == action.statusTip(), timeout=5000)
+    assert figures_shown()
+    QTest.keyClick(menu, Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: not menu.isVisible(), timeout=5000)
+    qtbot.waitUntil(lambda: window.statusBar().currentMessage() == "", timeout=5000)
+    assert figures_shown()
+
+
+def test_progress_text_fits_the_bar(window, qtbot):
+    """A long stage with the time left still reads whole in the bar (shortened to what fits; the
+    whole text in its tooltip), at the default size and in a narrow window."""
+    import time
+
+    for width in (1280, 1024):
+        window.resize(width, 760)
+        window.progress_bar.show()
+        qtbot.wait(10)
+        window._on_progress(0.05, "nfpt synthesis")
+        window._work_started = time.monotonic() - 10  # 10 s of work so far: the time left is known
+        window._on_progress(0.63, "nfpt synthesis")
+        bar = window.progress_bar
+        assert bar.value() == 630
+        text = bar.text()
+        assert "63%" in text
+        assert bar.fontMetrics().horizontalAdvance(text) <= bar.contentsRect().width(), (width, text)
+        assert "about 6 s left" in bar.toolTip()
+    window.progress_bar.hide()

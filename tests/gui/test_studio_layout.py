@@ -46,7 +46,7 @@ def test_the_status_line_gives_a_results_figures_in_words_and_units(window, qtbo
         window.doc.set_mask(g.key, Mask.empty(w, h).painted_line((w / 3, h / 2), (w / 2, h / 2), 6), "Brush stroke")
     qtbot.waitUntil(lambda: _final_of(window, method) and not window.renderer.running(), timeout=60000)
     shown = window.renderer.last
-    text = window.statusBar().currentMessage()
+    text = window.result_label.full_text()
     assert text.startswith("result ") and " — " in text
     assert not SNAKE.findall(text), text
     assert not [k for k in shown.figures if "_" in k and k in text], text
