@@ -358,6 +358,11 @@ def _auto(params: FastParams, shapes: Mapping[str, tuple]) -> dict:
     return {name: getattr(resolved, name) for name in ("p", "p_l")}
 
 
+def _limits(params: FastParams, shapes: Mapping[str, tuple]) -> dict:
+    """The neighbourhood fits in the source texture (its source region)."""
+    return {"n": (3, min(shapes["texture"][:2]))} if "texture" in shapes else {}
+
+
 METHOD = Method(
     name="fast",
     summary="fast texture transfer (Ashikhmin): live artistic styles, synthesis, super-resolution",
@@ -376,7 +381,8 @@ METHOD = Method(
         canvas="texture",
         geometry=(Geometry(SQUARE, on=("texture",),
                            help="drag a square: the source region (the method copies only from it)"),),
-        preview_inputs=("target",), preview_params=("size",), auto=_auto, compare=("target", "texture"),
+        preview_inputs=("target",), preview_params=("size",), auto=_auto, limits=_limits,
+        compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=0,
         figures={"mode": Figure("mode"), "metric": Figure("metric"),
                  "p": Figure("random candidates", "%", digits=2),

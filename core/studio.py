@@ -177,6 +177,11 @@ class Studio:
         studio's method): the studio shares inputs by name between methods, and an image opened as
         another method's input of that name must not change what this one does (``fill``'s optional
         ``texture``, a source to copy from, is not ``quilt``'s texture).
+    limits : ``limits(params, shapes) -> {name: (lo, hi)}``: the narrower range a parameter accepts
+        with inputs of these shapes and the other parameters' values (quilt's block must fit in the
+        sample: ``2..112`` for a 112x128 texture, against ``2..1024`` in general), the range the
+        method's own check would name in its error; the studio's sliders and tooltips follow it
+        (:meth:`ranges`). Takes the same ``shapes`` as ``auto``; may raise ``WeftError``.
     masks_of : inputs that are masks of another input without being painted (opened as files): each
         belongs to the first of its images that is open (``fill``'s ``source_mask`` is the texture's
         when one is open, else the image's); :func:`crop_around` crops it with that image.
@@ -195,6 +200,7 @@ class Studio:
     preview_around: str | None = None
     own_inputs: tuple[str, ...] = ()
     masks_of: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    limits: Callable[[Any, Mapping[str, tuple]], Mapping[str, tuple]] | None = None
 
     def describe(self, figures: Mapping[str, Any], *, crop: bool = False) -> list[str]:
         """A result's figures in words and units (see :func:`describe_figures`; ``crop``: of a
@@ -214,6 +220,28 @@ class Studio:
             return dict(self.auto(params, {name: tuple(shape) for name, shape in shapes.items()}))
         except WeftError:
             return {}
+
+    def ranges(self, params, shapes: Mapping[str, tuple]) -> dict[str, tuple]:
+        """The range each parameter accepts now, for inputs of these shapes and the other parameters'
+        values (:attr:`limits`, each within its ``Spec``'s range; a parameter not named keeps its
+        Spec's range). Empty if the method says nothing or refuses the inputs."""
+        if self.limits is None:
+            return {}
+        try:
+            found = dict(self.limits(params, {name: tuple(shape) for name, shape in shapes.items()}))
+        except WeftError:
+            return {}
+        from .params import specs
+
+        bounds = {spec.name: (spec.lo, spec.hi) for spec in specs(type(params))}
+        out = {}
+        for name, (lo, hi) in found.items():
+            spec_lo, spec_hi = bounds.get(name, (None, None))
+            lo = lo if spec_lo is None else max(lo, spec_lo)
+            hi = hi if spec_hi is None else min(hi, spec_hi)
+            if lo <= hi:
+                out[name] = (lo, hi)
+        return out
 
     def compare_input(self, open_inputs) -> str:
         for name in self.compare:

@@ -237,6 +237,11 @@ class Document(QObject):
         extended canvas can change them), and the shapes of its inputs."""
         return self.studio.resolved(self.run_params(live=False), self.input_shapes())
 
+    def param_ranges(self) -> dict[str, tuple]:
+        """The range each of the current method's parameters accepts now, with its open inputs and
+        the other parameters' values (``Studio.ranges``; a parameter not named keeps its Spec's)."""
+        return self.studio.ranges(self.run_params(live=False), self.input_shapes())
+
     def _input_parts(self, live: bool):
         """What the current method's inputs are made of: the open images it gets (name -> array, with
         alpha where its ``InputSpec`` asks), its painted masks (name -> ``Mask``), and its source region

@@ -194,7 +194,7 @@ class MethodPanel(QWidget):
 
     def show_params(self) -> None:
         """The current parameters, each unset ("auto") one with the value a run resolves it to."""
-        self.params_panel.show_params(self.doc.current_params, self.doc.auto_values())
+        self.params_panel.show_params(self.doc.current_params, self.doc.auto_values(), self.doc.param_ranges())
 
     def show_seed(self) -> None:
         self.seed_box.blockSignals(True)

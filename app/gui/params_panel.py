@@ -28,6 +28,10 @@ from superqt import QLabeledDoubleSlider, QLabeledSlider
 from weft.core.params import BOOL, CHOICE, FLOAT, INT, SIZE, Params, Spec, specs
 
 
+def _fmt(v) -> str:
+    return str(int(v)) if float(v).is_integer() else f"{float(v):g}"
+
+
 class _Row(QWidget):
     """One parameter's editor."""
 
@@ -84,12 +88,44 @@ class _Row(QWidget):
         self.reset.setToolTip(f"reset {spec.name} to its default")
         self.reset.clicked.connect(lambda: self.changed.emit(spec.default, False))
         lay.addWidget(self.reset)
+        self._range: tuple | None = None  # the narrower range the inputs allow (set_range), or None
+        self._set_tip()
+
+    def _set_tip(self) -> None:
+        spec, k = self.spec, self.spec.kind
         tip = [spec.help or spec.name]
         if spec.symbol:
             tip.insert(0, f"paper symbol: {spec.symbol}")
-        if spec.range_text():
+        if self._range is not None:
+            lo, hi = (_fmt(v) for v in self._range)
+            tip.append(f"range {lo}..{hi} for these inputs and settings ({spec.range_text()} in general)")
+        elif spec.range_text():
             tip.append(("one of " if k == CHOICE else "range ") + spec.range_text())
         self.setToolTip("\n".join(tip))
+        self._auto_tip()
+        label = getattr(self, "label", None)
+        if label is not None:
+            label.setToolTip(self.toolTip())
+
+    def set_range(self, bounds: tuple | None, value: Any = None) -> None:
+        """A slider's range for the open inputs (``bounds`` within the Spec's; None: the Spec's). A
+        value already set outside it widens it (shown as it is, never clamped: the render says why
+        it fails)."""
+        if self.spec.kind not in (INT, FLOAT):
+            return
+        spec = self.spec
+        full = (spec.lo if spec.lo is not None else 0, spec.hi if spec.hi is not None else 100)
+        lo, hi = full if bounds is None else bounds
+        if value is not None:
+            lo, hi = min(lo, value), max(hi, value)
+        self._range = None if (lo, hi) == tuple(full) else (lo, hi)
+        if (self.editor.minimum(), self.editor.maximum()) != (lo, hi):
+            self.editor.blockSignals(True)
+            try:
+                self.editor.setRange(lo, hi)
+            finally:
+                self.editor.blockSignals(False)
+        self._set_tip()
 
     def _auto_toggled(self, on: bool) -> None:
         # unticked: the editor already shows what "auto" resolved to (set_value), so the value
@@ -192,14 +228,20 @@ class ParamsPanel(QWidget):
             row.changed.connect(lambda value, dragging, name=spec.name: self.edited.emit(name, value, dragging))
             label = QLabel(f"{spec.name} ({spec.symbol})" if spec.symbol and spec.symbol != spec.name else spec.name)
             label.setToolTip(row.toolTip())
+            row.label = label
             self.form.addRow(label, row)
             self.rows[spec.name] = row
 
-    def show_params(self, params: Params, auto_values: dict[str, Any] | None = None) -> None:
-        """Show ``params`` (``auto_values`` are what "auto" resolves to, shown greyed)."""
-        auto_values = auto_values or {}
+    def show_params(self, params: Params, auto_values: dict[str, Any] | None = None,
+                    ranges: dict[str, tuple] | None = None) -> None:
+        """Show ``params`` (``auto_values`` are what "auto" resolves to, shown greyed; ``ranges`` the
+        narrower range a parameter accepts with the open inputs, for its slider and tooltip)."""
+        auto_values, ranges = auto_values or {}, ranges or {}
         for name, row in self.rows.items():
-            row.set_value(getattr(params, name), auto_values.get(name))
+            value = getattr(params, name)
+            row.set_range(ranges.get(name), value if isinstance(value, (int, float)) and not isinstance(value, bool)
+                          else None)
+            row.set_value(value, auto_values.get(name))
 
     def row(self, name: str) -> _Row:
         return self.rows[name]

@@ -346,6 +346,7 @@ METHOD = Method(
                                 "Delete to remove it"),),
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
         auto=lambda params, shapes: {"sigma_d": params.overlap / 2.0}, rank=3,
+        limits=lambda params, shapes: {"overlap": (2, params.block // 2)},
         figures={**{f"rectify_{k}": f.prefixed("rectification") if f.unit == "px" else f
                     for k, f in RECTIFY_FIGURES.items()},
                  "patches": Figure("patches"), "repaired_pixels": Figure("repaired pixels"),

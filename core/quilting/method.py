@@ -65,6 +65,18 @@ def _auto(params: QuiltParams, shapes: Mapping[str, tuple]) -> dict:
             "tol": params.tol or synth_tol(block)}
 
 
+def _limits(params: QuiltParams, shapes: Mapping[str, tuple]) -> dict:
+    """The ranges block and overlap accept with inputs of these shapes: a block fits in the sample
+    (its source region), an overlap is smaller than the block (given or resolved)."""
+    out = {}
+    if "texture" in shapes:
+        out["block"] = (2, min(shapes["texture"][:2]))
+    block = params.block or _auto(params, shapes).get("block")
+    if block:
+        out["overlap"] = (1, max(1, block - 1))
+    return out
+
+
 def warm_up() -> None:
     """Load (or compile) every numba kernel a run can use, on tiny inputs, so that no run compiles:
     the four selection kernels (tol, tol 1, epsilon, sampled), the seam rule's (candidates and the
@@ -105,7 +117,7 @@ METHOD = Method(
         canvas="texture",
         geometry=(Geometry(SQUARE, on=("texture",),
                            help="drag a square: the source region (blocks come only from it)"),),
-        preview_inputs=("target", "target_map"), preview_params=("size",), auto=_auto,
+        preview_inputs=("target", "target_map"), preview_params=("size",), auto=_auto, limits=_limits,
         compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=1,
         figures={"block": Figure("block", "px"), "blocks": Figure("blocks"),

@@ -2,6 +2,7 @@
 
 import dataclasses
 
+import numpy as np
 from PySide6.QtCore import Qt
 
 from weft.core.errors import WeftError
@@ -424,3 +425,33 @@ def test_auto_block_follows_the_sample_and_its_source_region(window, qtbot):
     qtbot.waitUntil(lambda: doc.current_params.block is not None, timeout=5000)
     assert doc.current_params.block == 28 and row.editor.value() == 28
     window.renderer.cancel()
+
+
+def test_a_slider_runs_only_over_what_the_open_inputs_allow(window, qtbot, tmp_path):
+    """Quilt's block on a 112x128 texture, "auto" unticked: the slider ends at 112 (the block must
+    fit in the sample), its tooltip says so, and its far end renders (it said "outside 2..112")."""
+    from weft.core.image import save_image
+
+    doc = window.doc
+    texture = tmp_path / "small.png"
+    save_image(texture, np.random.default_rng(3).random((128, 112, 3), dtype=np.float32))
+    doc.set_method("quilt")
+    doc.clear_input("target")  # synthesis
+    window.open_input("texture", str(texture))
+    qtbot.waitUntil(lambda: doc.image("texture") is not None and doc.image("texture").shape[:2] == (128, 112),
+                    timeout=10000)
+    qtbot.waitUntil(lambda: window.params_panel.row("block").auto.isVisible(), timeout=5000)
+    row = window.params_panel.row("block")
+    qtbot.mouseClick(row.auto, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: doc.current_params.block is not None, timeout=5000)
+    assert row.editor.maximum() == 112
+    assert "range 2..112 for these inputs" in row.toolTip() and "2..1024 in general" in row.toolTip()
+    slider = row.editor._slider
+    slider.setFocus()
+    qtbot.keyClick(slider, Qt.Key.Key_End)  # the far end, as a user drags it there
+    qtbot.waitUntil(lambda: doc.current_params.block == 112, timeout=5000)
+    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.params.get("block") == 112
+                    and not window.renderer.running(), timeout=60000)
+    assert not window.result_view.stale.isVisible()
+    overlap = window.params_panel.row("overlap")
+    assert overlap.editor.maximum() == 111  # smaller than the block
