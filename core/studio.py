@@ -48,6 +48,9 @@ class Geometry:
         session beside the session file. A mask has no ``param``.
     help : what the user does, shown as the view's title.
     live : ``live(params) -> bool``: re-render a preview while the geometry is being dragged.
+    needed : words for the user when the studio must not render without it (a run without it does
+        something else, e.g. treats the photo as frontal): while it is not drawn the studio shows
+        the input and these words instead of a result, e.g. ``"draw feature lines (or Quad…)"``.
     """
 
     kind: str
@@ -56,6 +59,7 @@ class Geometry:
     help: str = ""
     live: Callable[[Any], bool] | None = None
     input: str | None = None
+    needed: str = ""
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:

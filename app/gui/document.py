@@ -274,6 +274,15 @@ class Document(QObject):
             changes[g.param] = value
         return params.replace(**changes) if changes else params
 
+    def nothing_drawn(self) -> str | None:
+        """What the user must draw before the current method renders in the studio (the words of a
+        geometry it needs, ``Geometry.needed``, that is not drawn), or None."""
+        params = self.run_params(live=False)
+        for g in self.studio.geometry:
+            if g.needed and (getattr(params, g.param, None) if g.param is not None else self.value(g.key)) is None:
+                return g.needed
+        return None
+
     def recipe(self, params: Params | None = None) -> Recipe:
         """The recipe of a render of the document now with ``params`` (default :meth:`run_params`);
         input paths absolute (``Recipe.to_json(relative_to=...)`` writes them relative to its file).

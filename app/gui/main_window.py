@@ -165,6 +165,7 @@ class MainWindow(QMainWindow):
         self.renderer.preparing.connect(self._on_preparing)
         self.renderer.busy.connect(self._on_busy)
         self.renderer.failed.connect(self._on_failed)
+        self.renderer.needs.connect(self._on_needs)
         self.renderer.cancelled.connect(self._on_cancelled)
         self._rebuild_method()
         self._default_layout = self.saveState()  # View > Reset Layout returns to it
@@ -678,6 +679,11 @@ class MainWindow(QMainWindow):
                                        f" (F5 renders again).")
         if self.renderer.last is not None:
             self.result_view.set_image(self.renderer.last.image)
+
+    def _on_needs(self, words: str) -> None:
+        """The method renders nothing until something is drawn: the input, and what to draw on it."""
+        self._input_shown, self.renderer.input_shown = words[0].upper() + words[1:], True
+        self._show_before()
 
     def _show_before(self) -> None:
         """Show again what the result view showed before a stroke's previews or a cancelled render:

@@ -190,7 +190,8 @@ class Renderer(QObject):
 
     Signals: ``shown(Shown)`` a new result to display; ``partial(image)`` a partial image of a
     running job; ``progress(fraction, stage)``; ``busy(bool)`` a job over the progress delay is
-    running (show the bar); ``failed(message)``; ``cancelled()``; ``preparing(words)`` the running
+    running (show the bar); ``failed(message)``; ``needs(words)`` nothing rendered: the method needs
+    something drawn first (``Geometry.needed``); ``cancelled()``; ``preparing(words)`` the running
     final render is waiting for its method's kernels to compile (a first run), in words for the
     result view (then ``progress`` takes over again); ``submitted(job_id, slot)`` a job was handed
     to the workers (for measurements).
@@ -205,6 +206,7 @@ class Renderer(QObject):
     preparing = Signal(str)
     busy = Signal(bool)
     failed = Signal(str)
+    needs = Signal(str)  # the method needs a geometry drawn before it renders: what to draw (no job runs)
     cancelled = Signal()
     _delivered = Signal(object)
     _progressed = Signal(int, str, object)
@@ -352,6 +354,15 @@ class Renderer(QObject):
             self._preview_timer.stop()  # (asked for by the dabs this job covers)
         elif slot == "preview" and self._stroking:
             return None  # a stroke is painted: its next dab asks for its preview (no whole image meanwhile)
+        needed = doc.nothing_drawn()
+        if needed is not None:
+            if slot == "final":
+                self.runner.cancel("final")
+                self._final_running = False
+                self._busy_timer.stop()
+                self.busy.emit(False)
+                self.needs.emit(needed)
+            return None
         prepared = self._preparation(preview=preview, around_box=box)
         if prepared is None:
             return None

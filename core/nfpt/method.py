@@ -343,7 +343,10 @@ METHOD = Method(
         canvas="photo",
         geometry=(Geometry(LINES, on=("photo",), param="lines",
                            help="drag to draw feature lines; drag an end to move it; click a line + "
-                                "Delete to remove it"),),
+                                "Delete to remove it",
+                           # (a run without lines takes the photo as frontal: of a perspective photo,
+                           # a collage with hard seams)
+                           needed="draw feature lines on the photo (or Quad…: click the plane's four corners)"),),
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
         auto=lambda params, shapes: {"sigma_d": params.overlap / 2.0}, rank=3,
         limits=lambda params, shapes: {"overlap": (2, params.block // 2)},

@@ -216,3 +216,28 @@ def test_quad_corners_move_together(nfpt, qtbot):
     moved = [doc.image_lines[2][:2], doc.image_lines[1][2:]]  # the two ends that met there
     assert sorted(abs(m[0] - (x - 10)) < 0.6 for m in moved) == [False, True]  # Alt: one alone
     assert before[2][:2] in moved or before[1][2:] in moved
+
+
+def test_nfpt_without_lines_shows_the_photo_and_says_what_to_draw(window, qtbot):
+    """Switching to nfpt on the perspective photo with no lines renders nothing (it rendered a
+    collage of sky strips and bricks): the result view shows the photo and says to draw feature
+    lines or use Quad…; four Quad clicks then render."""
+    submitted = []
+    window.renderer.submitted.connect(lambda job_id, slot: submitted.append(slot))
+    window.doc.set_method("nfpt")
+    assert window.doc.value("lines") is None
+    view = window.result_view
+    qtbot.waitUntil(lambda: view.notice.isVisible() and "feature lines" in view.notice.text(), timeout=10000)
+    assert "Quad" in view.notice.text()
+    qtbot.waitUntil(lambda: view.image is window.doc.image("photo"), timeout=5000)
+    assert submitted == [] and not window.renderer.running()
+    assert window.nothing_to_export().startswith("nothing to export: draw feature lines")
+    data = json.loads((RESOURCES / "perspective-lines.json").read_text())
+    window.doc.set_param("size", (128, 96))
+    window.lines_panel.quad_button.setChecked(True)
+    for x, y in [line[:2] for line in data["image_lines"][:4]]:
+        mouse(window.canvas_view, "press", (x, y))
+        mouse(window.canvas_view, "release", (x, y))
+    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.method == "nfpt",
+                    timeout=60000)
+    assert not view.notice.isVisible() and window.nothing_to_export() is None
