@@ -15,6 +15,7 @@ time only (no imports, no image I/O).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import secrets
@@ -260,6 +261,8 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         jpeg = out.suffix.lower() in (".jpg", ".jpeg")
         bit_depth = info.bit_depth if info is not None and not jpeg else 8
     recipe = output_recipe(method, params, input_paths, seed, region, out)
+    if args.bit_depth is not None:  # asked for (or a recipe's): recorded, so weft run writes it again
+        recipe = dataclasses.replace(recipe, bit_depth=bit_depth)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if args.report:
         h, w = result.image.shape[:2]
@@ -337,6 +340,9 @@ def _dispatch(args: argparse.Namespace) -> int:
         else:
             seed = recipe.seed
         region = Square.parse(args.region) if args.region is not None else recipe.region
+        if args.bit_depth is None and recipe.bit_depth is not None and \
+                Path(args.output).suffix.lower() not in (".jpg", ".jpeg"):
+            args.bit_depth = str(recipe.bit_depth)  # the depth the recipe's output was written at
         return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region)
 
     method = registry.get(args.method)

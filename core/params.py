@@ -350,7 +350,10 @@ class Recipe:
          "inputs": {"texture": "a.png", "target": "b.png"}, "seed": 7}
 
     plus, when the user picked one, ``"region": [x, y, side]``: the square of the texture the method
-    used as its source (the studio's prototype rectangle; ``--region X,Y,S`` on the command line).
+    used as its source (the studio's prototype rectangle; ``--region X,Y,S`` on the command line);
+    and, when it was chosen (a studio export, ``--bit-depth``), ``"bit_depth": 8`` or ``16``: the bits
+    per sample of the output, which ``weft run`` then writes (without it: 8, or the depth of the input
+    the method keeps, ``Method.depth_from``).
 
     Input paths are stored as given; :meth:`load` resolves relative paths against the folder of the
     recipe file, so a recipe next to its images keeps working when the folder moves.
@@ -361,6 +364,7 @@ class Recipe:
     inputs: Mapping[str, str] = field(default_factory=dict)
     seed: int | None = None
     region: Square | None = None
+    bit_depth: int | None = None
 
     def to_json(self, relative_to: str | os.PathLike | None = None) -> str:
         """The recipe's JSON text; with ``relative_to`` (the folder of the file that will carry it),
@@ -372,6 +376,8 @@ class Recipe:
                 "inputs": inputs, "seed": self.seed}
         if self.region is not None:
             data["region"] = Square(*self.region).to_json()
+        if self.bit_depth is not None:
+            data["bit_depth"] = self.bit_depth
         return json.dumps(data, sort_keys=False)
 
     @classmethod
@@ -411,9 +417,12 @@ class Recipe:
                 region = Square.from_json(region, "region")
             except InvalidParameter:
                 raise WeftError(f"recipe \"region\" = {region!r} must be [x, y, side] in pixels") from None
+        bit_depth = data.get("bit_depth")
+        if bit_depth is not None and (isinstance(bit_depth, bool) or bit_depth not in (8, 16)):
+            raise WeftError(f"recipe \"bit_depth\" = {bit_depth!r} must be 8 or 16")
         if base is not None:
             inputs = {k: str(Path(base) / v) if not os.path.isabs(v) else v for k, v in inputs.items()}
-        return cls(method=method, params=params, inputs=inputs, seed=seed, region=region)
+        return cls(method=method, params=params, inputs=inputs, seed=seed, region=region, bit_depth=bit_depth)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "Recipe":

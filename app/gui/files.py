@@ -54,6 +54,17 @@ def _write_masks(masks: dict) -> None:
             raise WeftError(f"{file}: cannot write the {name.replace('_', ' ')} ({e.strerror or e})") from None
 
 
+def _source_depth(shown) -> int:
+    """The bits per sample of a PNG export of ``shown``: 16 when one of the image files its recipe
+    names is 16-bit (a 16-bit source keeps its precision), else 8."""
+    from weft.core.image import file_bit_depth
+
+    for path in shown.recipe.inputs.values():
+        if file_bit_depth(path) == 16:
+            return 16
+    return 8
+
+
 def off_gui_thread(fn: Callable[[], T]) -> T:
     """Run ``fn()`` on a worker thread and return its value (or raise its exception).
 
@@ -146,7 +157,8 @@ class FileActions(QObject):
             self.export_result(path)
 
     def export_result(self, path: str) -> bool:
-        """Save the shown full-size result: PNG carries the result's recipe, TIFF is 16-bit, JPEG 8-bit."""
+        """Save the shown full-size result: PNG carries the result's recipe (with the bit depth written)
+        and is 16-bit when a source image is, TIFF is 16-bit, JPEG 8-bit."""
         why = self.window.nothing_to_export()
         if why is not None:
             self.show_message(why)
@@ -162,13 +174,15 @@ class FileActions(QObject):
         if p.exists() and not self._confirm(f"{p.name} exists. Replace it?"):
             self.show_message(f"{p.name}: not exported (the existing file is kept)")
             return False
+        suffix = p.suffix.lower()
+        depth = 16 if suffix in (".tif", ".tiff") else 8 if suffix in (".jpg", ".jpeg") else _source_depth(shown)
         try:
             recipe, masks = self._with_masks(shown, p)
-            recipe = recipe.to_json(relative_to=p.resolve().parent)
+            # the bit depth written is recorded: weft run writes the same samples again
+            recipe = dataclasses.replace(recipe, bit_depth=depth).to_json(relative_to=p.resolve().parent)
         except WeftError as e:
             self.show_message(str(e))
             return False
-        depth = 16 if p.suffix.lower() in (".tif", ".tiff") else 8
         self.statusBar().showMessage(f"exporting {p.name}…")
 
         def write() -> None:
@@ -197,6 +211,7 @@ class FileActions(QObject):
         shown = self.renderer.last
         try:
             recipe, masks = self._with_masks(shown, Path(path))
+            recipe = dataclasses.replace(recipe, bit_depth=_source_depth(shown))  # (as a PNG export's)
 
             def write() -> None:
                 _write_masks(masks)

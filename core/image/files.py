@@ -544,6 +544,10 @@ def encode_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | No
     except cv2.error as e:
         raise ImageError(f"{target}: cannot encode {_SAVE_FORMATS[ext]} ({_one_line(e)})", path=where) from e
     data = encoded.tobytes()
+    if _SAVE_FORMATS[ext] == "TIFF" and arr.ndim == 3 and arr.shape[2] == 4 and bit_depth == 16:
+        # (not at 8 bits: OpenCV's 8-bit TIFF reader, libtiff's RGBA interface, then premultiplies
+        # the colour by an unassociated alpha)
+        data = _tiff_with_alpha(data)
     if recipe is not None and ext == ".png":
         try:
             chunk = _png_chunk(b"tEXt", _RECIPE_KEY + b"\0" + recipe.encode("latin-1"))
@@ -551,6 +555,28 @@ def encode_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | No
             chunk = _png_chunk(b"iTXt", _RECIPE_KEY + b"\0\0\0\0\0" + recipe.encode("utf-8"))
         data = data[:33] + chunk + data[33:]  # OpenCV writes signature (8) + IHDR (25) first
     return data
+
+
+def _tiff_with_alpha(data: bytes) -> bytes:
+    """A 4-channel TIFF from OpenCV (one IFD, no ExtraSamples tag) with ExtraSamples = 2, unassociated
+    alpha (TIFF 6.0, section 18), so that readers take the 4th channel as alpha, not a colour. The IFD
+    is written again, with the tag in order, after the data; the header points at it."""
+    order = {b"II": "<", b"MM": ">"}.get(data[:2])
+    if order is None:
+        return data
+    (offset,) = struct.unpack(order + "I", data[4:8])
+    (count,) = struct.unpack(order + "H", data[offset:offset + 2])
+    entries = [data[offset + 2 + 12 * i:offset + 14 + 12 * i] for i in range(count)]
+    tags = [struct.unpack(order + "H", e[:2])[0] for e in entries]
+    if 338 in tags:
+        return data
+    extra = struct.pack(order + "HHI", 338, 3, 1) + struct.pack(order + "H", 2) + b"\0\0"
+    entries.append(extra)
+    entries.sort(key=lambda e: struct.unpack(order + "H", e[:2])[0])
+    pad = b"\0" * (len(data) % 2)  # (an IFD starts on a word boundary)
+    new_offset = len(data) + len(pad)
+    ifd = struct.pack(order + "H", len(entries)) + b"".join(entries) + struct.pack(order + "I", 0)
+    return data[:4] + struct.pack(order + "I", new_offset) + data[8:] + pad + ifd
 
 
 def read_recipe(path: str | os.PathLike) -> str | None:
