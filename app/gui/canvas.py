@@ -155,6 +155,7 @@ class InputsPane(QSplitter):
                 continue  # painted over its image, not a view of its own
             view = self.view(inp.name)
             view.set_image(self.doc.image(inp.name))
+            view.set_transparency(self._alpha(inp.name))
             self._show_clear(inp.name, optional=not inp.required)
             if inp.name == studio.canvas:
                 continue
@@ -246,8 +247,14 @@ class InputsPane(QSplitter):
         if bar is not None:
             bar.refresh()
 
+    def _alpha(self, name: str):
+        """The alpha channel of input ``name`` as the current method sees it, or None."""
+        item = self.doc.item(name)
+        return None if item is None else item.alpha
+
     def input_changed(self, name: str) -> None:
         self.view(name).set_image(self.doc.image(name), fit=True)
+        self.view(name).set_transparency(self._alpha(name))
         spec = next((i for i in self.doc.current.inputs if i.name == name), None)
         self._show_clear(name, optional=spec is not None and not spec.required)
         self.sync_tools()

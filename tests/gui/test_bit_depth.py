@@ -7,6 +7,7 @@ import json
 import cv2
 import numpy as np
 from PIL import Image
+from PySide6.QtCore import QPointF, QRectF
 
 from weft.app.cli import main as weft
 from weft.core.geometry import Mask
@@ -67,3 +68,37 @@ def test_a_16_bit_rgba_tiff_marks_its_alpha(tmp_path, capsys):
         assert im.tag_v2.get(338) == (2,) and im.tag_v2.get(258) == (16, 16, 16, 16)
     a = cv2.imread(str(out), cv2.IMREAD_UNCHANGED)
     assert a.shape == (72, 96, 4) and a.dtype == np.uint16
+
+
+def test_transparency_shows_as_a_checkerboard_with_its_outline(window, qtbot, tmp_path):
+    """An RGBA picture's transparent part shows a checkerboard (not the colour stored under alpha 0)
+    and its outline, as image editors show it."""
+    rgba = np.zeros((72, 96, 4), np.float32)
+    rgba[..., 0] = 1.0  # pure red everywhere, also under the hole
+    rgba[..., 3] = 1.0
+    rgba[20:40, 30:60, 3] = 0.0
+    path = tmp_path / "holed.png"
+    save_image(path, rgba)
+    doc = window.doc
+    doc.set_method("fill")
+    window.open_input(doc.studio.canvas, str(path))
+    qtbot.waitUntil(lambda: doc.item(doc.studio.canvas) is not None and doc.item(doc.studio.canvas).path == str(path),
+                    timeout=10000)
+    view = window.canvas_view
+    qtbot.waitUntil(lambda: view.image is not None and view.image.shape[:2] == (72, 96), timeout=5000)
+    view.actual_size()
+    view.zoom_by(4.0)
+    view.centerOn(45, 30)
+    qtbot.wait(20)
+    assert view.transparency.path().boundingRect() == QRectF(30, 20, 30, 20)
+    shot = view.viewport().grab().toImage()
+
+    def colour(x, y):
+        p = view.mapFromScene(QPointF(x, y))
+        c = shot.pixelColor(p)
+        return c.red(), c.green(), c.blue()
+
+    inside = {colour(31 + i * 0.9, 21 + j * 0.9) for i in range(28) for j in range(16)}
+    assert (255, 0, 0) not in inside  # the red under alpha 0 is not shown ...
+    assert {(153, 153, 153), (204, 204, 204)} <= inside  # ... a checkerboard is
+    assert colour(10, 10) == (255, 0, 0)  # the opaque part as it is
