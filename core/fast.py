@@ -363,6 +363,16 @@ def _limits(params: FastParams, shapes: Mapping[str, tuple]) -> dict:
     return {"n": (3, min(shapes["texture"][:2]))} if "texture" in shapes else {}
 
 
+def _idle(params: FastParams, shapes: Mapping[str, tuple]) -> set:
+    """Parameters that change nothing with these settings: each metric's own weight outside it."""
+    idle = set()
+    if params.metric != "artistic":
+        idle.add("w")
+    if params.metric != "full":
+        idle.add("target_weight")
+    return idle
+
+
 METHOD = Method(
     name="fast",
     summary="fast texture transfer (Ashikhmin): live artistic styles, synthesis, super-resolution",
@@ -381,7 +391,7 @@ METHOD = Method(
         canvas="texture",
         geometry=(Geometry(SQUARE, on=("texture",),
                            help="drag a square: the source region (the method copies only from it)"),),
-        preview_inputs=("target",), preview_params=("size",), auto=_auto, limits=_limits,
+        preview_inputs=("target",), preview_params=("size",), auto=_auto, limits=_limits, idle=_idle,
         compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=0,
         figures={"mode": Figure("mode"), "metric": Figure("metric"),

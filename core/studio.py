@@ -186,6 +186,9 @@ class Studio:
         sample: ``2..112`` for a 112x128 texture, against ``2..1024`` in general), the range the
         method's own check would name in its error; the studio's sliders and tooltips follow it
         (:meth:`ranges`). Takes the same ``shapes`` as ``auto``; may raise ``WeftError``.
+    idle : ``idle(params, shapes) -> names``: the parameters that change nothing with these settings
+        and inputs (nfpt's ``a``, ``b``, ``p`` with the homography warp): Variations does not offer
+        them. Takes the same ``shapes`` as ``auto``.
     masks_of : inputs that are masks of another input without being painted (opened as files): each
         belongs to the first of its images that is open (``fill``'s ``source_mask`` is the texture's
         when one is open, else the image's); :func:`crop_around` crops it with that image.
@@ -205,6 +208,7 @@ class Studio:
     own_inputs: tuple[str, ...] = ()
     masks_of: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
     limits: Callable[[Any, Mapping[str, tuple]], Mapping[str, tuple]] | None = None
+    idle: Callable[[Any, Mapping[str, tuple]], Any] | None = None
 
     def describe(self, figures: Mapping[str, Any], *, crop: bool = False) -> list[str]:
         """A result's figures in words and units (see :func:`describe_figures`; ``crop``: of a
@@ -246,6 +250,15 @@ class Studio:
             if lo <= hi:
                 out[name] = (lo, hi)
         return out
+
+    def idle_params(self, params, shapes: Mapping[str, tuple]) -> frozenset:
+        """The parameters that change nothing with these settings and inputs (:attr:`idle`)."""
+        if self.idle is None:
+            return frozenset()
+        try:
+            return frozenset(self.idle(params, {name: tuple(shape) for name, shape in shapes.items()}))
+        except WeftError:
+            return frozenset()
 
     def compare_input(self, open_inputs) -> str:
         for name in self.compare:

@@ -1,5 +1,8 @@
 """The variations grid: two parameters, two ranges, an n x n grid of thumbnails rendered in parallel.
 
+It offers the parameters that change something with the current settings and inputs (the method's
+``Studio.idle`` names the others); an exported grid is labelled with the parameters and values.
+
 Clicking a cell adopts its two values (one undo step). Cells render on their own worker pool at
 thumbnail size (the target or output size scaled so its longer side is ``THUMB_SIDE``), so the main
 window's renders are not held up; a cell whose values the method refuses says why. The thumbnail-size
@@ -12,8 +15,8 @@ dropped.
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QSize, Qt, QTimer, Signal
-from PySide6.QtGui import QIcon, QPixmap
+from PySide6.QtCore import QPoint, QRect, QSize, Qt, QTimer, Signal
+from PySide6.QtGui import QColor, QFont, QFontMetrics, QIcon, QImage, QPainter, QPixmap
 from PySide6.QtWidgets import (
     QComboBox,
     QDialog,
@@ -65,7 +68,9 @@ class VariationsDialog(QDialog):
         self._delivered.connect(self._on_result)
         self.cells: dict[tuple[int, int], QToolButton] = {}
         self.values: dict[tuple[int, int], tuple] = {}
-        self.numeric = numeric_specs(doc.current.params)
+        # only the parameters that change something with the current settings and inputs
+        idle = doc.studio.idle_params(doc.run_params(live=False), doc.input_shapes())
+        self.numeric = [s for s in numeric_specs(doc.current.params) if s.name not in idle]
         lay = QVBoxLayout(self)
         controls = QGridLayout()
         self.combo, self.lo, self.hi = [], [], []
@@ -279,19 +284,40 @@ class VariationsDialog(QDialog):
         button.setEnabled(False)
 
     def grid_image(self) -> np.ndarray | None:
-        """The rendered cells as one image (rows and columns as on screen, refused cells grey), or None."""
+        """The rendered cells as one image (rows and columns as on screen, refused cells grey), with
+        the two parameters' names and each row's and column's value written beside it, or None."""
         if not self.images:
             return None
         n = max(i for i, _ in self.cells) + 1
         h = max(im.shape[0] for im in self.images.values())
         w = max(im.shape[1] for im in self.images.values())
         gap = 4
-        out = np.full((n * h + (n - 1) * gap, n * w + (n - 1) * gap, 3), 0.2, np.float32)
+        (na, _), (nb, _) = self.values[(0, 0)]
+        rows = [self.values[(i, 0)][0][1] for i in range(n)]
+        cols = [self.values[(0, j)][1][1] for j in range(n)]
+        font = QFont()
+        font.setPixelSize(max(11, min(16, w // 10)))
+        metrics = QFontMetrics(font)
+        line = metrics.height() + 4
+        left = max(metrics.horizontalAdvance(f"{na} = {v}") for v in rows) + 12
+        top = 2 * line + 4
+        width, height = left + n * w + (n - 1) * gap, top + n * h + (n - 1) * gap
+        sheet = QImage(width, height, QImage.Format.Format_RGB888)
+        sheet.fill(QColor(51, 51, 51))
+        painter = QPainter(sheet)
+        painter.setFont(font)
+        painter.setPen(QColor(235, 235, 235))
+        painter.drawText(QRect(left, 0, n * w, line), Qt.AlignmentFlag.AlignCenter, f"columns: {nb}")
+        for j, v in enumerate(cols):
+            painter.drawText(QRect(left + j * (w + gap), line, w, line), Qt.AlignmentFlag.AlignCenter, f"{nb} = {v}")
+        for i, v in enumerate(rows):
+            painter.drawText(QRect(4, top + i * (h + gap), left - 8, h),
+                             Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter, f"{na} = {v}")
         for (i, j), im in self.images.items():
-            rgb = im if im.ndim == 3 else np.repeat(im[..., None], 3, axis=2)
-            y, x = i * (h + gap), j * (w + gap)
-            out[y:y + rgb.shape[0], x:x + rgb.shape[1]] = rgb[..., :3]
-        return out
+            painter.drawImage(QPoint(left + j * (w + gap), top + i * (h + gap)), to_qimage(im))
+        painter.end()
+        bits = np.frombuffer(sheet.constBits(), np.uint8).reshape(height, sheet.bytesPerLine())
+        return bits[:, :width * 3].reshape(height, width, 3).astype(np.float32) / 255.0
 
     def export_grid(self, path: str | None = None) -> bool:
         """Write the grid as one PNG (asks where when no path is given)."""

@@ -350,6 +350,9 @@ METHOD = Method(
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
         auto=lambda params, shapes: {"sigma_d": params.overlap / 2.0}, rank=3,
         limits=lambda params, shapes: {"overlap": (2, params.block // 2)},
+        # the warp's a, b, p shape the line-based warps only; the repair's settings need the repair
+        idle=lambda params, shapes: ({"a", "b", "p"} if params.warp == "homography" else set())
+        | (set() if params.repair else {"band", "threshold", "n", "smooth"}),
         figures={**{f"rectify_{k}": f.prefixed("rectification") if f.unit == "px" else f
                     for k, f in RECTIFY_FIGURES.items()},
                  "patches": Figure("patches"), "repaired_pixels": Figure("repaired pixels"),

@@ -77,6 +77,19 @@ def _limits(params: QuiltParams, shapes: Mapping[str, tuple]) -> dict:
     return out
 
 
+def _idle(params: QuiltParams, shapes: Mapping[str, tuple]) -> set:
+    """Parameters that change nothing with these settings: epsilon outside its rule, the Poisson
+    band without Poisson, a transfer's alpha and passes without a target."""
+    idle = set()
+    if params.rule != "epsilon":
+        idle.add("epsilon")
+    if not params.poisson or params.mode == "random":
+        idle.add("band")
+    if "target" not in shapes:
+        idle |= {"alpha", "iterations"}
+    return idle
+
+
 def warm_up() -> None:
     """Load (or compile) every numba kernel a run can use, on tiny inputs, so that no run compiles:
     the four selection kernels (tol, tol 1, epsilon, sampled), the seam rule's (candidates and the
@@ -118,6 +131,7 @@ METHOD = Method(
         geometry=(Geometry(SQUARE, on=("texture",),
                            help="drag a square: the source region (blocks come only from it)"),),
         preview_inputs=("target", "target_map"), preview_params=("size",), auto=_auto, limits=_limits,
+        idle=_idle,
         compare=("target", "texture"),
         examples={"texture": "wood-grain", "target": "astronaut"}, rank=1,
         figures={"block": Figure("block", "px"), "blocks": Figure("blocks"),

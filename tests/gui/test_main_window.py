@@ -282,7 +282,7 @@ def test_variations_grid_renders_and_adopts_a_cell(window, qtbot):
     window.open_variations()
     dialog = window._variations
     dialog.combo[0].setCurrentText("p")
-    dialog.combo[1].setCurrentText("w")
+    dialog.combo[1].setCurrentText("target_weight")
     dialog.lo[0].setValue(0.0)
     dialog.hi[0].setValue(0.5)
     dialog.lo[1].setValue(0.0)
@@ -294,7 +294,7 @@ def test_variations_grid_renders_and_adopts_a_cell(window, qtbot):
     assert all(not b.icon().isNull() for b in dialog.cells.values())
     steps = window.doc.undo_stack.count()
     dialog.cells[(2, 1)].click()
-    assert window.doc.current_params.p == 0.5 and window.doc.current_params.w == 2.0
+    assert window.doc.current_params.p == 0.5 and window.doc.current_params.target_weight == 2.0
     assert window.doc.undo_stack.count() == steps + 1
     dialog.close()
 

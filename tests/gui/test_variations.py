@@ -20,7 +20,7 @@ def _dialog(window, p=(0.0, 0.5), w=(0.0, 4.0)):
     window.open_variations()
     dialog = window._variations
     dialog.combo[0].setCurrentText("p")
-    dialog.combo[1].setCurrentText("w")
+    dialog.combo[1].setCurrentText("target_weight")
     _ranges(dialog, p, w)
     return dialog
 
@@ -121,11 +121,11 @@ def test_a_second_render_during_the_preparation_cancels_the_first_grid(window, q
     cells = [j for j in jobs if j.slot.startswith("cell-")]
     assert len(cells) == 9 and all(j.id > jobs[1].id for j in cells)  # only the second grid's cells ran
     assert {v for (_, v), _ in dialog.values.values()} == {0.1, 0.2, 0.3}
-    assert dialog.cells[(0, 0)].text() == "p=0.1  w=1.0"
+    assert dialog.cells[(0, 0)].text() == "p=0.1  target_weight=1.0"
     # the cell shows the second grid's values' pixels
     prepare, _ = render.preparation(window.doc, side=THUMB_SIDE)
     inputs, base, _ = prepare()
-    expected = window.doc.current.run(inputs, base.replace(p=0.1, w=1.0), rng=window.doc.seed).image
+    expected = window.doc.current.run(inputs, base.replace(p=0.1, target_weight=1.0), rng=window.doc.seed).image
     assert np.array_equal(dialog.images[(0, 0)], expected)
     assert dialog.status.text() == "click a cell to adopt its values"
     dialog.close()
@@ -153,7 +153,7 @@ def test_a_failing_preparation_says_why_and_the_dialog_keeps_working(window, qtb
     assert dialog.isVisible() and dialog.export_button.isEnabled()
     assert dialog.status.text() == "click a cell to adopt its values"
     dialog.cells[(2, 1)].click()
-    assert window.doc.current_params.p == 0.5 and window.doc.current_params.w == 2.0
+    assert window.doc.current_params.p == 0.5 and window.doc.current_params.target_weight == 2.0
     dialog.close()
 
 
@@ -223,3 +223,58 @@ def test_a_preparation_that_arrives_as_the_dialog_closes_starts_nothing(window, 
     dialog.close()
     QApplication.processEvents()  # (a cell submitted to the closed runner would raise here)
     assert [j.slot for j in jobs] == ["prepare"] and dialog.images == {}
+
+
+def test_variations_offers_only_parameters_that_matter_and_labels_its_export(window, qtbot, tmp_path):
+    """nfpt with the homography warp: a, b and p change nothing (nine identical cells), so they are
+    not offered; switching to a line-based warp offers them. The exported grid names the two
+    parameters and every row's and column's value (the margins hold text)."""
+    import json
+
+
+    from weft.core.examples import RESOURCES
+    from weft.core.image import load_image
+
+    from .helpers import mouse
+
+    doc = window.doc
+    doc.set_method("nfpt")
+    assert doc.current_params.warp == "homography"
+    window.open_variations()
+    dialog = window._variations
+    offered = [dialog.combo[0].itemText(k) for k in range(dialog.combo[0].count())]
+    assert offered and not {"a", "b", "p"} & set(offered)
+    dialog.close()
+    doc.set_param("warp", "morph")
+    window.open_variations()
+    dialog = window._variations
+    offered = [dialog.combo[0].itemText(k) for k in range(dialog.combo[0].count())]
+    assert {"a", "b", "p"} <= set(offered)
+    dialog.close()
+    # a grid of a method with lines drawn, exported: labelled
+    data = json.loads((RESOURCES / "perspective-lines.json").read_text())
+    doc.set_param("warp", "homography")
+    doc.set_param("size", (96, 64))
+    window.lines_panel.quad_button.setChecked(True)
+    for x, y in [line[:2] for line in data["image_lines"][:4]]:
+        mouse(window.canvas_view, "press", (x, y))
+        mouse(window.canvas_view, "release", (x, y))
+    window.open_variations()
+    dialog = window._variations
+    dialog.combo[0].setCurrentText("tol")
+    dialog.combo[1].setCurrentText("sigma_s")
+    done = set()
+    dialog.cell_done.connect(lambda i, j: done.add((i, j)))
+    qtbot.mouseClick(dialog.render_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: len(done) == 9, timeout=120000)
+    out = tmp_path / "grid.png"
+    assert dialog.export_grid(str(out))
+    grid = load_image(out).image
+    cells = [im for im in dialog.images.values()]
+    h, w = cells[0].shape[:2]
+    assert grid.shape[0] > 3 * h + 8 and grid.shape[1] > 3 * w + 8  # room for the labels
+    margin_top = grid[: grid.shape[0] - (3 * h + 8), -(3 * w + 8):]
+    margin_left = grid[-(3 * h + 8):, : grid.shape[1] - (3 * w + 8)]
+    for margin in (margin_top, margin_left):
+        assert (margin.max(axis=2) > 0.6).sum() > 30  # light text on the dark margin
+    dialog.close()
