@@ -47,6 +47,7 @@ class InputImage:
     image: np.ndarray
     with_alpha: np.ndarray | None = None
     opened_for: str | None = None  # the method that was current when it was opened (Studio.own_inputs)
+    bit_depth: int = 8  # of the file (16 for a 16-bit PNG or TIFF): the pixel read-out counts in it
 
     @property
     def alpha(self) -> np.ndarray | None:
@@ -65,7 +66,7 @@ def read_input(path: str | Path) -> InputImage:
         kept = load_image(path, alpha=True).image
         if kept.ndim == 3 and kept.shape[2] in (2, 4) and kept.shape[:2] == loaded.image.shape[:2]:
             with_alpha = kept
-    return InputImage(str(path), loaded.image, with_alpha)
+    return InputImage(str(path), loaded.image, with_alpha, bit_depth=loaded.info.bit_depth)
 
 
 @dataclass(frozen=True)
@@ -303,18 +304,21 @@ class Document(QObject):
     def push(self, command: QUndoCommand) -> None:
         self.undo_stack.push(command)
 
-    def set_param(self, name: str, value: Any) -> None:
-        """Undoable change of one parameter of the current method (validated first)."""
+    def set_param(self, name: str, value: Any, *, merge: bool = True) -> None:
+        """Undoable change of one parameter of the current method (validated first). ``merge``: one
+        undo step with the change of the same parameter just before (a slider's drag); False for a
+        choice made from a list, each its own step."""
         new = self.current_params.replace(**{name: value})
         if new != self.current_params:
-            self.push(SetParams(self, self.method, new, f"{name} = {value}", merge_key=name))
+            self.push(SetParams(self, self.method, new, f"{name} = {value}", merge_key=name if merge else None))
 
     def set_params(self, params: Params, text: str) -> None:
         """Undoable change of several parameters of the current method at once (one step)."""
         if params != self.current_params:
             self.push(SetParams(self, self.method, params, text))
 
-    def set_input(self, name: str, path: str | None, image: np.ndarray, with_alpha: np.ndarray | None = None) -> None:
+    def set_input(self, name: str, path: str | None, image: np.ndarray, with_alpha: np.ndarray | None = None,
+                  bit_depth: int = 8) -> None:
         """Undoable opening of an input image. An input the current method paints (a mask geometry)
         becomes that mask (refused in one line if it is not the size of its image). Masks painted on
         this input that do not fit the new image are dropped (said in ``message``; undo brings them back)."""
@@ -331,7 +335,7 @@ class Document(QObject):
                 return
             self.set_mask(g.key, mask, f"Open {name.replace('_', ' ')} {Path(path).name if path else ''}".strip())
             return
-        self.push(SetInput(self, name, InputImage(path, image, with_alpha, self.method)))
+        self.push(SetInput(self, name, InputImage(path, image, with_alpha, self.method, bit_depth)))
 
     def clear_input(self, name: str) -> None:
         """Undoable removal of an open input (the method then runs without it)."""

@@ -313,17 +313,17 @@ class MainWindow(QMainWindow):
         # paints its own message only left of its first permanent widget, i.e. nowhere.
         self.status_label = ElidedLabel()
         self.statusBar().messageChanged.connect(self.status_label.set_full_text)
-        self.statusBar().addPermanentWidget(self.status_label, 1)
+        self.statusBar().addPermanentWidget(self.status_label, 3)
         # the shown result's figures stay in a widget of their own: a menu's or a tooltip's status
         # tip replaces (then clears) the status message, never them
         self.result_label = ElidedLabel()
         self.result_label.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-        self.statusBar().addPermanentWidget(self.result_label, 1)
+        self.statusBar().addPermanentWidget(self.result_label, 2)
         self.pixel_label = QLabel("")
         # the read-out keeps its own room (a typical read-out's width), so moving the mouse does not
         # shift the message, and a longer read-out is elided rather than pushed into it
         self.pixel_label.setFixedWidth(self.pixel_label.fontMetrics().horizontalAdvance(
-            "texture  x 0000  y 0000  0.000 0.000 0.000") + 8)
+            "texture  x 0000  y 0000  65535 65535 65535") + 8)
         self.zoom_label = QLabel("")
         self.progress_bar = QProgressBar()
         self.progress_bar.setMaximumWidth(320)
@@ -371,6 +371,7 @@ class MainWindow(QMainWindow):
         self._action(m, "Export &Recipe…", self.files.export_recipe_dialog, "Ctrl+Shift+E")
         self._action(m, "Apply to &Folder…", self.open_batch_dialog, "Ctrl+Shift+B")
         m.addSeparator()
+        self.file_menu = m
         self.load_lines_action = self._action(m, "Load Feature &Lines…", lambda: self.lines_panel.load_lines_dialog())
         self.save_lines_action = self._action(m, "Save Feature Li&nes…", lambda: self.lines_panel.save_lines_dialog())
         m.addSeparator()
@@ -489,7 +490,7 @@ class MainWindow(QMainWindow):
         image = item.image
         self.settings.setValue("last_dir", str(Path(path).parent))
         self._add_recent(path)
-        self.doc.set_input(name, path, image, item.with_alpha)
+        self.doc.set_input(name, path, image, item.with_alpha, item.bit_depth)
         self.statusBar().showMessage(f"{name}: {Path(path).name} {image.shape[1]}x{image.shape[0]}", 4000)
 
     def _add_recent(self, path: str) -> None:
@@ -550,9 +551,11 @@ class MainWindow(QMainWindow):
         self.geometry_menu.setEnabled(bar is not None)
         inputs = self.doc.current.inputs
         self.open_first_action.setText(f"&Open {inputs[0].name.replace('_', ' ')}…")
-        self.open_second_action.setVisible(len(inputs) > 1)
-        if len(inputs) > 1:
-            self.open_second_action.setText(f"Open {inputs[1].name.replace('_', ' ')}…")
+        # (always there, disabled when the method has one input: the File menu keeps its length, so
+        # a habitual click never lands on another entry)
+        self.open_second_action.setEnabled(len(inputs) > 1)
+        self.open_second_action.setText(f"Open {inputs[1].name.replace('_', ' ')}…" if len(inputs) > 1
+                                         else "Open Second Input…")
         self.open_other_menu.clear()
         for inp in inputs:
             act = self.open_other_menu.addAction(f"{inp.name.replace('_', ' ')}…")
@@ -736,12 +739,24 @@ class MainWindow(QMainWindow):
         if x < 0 or img is None:
             self.pixel_label.setText("")
             return
-        v = img[y, x]
-        value = f"{float(v):.3f}" if np.ndim(v) == 0 else " ".join(f"{float(c):.3f}" for c in v)
-        text = f"{view.title}  x {x}  y {y}  {value}"
+        # in the counts artists read (0-255; 0-65535 for a 16-bit picture, or a result of one)
+        top = 65535 if self._bit_depth(view) == 16 else 255
+        v = np.atleast_1d(img[y, x])
+        value = " ".join(str(int(round(float(c) * top))) for c in v)
+        text = f"{view.title}  x {x}  y {y}  {value}" + ("  (16-bit)" if top == 65535 else "")
         metrics = self.pixel_label.fontMetrics()
         self.pixel_label.setText(metrics.elidedText(text, Qt.TextElideMode.ElideMiddle, self.pixel_label.width()))
         self.pixel_label.setToolTip(text)
+
+    def _bit_depth(self, view: ImageView) -> int:
+        """The bits per sample of what ``view`` shows: its input's file's; for the result, 16 when one
+        of the current method's open inputs is 16-bit (a PNG export of it is)."""
+        if view is self.result_view:
+            items = [self.doc.item(i.name) for i in self.doc.current.inputs]
+            return 16 if any(item is not None and item.bit_depth == 16 for item in items) else 8
+        name = next((n for n, v in self.views.items() if v is view), None)
+        item = None if name is None else self.doc.item(name)
+        return 8 if item is None else item.bit_depth
 
     def _zoom_view(self) -> ImageView:
         """The view the zoom shortcuts act on: the one under the mouse (the last it moved over),

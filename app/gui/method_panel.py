@@ -32,6 +32,7 @@ from PySide6.QtWidgets import (
 
 from weft.core.errors import WeftError
 from weft.core.geometry import Square
+from weft.core.params import FLOAT, INT
 from weft.core.studio import SQUARE
 
 from .convert import to_qimage
@@ -138,7 +139,9 @@ class MethodPanel(QWidget):
     def _param_edited(self, name: str, value, dragging: bool) -> None:
         try:
             self.dragging = dragging
-            self.doc.set_param(name, value)
+            # a slider's moves are one undo step; a choice from a list, a switch or a typed size is its own
+            row = self.params_panel.rows.get(name)
+            self.doc.set_param(name, value, merge=row is not None and row.spec.kind in (INT, FLOAT))
         except WeftError as e:
             self.message.emit(str(e))
             self.show_params()  # back to the valid value

@@ -102,3 +102,29 @@ def test_transparency_shows_as_a_checkerboard_with_its_outline(window, qtbot, tm
     assert (255, 0, 0) not in inside  # the red under alpha 0 is not shown ...
     assert {(153, 153, 153), (204, 204, 204)} <= inside  # ... a checkerboard is
     assert colour(10, 10) == (255, 0, 0)  # the opaque part as it is
+
+
+def test_the_pixel_read_out_counts_0_255_and_0_65535_for_16_bit(window, qtbot, tmp_path):
+    from PySide6.QtCore import Qt
+
+    from .helpers import mouse
+
+    view = window.result_view
+    view.actual_size()
+    view.zoom_by(4.0)
+    view.centerOn(10.5, 20.5)
+    mouse(view, "move", (10.5, 20.5), buttons=Qt.MouseButton.NoButton)
+    expected = " ".join(str(int(round(float(c) * 255))) for c in view.image[20, 10])
+    assert window.pixel_label.toolTip() == f"result  x 10  y 20  {expected}"
+    source = _picture16(tmp_path / "deep.png")
+    doc = window.doc
+    window.open_input(doc.studio.canvas, str(source))
+    canvas = window.canvas_view
+    qtbot.waitUntil(lambda: canvas.image is not None and canvas.image.shape[:2] == (72, 96), timeout=10000)
+    canvas.actual_size()
+    canvas.zoom_by(4.0)
+    canvas.centerOn(40.5, 30.5)
+    mouse(canvas, "move", (40.5, 30.5), buttons=Qt.MouseButton.NoButton)
+    stored = cv2.imread(str(source), cv2.IMREAD_UNCHANGED)[30, 40][::-1]  # (BGR -> RGB)
+    assert window.pixel_label.toolTip() == (f"{canvas.title}  x 40  y 30  {' '.join(str(int(v)) for v in stored)}"
+                                            f"  (16-bit)")

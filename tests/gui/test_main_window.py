@@ -369,3 +369,44 @@ def test_progress_text_fits_the_bar(window, qtbot):
         assert bar.fontMetrics().horizontalAdvance(text) <= bar.contentsRect().width(), (width, text)
         assert "about 6 s left" in bar.toolTip()
     window.progress_bar.hide()
+
+
+def test_the_file_menu_keeps_its_entries_in_place_for_every_method(window, qtbot):
+    """A habitual click lands on the same entry whatever the method (it landed on Quit)."""
+    from weft.core import registry
+
+    layouts = {}
+    for name in registry.studio_methods():
+        window.doc.set_method(name)
+        menu = window.file_menu
+        menu.popup(window.mapToGlobal(window.rect().center()))
+        qtbot.waitUntil(menu.isVisible, timeout=5000)
+        quit_action = next(a for a in menu.actions() if a.text() == "&Quit")
+        layouts[name] = (len([a for a in menu.actions() if a.isVisible()]), menu.actionGeometry(quit_action).top())
+        menu.hide()
+    assert len(set(layouts.values())) == 1, layouts
+
+
+def test_each_choice_from_a_list_is_its_own_undo_step(window, qtbot):
+    """Four picks in a parameter's combo box are four undo steps (they merged into one); a slider's
+    moves still merge."""
+    from PySide6.QtCore import Qt
+
+    doc = window.doc
+    combo = window.params_panel.row("metric").editor
+    before = doc.undo_stack.count()
+    combo.setFocus()
+    picked = []
+    for key in (Qt.Key.Key_Down, Qt.Key.Key_Down, Qt.Key.Key_Up, Qt.Key.Key_Up):
+        qtbot.keyClick(combo, key)
+        picked.append(doc.current_params.metric)
+    assert picked == ["target", "artistic", "target", "full"]
+    assert doc.undo_stack.count() == before + 4
+    doc.undo_stack.undo()
+    assert doc.current_params.metric == "target"
+    slider = window.params_panel.row("iterations").editor._slider
+    slider.setFocus()
+    steps = doc.undo_stack.index()
+    for _ in range(2):
+        qtbot.keyClick(slider, Qt.Key.Key_Right)
+    assert doc.current_params.iterations == 3 and doc.undo_stack.index() == steps + 1
