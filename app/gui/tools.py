@@ -205,6 +205,7 @@ class LineTool(Tool):
     def __init__(self, view, doc, which: str, on_drag: Callable[[list, list], None] | None = None):
         self.view, self.doc, self.which, self.on_drag = view, doc, which, on_drag
         self.items: list = []
+        self._dragged: list | None = None  # the lines as the drag in progress has them
         self.drag = None  # ("new", start) or ("end", index, 0|1, [(index, 0|1), ...] the ends moved together)
         self.selected: int | None = None
         self.refresh()
@@ -226,6 +227,8 @@ class LineTool(Tool):
         for it in self.items:
             scene.removeItem(it)
         self.items = []
+        if lines is None and self.drag is not None and self._dragged is not None:
+            lines = self._dragged  # (a redraw mid-drag, e.g. a new rectification: the line being drawn stays)
         lines = self.lines() if lines is None else lines
         font = QFont()
         font.setPointSize(9)
@@ -280,6 +283,7 @@ class LineTool(Tool):
         return min(max(pos.x(), 0.0), float(w)), min(max(pos.y(), 0.0), float(h))
 
     def press(self, view, pos, event):
+        self._dragged = None
         end = self._near_end(pos)
         if end is not None:
             # ends at the same point move together (Quad…'s corners: two lines meet at each), unless
@@ -316,6 +320,7 @@ class LineTool(Tool):
         if self.drag is None or not (event.buttons() & Qt.MouseButton.LeftButton):
             return
         lines = self._edited(pos)
+        self._dragged = lines
         self.refresh(lines)
         if self.on_drag is not None:
             self.on_drag(*self._lists_with(lines))
@@ -325,7 +330,7 @@ class LineTool(Tool):
             return
         lines = self._edited(pos)
         kind = self.drag[0]
-        self.drag = None
+        self.drag = self._dragged = None
         if kind == "new":
             x1, y1, x2, y2 = lines[-1]
             if ((x2 - x1) ** 2 + (y2 - y1) ** 2) ** 0.5 < self.view.screen_to_image_distance(4):

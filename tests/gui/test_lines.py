@@ -150,6 +150,7 @@ def test_the_frontal_frame_does_not_move_under_a_drag(nfpt, qtbot):
     (two lines); drawing the 4th frontal line makes it rectify mid-drag. The frame must not move or
     zoom under the mouse: the line ends where the mouse went."""
     from PySide6.QtCore import QPointF
+    from PySide6.QtWidgets import QGraphicsLineItem
 
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     doc, panel = nfpt.doc, nfpt.lines_panel
@@ -177,6 +178,10 @@ def test_the_frontal_frame_does_not_move_under_a_drag(nfpt, qtbot):
         qtbot.wait(15)  # (the live rectification comes back meanwhile and changes the hint)
         if i == 10:
             qtbot.waitUntil(lambda: panel.rectify_status.text() == "rectified", timeout=10000)
+            qtbot.wait(50)
+            # the new rectification redrew the frame's lines: the one being drawn is among them
+            drawn = [it for it in panel.frontal_lines.items if isinstance(it, QGraphicsLineItem)]
+            assert len(drawn) == 4
     assert frontal.scale_factor() == pytest.approx(scale)  # no zoom mid-drag ...
     assert frontal.mapToScene(frontal.viewport().mapFromGlobal(g1.toPoint())).y() == pytest.approx(end[1], abs=1.0)
     _at_global(frontal, "release", g1)
