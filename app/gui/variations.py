@@ -132,8 +132,11 @@ class VariationsDialog(QDialog):
         if not self.numeric:
             return
         spec = self._spec(row)
+        # the range the method accepts with the open inputs (a block fits in the sample), else the Spec's
+        lo_limit, hi_limit = self.doc.param_ranges().get(spec.name, (spec.lo, spec.hi)) \
+            if self.method == self.doc.method else (spec.lo, spec.hi)
         for box in (self.lo[row], self.hi[row]):
-            box.setRange(spec.lo, spec.hi)
+            box.setRange(lo_limit, hi_limit)
             box.setDecimals(0 if spec.kind == INT else 3)
             box.setSingleStep(1 if spec.kind == INT else (spec.step or (spec.hi - spec.lo) / 20))
         params = self.doc.params[self.method]
@@ -142,13 +145,13 @@ class VariationsDialog(QDialog):
             current = self.doc.auto_values().get(spec.name)
         if current is None:
             current = spec.default if spec.default is not None else spec.lo
-        span = (spec.hi - spec.lo) / 4
+        span = (hi_limit - lo_limit) / 4
         if current:
             span = min(span, abs(current) / 2)
         if spec.kind == INT:
             span = max(1, int(span))  # whole steps: the middle of the grid is the current value
-        self.lo[row].setValue(max(spec.lo, current - span))
-        self.hi[row].setValue(min(spec.hi, current + span))
+        self.lo[row].setValue(max(lo_limit, current - span))
+        self.hi[row].setValue(min(hi_limit, current + span))
 
     def thumb_side(self, n: int) -> int:
         """Thumbnail side so that an n x n grid (with its labels and the controls) fits the screen."""

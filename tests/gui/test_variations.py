@@ -278,3 +278,23 @@ def test_variations_offers_only_parameters_that_matter_and_labels_its_export(win
     for margin in (margin_top, margin_left):
         assert (margin.max(axis=2) > 0.6).sum() > 30  # light text on the dark margin
     dialog.close()
+
+
+def test_variations_ranges_stay_within_what_the_inputs_allow(window, qtbot, tmp_path):
+    """Quilt on a 112x128 texture: the grid's block range ends at 112 (it offered 56..168)."""
+    from weft.core.image import save_image
+
+    doc = window.doc
+    texture = tmp_path / "small.png"
+    save_image(texture, np.random.default_rng(3).random((128, 112, 3), dtype=np.float32))
+    doc.set_method("quilt")
+    doc.clear_input("target")
+    window.open_input("texture", str(texture))
+    qtbot.waitUntil(lambda: doc.image("texture") is not None and doc.image("texture").shape[:2] == (128, 112),
+                    timeout=10000)
+    doc.set_param("block", 112)
+    window.open_variations()
+    dialog = window._variations
+    dialog.combo[0].setCurrentText("block")
+    assert dialog.hi[0].maximum() == 112 and dialog.hi[0].value() <= 112
+    dialog.close()
