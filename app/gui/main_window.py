@@ -323,7 +323,7 @@ class MainWindow(QMainWindow):
         # the read-out keeps its own room (a typical read-out's width), so moving the mouse does not
         # shift the message, and a longer read-out is elided rather than pushed into it
         self.pixel_label.setFixedWidth(self.pixel_label.fontMetrics().horizontalAdvance(
-            "texture  x 0000  y 0000  65535 65535 65535") + 8)
+            "texture  x 0000  y 0000  65535 65535 65535  (16-bit)") + 8)
         self.zoom_label = QLabel("")
         self.progress_bar = QProgressBar()
         self.progress_bar.setMaximumWidth(320)

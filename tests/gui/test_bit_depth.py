@@ -128,3 +128,4 @@ def test_the_pixel_read_out_counts_0_255_and_0_65535_for_16_bit(window, qtbot, t
     stored = cv2.imread(str(source), cv2.IMREAD_UNCHANGED)[30, 40][::-1]  # (BGR -> RGB)
     assert window.pixel_label.toolTip() == (f"{canvas.title}  x 40  y 30  {' '.join(str(int(v)) for v in stored)}"
                                             f"  (16-bit)")
+    assert window.pixel_label.text() == window.pixel_label.toolTip()  # whole, not elided
