@@ -56,6 +56,9 @@ NARROW = 1200  # a window narrower than this (px) gets the Examples panel as a t
 EXAMPLES_WIDTH = 170  # the Examples panel's width in a wider window: two columns of thumbnails
 
 
+RESULT_MIN = 360  # the result view's width (px) when the picture painted on takes the larger share
+
+
 class _ExampleList(QListWidget):
     """The bundled examples; drag one onto a view to open it there."""
 
@@ -416,7 +419,7 @@ class MainWindow(QMainWindow):
             self.resizeDocks([self.examples_dock, self.method_dock], [EXAMPLES_WIDTH, method_width],
                              Qt.Orientation.Horizontal)
         total = max(self.width() - method_width - (0 if width < NARROW else EXAMPLES_WIDTH) - 24, 400)
-        self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
+        self._split(total)
 
     # --- inputs ----------------------------------------------------------------------------------
     def load_examples(self) -> None:
@@ -489,6 +492,25 @@ class MainWindow(QMainWindow):
         self.recent_menu.setEnabled(bool(recent))
 
     # --- document changes ----------------------------------------------------------------------
+    # --- the painted picture on the large view (a method that paints on its canvas) ----------------
+    def _canvas_share(self, total: int) -> float:
+        """The inputs pane's share of the splitter's ``total`` width: when the method paints on its
+        canvas, the larger (up to 60 %; the result, a preview, beside it keeps RESULT_MIN px), else
+        45 % (the result is what is looked at)."""
+        if not self.inputs_pane.paints_on_canvas():
+            return 0.45
+        return max(0.45, min(0.6, (total - RESULT_MIN) / max(total, 1)))
+
+    def _split(self, total: int) -> None:
+        share = self._canvas_share(total)
+        self._split_share = self.inputs_pane.paints_on_canvas()
+        self.splitter.setSizes([int(total * share), total - int(total * share)])
+
+    def _resplit_for_method(self) -> None:
+        """After a method change: the split follows whether the new method paints on its canvas."""
+        if getattr(self, "_sized", False) and getattr(self, "_split_share", None) != self.inputs_pane.paints_on_canvas():
+            self._split(max(sum(self.splitter.sizes()), 400))
+
     def _on_doc_changed(self, what: str) -> None:
         if what.startswith("input:"):
             self.inputs_pane.input_changed(what.split(":", 1)[1])
@@ -516,6 +538,7 @@ class MainWindow(QMainWindow):
 
     def _rebuild_method(self) -> None:
         self.inputs_pane.rebuild()
+        self._resplit_for_method()
         self.method_panel.show_method()
         has_lines = self.lines_panel is not None and self.lines_panel.active
         self.load_lines_action.setEnabled(has_lines)
@@ -560,8 +583,17 @@ class MainWindow(QMainWindow):
             self.renderer.preview()
 
     def _mask_painted(self, key: str, mask, box) -> None:
-        """A mask stroke in progress: render the region around it (if the method previews strokes);
-        ``mask`` None: the stroke was cancelled."""
+        """A mask stroke in progress: render the region around it (if the method previews strokes so),
+        or a reduced preview of the whole image (a mask whose geometry asks for it live: a sampling
+        area changes the whole fill); ``mask`` None: the stroke was cancelled."""
+        g = self.doc.mask_geometry(key)
+        if g is not None and key != self.doc.studio.preview_around:
+            self.doc.live = None if mask is None else (key, mask)
+            if mask is None:
+                self.renderer.stroke_cancelled()
+            elif g.live is not None and g.live(self.doc.current_params):
+                self.renderer.preview()
+            return
         if mask is None:
             self.doc.live = None
             if not self.renderer.stroke_cancelled():
@@ -765,7 +797,7 @@ class MainWindow(QMainWindow):
             self._sized = True
             if self._restored_layout:
                 total = max(self.splitter.width(), 400)
-                self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
+                self._split(total)
             else:
                 self._lay_out_for_width()
 

@@ -363,11 +363,14 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
 STUDIO = Studio(
     title="Fill and extend",
     canvas="image",
-    geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)"),
-              Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas")),
+    geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)",
+                       label="hole"),
+              Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas"),
+              Geometry(MASK, on=("image",), input="source_mask", label="sampling area", empty_is_all=True,
+                       live=lambda params: True, help="paint where fill copies from (Include) or not (Exclude)")),
     preview_inputs=("image", "mask", "source_mask", "texture"),
     examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
-    masks_of={"source_mask": ("texture", "image")}, auto=_auto,
+    auto=_auto,
     figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
              "hole_fraction": Figure("filled", "%", "of the image", digits=2),
              "source_pixels": Figure("copied from", "px"), "edges_continued": Figure("edges continued")})
