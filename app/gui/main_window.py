@@ -386,6 +386,11 @@ class MainWindow(QMainWindow):
             toggle.setText(f"{dock.windowTitle()} Panel")
             toggle.setStatusTip(f"show or hide the {dock.windowTitle()} panel")
             v.addAction(toggle)
+        self.paint_large_action = self._action(v, "Large &Picture to Paint", self._toggle_paint_large, "Ctrl+L",
+                                               tip="the picture you paint on gets the larger share of the window, "
+                                                   "the result the smaller (a method that paints on its picture)")
+        self.paint_large_action.setCheckable(True)
+        self.paint_large_action.setChecked(self.settings.value("paint_large", False, type=bool))
         self.reset_layout_action = self._action(v, "Reset &Layout", self.reset_layout,
                                                 tip="put every panel back where it was when the studio was first opened")
         self.view_menu = v
@@ -499,7 +504,14 @@ class MainWindow(QMainWindow):
         45 % (the result is what is looked at)."""
         if not self.inputs_pane.paints_on_canvas():
             return 0.45
+        if self.paint_large_action.isChecked():
+            return 0.68
         return max(0.45, min(0.6, (total - RESULT_MIN) / max(total, 1)))
+
+    def _toggle_paint_large(self) -> None:
+        """View > Large Picture to Paint: the split follows at once, and the choice is remembered."""
+        self.settings.setValue("paint_large", self.paint_large_action.isChecked())
+        self._split(max(sum(self.splitter.sizes()), 400))
 
     def _split(self, total: int) -> None:
         share = self._canvas_share(total)
@@ -539,6 +551,7 @@ class MainWindow(QMainWindow):
     def _rebuild_method(self) -> None:
         self.inputs_pane.rebuild()
         self._resplit_for_method()
+        self.paint_large_action.setEnabled(self.inputs_pane.paints_on_canvas())
         self.method_panel.show_method()
         has_lines = self.lines_panel is not None and self.lines_panel.active
         self.load_lines_action.setEnabled(has_lines)
@@ -655,7 +668,8 @@ class MainWindow(QMainWindow):
     def _nothing_drawn(self) -> str | None:
         """What to draw, when the current method works on a drawn region (a mask, margins) and none
         is drawn yet: its geometry's help, e.g. "paint what to fill"."""
-        geometry = self.doc.studio.geometry
+        # (a mask that means "every pixel" unpainted, a sampling area, is not what there is to do)
+        geometry = [g for g in self.doc.studio.geometry if not g.empty_is_all]
         if not any(g.kind in (MASK, MARGINS) for g in geometry) or any(self.doc.value(g.key) is not None
                                                                          for g in geometry):
             return None

@@ -15,7 +15,7 @@ from PySide6.QtWidgets import QGraphicsItem
 from weft.core.geometry import Mask, MaskStroke
 
 #: The colours (RGBA) of the masks of one image, in the order the method lists them.
-MASK_COLOURS = ((255, 48, 96, 120), (40, 220, 120, 80), (64, 160, 255, 100), (255, 200, 40, 100))
+MASK_COLOURS = ((255, 48, 96, 120), (40, 220, 120, 64), (64, 160, 255, 100), (255, 200, 40, 100))
 MASK_RGBA = MASK_COLOURS[0]  # the first mask's colour
 
 

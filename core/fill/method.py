@@ -367,7 +367,7 @@ STUDIO = Studio(
                        label="hole"),
               Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas"),
               Geometry(MASK, on=("image",), input="source_mask", label="sampling area", empty_is_all=True,
-                       live=lambda params: True, help="paint where fill copies from (Include) or not (Exclude)")),
+                       live=lambda params: True, help="the sampling area (optional): where fill copies from")),
     preview_inputs=("image", "mask", "source_mask", "texture"),
     examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
     auto=_auto,

@@ -278,3 +278,10 @@ def test_every_button_over_the_picture_shows_and_the_picture_is_the_large_view(q
             assert window.canvas_view.width() > window.result_view.width()
         else:
             assert pane.width() >= 0.44 * (pane.width() + window.result_view.width())
+        # View > Large Picture to Paint (Ctrl+L): the picture gets the larger share at any width, remembered
+        assert window.paint_large_action.isEnabled() and not window.paint_large_action.isChecked()
+        qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+        assert window.paint_large_action.isChecked() and settings.value("paint_large", type=bool)
+        qtbot.waitUntil(lambda: window.canvas_view.width() > 1.5 * window.result_view.width(), timeout=5000)
+        qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+        qtbot.waitUntil(lambda: window.result_view.width() >= 350, timeout=5000)
