@@ -357,6 +357,11 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 
+def _always(params) -> bool:
+    """A sampling area previews the whole fill while it is painted, whatever the parameters."""
+    return True
+
+
 #: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting
 #: the mask previews the region around the stroke (``preview_around``); the optional ``texture`` is
 #: fill's own (``own_inputs``: the texture the studio has open for quilt and fast is not a source).
@@ -367,7 +372,7 @@ STUDIO = Studio(
                        label="hole"),
               Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas"),
               Geometry(MASK, on=("image",), input="source_mask", label="sampling area", empty_is_all=True,
-                       live=lambda params: True, help="the sampling area (optional): where fill copies from")),
+                       live=_always, help="the sampling area (optional): where fill copies from")),
     preview_inputs=("image", "mask", "source_mask", "texture"),
     examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
     auto=_auto,
