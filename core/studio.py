@@ -47,10 +47,17 @@ class Geometry:
         that input (``mask.to_image()``); a recipe names it as a PNG written beside the export, a
         session beside the session file. A mask has no ``param``.
     help : what the user does, shown as the view's title.
-    live : ``live(params) -> bool``: re-render a preview while the geometry is being dragged.
+    live : ``live(params) -> bool``: re-render a preview while the geometry is being dragged (for a
+        mask that does not preview around its stroke, :attr:`Studio.preview_around`: a reduced
+        preview of the whole image while it is painted).
     needed : words for the user when the studio must not render without it (a run without it does
         something else, e.g. treats the photo as frontal): while it is not drawn the studio shows
         the input and these words instead of a result, e.g. ``"draw feature lines (or Quad…)"``.
+    label : for a mask: its name on the brush's switch when one image carries several masks
+        (``"hole"``, ``"sampling area"``).
+    empty_is_all : for a mask: the method without this input acts as if every pixel were white (a
+        region to copy from: all of it), not none; the brush then paints it as *Include* and
+        *Exclude*, and the first *Exclude* starts from a mask that is white everywhere.
     """
 
     kind: str
@@ -60,6 +67,8 @@ class Geometry:
     live: Callable[[Any], bool] | None = None
     input: str | None = None
     needed: str = ""
+    label: str = ""
+    empty_is_all: bool = False
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -190,8 +199,9 @@ class Studio:
         and inputs (nfpt's ``a``, ``b``, ``p`` with the homography warp): Variations does not offer
         them. Takes the same ``shapes`` as ``auto``.
     masks_of : inputs that are masks of another input without being painted (opened as files): each
-        belongs to the first of its images that is open (``fill``'s ``source_mask`` is the texture's
-        when one is open, else the image's); :func:`crop_around` crops it with that image.
+        belongs to the first of its images that is open (a source mask of a texture when one is
+        open, else of the image); :func:`crop_around` crops it with that image. A painted mask
+        (a :class:`Geometry` of kind ``mask``) is cropped with its image without being listed here.
     """
 
     title: str

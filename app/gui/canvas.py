@@ -174,6 +174,15 @@ class InputsPane(QSplitter):
         self.tabs.setCurrentIndex(0)
         self.tabs.setVisible(self.tabs.count() > 0)
         self.sync_tools()
+        if self.paints_on_canvas() and self.tabs.count():  # the painted picture gets most of the height
+            total = max(sum(self.sizes()), 400)
+            self.setSizes([int(total * 0.78), total - int(total * 0.78)])
+
+    def paints_on_canvas(self) -> bool:
+        """The current method's canvas carries a painted mask: painting is the main work, on the
+        large view."""
+        return any(g.kind == MASK and g.input_for(self.doc.inputs) == self.doc.studio.canvas
+                   for g in self.doc.studio.geometry)
 
     def sync_tools(self) -> None:
         """Attach each geometry's tool to the view of the input it is drawn on now (others none), and
@@ -200,7 +209,7 @@ class InputsPane(QSplitter):
                 wanted[name] = tools[0]
             else:
                 wanted[name] = self._toolsets.setdefault(tuple(tools), ToolSet(tools))
-            self._bar(name).attach(next((t for t in tools if isinstance(t, MaskTool)), None),
+            self._bar(name).attach([t for t in tools if isinstance(t, MaskTool)] or None,
                                    next((t for t in tools if isinstance(t, MarginsTool)), None))
         for name, bar in self._bars.items():
             if name not in per_view:

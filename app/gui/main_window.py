@@ -56,6 +56,9 @@ NARROW = 1200  # a window narrower than this (px) gets the Examples panel as a t
 EXAMPLES_WIDTH = 170  # the Examples panel's width in a wider window: two columns of thumbnails
 
 
+RESULT_MIN = 360  # the result view's width (px) when the picture painted on takes the larger share
+
+
 class _ExampleList(QListWidget):
     """The bundled examples; drag one onto a view to open it there."""
 
@@ -405,6 +408,11 @@ class MainWindow(QMainWindow):
             toggle.setText(f"{dock.windowTitle()} Panel")
             toggle.setStatusTip(f"show or hide the {dock.windowTitle()} panel")
             v.addAction(toggle)
+        self.paint_large_action = self._action(v, "Large &Picture to Paint", self._toggle_paint_large, "Ctrl+L",
+                                               tip="the picture you paint on gets the larger share of the window, "
+                                                   "the result the smaller (a method that paints on its picture)")
+        self.paint_large_action.setCheckable(True)
+        self.paint_large_action.setChecked(self.settings.value("paint_large", False, type=bool))
         self.reset_layout_action = self._action(v, "Reset &Layout", self.reset_layout,
                                                 tip="put every panel back where it was when the studio was first opened")
         self.view_menu = v
@@ -438,7 +446,7 @@ class MainWindow(QMainWindow):
             self.resizeDocks([self.examples_dock, self.method_dock], [EXAMPLES_WIDTH, method_width],
                              Qt.Orientation.Horizontal)
         total = max(self.width() - method_width - (0 if width < NARROW else EXAMPLES_WIDTH) - 24, 400)
-        self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
+        self._split(total)
 
     # --- inputs ----------------------------------------------------------------------------------
     def load_examples(self) -> None:
@@ -511,6 +519,32 @@ class MainWindow(QMainWindow):
         self.recent_menu.setEnabled(bool(recent))
 
     # --- document changes ----------------------------------------------------------------------
+    # --- the painted picture on the large view (a method that paints on its canvas) ----------------
+    def _canvas_share(self, total: int) -> float:
+        """The inputs pane's share of the splitter's ``total`` width: when the method paints on its
+        canvas, the larger (up to 60 %; the result, a preview, beside it keeps RESULT_MIN px), else
+        45 % (the result is what is looked at)."""
+        if not self.inputs_pane.paints_on_canvas():
+            return 0.45
+        if self.paint_large_action.isChecked():
+            return 0.68
+        return max(0.45, min(0.6, (total - RESULT_MIN) / max(total, 1)))
+
+    def _toggle_paint_large(self) -> None:
+        """View > Large Picture to Paint: the split follows at once, and the choice is remembered."""
+        self.settings.setValue("paint_large", self.paint_large_action.isChecked())
+        self._split(max(sum(self.splitter.sizes()), 400))
+
+    def _split(self, total: int) -> None:
+        share = self._canvas_share(total)
+        self._split_share = self.inputs_pane.paints_on_canvas()
+        self.splitter.setSizes([int(total * share), total - int(total * share)])
+
+    def _resplit_for_method(self) -> None:
+        """After a method change: the split follows whether the new method paints on its canvas."""
+        if getattr(self, "_sized", False) and getattr(self, "_split_share", None) != self.inputs_pane.paints_on_canvas():
+            self._split(max(sum(self.splitter.sizes()), 400))
+
     def _on_doc_changed(self, what: str) -> None:
         if what.startswith("input:"):
             self.inputs_pane.input_changed(what.split(":", 1)[1])
@@ -538,6 +572,8 @@ class MainWindow(QMainWindow):
 
     def _rebuild_method(self) -> None:
         self.inputs_pane.rebuild()
+        self._resplit_for_method()
+        self.paint_large_action.setEnabled(self.inputs_pane.paints_on_canvas())
         self.method_panel.show_method()
         has_lines = self.lines_panel is not None and self.lines_panel.active
         self.load_lines_action.setEnabled(has_lines)
@@ -584,8 +620,17 @@ class MainWindow(QMainWindow):
             self.renderer.preview()
 
     def _mask_painted(self, key: str, mask, box) -> None:
-        """A mask stroke in progress: render the region around it (if the method previews strokes);
-        ``mask`` None: the stroke was cancelled."""
+        """A mask stroke in progress: render the region around it (if the method previews strokes so),
+        or a reduced preview of the whole image (a mask whose geometry asks for it live: a sampling
+        area changes the whole fill); ``mask`` None: the stroke was cancelled."""
+        g = self.doc.mask_geometry(key)
+        if g is not None and key != self.doc.studio.preview_around:
+            self.doc.live = None if mask is None else (key, mask)
+            if mask is None:
+                self.renderer.stroke_cancelled()
+            elif g.live is not None and g.live(self.doc.current_params):
+                self.renderer.preview()
+            return
         if mask is None:
             self.doc.live = None
             if not self.renderer.stroke_cancelled():
@@ -660,7 +705,8 @@ class MainWindow(QMainWindow):
     def _nothing_drawn(self) -> str | None:
         """What to draw, when the current method works on a drawn region (a mask, margins) and none
         is drawn yet: its geometry's help, e.g. "paint what to fill"."""
-        geometry = self.doc.studio.geometry
+        # (a mask that means "every pixel" unpainted, a sampling area, is not what there is to do)
+        geometry = [g for g in self.doc.studio.geometry if not g.empty_is_all]
         if not any(g.kind in (MASK, MARGINS) for g in geometry) or any(self.doc.value(g.key) is not None
                                                                          for g in geometry):
             return None
@@ -821,7 +867,7 @@ class MainWindow(QMainWindow):
             self._sized = True
             if self._restored_layout:
                 total = max(self.splitter.width(), 400)
-                self.splitter.setSizes([int(total * 0.45), int(total * 0.55)])
+                self._split(total)
             else:
                 self._lay_out_for_width()
 

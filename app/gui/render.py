@@ -170,7 +170,7 @@ def preparation(doc, *, side: int | None = None, around_box=None
         return None
     studio = doc.studio
     part = None if around_box is None else stroke_part(doc, around_box)
-    build = doc.deferred_inputs(live=around_box is not None and part is None)
+    build = doc.deferred_inputs(live=part is None)  # (a mask being painted, whole: Geometry.live)
     params = doc.run_params()
     names = None if part is None else [i.name for i in doc.current.inputs if i.name != studio.preview_around]
 

@@ -357,17 +357,25 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 
+def _always(params) -> bool:
+    """A sampling area previews the whole fill while it is painted, whatever the parameters."""
+    return True
+
+
 #: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting
 #: the mask previews the region around the stroke (``preview_around``); the optional ``texture`` is
 #: fill's own (``own_inputs``: the texture the studio has open for quilt and fast is not a source).
 STUDIO = Studio(
     title="Fill and extend",
     canvas="image",
-    geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)"),
-              Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas")),
+    geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)",
+                       label="hole"),
+              Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas"),
+              Geometry(MASK, on=("image",), input="source_mask", label="sampling area", empty_is_all=True,
+                       live=_always, help="the sampling area (optional): where fill copies from")),
     preview_inputs=("image", "mask", "source_mask", "texture"),
     examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
-    masks_of={"source_mask": ("texture", "image")}, auto=_auto,
+    auto=_auto,
     figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
              "hole_fraction": Figure("filled", "%", "of the image", digits=2),
              "source_pixels": Figure("copied from", "px"), "edges_continued": Figure("edges continued")})

@@ -290,8 +290,9 @@ def test_every_scalar_figure_has_a_human_reading_in_the_studio_description(case,
     words = STUDIO.describe(result.figures)
     assert len(words) == len(scalars) and not any(re.search(r"\b[a-z0-9]+(?:_[a-z0-9]+)+\b", t) for t in words)
     json.dumps(dict(result.figures))
-    assert STUDIO.canvas == "image" and [g.kind for g in STUDIO.geometry] == ["mask", "margins"]
+    assert STUDIO.canvas == "image" and [g.kind for g in STUDIO.geometry] == ["mask", "margins", "mask"]
     assert STUDIO.geometry[0].input == "mask" and STUDIO.geometry[1].param == "extend"
+    assert STUDIO.geometry[2].input == "source_mask" and STUDIO.geometry[2].empty_is_all  # the sampling area
 
 
 def test_numpy_cut_and_solver_agree_with_the_kernels():
