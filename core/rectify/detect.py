@@ -1,0 +1,483 @@
+"""Suggested feature lines: two vanishing directions found in the photo, and the lines they imply.
+
+A photo of a planar texture with straight structure (mortar joints, tiles, a weave, lines of text)
+shows two families of lines, each converging to a vanishing point. :func:`suggest_lines` finds
+them and turns them into feature-line pairs the user can edit like drawn ones:
+
+1. line segments (OpenCV's LSD) on the photo reduced to :data:`WORK_SIDE` pixels;
+2. vanishing points by RANSAC over pairs of segments (a segment supports a point when its direction
+   points at it within :data:`INLIER_DEG`), the two best-supported, mutually compatible points,
+   each refined by weighted least squares over its segments;
+3. rectification: the vanishing line sent to infinity (affine), then the two directions made
+   perpendicular and of equal scale (metric) with a camera of square pixels whose principal point
+   is the photo's centre; the two orthogonal vanishing points then fix the focal length.
+   When they cannot (a vanishing point at infinity), the aspect is left to an assumed focal length
+   of :data:`ASSUMED_FOCAL` times the photo's longer side, and the suggestion says so;
+4. feature lines: up to three long segments of each family, extended across the textured region,
+   paired with their axis-aligned images in the frontal frame.
+
+Where segments are too few, segments joining the texture's own repeats (SIFT features matched
+within the photo) take their place: the line through a feature and its repeat points at the
+vanishing point of the repeat's direction on the plane.
+
+When neither gives two families it raises :class:`~weft.core.errors.GeometryError` with one line
+(:data:`REFUSAL`); it never returns a guess it has no support for.
+
+References
+----------
+Yan, Lee & Lin, "Patch-based synthesis of non-frontal-parallel textures", §3 (the feature lines this
+module proposes).
+Hartley & Zisserman, *Multiple View Geometry*, 2nd ed., §2.7 (affine and metric rectification) and
+§8.6-8.8 (vanishing points, the image of the absolute conic, focal length from two orthogonal
+vanishing points).
+Grompone von Gioi et al., "LSD: a fast line segment detector with a false detection control",
+IPOL 2012.
+Bharadwaj, Collins & Liu, "R-VPD: repeated-pattern vanishing point detection", 2024 (repeats as
+evidence of vanishing directions).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+
+from ..errors import GeometryError
+from ..geometry import FeatureLines
+from ..image import validate_image
+from .homography import apply_homography
+
+__all__ = ["Suggestion", "suggest_lines", "REFUSAL", "WORK_SIDE", "INLIER_DEG", "ASSUMED_FOCAL"]
+
+#: The one line said when the photo shows no two families of straight lines (nor of repeats).
+REFUSAL = "no two families of straight lines found: draw feature lines"
+WORK_SIDE = 720  # longer side (px) of the reduced photo the segments are found on
+INLIER_DEG = 1.5  # a segment supports a vanishing point when it points at it within this angle
+MIN_FAMILY = 5  # segments a family needs
+MIN_SPREAD_DEG = 15.0  # the two families must differ by this much in direction in the photo
+ASSUMED_FOCAL = 1.2  # focal length (in photo longer sides) when the vanishing points leave it open
+MAX_FRONTAL_SIDE = 4096
+_CANDIDATES = 400  # RANSAC hypotheses (pairs of segments)
+
+
+@dataclass(frozen=True)
+class Suggestion:
+    """Feature lines proposed for a photo, and the evidence behind them.
+
+    Attributes
+    ----------
+    lines : FeatureLines
+        Line pairs (photo, frontal) in DESIGN.md's format; the frontal frame's axes follow the two
+        families (the more horizontal one along x).
+    homography : (3, 3) float64
+        Frontal -> photo, the one the lines encode.
+    confidence : float in [0, 1]
+        How much of the photo's structure the two families explain, times how well supported the
+        weaker family is (halved when the aspect rests on an assumed focal length).
+    angle_deg : float
+        Angle in the photo between the two recovered directions at the textured region's centre.
+    vanishing_points : (2, 3) float64
+        Homogeneous, in photo pixels (third coordinate 0: a direction at infinity).
+    focal_px : float
+        The focal length the metric step used, in photo pixels.
+    aspect : str
+        ``"camera"`` (fixed by the two vanishing points) or ``"assumed focal"``.
+    source : str
+        ``"lines"`` (straight segments) or ``"repeats"`` (the texture's own repeats).
+    figures : dict
+        Counts and timings for reports.
+    """
+
+    lines: FeatureLines
+    homography: np.ndarray
+    confidence: float
+    angle_deg: float
+    vanishing_points: np.ndarray
+    focal_px: float
+    aspect: str
+    source: str
+    figures: dict = field(default_factory=dict)
+
+    def report(self) -> dict:
+        """The figures ``--report`` prints (JSON-able)."""
+        return {"suggest_confidence": round(self.confidence, 3), "suggest_angle_deg": round(self.angle_deg, 2),
+                "suggest_source": self.source, "suggest_aspect": self.aspect,
+                "suggest_focal_px": round(self.focal_px, 1), "suggest_pairs": len(self.lines),
+                **{f"suggest_{k}": v for k, v in self.figures.items()}}
+
+
+# -- segments ---------------------------------------------------------------------------------------
+
+def _grey_work(photo: np.ndarray) -> tuple[np.ndarray, float]:
+    """The photo as 8-bit grey, reduced so its longer side is at most :data:`WORK_SIDE`; the factor."""
+    grey = photo if photo.ndim == 2 else cv2.cvtColor(photo, cv2.COLOR_RGB2GRAY)
+    h, w = grey.shape
+    k = min(1.0, WORK_SIDE / max(h, w))
+    if k < 1.0:
+        grey = cv2.resize(grey, (max(1, round(w * k)), max(1, round(h * k))), interpolation=cv2.INTER_AREA)
+    return np.clip(grey * 255.0 + 0.5, 0, 255).astype(np.uint8), k
+
+
+def _line_segments(grey: np.ndarray) -> np.ndarray:
+    """(N, 4) segments found by LSD, at least 1/90 of the longer side long."""
+    lsd = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD)
+    found = lsd.detect(grey)[0]
+    if found is None:
+        return np.zeros((0, 4))
+    seg = found.reshape(-1, 4).astype(np.float64)
+    length = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1])
+    return seg[length >= max(6.0, max(grey.shape) / 90.0)]
+
+
+def _repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Segments joining SIFT features to their repeats elsewhere in the photo (similar descriptor,
+    scale and orientation), at least three feature sizes apart."""
+    sift = cv2.SIFT_create(nfeatures=1500)
+    kps, desc = sift.detectAndCompute(grey, None)
+    if desc is None or len(kps) < 20:
+        return np.zeros((0, 4))
+    pts = np.array([k.pt for k in kps])
+    size = np.array([k.size for k in kps])
+    ang = np.radians([k.angle for k in kps])
+    matcher = cv2.BFMatcher(cv2.NORM_L2)
+    knn = matcher.knnMatch(desc, desc, k=5)
+    pairs, dists = [], []
+    for row in knn:
+        for m in row[1:]:
+            pairs.append((m.queryIdx, m.trainIdx))
+            dists.append(m.distance)
+    if not pairs:
+        return np.zeros((0, 4))
+    pairs, dists = np.array(pairs), np.array(dists)
+    i, j = pairs[:, 0], pairs[:, 1]
+    gap = np.hypot(*(pts[i] - pts[j]).T)
+    turn = np.abs(np.angle(np.exp(1j * (ang[i] - ang[j]))))
+    keep = ((i < j) & (gap > 3 * np.maximum(size[i], size[j])) & (turn < math.radians(20))
+            & (np.abs(np.log(size[i] / size[j])) < 0.3) & (dists < np.quantile(dists, 0.3)))
+    return np.column_stack([pts[i[keep]], pts[j[keep]]])
+
+
+# -- vanishing points -----------------------------------------------------------------------------
+
+def _homogeneous(seg: np.ndarray) -> np.ndarray:
+    p = np.column_stack([seg[:, :2], np.ones(len(seg))])
+    q = np.column_stack([seg[:, 2:], np.ones(len(seg))])
+    ln = np.cross(p, q)
+    return ln / np.hypot(ln[:, 0], ln[:, 1])[:, None]
+
+
+def _support(vps: np.ndarray, mids: np.ndarray, dirs: np.ndarray, sin_tol: np.ndarray) -> np.ndarray:
+    """(M, N) bool: segment n points at vanishing point m within its tolerance (sine of the angle)."""
+    q = vps[:, None, :2] - vps[:, None, 2:3] * mids[None, :, :]
+    cross = np.abs(dirs[None, :, 0] * q[..., 1] - dirs[None, :, 1] * q[..., 0])
+    return cross <= sin_tol[None, :] * np.hypot(q[..., 0], q[..., 1]) + 1e-15
+
+
+def _refine(lines: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """The point closest (weighted least squares, algebraic) to all ``lines``: unit 3-vector."""
+    m = (lines * weights[:, None]).T @ lines
+    return np.linalg.eigh(m)[1][:, 0]
+
+
+def _focal_sq(v1: np.ndarray, v2: np.ndarray) -> float | None:
+    """f² from two orthogonal vanishing points about the origin (the principal point), or None when
+    one of them is (near) infinity and f is left open."""
+    if abs(v1[2]) < 1e-9 or abs(v2[2]) < 1e-9:
+        return None
+    return float(-(v1[:2] @ v2[:2]) / (v1[2] * v2[2]))
+
+
+@dataclass
+class _Families:
+    vps: np.ndarray  # (2, 3) in normalised coordinates
+    members: list  # two index arrays into the segments
+    explained: float  # fraction of the segments' length in the two families
+
+
+def _hypotheses(lines: np.ndarray, length: np.ndarray, pool: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Candidate vanishing points (unit 3-vectors): intersections of random pairs of segments of
+    ``pool``, longer segments drawn more often."""
+    p = length[pool] / length[pool].sum()
+    a = rng.choice(pool, _CANDIDATES, p=p)
+    b = rng.choice(pool, _CANDIDATES, p=p)
+    cand = np.cross(lines[a[a != b]], lines[b[a != b]])
+    norm = np.linalg.norm(cand, axis=1)
+    return cand[norm > 1e-12] / norm[norm > 1e-12, None]
+
+
+def _near(points: np.ndarray, of: np.ndarray, margin: float) -> np.ndarray:
+    """Whether each of ``points`` lies within ``margin`` of the convex hull of ``of`` (all 2-D)."""
+    hull = cv2.convexHull(of.astype(np.float32))
+    return np.array([cv2.pointPolygonTest(hull, (float(x), float(y)), True) >= -margin for x, y in points])
+
+
+def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Families | None:
+    """Two well-supported vanishing points of segments in normalised coordinates (the principal
+    point at the origin) that a camera can see as perpendicular directions: the best supported
+    first, then the best supported among the other segments on the region of the first (clutter
+    beside the surface counts a tenth). ``px`` is the length of a work pixel in these units: a
+    short segment's direction is known only to about a pixel over its length."""
+    n = len(seg)
+    if n < 2 * MIN_FAMILY:
+        return None
+    lines = _homogeneous(seg)
+    d = seg[:, 2:] - seg[:, :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    dirs = d / length[:, None]
+    mids = (seg[:, :2] + seg[:, 2:]) / 2
+    sin_tol = np.maximum(math.sin(math.radians(INLIER_DEG)), 1.2 * px / length)
+
+    def refine(v: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        mem = _support(v[None], mids, dirs, sin_tol)[0] & free
+        for _ in range(3):
+            if mem.sum() < 2:
+                break
+            v = _refine(lines[mem], length[mem] ** 2)
+            mem = _support(v[None], mids, dirs, sin_tol)[0] & free
+        return v, mem
+
+    everything = np.ones(n, bool)
+    cand = _hypotheses(lines, length, np.arange(n), rng)
+    sup = _support(cand, mids, dirs, sin_tol)
+    v1, mem1 = refine(cand[np.argmax(sup @ length)], everything)
+    rest = np.flatnonzero(~mem1)
+    if mem1.sum() < MIN_FAMILY or len(rest) < MIN_FAMILY:
+        return None
+    ends1 = np.vstack([seg[mem1, :2], seg[mem1, 2:]])
+    weight = length * np.where(_near(mids, ends1, 0.05), 1.0, 0.1)
+    cand = _hypotheses(lines, weight, rest, rng)
+    sup = _support(cand, mids, dirs, sin_tol) & ~mem1
+    score = sup @ weight
+    for m in np.argsort(-score)[:50]:
+        if sup[m].sum() < MIN_FAMILY:
+            break
+        f2 = _focal_sq(v1, cand[m])
+        if f2 is not None and f2 <= 0.01:  # no camera sees these two directions as perpendicular
+            continue
+        v2, mem2 = refine(cand[m], ~mem1)
+        if mem2.sum() < MIN_FAMILY:
+            continue
+        f2 = _focal_sq(v1, v2)
+        if f2 is not None and f2 <= 0.01:
+            continue
+        explained = float((mem1 | mem2) @ length / length.sum())
+        return _Families(np.array([v1, v2]), [np.flatnonzero(mem1), np.flatnonzero(mem2)], explained)
+    return None
+
+
+def _direction_at(v: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Unit direction from point ``x`` (2,) towards the homogeneous point ``v``."""
+    q = v[:2] - v[2] * x
+    return q / np.linalg.norm(q)
+
+
+# -- rectification ----------------------------------------------------------------------------------
+
+def _plane_homography(v1: np.ndarray, v2: np.ndarray, focal: float, x0: np.ndarray) -> np.ndarray:
+    """Plane (X, Y) -> normalised photo point for the camera K = diag(f, f, 1) (principal point at the
+    origin): X along ``v1``, Y along ``v2``, the origin at photo point ``x0``, unit = 1 / f at x0."""
+    kinv = np.diag([1.0 / focal, 1.0 / focal, 1.0])
+    r1 = kinv @ v1
+    r1 /= np.linalg.norm(r1)
+    r2 = kinv @ v2
+    r2 -= r1 * (r1 @ r2)
+    r2 /= np.linalg.norm(r2)
+    t = kinv @ np.array([x0[0], x0[1], 1.0])
+    k = np.diag([focal, focal, 1.0])
+    h = k @ np.column_stack([r1, r2, t])
+    # X to the right and Y downwards in the photo near x0 (no mirror image, no half-turn)
+    for col, axis in ((0, 0), (1, 1)):
+        step = apply_homography(h, np.array([[0.0, 0.0], [1e-3 if col == 0 else 0.0, 1e-3 if col == 1 else 0.0]]))
+        if step[1, axis] - step[0, axis] < 0:
+            h[:, col] = -h[:, col]
+    return h
+
+
+def _in_front(h: np.ndarray, pts: np.ndarray) -> bool:
+    w = h[2, 0] * pts[:, 0] + h[2, 1] * pts[:, 1] + h[2, 2]
+    return bool(np.all(w > 1e-9) or np.all(w < -1e-9))
+
+
+def _frame(h: np.ndarray, seg_px: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The rectangle (x0, y0, x1, y1) of plane coordinates the families cover (2-98 % of their end
+    points), shrunk about its centre until it lies inside the photo; and the segments on the plane."""
+    w, hgt = size
+    inv = np.linalg.inv(h)
+    ends = np.vstack([seg_px[:, :2], seg_px[:, 2:]])
+    plane = apply_homography(inv, ends)
+    lo, hi = np.percentile(plane, 2, axis=0), np.percentile(plane, 98, axis=0)
+    centre = (lo + hi) / 2
+    scale = 1.0
+    for _ in range(40):
+        a, b = centre + (lo - centre) * scale, centre + (hi - centre) * scale
+        corners = np.array([[a[0], a[1]], [b[0], a[1]], [b[0], b[1]], [a[0], b[1]]])
+        img = apply_homography(h, corners)
+        if (_in_front(h, corners) and np.all(img[:, 0] >= 0) and np.all(img[:, 0] <= w - 1)
+                and np.all(img[:, 1] >= 0) and np.all(img[:, 1] <= hgt - 1)):
+            return np.array([a[0], a[1], b[0], b[1]]), apply_homography(inv, seg_px.reshape(-1, 2)).reshape(-1, 4)
+        scale *= 0.93
+    raise GeometryError(REFUSAL)
+
+
+def _pick(positions: np.ndarray, weights: np.ndarray, lo: float, hi: float, k: int = 3) -> list[float]:
+    """Up to ``k`` positions in (lo, hi), heaviest first, at least a fifth of the span apart."""
+    out: list[float] = []
+    span = hi - lo
+    for i in np.argsort(-weights):
+        p = positions[i]
+        if not (lo + 0.02 * span < p < hi - 0.02 * span):
+            continue
+        if all(abs(p - q) > span / 5 for q in out):
+            out.append(float(p))
+        if len(out) == k:
+            break
+    return out
+
+
+def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 0,
+                  repeats: bool = True) -> Suggestion:
+    """Suggest feature lines for a photo of a planar texture seen at an angle.
+
+    Parameters
+    ----------
+    photo : float32 (H, W) or (H, W, 3) in [0, 1]
+        The non-frontal-parallel texture photo.
+    rng : None, int or numpy.random.Generator, default 0
+        The RANSAC's random source: the same seed gives the same lines.
+    repeats : bool, default True
+        When straight segments give no two families, try the texture's own repeats.
+
+    Returns
+    -------
+    Suggestion
+        ``lines`` (feature-line pairs for :func:`~weft.core.rectify.rectify`), the homography they
+        encode, a confidence, the angle between the two directions in the photo, and figures.
+
+    Raises
+    ------
+    GeometryError
+        :data:`REFUSAL` when no two families of straight lines (nor of repeats) are found: a
+        photo with one family only (parallel stripes), no structure, or directions no camera
+        could see as perpendicular.
+    ImageError
+        A photo that is not a valid image.
+
+    References
+    ----------
+    Yan, Lee & Lin §3 (feature lines); Hartley & Zisserman §2.7, §8.6-8.8 (rectification from
+    vanishing points); Grompone von Gioi et al. 2012 (LSD); Bharadwaj, Collins & Liu 2024 (repeats).
+    """
+    t0 = time.perf_counter()
+    photo = validate_image(photo, "photo")
+    rng = np.random.default_rng(rng)
+    hgt, w = photo.shape[:2]
+    grey, k = _grey_work(photo)
+    c = np.array([(w - 1) / 2.0, (hgt - 1) / 2.0])
+    s = max(w, hgt) / 2.0
+
+    def to_px(seg_work: np.ndarray) -> np.ndarray:
+        return (seg_work + 0.5) / k - 0.5
+
+    source = "lines"
+    seg_px = to_px(_line_segments(grey))
+    found = len(seg_px)
+    px = 1.0 / (k * s)  # a work pixel in normalised units
+    fam = _two_families((seg_px - np.tile(c, 2)) / s, rng, px)
+    if fam is None and repeats:
+        source = "repeats"
+        seg_px = to_px(_repeat_segments(grey, rng))
+        fam = _two_families((seg_px - np.tile(c, 2)) / s, rng, px) if len(seg_px) else None
+    if fam is None:
+        raise GeometryError(REFUSAL)
+    out = suggestion_from_families(seg_px, fam.vps, fam.members, fam.explained, (w, hgt), source=source)
+    out.figures.update({"segments": int(found), "seconds": round(time.perf_counter() - t0, 4)})
+    return out
+
+
+def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list, explained: float,
+                             size: tuple[int, int], *, source: str = "lines") -> Suggestion:
+    """The rectification and feature lines of two families of segments (steps 3-4 of the module).
+
+    Parameters
+    ----------
+    seg_px : (N, 4) segments in photo pixels.
+    vps : (2, 3) their vanishing points in normalised coordinates ``(x - c) / s`` (``c`` the
+        photo's centre, ``s`` half its longer side).
+    members : two index arrays into ``seg_px``: the segments of each family.
+    explained : fraction of the segments' length in the two families (for the confidence).
+    size : (width, height) of the photo.
+
+    Raises
+    ------
+    GeometryError
+        :data:`REFUSAL` when the two directions are closer than :data:`MIN_SPREAD_DEG` in the photo.
+    """
+    w, hgt = size
+    c = np.array([(w - 1) / 2.0, (hgt - 1) / 2.0])
+    s = max(w, hgt) / 2.0
+    fam = _Families(np.asarray(vps, dtype=np.float64), [np.asarray(m) for m in members], explained)
+    # normalised coordinates: u = (x - c) / s; the principal point is the origin
+    used = seg_px[np.concatenate(fam.members)]
+    x0 = np.median(((used[:, :2] + used[:, 2:]) / 2 - c) / s, axis=0)
+    v1, v2 = fam.vps
+    d1, d2 = _direction_at(v1, x0), _direction_at(v2, x0)
+    angle = math.degrees(math.acos(min(1.0, abs(float(d1 @ d2)))))
+    if angle < MIN_SPREAD_DEG:
+        raise GeometryError(REFUSAL)
+    if abs(d1[0]) < abs(d2[0]):  # the more horizontal family along x
+        v1, v2 = v2, v1
+        fam.members.reverse()
+    members = np.concatenate(fam.members)
+    f2 = _focal_sq(v1, v2)
+    max_f = 50.0  # beyond this (normalised units) the vanishing points barely converge: f is open
+    if f2 is not None and 0.04 < f2 < max_f ** 2:
+        focal, aspect = math.sqrt(f2), "camera"
+    else:
+        focal, aspect = 2.0 * ASSUMED_FOCAL, "assumed focal"
+    hn = _plane_homography(v1, v2, focal, x0)
+    to_px_m = np.array([[s, 0, c[0]], [0, s, c[1]], [0, 0, 1.0]])
+    h_plane = to_px_m @ hn  # plane -> photo pixels
+    rect, plane_seg = _frame(h_plane, seg_px[members], (w, hgt))
+
+    # frontal pixels: the photo's pixel density over the region, at most MAX_FRONTAL_SIDE
+    quad = apply_homography(h_plane, np.array([[rect[0], rect[1]], [rect[2], rect[1]], [rect[2], rect[3]],
+                                               [rect[0], rect[3]]]))
+    area_px = 0.5 * abs(np.dot(quad[:, 0], np.roll(quad[:, 1], 1)) - np.dot(quad[:, 1], np.roll(quad[:, 0], 1)))
+    pw, ph = rect[2] - rect[0], rect[3] - rect[1]
+    scale = math.sqrt(area_px / (pw * ph))
+    scale = min(scale, MAX_FRONTAL_SIDE / max(pw, ph))
+    fw, fh = max(16, round(pw * scale)), max(16, round(ph * scale))
+    sx, sy = pw / fw, ph / fh
+    # frontal pixel (x, y), centres at integers -> plane point
+    to_plane = np.array([[sx, 0, rect[0] + 0.5 * sx], [0, sy, rect[1] + 0.5 * sy], [0, 0, 1.0]])
+    hom = h_plane @ to_plane
+    hom /= hom[2, 2]
+
+    fr_seg = apply_homography(np.linalg.inv(to_plane), plane_seg.reshape(-1, 2)).reshape(-1, 4)
+    n1 = len(fam.members[0])
+    frontal = []
+    for axis, rows in ((1, fr_seg[:n1]), (0, fr_seg[n1:])):  # x family: rows at y; y family: columns at x
+        pos = (rows[:, axis] + rows[:, axis + 2]) / 2
+        wts = np.hypot(rows[:, 2] - rows[:, 0], rows[:, 3] - rows[:, 1])
+        span = fh - 1 if axis == 1 else fw - 1
+        picks = _pick(pos, wts, 0.0, span)
+        if len(picks) < 2:
+            picks = sorted(set(picks) | {0.0, float(span)})[:3] if len(picks) else [0.0, float(span)]
+        for p in sorted(picks):
+            frontal.append([0.0, p, fw - 1.0, p] if axis == 1 else [p, 0.0, p, fh - 1.0])
+    frontal = np.array(frontal)
+    image = np.column_stack([apply_homography(hom, frontal[:, :2]), apply_homography(hom, frontal[:, 2:])])
+    image[:, 0::2] = np.clip(image[:, 0::2], 0, w - 1)
+    image[:, 1::2] = np.clip(image[:, 1::2], 0, hgt - 1)
+    lines = FeatureLines(np.round(image, 3), np.round(frontal, 3), (fw, fh))
+
+    weaker = min(len(m) for m in fam.members)
+    confidence = fam.explained * (1.0 - math.exp(-weaker / 8.0)) * (1.0 if aspect == "camera" else 0.5)
+    vps_px = np.array([to_px_m @ v1, to_px_m @ v2])
+    vps_px = np.where(np.abs(vps_px[:, 2:3]) > 1e-12, vps_px / np.where(np.abs(vps_px[:, 2:3]) > 1e-12,
+                                                                        vps_px[:, 2:3], 1.0), vps_px)
+    figures = {"family_sizes": [len(m) for m in fam.members]}
+    return Suggestion(lines, hom, float(confidence), angle, vps_px, focal * s, aspect, source, figures)
