@@ -48,6 +48,10 @@ class Geometry:
         session beside the session file. A mask has no ``param``.
     help : what the user does, shown as the view's title.
     live : ``live(params) -> bool``: re-render a preview while the geometry is being dragged.
+    suggest : ``suggest(image) -> (value, text)``: proposes the geometry for the ``on`` image (the
+        value a user would draw, e.g. :class:`~weft.core.geometry.FeatureLines`) and says in a
+        sentence what it found; raises ``WeftError`` (one line) when it cannot. The studio offers it
+        as a button and runs it off the GUI thread; None: nothing to suggest.
     """
 
     kind: str
@@ -56,6 +60,7 @@ class Geometry:
     help: str = ""
     live: Callable[[Any], bool] | None = None
     input: str | None = None
+    suggest: Callable[[np.ndarray], tuple[Any, str]] | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:

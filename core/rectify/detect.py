@@ -50,7 +50,7 @@ from ..geometry import FeatureLines
 from ..image import validate_image
 from .homography import apply_homography
 
-__all__ = ["Suggestion", "suggest_lines", "REFUSAL", "WORK_SIDE", "INLIER_DEG", "ASSUMED_FOCAL"]
+__all__ = ["Suggestion", "suggest_lines", "suggest_for_studio", "REFUSAL", "WORK_SIDE", "INLIER_DEG", "ASSUMED_FOCAL"]
 
 #: The one line said when the photo shows no two families of straight lines (nor of repeats).
 REFUSAL = "no two families of straight lines found: draw feature lines"
@@ -100,6 +100,12 @@ class Suggestion:
     aspect: str
     source: str
     figures: dict = field(default_factory=dict)
+
+    def describe(self) -> str:
+        """The suggestion in words, for a status line."""
+        aspect = "" if self.aspect == "camera" else ", aspect from an assumed focal length"
+        return (f"suggested {len(self.lines)} line pairs from {self.source}: confidence {self.confidence:.2f}, "
+                f"directions {self.angle_deg:.0f}° apart{aspect}")
 
     def report(self) -> dict:
         """The figures ``--report`` prints (JSON-able)."""
@@ -481,3 +487,9 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
                                                                         vps_px[:, 2:3], 1.0), vps_px)
     figures = {"family_sizes": [len(m) for m in fam.members]}
     return Suggestion(lines, hom, float(confidence), angle, vps_px, focal * s, aspect, source, figures)
+
+
+def suggest_for_studio(photo: np.ndarray) -> tuple[FeatureLines, str]:
+    """:func:`suggest_lines` as a studio geometry's ``suggest``: the lines and their description."""
+    s = suggest_lines(photo)
+    return s.lines, s.describe()
