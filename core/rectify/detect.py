@@ -59,6 +59,9 @@ INLIER_DEG = 1.5  # a segment supports a vanishing point when it points at it wi
 MIN_FAMILY = 5  # segments a family needs
 MIN_SPREAD_DEG = 15.0  # the two families must differ by this much in direction in the photo
 ASSUMED_FOCAL = 1.2  # focal length (in photo longer sides) when the vanishing points leave it open
+MIN_FOCAL = 0.5  # in half longer sides: a shorter focal length than this is no camera's (a 9 mm lens on 35 mm film)
+MAX_FOCAL = 10.0  # in half longer sides: beyond it the vanishing points barely converge and leave f open
+MIN_CONFIDENCE = 0.3  # a weaker suggestion is refused
 MAX_FRONTAL_SIDE = 4096
 _CANDIDATES = 400  # RANSAC hypotheses (pairs of segments)
 
@@ -214,6 +217,47 @@ def _hypotheses(lines: np.ndarray, length: np.ndarray, pool: np.ndarray, rng: np
     return cand[norm > 1e-12] / norm[norm > 1e-12, None]
 
 
+def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _merged(seg: np.ndarray, v: np.ndarray, px: float) -> tuple[np.ndarray, np.ndarray]:
+    """The family's segments grouped into whole lines (same polarity, on one line through ``v``
+    within a work pixel), each fitted to its segments' end points: (K, 3) lines and their lengths.
+    A long line's direction is known far better than its pieces' (a joint broken at every brick)."""
+    mids = (seg[:, :2] + seg[:, 2:]) / 2
+    d = seg[:, 2:] - seg[:, :2]
+    q = v[:2][None, :] - v[2] * mids
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    polarity = np.sign(np.einsum("ij,ij->i", d, q))
+    g = mids.mean(axis=0)
+    dg = _direction_at(v, g)
+    ng = np.array([-dg[1], dg[0]])
+    t = _cross2(mids - g, q) / _cross2(ng[None, :], q)
+    order = np.lexsort((t, polarity))
+    groups, current = [], [order[0]]
+    for i in order[1:]:
+        j = current[0]
+        if polarity[i] == polarity[j] and t[i] - t[j] <= px:
+            current.append(i)
+        else:
+            groups.append(current)
+            current = [i]
+    groups.append(current)
+    lines, lengths = [], []
+    for grp in groups:
+        ends = np.vstack([seg[grp, :2], seg[grp, 2:]])
+        w = np.tile(np.hypot(d[grp, 0], d[grp, 1]), 2)
+        c = (ends * w[:, None]).sum(axis=0) / w.sum()
+        cov = ((ends - c) * w[:, None]).T @ (ends - c)
+        u = np.linalg.eigh(cov)[1][:, 1]  # the line's direction
+        proj = (ends - c) @ u
+        normal = np.array([-u[1], u[0]])
+        lines.append([normal[0], normal[1], -normal @ c])
+        lengths.append(proj.max() - proj.min())
+    return np.array(lines), np.array(lengths)
+
+
 def _near(points: np.ndarray, of: np.ndarray, margin: float) -> np.ndarray:
     """Whether each of ``points`` lies within ``margin`` of the convex hull of ``of`` (all 2-D)."""
     hull = cv2.convexHull(of.astype(np.float32))
@@ -243,6 +287,12 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Fami
                 break
             v = _refine(lines[mem], length[mem] ** 2)
             mem = _support(v[None], mids, dirs, sin_tol)[0] & free
+        for _ in range(2):
+            if mem.sum() < 2:
+                break
+            merged, span = _merged(seg[mem], v, px)
+            v = _refine(merged, span ** 2)
+            mem = _support(v[None], mids, dirs, sin_tol)[0] & free
         return v, mem
 
     everything = np.ones(n, bool)
@@ -261,13 +311,13 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Fami
         if sup[m].sum() < MIN_FAMILY:
             break
         f2 = _focal_sq(v1, cand[m])
-        if f2 is not None and f2 <= 0.01:  # no camera sees these two directions as perpendicular
+        if f2 is not None and f2 <= MIN_FOCAL ** 2:  # no camera sees these two directions as perpendicular
             continue
         v2, mem2 = refine(cand[m], ~mem1)
         if mem2.sum() < MIN_FAMILY:
             continue
         f2 = _focal_sq(v1, v2)
-        if f2 is not None and f2 <= 0.01:
+        if f2 is not None and f2 <= MIN_FOCAL ** 2:
             continue
         explained = float((mem1 | mem2) @ length / length.sum())
         return _Families(np.array([v1, v2]), [np.flatnonzero(mem1), np.flatnonzero(mem2)], explained)
@@ -438,8 +488,9 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
         fam.members.reverse()
     members = np.concatenate(fam.members)
     f2 = _focal_sq(v1, v2)
-    max_f = 50.0  # beyond this (normalised units) the vanishing points barely converge: f is open
-    if f2 is not None and 0.04 < f2 < max_f ** 2:
+    if f2 is not None and f2 <= MIN_FOCAL ** 2:
+        raise GeometryError(REFUSAL)
+    if f2 is not None and f2 < MAX_FOCAL ** 2:
         focal, aspect = math.sqrt(f2), "camera"
     else:
         focal, aspect = 2.0 * ASSUMED_FOCAL, "assumed focal"
@@ -482,6 +533,8 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
 
     weaker = min(len(m) for m in fam.members)
     confidence = fam.explained * (1.0 - math.exp(-weaker / 8.0)) * (1.0 if aspect == "camera" else 0.5)
+    if confidence < MIN_CONFIDENCE:
+        raise GeometryError(REFUSAL)
     vps_px = np.array([to_px_m @ v1, to_px_m @ v2])
     vps_px = np.where(np.abs(vps_px[:, 2:3]) > 1e-12, vps_px / np.where(np.abs(vps_px[:, 2:3]) > 1e-12,
                                                                         vps_px[:, 2:3], 1.0), vps_px)
