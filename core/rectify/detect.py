@@ -44,6 +44,9 @@ from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
 from ..geometry import FeatureLines
@@ -55,6 +58,7 @@ __all__ = ["Suggestion", "suggest_lines", "suggest_for_studio", "REFUSAL", "WORK
 #: The one line said when the photo shows no two families of straight lines (nor of repeats).
 REFUSAL = "no two families of straight lines found: draw feature lines"
 WORK_SIDE = 720  # longer side (px) of the reduced photo the segments are found on
+FINE_SIDE = 1600  # a second look at up to this size when the reduced photo shows no two families
 INLIER_DEG = 1.5  # a segment supports a vanishing point when it points at it within this angle
 MIN_FAMILY = 5  # segments a family needs
 MIN_SPREAD_DEG = 15.0  # the two families must differ by this much in direction in the photo
@@ -120,11 +124,12 @@ class Suggestion:
 
 # -- segments ---------------------------------------------------------------------------------------
 
-def _grey_work(photo: np.ndarray) -> tuple[np.ndarray, float]:
-    """The photo as 8-bit grey, reduced so its longer side is at most :data:`WORK_SIDE`; the factor."""
+def _grey_work(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, float]:
+    """The photo as 8-bit grey, reduced so its longer side is at most ``side`` (default
+    :data:`WORK_SIDE`); the factor."""
     grey = photo if photo.ndim == 2 else cv2.cvtColor(photo, cv2.COLOR_RGB2GRAY)
     h, w = grey.shape
-    k = min(1.0, WORK_SIDE / max(h, w))
+    k = min(1.0, (side or WORK_SIDE) / max(h, w))
     if k < 1.0:
         grey = cv2.resize(grey, (max(1, round(w * k)), max(1, round(h * k))), interpolation=cv2.INTER_AREA)
     return np.clip(grey * 255.0 + 0.5, 0, 255).astype(np.uint8), k
@@ -185,10 +190,23 @@ def _support(vps: np.ndarray, mids: np.ndarray, dirs: np.ndarray, sin_tol: np.nd
     return cross <= sin_tol[None, :] * np.hypot(q[..., 0], q[..., 1]) + 1e-15
 
 
-def _refine(lines: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """The point closest (weighted least squares, algebraic) to all ``lines``: unit 3-vector."""
-    m = (lines * weights[:, None]).T @ lines
-    return np.linalg.eigh(m)[1][:, 0]
+def _refine(lines: np.ndarray, weights: np.ndarray, mids: np.ndarray | None = None,
+            v: np.ndarray | None = None, iterations: int = 4) -> np.ndarray:
+    """The point the ``lines`` point at best: unit 3-vector. Without ``mids``, the algebraic least
+    squares; with them (each line's centre) and a start ``v``, the sum of squared sines of the
+    angles between each line and the direction from its centre to the point, by reweighting: the
+    algebraic residual of a line is that sine times the distance (in ``v``'s scale) from its centre
+    to the point, which would favour points near the long lines."""
+    def solve(w: np.ndarray) -> np.ndarray:
+        m = (lines * w[:, None]).T @ lines
+        return np.linalg.eigh(m)[1][:, 0]
+
+    if mids is None:
+        return solve(weights)
+    for _ in range(iterations):
+        q = v[None, :2] - v[2] * mids
+        v = solve(weights / np.maximum(np.einsum("ij,ij->i", q, q), 1e-12))
+    return v
 
 
 def _focal_sq(v1: np.ndarray, v2: np.ndarray) -> float | None:
@@ -217,45 +235,56 @@ def _hypotheses(lines: np.ndarray, length: np.ndarray, pool: np.ndarray, rng: np
     return cand[norm > 1e-12] / norm[norm > 1e-12, None]
 
 
-def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+def _chains(seg: np.ndarray, px: float, tol: float = 1.2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The segments joined into whole lines: two segments are links of one line when each one's end
+    points lie within ``tol`` work pixels of the other's line and the gap between them is at most
+    twice the longer one (links chain along a line: a joint broken at every brick, a checkerboard's
+    edge); each line is fitted to its segments' end points. Returns (K, 3) lines, their lengths and
+    their centres. A long line's direction is known far better than its pieces' (short segments
+    cut at corners lean towards the corners)."""
+    n = len(seg)
+    lines = _homogeneous(seg)
+    p, q = seg[:, :2], seg[:, 2:]
+    d = q - p
+    length = np.hypot(d[:, 0], d[:, 1])
+    ends = np.vstack([p, q])
+    reach = 2.0 * np.percentile(length, 90)
+    pairs = cKDTree(ends).query_pairs(reach, output_type="ndarray")
+    i, j = pairs[:, 0] % n, pairs[:, 1] % n
+    keep = i != j
+    i, j = i[keep], j[keep]
+    gap = np.hypot(*(ends[pairs[keep, 0]] - ends[pairs[keep, 1]]).T)
+    near = gap <= 2 * np.maximum(length[i], length[j])
+    i, j = i[near], j[near]
 
+    def off(a, b):  # how far b's end points lie from a's line
+        return np.maximum(np.abs(np.einsum("ij,ij->i", lines[a, :2], p[b]) + lines[a, 2]),
+                          np.abs(np.einsum("ij,ij->i", lines[a, :2], q[b]) + lines[a, 2]))
 
-def _merged(seg: np.ndarray, v: np.ndarray, px: float) -> tuple[np.ndarray, np.ndarray]:
-    """The family's segments grouped into whole lines (same polarity, on one line through ``v``
-    within a work pixel), each fitted to its segments' end points: (K, 3) lines and their lengths.
-    A long line's direction is known far better than its pieces' (a joint broken at every brick)."""
-    mids = (seg[:, :2] + seg[:, 2:]) / 2
-    d = seg[:, 2:] - seg[:, :2]
-    q = v[:2][None, :] - v[2] * mids
-    q /= np.linalg.norm(q, axis=1)[:, None]
-    polarity = np.sign(np.einsum("ij,ij->i", d, q))
-    g = mids.mean(axis=0)
-    dg = _direction_at(v, g)
-    ng = np.array([-dg[1], dg[0]])
-    t = _cross2(mids - g, q) / _cross2(ng[None, :], q)
-    order = np.lexsort((t, polarity))
-    groups, current = [], [order[0]]
-    for i in order[1:]:
-        j = current[0]
-        if polarity[i] == polarity[j] and t[i] - t[j] <= px:
-            current.append(i)
-        else:
-            groups.append(current)
-            current = [i]
-    groups.append(current)
-    lines, lengths = [], []
-    for grp in groups:
-        ends = np.vstack([seg[grp, :2], seg[grp, 2:]])
-        w = np.tile(np.hypot(d[grp, 0], d[grp, 1]), 2)
-        c = (ends * w[:, None]).sum(axis=0) / w.sum()
-        cov = ((ends - c) * w[:, None]).T @ (ends - c)
-        u = np.linalg.eigh(cov)[1][:, 1]  # the line's direction
-        proj = (ends - c) @ u
-        normal = np.array([-u[1], u[0]])
-        lines.append([normal[0], normal[1], -normal @ c])
-        lengths.append(proj.max() - proj.min())
-    return np.array(lines), np.array(lengths)
+    link = np.maximum(off(i, j), off(j, i)) <= tol * px
+    linked = coo_matrix((np.ones(int(link.sum())), (i[link], j[link])), shape=(n, n))
+    count, label = connected_components(linked, directed=False)
+    lab = np.concatenate([label, label])
+    pts = np.vstack([p, q])
+    w = np.concatenate([length, length])
+
+    def total(values):
+        return np.bincount(lab, weights=values, minlength=count)
+
+    wsum = total(w)
+    c = np.column_stack([total(w * pts[:, 0]), total(w * pts[:, 1])]) / wsum[:, None]
+    rel = pts - c[lab]
+    cxx, cyy, cxy = total(w * rel[:, 0] ** 2), total(w * rel[:, 1] ** 2), total(w * rel[:, 0] * rel[:, 1])
+    theta = 0.5 * np.arctan2(2 * cxy, cxx - cyy)  # each line's direction (principal axis)
+    u = np.column_stack([np.cos(theta), np.sin(theta)])
+    proj = np.einsum("ij,ij->i", rel, u[lab])
+    hi = np.full(count, -np.inf)
+    lo = np.full(count, np.inf)
+    np.maximum.at(hi, lab, proj)
+    np.minimum.at(lo, lab, proj)
+    normal = np.column_stack([-u[:, 1], u[:, 0]])
+    out = np.column_stack([normal, -np.einsum("ij,ij->i", normal, c)])
+    return out, hi - lo, c + u * ((hi + lo) / 2)[:, None]
 
 
 def _near(points: np.ndarray, of: np.ndarray, margin: float) -> np.ndarray:
@@ -285,13 +314,13 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Fami
         for _ in range(3):
             if mem.sum() < 2:
                 break
-            v = _refine(lines[mem], length[mem] ** 2)
+            v = _refine(lines[mem], length[mem] ** 2, mids[mem], v)
             mem = _support(v[None], mids, dirs, sin_tol)[0] & free
         for _ in range(2):
             if mem.sum() < 2:
                 break
-            merged, span = _merged(seg[mem], v, px)
-            v = _refine(merged, span ** 2)
+            merged, span, centres = _chains(seg[mem], px)
+            v = _refine(merged, span ** 2, centres, v)
             mem = _support(v[None], mids, dirs, sin_tol)[0] & free
         return v, mem
 
@@ -430,27 +459,33 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
     photo = validate_image(photo, "photo")
     rng = np.random.default_rng(rng)
     hgt, w = photo.shape[:2]
-    grey, k = _grey_work(photo)
     c = np.array([(w - 1) / 2.0, (hgt - 1) / 2.0])
     s = max(w, hgt) / 2.0
 
-    def to_px(seg_work: np.ndarray) -> np.ndarray:
-        return (seg_work + 0.5) / k - 0.5
-
-    source = "lines"
-    seg_px = to_px(_line_segments(grey))
-    found = len(seg_px)
-    px = 1.0 / (k * s)  # a work pixel in normalised units
-    fam = _two_families((seg_px - np.tile(c, 2)) / s, rng, px)
-    if fam is None and repeats:
-        source = "repeats"
-        seg_px = to_px(_repeat_segments(grey, rng))
-        fam = _two_families((seg_px - np.tile(c, 2)) / s, rng, px) if len(seg_px) else None
-    if fam is None:
-        raise GeometryError(REFUSAL)
-    out = suggestion_from_families(seg_px, fam.vps, fam.members, fam.explained, (w, hgt), source=source)
-    out.figures.update({"segments": int(found), "seconds": round(time.perf_counter() - t0, 4)})
-    return out
+    attempts = [(WORK_SIDE, "lines")]
+    if max(w, hgt) > WORK_SIDE:  # fine structure (a weave) may need every pixel
+        attempts.append((FINE_SIDE, "lines"))
+    if repeats:
+        attempts.append((WORK_SIDE, "repeats"))
+    found = 0
+    greys: dict = {}
+    for side, source in attempts:
+        if side not in greys:
+            greys[side] = _grey_work(photo, side)
+        grey, k = greys[side]
+        found_work = _line_segments(grey) if source == "lines" else _repeat_segments(grey, rng)
+        seg_px = (found_work + 0.5) / k - 0.5
+        found = max(found, len(seg_px)) if source == "lines" else found
+        fam = _two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s)) if len(seg_px) else None
+        if fam is None:
+            continue
+        try:
+            out = suggestion_from_families(seg_px, fam.vps, fam.members, fam.explained, (w, hgt), source=source)
+        except GeometryError:
+            continue
+        out.figures.update({"segments": int(found), "seconds": round(time.perf_counter() - t0, 4)})
+        return out
+    raise GeometryError(REFUSAL)
 
 
 def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list, explained: float,
