@@ -10,7 +10,9 @@ vanishing point by least squares, the same rectification) run on every case.
 Success: the residual between the suggested rectification and the truth (estimated frontal frame ->
 true frontal frame) is a similarity over the suggested frame: at a 3x3 grid of points its local
 right angle is kept within 1 degree and its aspect within 2 %. A refusal counts as no success (it
-is the right answer only for the cases ``expect: refuse``, a texture with one family of lines).
+is the right answer only for the ``refuse`` cases: non-repeating noise, neither lines nor repeats).
+The ``without`` textures (gravel, grass, wood grain: one family of lines) are tiled samples, so they
+repeat exactly; the cells (a jittered hexagonal lattice) do not repeat exactly.
 
 Writes ``benchmarks/results/rectify_suggest.json`` (machine, date, per-case rows, aggregates) and
 prints a table.
@@ -137,15 +139,23 @@ def cells() -> np.ndarray:
 
 
 def wood() -> np.ndarray:
-    """One family of lines only (the grain): the suggestion must refuse."""
+    """One family of lines only (the grain); a tiled sample, so it repeats."""
     grain = _resource("wood-grain.png")
     return _tile(cv2.resize(grain, (grain.shape[1] * 2, grain.shape[0] * 2)), (900, 900))
 
 
+def noise(seed: int = 6) -> np.ndarray:
+    """Blotches of filtered noise, not tiled: no lines and no repeats, the suggestion must refuse."""
+    rng = np.random.default_rng(seed)
+    grey = cv2.GaussianBlur(rng.standard_normal((900, 900)).astype(np.float32), (0, 0), 4.0)
+    grey = 0.5 + 0.25 * grey / grey.std()
+    return _rgb(np.clip(grey, 0, 1), (0.8, 0.7, 0.6))
+
+
 STRAIGHT = {"brick": brick, "checkerboard": checkerboard, "tiles": tiles, "text": text, "weave": weave,
             "planks": planks}
-WITHOUT = {"gravel": gravel, "grass": grass, "cells": cells}
-REFUSE = {"wood": wood}
+WITHOUT = {"gravel": gravel, "grass": grass, "cells": cells, "wood": wood}
+REFUSE = {"noise": noise}
 
 
 # -- the camera and the scene ----------------------------------------------------------------------
@@ -304,7 +314,8 @@ def hough_baseline(photo: np.ndarray) -> detect.Suggestion:
         members.append(mem)
         vps.append(detect._refine(lines[mem], length[mem]))
     explained = float(length[np.concatenate(members)].sum() / length.sum())
-    return detect.suggestion_from_families(seg, np.array(vps), members, explained, (w, h), source="hough")
+    return detect.suggestion_from_families(seg, np.array(vps), members, explained, (w, h), source="hough",
+                                           min_confidence=0.0)
 
 
 def run_one(fn, photo: np.ndarray, h_true: np.ndarray, repeats: int) -> dict:
@@ -351,6 +362,9 @@ def main(argv: list[str] | None = None) -> int:
         # interleaved: the suggestion and the baseline on the same photo, one after the other
         row["weft"] = run_one(lambda p: detect.suggest_lines(p), photo, h_true, args.repeats)
         row["hough"] = run_one(hough_baseline, photo, h_true, args.repeats)
+        if case.kind == "refuse":  # the right answer there is the refusal
+            for tool in ("weft", "hough"):
+                row[tool]["success"] = row[tool]["refused"]
         rows.append(row)
         w, b = row["weft"], row["hough"]
         print(f"{case.name:18} {case.kind:8} weft {'ok ' if w['success'] else 'no '}"
@@ -365,6 +379,7 @@ def main(argv: list[str] | None = None) -> int:
         ok = [r for r in sel if not r["refused"]]
         return {"cases": len(sel), "success": round(sum(r["success"] for r in sel) / len(sel), 3),
                 "refused": sum(r["refused"] for r in sel),
+                "wrong_warps": sum(not r["refused"] and not r["success"] for r in sel),
                 "median_angle_err_deg": round(statistics.median(r["angle_err_deg"] for r in ok), 3) if ok else None,
                 "median_aspect_err": round(statistics.median(r["aspect_err"] for r in ok), 4) if ok else None,
                 "median_ms_per_mp": round(statistics.median(r["median_ms"] / rr["megapixels"]

@@ -58,7 +58,10 @@ __all__ = ["Suggestion", "suggest_lines", "suggest_for_studio", "REFUSAL", "WORK
 #: The one line said when the photo shows no two families of straight lines (nor of repeats).
 REFUSAL = "no two families of straight lines found: draw feature lines"
 WORK_SIDE = 720  # longer side (px) of the reduced photo the segments are found on
+LSD_SCALE = 0.8  # LSD's own Gaussian reduction of the work image (its default)
 FINE_SIDE = 1600  # a second look at up to this size when the reduced photo shows no two families
+FINE_BELOW = 300  # ... and fewer segments than this (fine structure lost in the reduction)
+REPEAT_SIDE = 560  # longer side of the photo the repeats are looked for on
 INLIER_DEG = 1.5  # a segment supports a vanishing point when it points at it within this angle
 MIN_FAMILY = 5  # segments a family needs
 MIN_SPREAD_DEG = 15.0  # the two families must differ by this much in direction in the photo
@@ -66,6 +69,7 @@ ASSUMED_FOCAL = 1.2  # focal length (in photo longer sides) when the vanishing p
 MIN_FOCAL = 0.5  # in half longer sides: a shorter focal length than this is no camera's (a 9 mm lens on 35 mm film)
 MAX_FOCAL = 10.0  # in half longer sides: beyond it the vanishing points barely converge and leave f open
 MIN_CONFIDENCE = 0.3  # a weaker suggestion is refused
+THIRD_FAMILY = 0.5  # a third family with this much of the weaker one's support makes the pair ambiguous
 MAX_FRONTAL_SIDE = 4096
 _CANDIDATES = 400  # RANSAC hypotheses (pairs of segments)
 
@@ -137,7 +141,7 @@ def _grey_work(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, 
 
 def _line_segments(grey: np.ndarray) -> np.ndarray:
     """(N, 4) segments found by LSD, at least 1/90 of the longer side long."""
-    lsd = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD)
+    lsd = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD, LSD_SCALE)
     found = lsd.detect(grey)[0]
     if found is None:
         return np.zeros((0, 4))
@@ -149,7 +153,7 @@ def _line_segments(grey: np.ndarray) -> np.ndarray:
 def _repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Segments joining SIFT features to their repeats elsewhere in the photo (similar descriptor,
     scale and orientation), at least three feature sizes apart."""
-    sift = cv2.SIFT_create(nfeatures=1500)
+    sift = cv2.SIFT_create(nfeatures=1000)
     kps, desc = sift.detectAndCompute(grey, None)
     if desc is None or len(kps) < 20:
         return np.zeros((0, 4))
@@ -293,12 +297,16 @@ def _near(points: np.ndarray, of: np.ndarray, margin: float) -> np.ndarray:
     return np.array([cv2.pointPolygonTest(hull, (float(x), float(y)), True) >= -margin for x, y in points])
 
 
-def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Families | None:
+def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice: bool = False) -> _Families | None:
     """Two well-supported vanishing points of segments in normalised coordinates (the principal
     point at the origin) that a camera can see as perpendicular directions: the best supported
     first, then the best supported among the other segments on the region of the first (clutter
     beside the surface counts a tenth). ``px`` is the length of a work pixel in these units: a
-    short segment's direction is known only to about a pixel over its length."""
+    short segment's direction is known only to about a pixel over its length.
+
+    ``lattice``: the segments join repeats of a lattice, whose every translation has a vanishing
+    point on the horizon (the axes and the diagonals): the four best-supported points are found in
+    turn and the best-supported pair a camera can see as perpendicular is taken."""
     n = len(seg)
     if n < 2 * MIN_FAMILY:
         return None
@@ -316,7 +324,7 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Fami
                 break
             v = _refine(lines[mem], length[mem] ** 2, mids[mem], v)
             mem = _support(v[None], mids, dirs, sin_tol)[0] & free
-        for _ in range(2):
+        for _ in range(0 if lattice else 2):  # (repeats are no pieces of longer lines)
             if mem.sum() < 2:
                 break
             merged, span, centres = _chains(seg[mem], px)
@@ -325,6 +333,33 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Fami
         return v, mem
 
     everything = np.ones(n, bool)
+    if lattice:
+        found, free = [], everything.copy()
+        for _ in range(4):
+            pool = np.flatnonzero(free)
+            if len(pool) < MIN_FAMILY:
+                break
+            cand = _hypotheses(lines, length, pool, rng)
+            sup = _support(cand, mids, dirs, sin_tol) & free
+            v, mem = refine(cand[np.argmax(sup @ length)], free)
+            if mem.sum() < MIN_FAMILY:
+                break
+            found.append((v, mem))
+            free &= ~mem
+        best, score = None, 0.0
+        for a in range(len(found)):
+            for b in range(a + 1, len(found)):
+                f2 = _focal_sq(found[a][0], found[b][0])
+                if f2 is None or not MIN_FOCAL ** 2 < f2 < MAX_FOCAL ** 2:
+                    continue
+                sc = min(found[a][1] @ length, found[b][1] @ length)
+                if sc > score:
+                    best, score = (found[a], found[b]), sc
+        if best is None:
+            return None
+        explained = float((best[0][1] | best[1][1]) @ length / length.sum())
+        return _Families(np.array([best[0][0], best[1][0]]), [np.flatnonzero(best[0][1]), np.flatnonzero(best[1][1])],
+                         explained)
     cand = _hypotheses(lines, length, np.arange(n), rng)
     sup = _support(cand, mids, dirs, sin_tol)
     v1, mem1 = refine(cand[np.argmax(sup @ length)], everything)
@@ -348,6 +383,21 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float) -> _Fami
         f2 = _focal_sq(v1, v2)
         if f2 is not None and f2 <= MIN_FOCAL ** 2:
             continue
+        # a third family as strong as the weaker one (the edges of hexagonal cells) leaves it open
+        # which two are the perpendicular ones: no guess
+        rest3 = np.flatnonzero(~(mem1 | mem2))
+        if len(rest3) >= MIN_FAMILY:
+            cand3 = _hypotheses(lines, weight, rest3, rng)
+            sup3 = _support(cand3, mids, dirs, sin_tol) & ~(mem1 | mem2)
+            g = np.median(mids[mem1 | mem2], axis=0)
+            cos_max = math.cos(math.radians(MIN_SPREAD_DEG))
+            d1, d2 = _direction_at(v1, g), _direction_at(v2, g)
+            for m3 in np.argsort(-(sup3 @ weight))[:20]:
+                d3 = _direction_at(cand3[m3], g)
+                if abs(d3 @ d1) < cos_max and abs(d3 @ d2) < cos_max:  # a direction of its own
+                    if sup3[m3] @ weight >= THIRD_FAMILY * min(mem1 @ weight, mem2 @ weight):
+                        return None
+                    break
         explained = float((mem1 | mem2) @ length / length.sum())
         return _Families(np.array([v1, v2]), [np.flatnonzero(mem1), np.flatnonzero(mem2)], explained)
     return None
@@ -462,21 +512,24 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
     c = np.array([(w - 1) / 2.0, (hgt - 1) / 2.0])
     s = max(w, hgt) / 2.0
 
-    attempts = [(WORK_SIDE, "lines")]
-    if max(w, hgt) > WORK_SIDE:  # fine structure (a weave) may need every pixel
-        attempts.append((FINE_SIDE, "lines"))
+    attempts = [(WORK_SIDE, "lines"), (FINE_SIDE, "fine lines")]
     if repeats:
-        attempts.append((WORK_SIDE, "repeats"))
+        attempts.append((REPEAT_SIDE, "repeats"))
     found = 0
     greys: dict = {}
     for side, source in attempts:
+        if source == "fine lines":  # fine structure (a weave) may need every pixel: when few segments showed
+            if max(w, hgt) <= WORK_SIDE or found >= FINE_BELOW:
+                continue
+            source = "lines"
         if side not in greys:
             greys[side] = _grey_work(photo, side)
         grey, k = greys[side]
         found_work = _line_segments(grey) if source == "lines" else _repeat_segments(grey, rng)
         seg_px = (found_work + 0.5) / k - 0.5
         found = max(found, len(seg_px)) if source == "lines" else found
-        fam = _two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s)) if len(seg_px) else None
+        fam = (_two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s), lattice=source == "repeats")
+               if len(seg_px) else None)
         if fam is None:
             continue
         try:
@@ -489,7 +542,8 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
 
 
 def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list, explained: float,
-                             size: tuple[int, int], *, source: str = "lines") -> Suggestion:
+                             size: tuple[int, int], *, source: str = "lines",
+                             min_confidence: float = MIN_CONFIDENCE) -> Suggestion:
     """The rectification and feature lines of two families of segments (steps 3-4 of the module).
 
     Parameters
@@ -500,6 +554,8 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
     members : two index arrays into ``seg_px``: the segments of each family.
     explained : fraction of the segments' length in the two families (for the confidence).
     size : (width, height) of the photo.
+    source : what the segments are (``"lines"``, ``"repeats"``), for the suggestion.
+    min_confidence : a suggestion less confident than this is refused.
 
     Raises
     ------
@@ -568,7 +624,7 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
 
     weaker = min(len(m) for m in fam.members)
     confidence = fam.explained * (1.0 - math.exp(-weaker / 8.0)) * (1.0 if aspect == "camera" else 0.5)
-    if confidence < MIN_CONFIDENCE:
+    if confidence < min_confidence:
         raise GeometryError(REFUSAL)
     vps_px = np.array([to_px_m @ v1, to_px_m @ v2])
     vps_px = np.where(np.abs(vps_px[:, 2:3]) > 1e-12, vps_px / np.where(np.abs(vps_px[:, 2:3]) > 1e-12,

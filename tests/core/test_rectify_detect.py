@@ -59,3 +59,16 @@ def test_a_photo_without_structure_is_refused_in_one_line():
     flat = np.clip(0.5 + 0.05 * rng.standard_normal((300, 400, 3)), 0, 1).astype(np.float32)
     with pytest.raises(GeometryError, match="^no two families of straight lines found: draw feature lines$"):
         suggest_lines(flat)
+
+
+def test_a_repeating_texture_without_lines_is_rectified_from_its_repeats():
+    from benchmarks.rectify_suggest import gravel
+
+    case = Case("g", "gravel", "without", 35.0, 40.0, 2.0, 1.0, 0.8, 0.015, seed=11)
+    photo, truth = photograph(case, gravel())
+    s = suggest_lines(photo)
+    assert s.source == "repeats"
+    angle, aspect = residual(s.homography, truth, s.lines.frontal_size)
+    assert angle <= 1.0 and aspect <= 0.02
+    with pytest.raises(GeometryError, match=REFUSAL):
+        suggest_lines(photo, repeats=False)
