@@ -69,7 +69,8 @@ ASSUMED_FOCAL = 1.2  # focal length (in photo longer sides) when the vanishing p
 MIN_FOCAL = 0.5  # in half longer sides: a shorter focal length than this is no camera's (a 9 mm lens on 35 mm film)
 MAX_FOCAL = 10.0  # in half longer sides: beyond it the vanishing points barely converge and leave f open
 MIN_CONFIDENCE = 0.3  # a weaker suggestion is refused
-THIRD_FAMILY = 0.5  # a third family with this much of the weaker one's support makes the pair ambiguous
+THIRD_FAMILY = 0.5  # a third family with this much of the weaker one's support makes the pair ambiguous ...
+BALANCED = 0.4  # ... when the weaker one has this much of the stronger one's (a lattice of cells)
 MAX_FRONTAL_SIDE = 4096
 _CANDIDATES = 400  # RANSAC hypotheses (pairs of segments)
 
@@ -383,10 +384,11 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice:
         f2 = _focal_sq(v1, v2)
         if f2 is not None and f2 <= MIN_FOCAL ** 2:
             continue
-        # a third family as strong as the weaker one (the edges of hexagonal cells) leaves it open
-        # which two are the perpendicular ones: no guess
+        # two families of comparable strength and a third nearly as strong (the edges of hexagonal
+        # cells) leave it open which two are the perpendicular ones: no guess
         rest3 = np.flatnonzero(~(mem1 | mem2))
-        if len(rest3) >= MIN_FAMILY:
+        s1, s2 = mem1 @ weight, mem2 @ weight
+        if len(rest3) >= MIN_FAMILY and min(s1, s2) >= BALANCED * max(s1, s2):
             cand3 = _hypotheses(lines, weight, rest3, rng)
             sup3 = _support(cand3, mids, dirs, sin_tol) & ~(mem1 | mem2)
             g = np.median(mids[mem1 | mem2], axis=0)
@@ -395,7 +397,7 @@ def _two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice:
             for m3 in np.argsort(-(sup3 @ weight))[:20]:
                 d3 = _direction_at(cand3[m3], g)
                 if abs(d3 @ d1) < cos_max and abs(d3 @ d2) < cos_max:  # a direction of its own
-                    if sup3[m3] @ weight >= THIRD_FAMILY * min(mem1 @ weight, mem2 @ weight):
+                    if sup3[m3] @ weight >= THIRD_FAMILY * min(s1, s2):
                         return None
                     break
         explained = float((mem1 | mem2) @ length / length.sum())
