@@ -39,6 +39,8 @@ from weft.core.errors import GeometryError
 from weft.core.examples import RESOURCES
 from weft.core.image import load_image
 from weft.core.rectify import detect
+from weft.core.rectify.detect.segments import homogeneous, work_grey
+from weft.core.rectify.detect.vanishing import refine_point
 from weft.core.rectify.homography import apply_homography
 
 from .fixtures import procedural
@@ -286,7 +288,7 @@ def hough_baseline(photo: np.ndarray) -> detect.Suggestion:
     """Probabilistic Hough lines on Canny edges; the two largest orientation clusters (peaks of a
     length-weighted angle histogram at least 20 degrees apart); each cluster's vanishing point by
     least squares; the same rectification as the suggestion."""
-    grey, k = detect._grey_work(photo)
+    grey, k = work_grey(photo)
     edges = cv2.Canny(grey, 60, 150)
     found = cv2.HoughLinesP(edges, 1, np.pi / 360, threshold=40, minLineLength=max(grey.shape) // 25, maxLineGap=4)
     if found is None or len(found) < 10:
@@ -304,7 +306,7 @@ def hough_baseline(photo: np.ndarray) -> detect.Suggestion:
     h, w = photo.shape[:2]
     c = np.array([(w - 1) / 2.0, (h - 1) / 2.0])
     s = max(w, h) / 2.0
-    lines = detect._homogeneous((seg - np.tile(c, 2)) / s)
+    lines = homogeneous((seg - np.tile(c, 2)) / s)
     members, vps = [], []
     for b in (first, second):
         diff = np.abs(((ang - (b * 2 + 1)) + 90) % 180 - 90)
@@ -312,7 +314,7 @@ def hough_baseline(photo: np.ndarray) -> detect.Suggestion:
         if len(mem) < 2:
             raise GeometryError(detect.REFUSAL)
         members.append(mem)
-        vps.append(detect._refine(lines[mem], length[mem]))
+        vps.append(refine_point(lines[mem], length[mem]))
     explained = float(length[np.concatenate(members)].sum() / length.sum())
     return detect.suggestion_from_families(seg, np.array(vps), members, explained, (w, h), source="hough",
                                            min_confidence=0.0)
