@@ -7,9 +7,6 @@ import math
 
 import cv2
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 __all__ = ["work_grey", "line_segments", "repeat_segments", "homogeneous", "chains", "WORK_SIDE", "LSD_SCALE"]
 
@@ -86,6 +83,10 @@ def chains(seg: np.ndarray, px: float, tol: float = 1.2) -> tuple[np.ndarray, np
     p, q = seg[:, :2], seg[:, 2:]
     d = q - p
     length = np.hypot(d[:, 0], d[:, 1])
+    from scipy.sparse import coo_matrix  # (here: importing the studio's methods need not load SciPy)
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
     ends = np.vstack([p, q])
     reach = 2.0 * np.percentile(length, 90)
     pairs = cKDTree(ends).query_pairs(reach, output_type="ndarray")
