@@ -321,18 +321,20 @@ def hough_baseline(photo: np.ndarray) -> detect.Suggestion:
 
 
 def run_one(fn, photo: np.ndarray, h_true: np.ndarray, repeats: int) -> dict:
-    times = []
+    times, cpu = [], []
     out: dict = {}
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         try:
             sug = fn(photo)
             err = None
         except GeometryError as e:
             sug, err = None, str(e)
         times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
     out["first_ms"] = round(times[0] * 1000, 1)
     out["median_ms"] = round(statistics.median(times) * 1000, 1)
+    out["median_cpu_ms"] = round(statistics.median(cpu) * 1000, 1)
     if sug is None:
         out.update(refused=True, message=err, success=False)
         return out
@@ -386,13 +388,17 @@ def main(argv: list[str] | None = None) -> int:
                 "median_aspect_err": round(statistics.median(r["aspect_err"] for r in ok), 4) if ok else None,
                 "median_ms_per_mp": round(statistics.median(r["median_ms"] / rr["megapixels"]
                                                             for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])), 1),
+                "median_cpu_ms_per_mp": round(statistics.median(r["median_cpu_ms"] / rr["megapixels"]
+                                                                for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])), 1),
                 "first_run_ms": sel[0]["first_ms"]}
 
     aggregates = {tool: {kind: agg(kind, tool) for kind in ("straight", "without", "refuse")} for tool in ("weft", "hough")}
     data = {"suite": "rectify_suggest", "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
             "machine": {"platform": platform.platform(), "python": platform.python_version(), "cpus": os.cpu_count(),
                         "processor": platform.processor() or platform.machine(), "opencv": cv2.__version__,
-                        "note": "shared by several engineers' jobs while measured"},
+                        "note": "shared by several engineers' jobs while measured (load average "
+                                f"{os.getloadavg()[0]:.1f} at the end); median_cpu_ms is the process's CPU time, "
+                                "less affected by the sharing than the wall time"},
             "command": "python -m benchmarks.rectify_suggest" + (f" --repeats {args.repeats}" if args.repeats != 5 else ""),
             "success_rule": "residual right angle within 1 deg and aspect within 2 % at a 3x3 grid over the frame",
             "aggregates": aggregates, "rows": rows}

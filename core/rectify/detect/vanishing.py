@@ -27,9 +27,12 @@ _CANDIDATES = 400  # RANSAC hypotheses (pairs of segments)
 
 def support(vps: np.ndarray, mids: np.ndarray, dirs: np.ndarray, sin_tol: np.ndarray) -> np.ndarray:
     """(M, N) bool: segment n points at vanishing point m within its tolerance (sine of the angle)."""
-    q = vps[:, None, :2] - vps[:, None, 2:3] * mids[None, :, :]
-    cross = np.abs(dirs[None, :, 0] * q[..., 1] - dirs[None, :, 1] * q[..., 0])
-    return cross <= sin_tol[None, :] * np.hypot(q[..., 0], q[..., 1]) + 1e-15
+    v = vps.astype(np.float32)
+    m = mids.astype(np.float32)
+    qx = v[:, None, 0] - v[:, None, 2] * m[None, :, 0]
+    qy = v[:, None, 1] - v[:, None, 2] * m[None, :, 1]
+    cross = dirs[None, :, 0].astype(np.float32) * qy - dirs[None, :, 1].astype(np.float32) * qx
+    return cross * cross <= (sin_tol * sin_tol).astype(np.float32)[None, :] * (qx * qx + qy * qy)
 
 
 def refine_point(lines: np.ndarray, weights: np.ndarray, mids: np.ndarray | None = None,
