@@ -41,7 +41,8 @@ def refine_point(lines: np.ndarray, weights: np.ndarray, mids: np.ndarray | None
     squares; with them (each line's centre) and a start ``v``, the sum of squared sines of the
     angles between each line and the direction from its centre to the point, by reweighting: the
     algebraic residual of a line is that sine times the distance (in ``v``'s scale) from its centre
-    to the point, which would favour points near the long lines."""
+    to the point, which would favour points near the long lines. A Cauchy weight (scale twice the
+    robust spread of the sines, at least 0.3 degrees) keeps stray members from pulling."""
     def solve(w: np.ndarray) -> np.ndarray:
         m = (lines * w[:, None]).T @ lines
         return np.linalg.eigh(m)[1][:, 0]
@@ -50,7 +51,11 @@ def refine_point(lines: np.ndarray, weights: np.ndarray, mids: np.ndarray | None
         return solve(weights)
     for _ in range(iterations):
         q = v[None, :2] - v[2] * mids
-        v = solve(weights / np.maximum(np.einsum("ij,ij->i", q, q), 1e-12))
+        qq = np.maximum(np.einsum("ij,ij->i", q, q), 1e-12)
+        sine = np.abs(lines @ v) / np.sqrt(qq)
+        scale = max(math.sin(math.radians(0.3)), 1.4826 * float(np.median(sine)))
+        robust = 1.0 / (1.0 + (sine / (2.0 * scale)) ** 2)  # Cauchy: a stray segment barely counts
+        v = solve(weights * robust / qq)
     return v
 
 
