@@ -57,3 +57,61 @@ def test_suggest_lines_on_a_photo_without_lines_says_so_and_keeps_the_lines(nfpt
     assert messages == ["no two families of straight lines found: draw feature lines"]
     assert doc.undo_stack.count() == depth
     assert (list(doc.image_lines), list(doc.frontal_lines)) == before
+
+
+# -- the button belongs to whatever method declares a suggestion (the studio knows no method) -------
+
+from dataclasses import dataclass  # noqa: E402
+
+from weft.core import registry  # noqa: E402
+from weft.core.geometry import FeatureLines  # noqa: E402
+from weft.core.image import save_image  # noqa: E402
+from weft.core.params import Params, param  # noqa: E402
+from weft.core.registry import InputSpec, Method, Result  # noqa: E402
+from weft.core.studio import LINES, Geometry, Studio  # noqa: E402
+
+_PROPOSED = FeatureLines([[5, 5, 50, 6], [6, 40, 52, 41], [5, 5, 6, 40], [50, 6, 52, 41]],
+                         [[0, 0, 63, 0], [0, 47, 63, 47], [0, 0, 0, 47], [63, 0, 63, 47]], (64, 48))
+
+
+@dataclass(frozen=True)
+class _TraceParams(Params):
+    trace: FeatureLines = param(None, kind="geometry", type=FeatureLines, optional=True, help="lines to trace")
+
+
+def _method(suggest):
+    return Method(
+        name="trace-lines", summary="returns its picture", params=_TraceParams,
+        inputs=(InputSpec("picture", "the picture"),),
+        run=lambda inputs, params, **_: Result(inputs["picture"].copy(), {}),
+        studio=Studio(title="Trace lines", canvas="picture",
+                      geometry=(Geometry(LINES, on=("picture",), param="trace", help="draw lines", suggest=suggest),)))
+
+
+@pytest.mark.parametrize("declared", [True, False])
+def test_a_plugin_method_gets_the_button_only_when_it_declares_a_suggestion(declared, qtbot, settings, tmp_path):
+    from weft.app.gui.main_window import MainWindow
+
+    method = _method((lambda image: (_PROPOSED, "four pairs")) if declared else None)
+    registry.register(method)
+    picture = tmp_path / "picture.png"
+    save_image(picture, np.random.default_rng(2).random((60, 70, 3)).astype(np.float32))
+    window = MainWindow(settings=settings, load_defaults=False)
+    qtbot.addWidget(window)
+    window.resize(1300, 820)
+    window.show()
+    try:
+        box = window.method_panel.method_box
+        box.setCurrentIndex(box.findData(method.name))
+        window.open_input("picture", str(picture))
+        qtbot.waitUntil(lambda: window.doc.image("picture") is not None, timeout=10000)
+        panel = window.lines_panel
+        assert panel.suggest_button.isVisible() == declared
+        if declared:
+            qtbot.mouseClick(panel.suggest_button, Qt.MouseButton.LeftButton)
+            qtbot.waitUntil(lambda: len(window.doc.image_lines) == 4, timeout=10000)
+            assert window.doc.frontal_size == (64, 48)
+            assert window.doc.run_params().trace == _PROPOSED
+    finally:
+        window.shutdown()
+        registry.unregister(method.name)
