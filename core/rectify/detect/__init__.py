@@ -19,8 +19,10 @@ them and turns them into feature-line pairs the user can edit like drawn ones:
    principal point is the photo's centre; the two orthogonal vanishing points then fix the focal
    length. When they cannot (a vanishing point at infinity), the aspect is left to an assumed focal
    length of 1.2 times the photo's longer side, and the suggestion says so;
-4. feature lines: up to three long segments of each family, extended across the textured region,
-   paired with their axis-aligned images in the frontal frame.
+4. feature lines: two long, well separated segments of each family, extended across the textured
+   region, paired with their axis-aligned images in the frontal frame: four pairs fix the
+   homography exactly, so every end the user drags moves the frontal view (with more, the robust
+   fit would outvote one moved line).
 
 Where segments give no two families, segments joining the texture's own repeats (SIFT features
 matched within the photo) take their place: the line through a feature and its repeat points at the

@@ -127,15 +127,15 @@ def _frame(h: np.ndarray, seg_px: np.ndarray, size: tuple[int, int]) -> tuple[np
     raise GeometryError(REFUSAL)
 
 
-def _pick(positions: np.ndarray, weights: np.ndarray, lo: float, hi: float, k: int = 3) -> list[float]:
-    """Up to ``k`` positions in (lo, hi), heaviest first, at least a fifth of the span apart."""
+def _pick(positions: np.ndarray, weights: np.ndarray, lo: float, hi: float, k: int = 2) -> list[float]:
+    """Up to ``k`` positions in (lo, hi), heaviest first, at least two fifths of the span apart."""
     out: list[float] = []
     span = hi - lo
     for i in np.argsort(-weights):
         p = positions[i]
         if not (lo + 0.02 * span < p < hi - 0.02 * span):
             continue
-        if all(abs(p - q) > span / 5 for q in out):
+        if all(abs(p - q) > 0.4 * span for q in out):
             out.append(float(p))
         if len(out) == k:
             break
@@ -282,8 +282,10 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
         wts = np.hypot(rows[:, 2] - rows[:, 0], rows[:, 3] - rows[:, 1])
         span = fh - 1 if axis == 1 else fw - 1
         picks = _pick(pos, wts, 0.0, span)
-        if len(picks) < 2:
-            picks = sorted(set(picks) | {0.0, float(span)})[:3] if len(picks) else [0.0, float(span)]
+        if len(picks) == 1:  # the frame's edge farther from it
+            picks.append(0.0 if picks[0] > span / 2 else float(span))
+        elif not picks:
+            picks = [0.0, float(span)]
         for p in sorted(picks):
             frontal.append([0.0, p, fw - 1.0, p] if axis == 1 else [p, 0.0, p, fh - 1.0])
     frontal = np.array(frontal)
