@@ -187,6 +187,14 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             metavar = spec.type.METAVAR if spec.kind == "geometry" else spec.kind.upper()
             group.add_argument(spec.option, dest="param_" + spec.name, metavar=metavar,
                                help="; ".join(bits).replace("%", "%%"))
+        if _lines_spec(method) is not None:
+            p.add_argument("--auto", action="store_true",
+                           help="suggest the feature lines from two families of straight lines in the photo "
+                                "(the recipe records the suggested lines; --report adds the confidence and the "
+                                "angle between the two directions)")
+            p.add_argument("--save-lines", metavar="F.json",
+                           help="also write the feature lines used (the suggestion, with --auto) to this JSON "
+                                "file: edit it and pass it back with --lines")
         _add_common(p, region=method.takes_region)
         p.set_defaults(method=method.name)
     w = sub.add_parser("warm-up", help="prepare every method's compiled kernels now (installers, render nodes, CI)",
@@ -208,6 +216,33 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+def _lines_spec(method):
+    """The method's feature-lines parameter (its spec), or None: such a method takes ``--auto``."""
+    from weft.core.geometry import FeatureLines
+
+    return next((sp for sp in specs(method.params) if sp.kind == "geometry" and sp.type is FeatureLines), None)
+
+
+def _suggest(method, params: Params, inputs: dict[str, str], args: argparse.Namespace) -> tuple[Params, dict]:
+    """``--auto``: the feature lines suggested for the method's first input, in ``params``; the
+    suggestion's figures for ``--report``."""
+    from weft.core.image import load_image
+    from weft.core.rectify import suggest_lines
+
+    spec = _lines_spec(method)
+    if getattr(params, spec.name) is not None:
+        raise UsageError(f"weft {method.name}: give --{spec.name} or --auto, not both")
+    first = method.inputs[0].name
+    if first not in inputs:
+        raise UsageError(f"weft {method.name}: --auto needs the {first}")
+    photo = load_image(inputs[first]).image
+    try:
+        suggestion = suggest_lines(photo)
+    except WeftError as e:
+        raise WeftError(f"{inputs[first]}: {e}") from None
+    return params.replace(**{spec.name: suggestion.lines}), suggestion.report()
+
+
 def _check_output(output: str, inputs: Sequence[str]) -> Path:
     out = Path(output)
     if out.suffix.lower() not in SAVE_EXTENSIONS:
@@ -225,7 +260,7 @@ def _check_output(output: str, inputs: Sequence[str]) -> Path:
 
 
 def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
-             args: argparse.Namespace, region: tuple[int, int, int] | None = None) -> int:
+             args: argparse.Namespace, region: tuple[int, int, int] | None = None, extra: dict | None = None) -> int:
     from weft.core import registry
     from weft.core.image import save_image
     from weft.core.run import output_recipe, render
@@ -235,6 +270,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     params = params_dict if isinstance(params_dict, Params) else method.params.from_dict(params_dict)
     bit_depth = _parse_bit_depth(args) if args.bit_depth is not None else None  # None: see below
     out = _check_output(args.output, list(input_paths.values()))
+    save_lines = _check_lines_file(method, params, getattr(args, "save_lines", None), [*input_paths.values(), out])
     if bit_depth == 16 and out.suffix.lower() in (".jpg", ".jpeg"):
         raise WeftError(f"{args.output}: JPEG cannot hold 16 bits per channel (use .png or .tif)")
     if seed is None:
@@ -264,12 +300,35 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     if args.bit_depth is not None:  # asked for (or a recipe's): recorded, so weft run writes it again
         recipe = dataclasses.replace(recipe, bit_depth=bit_depth)
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
+    if save_lines is not None:
+        from weft.core.image import atomic_write_bytes
+
+        atomic_write_bytes(save_lines[0], (save_lines[1].to_text() + "\n").encode("utf-8"))
     if args.report:
         h, w = result.image.shape[:2]
         line = {"method": method.name, "seconds": round(seconds, 6), "size": [w, h], "seed": seed}
         line.update(result.figures)
+        line.update(extra or {})
         print(json.dumps(line), flush=True)
     return 0
+
+
+def _check_lines_file(method, params: Params, path: str | None, others: Sequence) -> tuple[Path, object] | None:
+    """``--save-lines F.json``: where to write which lines (checked before any work), or None."""
+    if path is None:
+        return None
+    lines = getattr(params, _lines_spec(method).name)
+    if lines is None:
+        raise UsageError(f"weft {method.name}: --save-lines needs --lines or --auto (there are no lines to save)")
+    target = Path(path)
+    if target.suffix.lower() != ".json":
+        raise WeftError(f"{path}: feature lines are saved as .json")
+    parent = target.parent if str(target.parent) else Path(".")
+    if target.is_dir() or not parent.is_dir():
+        raise WeftError(f"{path}: " + ("is a directory" if target.is_dir() else f"folder {parent} does not exist"))
+    if any(os.path.realpath(o) == os.path.realpath(target) for o in others):
+        raise WeftError(f"{path}: refusing to overwrite an input or the output")
+    return target, lines
 
 
 def _warm_up_all(args: argparse.Namespace) -> int:
@@ -360,7 +419,11 @@ def _dispatch(args: argparse.Namespace) -> int:
             inputs[inp.name] = value
     seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
     region = Square.parse(args.region) if getattr(args, "region", None) is not None else None
-    return _execute(method.name, params, inputs, seed, args, region)
+    extra = None
+    if getattr(args, "auto", False):
+        _check_output(args.output, list(inputs.values()))  # a wrong output is said before the suggestion's work
+        params, extra = _suggest(method, params, inputs, args)
+    return _execute(method.name, params, inputs, seed, args, region, extra)
 
 
 def _reuse_freed_memory() -> None:

@@ -58,6 +58,10 @@ class Geometry:
     empty_is_all : for a mask: the method without this input acts as if every pixel were white (a
         region to copy from: all of it), not none; the brush then paints it as *Include* and
         *Exclude*, and the first *Exclude* starts from a mask that is white everywhere.
+    suggest : ``suggest(image) -> (value, text)``: proposes the geometry for the ``on`` image (the
+        value a user would draw, e.g. :class:`~weft.core.geometry.FeatureLines`) and says in a
+        sentence what it found; raises ``WeftError`` (one line) when it cannot. The studio offers it
+        as a button and runs it off the GUI thread; None: nothing to suggest.
     """
 
     kind: str
@@ -69,6 +73,7 @@ class Geometry:
     needed: str = ""
     label: str = ""
     empty_is_all: bool = False
+    suggest: Callable[[np.ndarray], tuple[Any, str]] | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:

@@ -3,8 +3,10 @@
 Line i drawn on the photo goes with line i drawn in the frontal frame (numbered and coloured alike).
 While an end point is dragged, the photo is rectified on a worker (latest wins) and shown in the
 frontal frame, so the user sees the effect of every move; *Quad…* makes four pairs from four clicked
-corners; the frontal size sets the frame the lines live in. Lines load from and save to DESIGN.md's
-JSON; the document holds them (undoable, per method) and the render takes them from there.
+corners; *Suggest lines* (when the method's lines geometry declares a ``suggest``) proposes pairs
+on a worker and sets them as one undo step; the frontal size sets the frame the lines live in. Lines
+load from and save to DESIGN.md's JSON; the document holds them (undoable, per method) and the
+render takes them from there.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from PySide6.QtWidgets import QFileDialog, QHBoxLayout, QLabel, QPushButton, QSi
 
 from weft.core.errors import WeftError
 from weft.core.jobs import JobResult, JobRunner
+from weft.core.studio import LINES
 
 from .tools import LineTool, QuadTool
 from .views import ImageView
@@ -27,6 +30,7 @@ class FeatureLinesPanel(QWidget):
 
     message = Signal(str)
     _rectified = Signal(object)
+    _suggested = Signal(object)
 
     def __init__(self, doc, photo_view: ImageView, input_name: str, parent=None):
         super().__init__(parent)
@@ -41,6 +45,9 @@ class FeatureLinesPanel(QWidget):
         self.frontal_view.tool = self.frontal_lines
         self.runner = JobRunner(max_workers=1, on_result=self._rectified.emit)
         self._rectified.connect(self._on_rectified)
+        self._suggested.connect(self._on_suggested)
+        self.suggest_runner = JobRunner(max_workers=1, on_result=self._suggested.emit)
+        self._suggest_photo = None  # the photo a pending suggestion is for
         self._rectifier = None
         self._build()
 
@@ -57,11 +64,46 @@ class FeatureLinesPanel(QWidget):
 
     def set_active(self, on: bool) -> None:
         self.active = on
+        self.suggest_button.setVisible(on and self._suggester() is not None)
         if on:
             self._update_rectified()
 
     def shutdown(self) -> None:
+        self.suggest_runner.shutdown(wait=True, cancel=True)
         self.runner.shutdown(wait=True, cancel=True)
+
+    def _suggester(self):
+        g = self.doc.geometry_of(LINES)
+        return None if g is None else g.suggest
+
+    def suggest(self) -> None:
+        """Propose line pairs for the photo on a worker; they replace the lines as one undo step."""
+        suggest, photo = self._suggester(), self.doc.image(self.input_name)
+        if suggest is None or photo is None:
+            return
+        self._suggest_photo = photo
+        self.suggest_button.setEnabled(False)
+        self.rectify_status.setText("looking for two families of straight lines…")
+
+        def job(*, progress=None, cancel=None):
+            return suggest(photo)
+
+        self.suggest_runner.submit("suggest", job)
+
+    def _on_suggested(self, result: JobResult) -> None:
+        self.suggest_button.setEnabled(True)
+        photo, self._suggest_photo = self._suggest_photo, None
+        if result.cancelled or photo is None or self.doc.image(self.input_name) is not photo:
+            return  # another photo (or none) since: the suggestion is not for it
+        if result.error is not None:
+            text = str(result.error) if isinstance(result.error, WeftError) else f"no suggestion: {result.error}"
+            self.rectify_status.setText(text)
+            self.message.emit(text)
+            return
+        lines, words = result.value
+        self.doc.set_lines(lines.image_lines.tolist(), lines.frontal_lines.tolist(), text="Suggest lines",
+                           frontal_size=lines.frontal_size)
+        self.message.emit(words)
 
     def _build(self) -> None:
         lay = QVBoxLayout(self)
@@ -73,6 +115,12 @@ class FeatureLinesPanel(QWidget):
                                     "four line pairs (the frontal rectangle's edges)")
         self.quad_button.toggled.connect(self._quad_mode)
         row.addWidget(self.quad_button)
+        self.suggest_button = QPushButton("Suggest lines")
+        self.suggest_button.setToolTip("find two families of straight lines in the photo and propose line pairs "
+                                       "from them (edit them like drawn ones; Undo takes them back)")
+        self.suggest_button.clicked.connect(self.suggest)
+        self.suggest_button.setVisible(False)
+        row.addWidget(self.suggest_button)
         row.addWidget(QLabel("frontal size"))
         self.frontal_w, self.frontal_h = QSpinBox(), QSpinBox()
         for box_ in (self.frontal_w, self.frontal_h):

@@ -12,6 +12,7 @@ from ..image import validate_image
 from ..jobs import CancelToken, Progress
 from ..params import out_of_range, param
 from ..rectify import FIGURES as RECTIFY_FIGURES, FeatureLines, View, WarpParams
+from ..rectify.detect import suggest_for_studio
 from ..registry import InputSpec, Method, Result
 from ..studio import LINES, Figure, Geometry, Studio
 from .synthesis import SMOOTH_SIGMA, Synthesis, distance_weights, synthesize_patches
@@ -343,10 +344,11 @@ METHOD = Method(
         canvas="photo",
         geometry=(Geometry(LINES, on=("photo",), param="lines",
                            help="drag to draw feature lines; drag an end to move it; click a line + "
-                                "Delete to remove it",
+                                "Delete to remove it", suggest=suggest_for_studio,
                            # (a run without lines takes the photo as frontal: of a perspective photo,
                            # a collage with hard seams)
-                           needed="draw feature lines on the photo (or Quad…: click the plane's four corners)"),),
+                           needed="draw feature lines on the photo (or press Suggest lines, or Quad…: click "
+                                  "the plane's four corners)"),),
         preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
         auto=lambda params, shapes: {"sigma_d": params.overlap / 2.0}, rank=3,
         limits=lambda params, shapes: {"overlap": (2, params.block // 2)},

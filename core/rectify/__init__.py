@@ -22,9 +22,13 @@ photo is validated once), or ``.warp(homography, frontal_size)`` when the homogr
 :func:`load_feature_lines` reads the JSON. Re-projection into a view or back into the photo lives
 in :mod:`weft.core.rectify.view` and is driven by :mod:`weft.core.nfpt`.
 
-``weft rectify PHOTO --lines L.json -o OUT`` is the command line of it.
+Without drawn lines, :func:`suggest_lines` proposes them from two families of straight lines in
+the photo (:mod:`weft.core.rectify.detect`).
+
+``weft rectify PHOTO --lines L.json -o OUT`` (or ``--auto``) is the command line of it.
 """
 
+from .detect import REFUSAL, Suggestion, suggest_lines
 from .homography import HomographyFit, apply_homography, fit_homography
 from .lines import FeatureLines, line_correspondences, load_feature_lines, parse_feature_lines
 from .method import (FIGURES, INTERPOLATIONS, METHOD, Rectified, Rectifier, RectifyParams, WarpParams, homography_figure,
@@ -33,7 +37,7 @@ from .view import View, load_view
 from .warps import PLANAR_TOL_PX, WARPS, WarpPlan, homography_plan, plan_warp
 
 __all__ = [
-    "FeatureLines", "HomographyFit", "Rectified", "Rectifier", "RectifyParams", "View", "WARPS", "WarpParams", "WarpPlan",
+    "FeatureLines", "HomographyFit", "REFUSAL", "Suggestion", "suggest_lines", "Rectified", "Rectifier", "RectifyParams", "View", "WARPS", "WarpParams", "WarpPlan",
     "apply_homography", "fit_homography", "line_correspondences", "load_feature_lines", "load_view",
     "parse_feature_lines", "plan_warp", "rectify", "rectify_feature_lines", "scale_lines", "METHOD",
 ]
