@@ -12,7 +12,6 @@ square in the middle of the 4096² picture for the fill.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
 import subprocess
@@ -70,7 +69,7 @@ def peak_rss(argv: list[str]) -> tuple[int, float, int]:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--json", help="also write the figures to this file")
+    parser.add_argument("--json", help="where to write the results (default benchmarks/results/memory.json)")
     args = parser.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory(prefix="weft-memory-") as tmp:
@@ -89,9 +88,12 @@ def main(argv=None) -> int:
             each = ", ".join(f"{r[0] / 2**20:.0f}" for r in runs)
             print(f"| {name} | {peak / 2**20:.0f} MiB | {each} | {wall:.1f} | {'yes' if peak < LIMIT else 'NO'} |",
                   flush=True)
-            rows.append({"job": name, "peak_bytes": peak, "runs_bytes": [r[0] for r in runs], "seconds": wall})
-    if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=1))
+            rows.append({"job": name, "peak_bytes": peak, "peak_mib": round(peak / 2**20),
+                         "runs_bytes": [r[0] for r in runs], "seconds": wall, "under_2_gib": peak < LIMIT})
+    from .record import command, write_results
+
+    write_results("memory", rows, command=command("benchmarks.memory", argv), path=args.json,
+                  note=f"peak resident set size of the whole weft process, median of {args.repeat} runs")
     return 0 if all(r["peak_bytes"] < LIMIT for r in rows) and len(rows) == 3 else 1
 
 
