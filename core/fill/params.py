@@ -63,8 +63,8 @@ class FillParams(Params):
                         help="uncrop to this canvas size (at least the image's), the image placed by --anchor")
     anchor: str = param("center", choices=ANCHORS, help="where the image sits on a --size canvas")
     band: int = param(2, lo=0, hi=32,
-                      help="blend band: known pixels up to this many px from the hole may change (Poisson "
-                           "seam band); 0 = they never change")
+                      help="how far around the hole, in pixels, known pixels may change so the fill meets them "
+                           "without a visible step (a Poisson band); 0 = they never change")
     structure: str = param("auto", choices=STRUCTURE,
                            help="continue the strong edges that cross the hole (a rim, a horizon) along smooth "
                                 "curves, where patches alone run them on straight or drip; auto: whenever the "
