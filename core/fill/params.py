@@ -118,7 +118,7 @@ def structure_value(value):
 def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto") -> str:
     """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (its guide is that engine's), and
     for a hole inside a colour picture (removing an
-    object from a photo: coherence 4.45 against quilt's 5.40 on issue 15's photo, seeds 0-4), unless
+    object from a photo: coherence 4.45 against quilt's 5.40 on the fill benchmark's photo, seeds 0-4), unless
     the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.24,
     brick 1.05 against 1.35) and for holes along the canvas border, an uncrop's (0.81 against 0.85,
     seeds 0-4 medians, in a quarter of the time: 0.27 against 1.01 s in the benchmark's run)."""

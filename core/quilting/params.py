@@ -38,7 +38,7 @@ class QuiltParams(Params):
     relevant structures in the texture, but small enough so that the interaction between these
     structures is left up to the algorithm" (E&F §2.1). A sample is usually cropped around a few of
     its elements, so the default scales with it: 7/16 of the side holds the whole bricks of the
-    peers' brick_128 sample (issue 17's T1: coherence 0.0358 → 0.0266 over seeds 0–9 against a fixed
+    peers' brick_128 sample (the quilting benchmark's T1: coherence 0.0358 → 0.0266 over seeds 0–9 against a fixed
     32) while one block stays under a fifth of the sample's area, so no verbatim region nears the
     quarter of the sample the verbatim goal allows; the cap keeps the output of a large sample from
     being a few large copies of it. With a block of 48 or more the min-cut seam rule cuts 24
