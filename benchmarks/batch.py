@@ -21,7 +21,7 @@ one item on its worker (read, run, encode, write: if two workers make it longer 
 compete for cores or memory bandwidth), the CPU time its process used for it (all threads: if that
 grows with two workers, they slow each other down; if only the wall time grows, other programs took
 the cores), and how busy the workers were (the items' times over wall time x workers: below 100 %
-is time the pool left a worker idle). Goals (issue 16):
+is time the pool left a worker idle). Goals:
 2 workers >= 1.7x the items per second of 1, and Dask within 15 % of the local pool of 2.
 """
 

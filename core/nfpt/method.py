@@ -140,7 +140,7 @@ def synthesize(
     Notes
     -----
     Eqs. 1-3 and steps 1-7 of §2; the choices where the paper is silent are listed in
-    :mod:`weft.core.nfpt.synthesis` (luminance P_diff, units and sigmas, |P - M|, the tol rule, the
+    :mod:`weft.core.nfpt.synthesis` (luminance P_diff, units and sigmas, ``|P - M|``, the tol rule, the
     mismatch test, coherent repair candidates).
     """
     params = NfptParams(size=size, block=block, overlap=overlap, sigma_d=sigma_d, sigma_s=sigma_s, tol=tol,
