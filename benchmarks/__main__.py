@@ -14,7 +14,8 @@ from pathlib import Path
 
 from . import fill
 from .cases import CASES, by_name
-from .harness import markdown_table, run_case, write_json
+from .harness import markdown_table, run_case
+from .record import command, write_results
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -22,7 +23,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("cases", nargs="*", metavar="CASE", help="case names (default: all)")
     ap.add_argument("--quick", action="store_true", help="smaller inputs, one timed run: a smoke test")
     ap.add_argument("--repeats", type=int, default=None, help="timed runs per case (default 5, quick 1)")
-    ap.add_argument("--json", type=Path, default=Path("benchmarks/results/latest.json"), help="where to write the rows")
+    ap.add_argument("--json", type=Path, default=None,
+                    help="where to write the results (default benchmarks/results/methods.json)")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
     ap.add_argument("--tools", default=None,
                     help="fill cases: only the tools whose names start with these (comma-separated, e.g. weft,G'MIC)")
@@ -54,7 +56,8 @@ def main(argv: list[str] | None = None) -> int:
             fill_rows += fill.run_fill_case(case, repeats=repeats, quick=args.quick, tools=tools, keep=args.keep)
         else:
             rows.append(run_case(case, repeats=repeats, quick=args.quick))
-    write_json(rows + fill_rows, args.json)
+    written = write_results("methods", rows + fill_rows, command=command("benchmarks", argv), quick=args.quick,
+                            path=args.json, note="compute seconds of one run (inputs decoded), median of the runs")
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
           f", load average {load:.1f}{', quick' if args.quick else ''}")
@@ -62,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
         print(markdown_table(rows))
     if fill_rows:
         print(fill.markdown_table(fill_rows))
-    print(f"(written to {args.json})", file=sys.stderr)
+    print(f"(written to {written})", file=sys.stderr)
     return 0
 
 

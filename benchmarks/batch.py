@@ -21,7 +21,7 @@ one item on its worker (read, run, encode, write: if two workers make it longer 
 compete for cores or memory bandwidth), the CPU time its process used for it (all threads: if that
 grows with two workers, they slow each other down; if only the wall time grows, other programs took
 the cores), and how busy the workers were (the items' times over wall time x workers: below 100 %
-is time the pool left a worker idle). Goals (issue 16):
+is time the pool left a worker idle). Goals:
 2 workers >= 1.7x the items per second of 1, and Dask within 15 % of the local pool of 2.
 """
 
@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--frames", type=int, default=24)
     ap.add_argument("--only", choices=("fast", "quilt"))
     ap.add_argument("--no-dask", action="store_true", help="local pools only")
-    ap.add_argument("--json", type=Path, help="write the rows here")
+    ap.add_argument("--json", type=Path, help="where to write the results (default benchmarks/results/batch.json)")
     args = ap.parse_args(argv)
 
     from weft.core import batch
@@ -178,8 +178,13 @@ def main(argv: list[str] | None = None) -> int:
         if dask:
             line += f"; Dask {dask / two:.2f} of the local pool of 2 (goal >= 0.85)"
         print(line)
-    if args.json:
-        args.json.write_text(json.dumps(rows, indent=1))
+    for r in rows:
+        one = next(x for x in rows if x["recipe"] == r["recipe"] and x["pool"] == "local, 1 worker")
+        r["vs_one_worker"] = round(r["items_per_s"] / one["items_per_s"], 2)
+    from .record import command, write_results
+
+    write_results("batch", rows, command=command("benchmarks.batch", argv), path=args.json,
+                  note=f"{args.frames} frames of 640x480; median of {args.repeats} runs, the pools alternating")
     return 0
 
 

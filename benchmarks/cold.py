@@ -200,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--runs", type=int, default=3, help="cold runs and warm runs per command (default 3)")
     ap.add_argument("--only", nargs="*", metavar="NAME", help="only these commands (names as in the table)")
-    ap.add_argument("--json", type=Path, default=None, help="also write the rows here")
+    ap.add_argument("--json", type=Path, default=None, help="where to write the results (default benchmarks/results/cold.json)")
     ap.add_argument("--python", default=sys.executable,
                     help="the interpreter whose weft is measured (e.g. another checkout's .venv/bin/python)")
     ap.add_argument("--root", type=Path, default=ROOT, help="that checkout's folder (the commands run there)")
@@ -211,9 +211,10 @@ def main(argv: list[str] | None = None) -> int:
     rows = measure(args.only, args.runs, args.python, args.root)
     print(f"{os.cpu_count()} cores, cold = a fresh NUMBA_CACHE_DIR per run, median of {args.runs}")
     print(markdown_table(rows))
-    if args.json is not None:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(rows, indent=1))
+    from .record import command, write_results
+
+    write_results("cold", rows, command=command("benchmarks.cold", argv), path=args.json,
+                  note=f"cold: a fresh NUMBA_CACHE_DIR per run; median of {args.runs} runs")
     return 0
 
 

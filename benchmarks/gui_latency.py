@@ -405,14 +405,33 @@ def main(argv: list[str] | None = None) -> int:
                     "method's own; coffee: a colour photo)")
     args = ap.parse_args(argv)
     if args.variations:
-        print(json.dumps(measure_variations(args.side or 4096, args.runs, args.method or "fill")))
+        kind, row = "variations", measure_variations(args.side or 4096, args.runs, args.method or "fill")
     elif args.open:
-        print(json.dumps(measure_opening(args.side or 4096, args.runs, args.method or "fill")))
+        kind, row = "open", measure_opening(args.side or 4096, args.runs, args.method or "fill")
     elif args.paint:
-        print(json.dumps(measure_painting(args.values or 60, args.hz, args.method, args.side or 512, args.example)))
+        kind, row = "paint", measure_painting(args.values or 60, args.hz, args.method, args.side or 512, args.example)
     else:
-        print(json.dumps(measure(args.values or 30, args.hz)))
+        kind, row = "slider", measure(args.values or 30, args.hz)
+    print(json.dumps(row))
+    record_row(kind, row, argv)
     return 0
+
+
+def record_row(kind: str, row: dict, argv: list[str] | None) -> None:
+    """Put ``row`` in ``benchmarks/results/gui_latency.json`` in place of that file's row of the same
+    kind (slider, paint, open, variations), keeping the others: each kind is its own run."""
+    from .record import RESULTS, command, write_results
+
+    path = RESULTS / "gui_latency.json"
+    try:
+        rows = [r for r in json.loads(path.read_text(encoding="utf-8"))["rows"] if r.get("measure") != kind]
+    except (OSError, ValueError, KeyError, TypeError):
+        rows = []
+    order = ["slider", "paint", "open", "variations"]
+    rows.append({"measure": kind, "command": command("benchmarks.gui_latency", argv), **row})
+    rows.sort(key=lambda r: order.index(r["measure"]) if r.get("measure") in order else len(order))
+    write_results("gui_latency", rows, command="python -m benchmarks.gui_latency [--paint | --open | --variations]",
+                  note="the real main window, offscreen; each row is its own run, with its command")
 
 
 if __name__ == "__main__":

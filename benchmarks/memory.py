@@ -1,4 +1,4 @@
-"""Peak memory of large jobs run through the `weft` command (issue 8: under 2 GiB).
+"""Peak memory of large jobs run through the `weft` command (the goal: under 2 GiB).
 
     python -m benchmarks.memory [--repeat N] [--json FILE]
 
@@ -12,7 +12,6 @@ square in the middle of the 4096² picture for the fill.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
 import subprocess
@@ -70,7 +69,7 @@ def peak_rss(argv: list[str]) -> tuple[int, float, int]:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--json", help="also write the figures to this file")
+    parser.add_argument("--json", help="where to write the results (default benchmarks/results/memory.json)")
     args = parser.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory(prefix="weft-memory-") as tmp:
@@ -78,7 +77,8 @@ def main(argv=None) -> int:
         out = str(Path(tmp) / "out.png")
         print("| job | peak RSS (median) | runs | wall s (median) | under 2 GiB |")
         print("|---|---:|---|---:|---|")
-        for name, cmd in _jobs(files):
+        jobs = _jobs(files)
+        for name, cmd in jobs:
             full = [sys.executable, "-m", "weft.app.cli", *cmd, "-o", out, "-q", "--seed", "1"]
             runs = [peak_rss(full) for _ in range(args.repeat)]
             if any(code for _, _, code in runs):
@@ -89,10 +89,13 @@ def main(argv=None) -> int:
             each = ", ".join(f"{r[0] / 2**20:.0f}" for r in runs)
             print(f"| {name} | {peak / 2**20:.0f} MiB | {each} | {wall:.1f} | {'yes' if peak < LIMIT else 'NO'} |",
                   flush=True)
-            rows.append({"job": name, "peak_bytes": peak, "runs_bytes": [r[0] for r in runs], "seconds": wall})
-    if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=1))
-    return 0 if all(r["peak_bytes"] < LIMIT for r in rows) and len(rows) == 3 else 1
+            rows.append({"job": name, "peak_bytes": peak, "peak_mib": round(peak / 2**20),
+                         "runs_bytes": [r[0] for r in runs], "seconds": wall, "under_2_gib": peak < LIMIT})
+    from .record import command, write_results
+
+    write_results("memory", rows, command=command("benchmarks.memory", argv), path=args.json,
+                  note=f"peak resident set size of the whole weft process, median of {args.repeat} runs")
+    return 0 if all(r["peak_bytes"] < LIMIT for r in rows) and len(rows) == len(jobs) else 1
 
 
 if __name__ == "__main__":

@@ -243,9 +243,12 @@ class BlendParams(Params):
     """Parameters of ``weft blend``."""
 
     mode: str = param("pyramid", choices=("pyramid", "poisson"),
-                      help="pyramid: Laplacian-pyramid blend; poisson: seamless cloning of the masked foreground")
+                      help="how the pictures meet: pyramid = a soft Laplacian-pyramid blend that keeps each "
+                           "picture's colours; poisson = seamless cloning, the foreground takes on the background's"
+                           " colours at its edge")
     levels: int = param(5, lo=1, hi=16, symbol="k",
-                        help="pyramid levels (pyramid mode), at most log2 of the image's smaller side + 1")
+                        help="pyramid levels (pyramid mode): more levels give a wider, softer transition; at most "
+                             "log2 of the image's smaller side + 1")
 
 
 def _run(inputs: Mapping[str, np.ndarray], params: BlendParams, *, rng=None, progress=None, cancel=None) -> Result:

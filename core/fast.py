@@ -55,30 +55,38 @@ class FastParams(Params):
     """Parameters of fast texture transfer (Ashikhmin 2003)."""
 
     mode: str = param("auto", choices=MODES,
-                      help="auto: transfer with a target, superres with --magnify > 1, else synthesis; "
-                           "novel: the picture restyled from itself (Fig. 2)")
+                      help="what is made: transfer = the target rendered in the texture; synthesis = more texture; "
+                           "superres = the picture magnified from itself; novel = the picture restyled from itself "
+                           "(Fig. 2); auto: transfer with a target, superres with --magnify > 1, else synthesis")
     metric: str = param("full", choices=tuple(METRICS),
-                        help="neighbourhood distance: full = eq. 1, target = target part only, "
-                             "artistic = mean + high-pass L2")
-    n: int = param(5, lo=3, hi=15, symbol="n", help="neighbourhood side (odd)")
+                        help="what a candidate must match: full = the result so far and the picture (eq. 1); target"
+                             " = the picture only (most faithful); artistic = tones and strokes, for drawings and "
+                             "paintings")
+    n: int = param(5, lo=3, hi=15, symbol="n", help="side of the neighbourhood compared (odd): small copies fine "
+                                                    "grain, large carries larger structures of the texture")
     p: float = param(None, kind="float", lo=0.0, hi=1.0, optional=True, symbol="p", step=0.01,
-                     help="probability of a random extra candidate; default 0.05 (super-resolution 0)")
+                     help="chance of a random candidate: 0 gives long coherent pieces of the texture, higher values"
+                          " follow the picture in smaller pieces; default 0.05 (super-resolution 0)")
     p_l: float = param(None, kind="float", lo=0.0, hi=1.0, optional=True, symbol="p_l", step=0.01,
-                       help="probability of the location-specific candidate (x/m, y/m); default 0 "
-                            "(super-resolution 0.03)")
+                       help="chance of the candidate at the same place in the picture (x/m, y/m): higher keeps the "
+                            "original layout; default 0 (super-resolution 0.03)")
     magnify: int = param(1, lo=1, hi=16, symbol="m",
-                         help="magnification: target = picture magnified m times (superres, novel); "
-                              "scale of the location-specific candidate")
+                         help="magnification: the result is the picture magnified m times (superres, novel); also "
+                              "the scale of the same-place candidate")
     w: float = param(1.0, lo=0.0, hi=100.0, symbol="w", step=0.1,
-                     help="weight of the neighbourhood-average term of the artistic metric")
+                     help="artistic metric: weight of the tones (neighbourhood averages) against the strokes; "
+                          "higher follows the picture's tones more closely")
     target_weight: float = param(1.0, lo=0.0, hi=100.0, step=0.1,
-                                 help="weight of the target part against the result part (full metric)")
-    iterations: int = param(1, lo=1, hi=20, help="synthesis passes")
-    remap: bool = param(True, help="match against the source luminance remapped to the target's mean and "
-                                   "standard deviation (luminance remapping of Hertzmann et al.); the output "
-                                   "keeps the source's own values")
+                                 help="full metric: weight of matching the picture against matching the result so "
+                                      "far; higher is more faithful, lower more coherent")
+    iterations: int = param(1, lo=1, hi=20, help="synthesis passes: later passes match every pixel again and smooth"
+                                                 " out early mistakes")
+    remap: bool = param(True, help="match against the texture's brightness remapped to the picture's mean and "
+                                   "contrast (Hertzmann et al.), so a dark texture can render a bright picture; the"
+                                   " output keeps the texture's own values")
     colour: str = param("auto", choices=("auto", "target", "source"),
-                        help="target: keep the target's chroma (YIQ); source: copy the source pixels' colour")
+                        help="colour of the result: target keeps the picture's colours (YIQ chroma); source copies "
+                             "the texture's colours")
     size: tuple = param(None, kind="size", lo=8, hi=16384, optional=True,
                         help="output size WIDTHxHEIGHT for synthesis; default twice the texture")
 

@@ -24,7 +24,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "docs"))
+sys.path.insert(0, str(ROOT / "docs" / "gallery"))
 
 from benchmarks import fill as bench  # noqa: E402
 from panels import grid, label, rgb  # noqa: E402

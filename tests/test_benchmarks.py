@@ -45,8 +45,10 @@ def test_command_line_writes_json(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr("shutil.which", lambda name: None)
     out = tmp_path / "rows.json"
     assert bench_main(["--quick", "--json", str(out), CASES[0].name]) == 0
-    rows = json.loads(out.read_text())
-    assert rows[0]["case"] == CASES[0].name
+    written = json.loads(out.read_text())
+    assert written["suite"] == "methods" and written["machine"]["cores"] >= 1 and written["quick"] is True
+    assert written["command"].startswith("python -m benchmarks --quick")
+    assert written["rows"][0]["case"] == CASES[0].name
     assert CASES[0].name in capsys.readouterr().out
     assert bench_main(["no-such-case"]) == 2
 

@@ -1,6 +1,6 @@
 """Benchmark cases of image quilting (``weft.core.quilting``).
 
-The ``quilt-t1-*`` and ``quilt-t2-*`` cases use the peers' own inputs (issue 17), rebuilt from
+The ``quilt-t1-*`` and ``quilt-t2-*`` cases use the peers' own inputs, rebuilt from
 scikit-image's data: ``brick_128`` = ``brick()[0:256, 256:512]`` box-downscaled 2x, ``gravel_128``
 = ``gravel()[0:256, 0:256]`` box-downscaled 2x, ``camera_256`` = ``camera()`` box-downscaled 2x.
 T1 is a 512x512 synthesis from brick_128 with the defaults, measured over seeds 0-9; T2 renders

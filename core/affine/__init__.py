@@ -12,7 +12,7 @@ per section of the paper:
 §2.4 best transform         :func:`analyse` (:mod:`weft.core.affine.analysis`)
 §3.1 cos² windows           :func:`cos2_window`
 §3.2 intensity factors      :func:`analyse`
-§3 synthesis               :func:`render` (:mod:`weft.core.affine.synthesis`), :class:`Grid`
+§3 synthesis                :func:`render` (:mod:`weft.core.affine.synthesis`), :class:`Grid`
 §3.3 lowpass (add/absorb)   :func:`lowpass`, :func:`decompose` (:mod:`weft.core.affine.model`)
 §3.4 colour (YUV/PCA)       :func:`decompose`, :func:`make_prototype`
 §4 transfer                 ``analyse(prototype_image=...)``; :func:`render` with another prototype

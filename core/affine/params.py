@@ -71,41 +71,53 @@ class AffineParams(Params):
     """Parameters of the affine prototype model (Smith & Bhalerao)."""
 
     prototype: Square = param(None, kind="geometry", type=Square, optional=True,
-                           help="prototype square X,Y,S (top-left corner and side, pixels) in the "
-                                "prototype image or the texture; default a 2B square in the middle")
-    block: int = param(32, lo=8, hi=256, symbol="B", help="target patch side (even); patches overlap by B/2")
-    segments: int = param(32, lo=4, hi=128, symbol="N", help="angular segments of the spectrum (even)")
+                           help="the patch every part of the result is drawn from: square X,Y,S (top-left corner "
+                                "and side, pixels) in the prototype image or the texture; a patch holding one clear"
+                                " element works best; default a 2B square in the middle")
+    block: int = param(32, lo=8, hi=256, symbol="B", help="side of the patches (even), overlapping by half: smaller"
+                                                          " follows the texture more closely and costs more time, "
+                                                          "larger smooths it")
+    segments: int = param(32, lo=4, hi=128, symbol="N", help="angular segments of each patch's spectrum, used to "
+                                                             "find its orientation (even): more finds finer angles "
+                                                             "and costs time")
     lowpass: str = param("add", choices=LOWPASS,
-                         help="add: synthesize the highpass and add the image's subsampled lowpass "
-                              "(and chroma) back; absorb: unfiltered (colour) prototype, the lowpass "
-                              "goes into the intensity factors (§3.3, §3.4)")
+                         help="add: draw only the detail and keep the picture's own shading and colour (its "
+                              "subsampled lowpass); absorb: draw everything from the unfiltered (colour) prototype "
+                              "(§3.3, §3.4)")
     colour: str = param("pca", choices=COLOURS,
-                        help="grey channel the transforms are estimated on: pca = the principal "
-                             "component of the colours, yuv = luma Y (§3.4)")
+                        help="the grey the transforms are found on: pca = the main direction of the colours "
+                             "(follows a colour texture), yuv = luma Y (§3.4)")
     propagate: bool = param(True,
-                            help="also try the neighbouring patches' transforms (top-down, then bottom-up), "
-                                 "as §6 suggests; off = the paper's eight candidates only")
+                            help="also try the neighbouring patches' transforms (top-down, then bottom-up), which "
+                                 "keeps neighbours consistent; off = the paper's eight candidates only")
     refine: int = param(2, lo=0, hi=20,
-                        help="Levenberg-Marquardt steps refining each chosen transform and its translation "
-                             "to sub-pixel (0 = the paper's pipeline)")
+                        help="Levenberg-Marquardt steps polishing each patch's transform and position to sub-pixel:"
+                             " a truer reproduction (0 = the paper's pipeline)")
     reuse_transforms: bool = param(False,
-                                   help="compute the transforms with --analysis-prototype of the texture and "
-                                        "re-render them with --prototype (a prototype swap, §4)")
+                                   help="keep the transforms found for --analysis-prototype of the texture and draw"
+                                        " them with --prototype (a prototype swap, §4): the layout stays, the look "
+                                        "changes")
     analysis_prototype: Square = param(None, kind="geometry", type=Square, optional=True,
                                     help="with --reuse-transforms: the texture square X,Y,S the transforms are "
                                          "computed for; default the default prototype")
     boundary: str = param("auto", choices=BOUNDARIES,
-                          help="patch boundary matching (§4): none = translations from the target "
-                               "(§2.3); partial = raster partial correlation; shaker = shaker box; "
-                               "auto = shaker with a field, else none")
-    iterations: int = param(20, lo=1, hi=500, help="shaker box: most iterations")
+                          help="how neighbouring patches are lined up (§4): none = where the analysis put them "
+                               "(§2.3); partial = one pass in raster order; shaker = the shaker box moves each "
+                               "patch until it agrees with all its neighbours (fewest doubled edges); auto = shaker"
+                               " with a field, else none")
+    iterations: int = param(20, lo=1, hi=500, help="shaker box: most passes over the patches; more can remove more "
+                                                   "doubled edges")
     per_radius: int = param(5, lo=1, hi=100,
-                            help="shaker box: iterations per search radius (B/4 down by one after each run)")
+                            help="shaker box: passes at each search radius (B/4, then down by one after each run); "
+                                 "more settles each radius before it narrows")
     shaker_start: str = param("partial", choices=SHAKER_STARTS,
-                              help="shaker box: start from partial-correlation translations or the analysis ones")
+                              help="shaker box: start from the partial-correlation positions or from the analysis "
+                                   "ones")
     field: str = param("none", choices=FIELDS,
-                       help="synthesize from a parametric transform field instead of the texture (Fig. 6)")
-    field_strength: float = param(1.0, lo=0.0, hi=2.0, step=0.05, help="amount of rotation / zoom of the field")
+                       help="make a new texture from a transform field (swirl, zoom, rotate) instead of the "
+                            "texture's own transforms (Fig. 6)")
+    field_strength: float = param(1.0, lo=0.0, hi=2.0, step=0.05, help="how strongly the field turns or zooms the "
+                                                                       "prototype")
     size: tuple = param(None, kind="size", lo=16, hi=8192, optional=True,
                         help="output size WIDTHxHEIGHT with a field; default the texture's")
 

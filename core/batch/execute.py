@@ -298,7 +298,7 @@ def default_workers() -> int:
 def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None,
         progress: Callable[[BatchProgress], None] | None = None,
         on_outcome: Callable[[Outcome], None] | None = None, cancel=None, pool=None) -> Summary:
-    """Run a planned batch; returns its :class:`Summary` once every item is done (or ``cancel``led).
+    """Run a planned batch; returns its :class:`Summary` once every item is done (or cancelled).
 
     Parameters
     ----------

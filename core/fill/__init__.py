@@ -1,4 +1,4 @@
-"""Fill and extend: heal a painted region, remove an object, uncrop (issue 15).
+"""Fill and extend: heal a painted region, remove an object, uncrop.
 
 ``weft fill IMAGE --mask MASK -o OUT`` fills the white region of the mask from the rest of the image
 (or only from ``--source-mask``'s white region, or from a second image ``--texture``);
@@ -26,7 +26,7 @@ hole; the method then runs no Poisson blend for them.
 **The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE`, ``auto``
 (:func:`~weft.core.fill.params.auto_engine`): ``patchmatch`` for a hole inside a colour picture,
 with the edge guide of :mod:`weft.core.fill.structure` (``structure`` ``auto``), ``quilt``
-otherwise; the figures name the engine that ran. Measured on issue 15's cases (seeds 0-4 medians,
+otherwise; the figures name the engine that ran. Measured on the fill benchmark's cases (seeds 0-4 medians,
 ``python -m benchmarks.fill --seeds 0-4``; coherence / detail / seam against the truth's): on the
 photo ``patchmatch`` is the most coherent of weft's engines (without the guide 4.45 / 1.02 / -0.04
 against ``quilt``'s 5.40 / 1.08 / +0.01); with the guide, which continues the saucer's rim where

@@ -63,8 +63,8 @@ class FillParams(Params):
                         help="uncrop to this canvas size (at least the image's), the image placed by --anchor")
     anchor: str = param("center", choices=ANCHORS, help="where the image sits on a --size canvas")
     band: int = param(2, lo=0, hi=32,
-                      help="blend band: known pixels up to this many px from the hole may change (Poisson "
-                           "seam band); 0 = they never change")
+                      help="how far around the hole, in pixels, known pixels may change so the fill meets them "
+                           "without a visible step (a Poisson band); 0 = they never change")
     structure: str = param("auto", choices=STRUCTURE,
                            help="continue the strong edges that cross the hole (a rim, a horizon) along smooth "
                                 "curves, where patches alone run them on straight or drip; auto: whenever the "
@@ -118,7 +118,7 @@ def structure_value(value):
 def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto") -> str:
     """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (its guide is that engine's), and
     for a hole inside a colour picture (removing an
-    object from a photo: coherence 4.45 against quilt's 5.40 on issue 15's photo, seeds 0-4), unless
+    object from a photo: coherence 4.45 against quilt's 5.40 on the fill benchmark's photo, seeds 0-4), unless
     the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.24,
     brick 1.05 against 1.35) and for holes along the canvas border, an uncrop's (0.81 against 0.85,
     seeds 0-4 medians, in a quarter of the time: 0.27 against 1.01 s in the benchmark's run)."""

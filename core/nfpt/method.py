@@ -31,26 +31,35 @@ class NfptParams(WarpParams):
 
     size: tuple = param(None, kind="size", lo=8, hi=16384, optional=True,
                         help="size WIDTHxHEIGHT of the synthesized frontal texture; default twice the rectified one")
-    block: int = param(DEFAULT_BLOCK, lo=8, hi=512, symbol="B", help="side of the square patches in pixels")
+    block: int = param(DEFAULT_BLOCK, lo=8, hi=512, symbol="B", help="side of the square patches copied: larger "
+                                                                     "keeps larger texture elements (whole bricks) "
+                                                                     "whole, smaller mixes them more")
     overlap: int = param(DEFAULT_OVERLAP, lo=2, hi=256,
-                         help="width of the L-shaped neighbourhood (overlap with the placed patches), at most block/2")
+                         help="how much each patch overlaps those already placed (the L-shaped neighbourhood): more"
+                              " matches and hides seams better; at most block/2")
     sigma_d: float = param(None, kind="float", lo=0.1, hi=256.0, optional=True, symbol="σ_d", step=0.1,
-                           help="eq. 1: spread in pixels of the weight of distance to the patch boundary "
-                                "(default overlap / 2)")
+                           help="eq. 1: how far from the patch's edge, in pixels, the match still weighs pixels "
+                                "fully; small = only the edge counts (default overlap / 2)")
     sigma_s: float = param(0.35, lo=0.01, hi=10.0, symbol="σ_s", step=0.01,
-                           help="eq. 2: spread (intensity 0..1) of the weight of difference to the dominant colour")
-    tol: int = param(2, lo=1, hi=64, help="pick at random among the tol best-matching patches (1 = always the best)")
-    repair: bool = param(True, help="steps 4-7: re-synthesize mismatched pixels around the cuts pixel by pixel")
-    band: int = param(2, lo=1, hi=16, help="repair band: pixels on each side of the minimum-error cut")
+                           help="eq. 2: how much the match favours feature pixels, those unlike the patch's "
+                                "dominant colour (mortar, cracks); smaller weighs features more (intensity 0..1)")
+    tol: int = param(2, lo=1, hi=64, help="variety: pick at random among the tol best-matching patches (1 = always "
+                                          "the best)")
+    repair: bool = param(True, help="steps 4-7: re-make, pixel by pixel, the pixels along each seam where the two "
+                                    "patches disagree, so broken lines join")
+    band: int = param(2, lo=1, hi=16, help="repair band: how many pixels on each side of a seam may be re-made")
     threshold: float = param(0.1, lo=0.0, hi=1.0, step=0.01,
-                             help="a pixel of the band is mismatched when the two patches differ there by more "
-                                  "than this (RMS over channels, intensity 0..1)")
-    n: int = param(5, lo=3, hi=15, help="neighbourhood side for re-synthesizing a pixel (odd)")
-    smooth: bool = param(False, help="step 7: Gaussian-filter the re-synthesized pixels")
+                             help="repair: how different the two patches must be at a pixel (RMS over channels, "
+                                  "intensity 0..1) for it to be re-made; lower repairs more")
+    n: int = param(5, lo=3, hi=15, help="repair: side of the neighbourhood matched when a pixel is re-made (odd); "
+                                        "larger follows larger structures")
+    smooth: bool = param(False, help="step 7: blur the re-made pixels slightly (Gaussian) to hide what the repair "
+                                     "leaves")
     view: View = param(None, kind="geometry", type=View, optional=True,
                        help="put the result into this view: a JSON file (or the JSON text, starting with {), {\"quad\": [[x, y] x 4], \"size\": "
                            "[w, h]} or view image_lines + texture frontal_lines; texture pixel coordinates")
-    into_photo: bool = param(False, help="replace the textured plane in the photo with the larger synthesized one")
+    into_photo: bool = param(False, help="put the larger synthesized texture back into the photo in place of the "
+                                         "textured plane (a bigger wall)")
 
     def check(self) -> None:
         if self.overlap * 2 > self.block:
@@ -132,7 +141,7 @@ def synthesize(
     Notes
     -----
     Eqs. 1-3 and steps 1-7 of §2; the choices where the paper is silent are listed in
-    :mod:`weft.core.nfpt.synthesis` (luminance P_diff, units and sigmas, |P - M|, the tol rule, the
+    :mod:`weft.core.nfpt.synthesis` (luminance P_diff, units and sigmas, ``|P - M|``, the tol rule, the
     mismatch test, coherent repair candidates).
     """
     params = NfptParams(size=size, block=block, overlap=overlap, sigma_d=sigma_d, sigma_s=sigma_s, tol=tol,

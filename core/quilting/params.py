@@ -38,7 +38,7 @@ class QuiltParams(Params):
     relevant structures in the texture, but small enough so that the interaction between these
     structures is left up to the algorithm" (E&F §2.1). A sample is usually cropped around a few of
     its elements, so the default scales with it: 7/16 of the side holds the whole bricks of the
-    peers' brick_128 sample (issue 17's T1: coherence 0.0358 → 0.0266 over seeds 0–9 against a fixed
+    peers' brick_128 sample (the quilting benchmark's T1: coherence 0.0358 → 0.0266 over seeds 0–9 against a fixed
     32) while one block stays under a fifth of the sample's area, so no verbatim region nears the
     quarter of the sample the verbatim goal allows; the cap keeps the output of a large sample from
     being a few large copies of it. With a block of 48 or more the min-cut seam rule cuts 24
@@ -49,40 +49,50 @@ class QuiltParams(Params):
     """
 
     mode: str = param("mincut", choices=MODES,
-                      help="random: blocks side by side; overlap: blocks matched on their overlap; "
-                           "mincut: plus the least-error cut")
+                      help="how blocks join: random = side by side (seams show); overlap = matched where they "
+                           "overlap; mincut = also cut along the least visible path (smoothest)")
     block: int = param(None, kind="int", lo=2, hi=1024, optional=True, symbol="B",
-                       help="side of the square blocks in pixels (default 7/16 of the texture's shorter side, "
-                            "at most 56; transfer 9, iterative 31)")
+                       help="size of the pieces copied from the sample: larger keeps whole structures (a brick with"
+                            " its joints) but repeats more of the sample, smaller breaks them up (default 7/16 of "
+                            "the texture's shorter side, at most 56; transfer 9, iterative 31)")
     overlap: int = param(None, kind="int", lo=1, hi=1023, optional=True,
-                         help="overlap between neighbouring blocks in pixels, smaller than block "
-                              "(default block/6 rounded up; transfer block/3, iterative 2*block/3)")
+                         help="how much neighbouring blocks share, the seam is cut inside it: more hides seams "
+                              "better and costs time; smaller than block (default block/6 rounded up; transfer "
+                              "block/3, iterative 2*block/3)")
     size: tuple = param(
         None, kind="size", lo=1, hi=16384, optional=True,
         help="output size WIDTHxHEIGHT; default twice the texture's size (transfer: the target's)",
     )
     tol: int = param(None, kind="int", lo=1, hi=100000, optional=True,
-                     help="rule tol: pick at random among the tol best positions (default 2, 6 from block 48; "
-                          "transfer 1); "
-                          "min-cut synthesis: of the 4 x tol best, the one with the least error along its cut")
+                     help="variety: each block is drawn at random from the tol best matches; 1 always takes the "
+                          "best (seamless, but a spot may repeat), more varies the result with rougher seams "
+                          "(default 2, 6 from block 48; transfer 1); min-cut synthesis keeps, of the 4 x tol best, "
+                          "the one with the least visible cut")
     rule: str = param("tol", choices=RULES,
-                      help="how a position is picked: tol best; epsilon: within (1+epsilon) x the best; "
-                           "sampled: best 10% of a random 10%")
+                      help="how a block is picked among the matches: tol = among the tol best; epsilon = any within"
+                           " (1+epsilon) x the best error; sampled = the best 10% of a random 10% (quicker, "
+                           "rougher)")
     epsilon: float = param(0.1, lo=0.0, hi=10.0, symbol="ε", step=0.01,
-                           help="rule epsilon: candidates within (1+epsilon) times the least error")
-    tile: bool = param(False, help="make the output tileable: it wraps seamlessly left-right and top-bottom")
-    poisson: bool = param(False, help="Poisson-blend a band around every seam (modes overlap, mincut)")
-    band: int = param(4, lo=1, hi=5, help="width in pixels of the Poisson band around each seam")
+                           help="rule epsilon: how much worse than the best match a block may be; larger gives more"
+                                " variety and more visible seams")
+    tile: bool = param(False, help="make the output a tile: it repeats without a seam left-right and top-bottom")
+    poisson: bool = param(False, help="smooth away colour steps across every seam by a Poisson blend of a band "
+                                      "around it (modes overlap, mincut)")
+    band: int = param(4, lo=1, hi=5, help="width in pixels of the smoothed band around each seam (with poisson): "
+                                          "wider hides larger colour steps")
     iterations: int = param(1, lo=1, hi=10, symbol="N",
-                            help="transfer passes; block and overlap shrink by a third per pass")
+                            help="transfer passes: each pass uses blocks a third smaller and follows the picture's "
+                                 "detail more closely")
     alpha: float = param(0.1, lo=0.0, hi=1.0, symbol="α", step=0.05,
-                         help="transfer: weight of the overlap error against the correspondence error "
-                              "(first pass; later passes go linearly to 0.9)")
+                         help="transfer: texture against picture; near 0 the result follows the picture faithfully,"
+                              " near 1 it stays a clean texture (first pass; later passes go linearly to 0.9)")
     correspondence: str = param("blur", choices=CORRESPONDENCES,
-                                help="transfer correspondence map: blurred luminance or raw luminance "
-                                     "(ignored when --source-map and --target-map are given)")
-    remap: bool = param(True, help="transfer: give the target's correspondence map the texture's mean and "
-                                   "deviation first, so dark and bright areas do not repeat the texture's extremes")
+                                help="transfer: what the picture is matched on: blurred luminance (broad shapes) or"
+                                     " raw luminance (fine detail); ignored when --source-map and --target-map are "
+                                     "given")
+    remap: bool = param(True, help="transfer: give the target's correspondence map the texture's brightness and "
+                                   "contrast first, so dark and bright areas are not all drawn from the texture's "
+                                   "few extreme spots")
 
     def check(self) -> None:
         if self.block is not None and self.overlap is not None and self.overlap >= self.block:

@@ -25,20 +25,24 @@ class WarpParams(Params):
     """The rectification parameters, shared by ``weft rectify`` and ``weft nfpt`` (which add theirs)."""
 
     lines: FeatureLines = param(None, kind="geometry", type=FeatureLines, optional=True,
-                                help="feature lines: a JSON file {image_lines, frontal_lines, frontal_size} "
-                                     "(DESIGN.md), or that JSON text itself, starting with { (nfpt without "
-                                     "lines: the photo is frontal)")
+                                help="the lines drawn on the photo and where each lies seen from the front: a JSON "
+                                     "file {image_lines, frontal_lines, frontal_size}, or that JSON text itself, "
+                                     "starting with { (nfpt without lines takes the photo as frontal)")
     warp: str = param("homography", choices=WARPS,
-                      help="homography: exact for a plane (least squares + robust refinement); morph: the paper's "
-                           "view morph (fundamental matrix, needs points off one plane); lines: Beier-Neely field "
-                           "morph, for gently curved surfaces")
+                      help="how the photo is straightened: homography = exact for a flat surface, outvotes a badly "
+                           "drawn line; morph = the paper's view morph, for surfaces that are not one plane (needs "
+                           "8 points off one plane); lines = Beier-Neely field morph, bends between the lines, for "
+                           "gently curved surfaces")
     a: float = param(1.0, lo=0.001, hi=1000.0, symbol="a", step=0.1,
-                     help="Beier-Neely: distance offset in pixels of the weight (length^p / (a + dist))^b "
-                          "(morph, lines)")
+                     help="Beier-Neely (morph, lines): distance in pixels within which a line pulls at full "
+                          "strength (weight (length^p / (a + dist))^b); small values make the warp snap to the "
+                          "lines, large ones smooth it")
     b: float = param(2.0, lo=0.0, hi=4.0, symbol="b", step=0.1,
-                     help="Beier-Neely: how fast a line's influence falls off with distance (morph, lines)")
+                     help="Beier-Neely (morph, lines): how fast a line's pull falls off with distance; higher keeps"
+                          " each line's effect local")
     p: float = param(0.5, lo=0.0, hi=2.0, symbol="p", step=0.1,
-                     help="Beier-Neely: how much longer lines weigh more (0 = all equal) (morph, lines)")
+                     help="Beier-Neely (morph, lines): how much more long lines pull than short ones (0 = all "
+                          "equal)")
 
 
 @dataclass(frozen=True)
@@ -49,7 +53,8 @@ class RectifyParams(WarpParams):
                         help="size WIDTHxHEIGHT of the rectified image; default the lines' frontal_size "
                              "(frontal coordinates are scaled to it)")
     interpolation: str = param("cubic", choices=INTERPOLATIONS,
-                               help="resampling of the photo: cubic (sharp), linear (fast), lanczos (sharpest)")
+                               help="resampling of the photo: cubic (sharp), linear (quick, softer), lanczos "
+                                    "(sharpest, may ring at hard edges)")
 
 
 @dataclass(frozen=True)

@@ -1,19 +1,11 @@
-"""Render the affine-model gallery of the README: ``.venv/bin/python docs/gallery_affine.py``.
-
-* ``affine-synthesis.jpg``: originals (procedural scales and basket weave, brick) and their
-  synthesis by the paper's pipeline (eight candidates) and by weft's default (with the
-  neighbours' transforms and refinement), with the SNR of each (Fig. 4b);
-* ``affine-boundary.jpg``: the same transforms with the analysis translations, new translations
-  by partial correlation, and by the shaker box, with the total boundary error (Fig. 4b-d);
-* ``affine-transfer.jpg``: a colour "snakeskin" prototype swapped into the scales' transforms
-  (Fig. 5 top), the same prototype with recomputed transforms, and the scales (and a basket
-  weave) transferred onto a photo keeping its lowpass and colour, without and with the shaker
-  box (Fig. 5 middle and bottom);
-* ``affine-fields.jpg``: textures synthesized from parametric transform fields with the shaker
-  box providing the translations (Fig. 6).
-
-Every panel is computed here by ``weft.core.affine`` with fixed seeds; labels are drawn with OpenCV.
 """
+Affine prototype model: synthesis, boundaries, transfer, fields
+===============================================================
+
+Smith & Bhalerao model a texture as one prototype patch and an affine transform per patch.
+Every panel is computed by ``weft.core.affine`` with fixed seeds.
+"""
+
 
 from __future__ import annotations
 
@@ -23,17 +15,15 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from weft.core.affine import (analyse, field_model, make_prototype, match_boundaries,  # noqa: E402
+from weft.core.affine import (analyse, field_model, make_prototype, match_boundaries,
                          render, synthesize)
-from benchmarks.fixtures.procedural import cells, weave  # noqa: E402
-from panels import grid, label  # noqa: E402 (docs/panels.py)
-from weft.core.examples import example  # noqa: E402
-from weft.core.image import load_image, save_image  # noqa: E402
-from weft.core.metrics import snr_db  # noqa: E402
+from benchmarks.fixtures.procedural import cells, weave
+from panels import grid, label  # docs/gallery/panels.py
+from weft.core.examples import example
+from weft.core.image import load_image, save_image
+from weft.core.metrics import snr_db
 
-OUT = Path(__file__).resolve().parent / "images"
 
 
 def _textures() -> list[tuple[str, np.ndarray]]:
@@ -121,14 +111,39 @@ def fields() -> np.ndarray:
     return grid(panels, 3)
 
 
-def main() -> int:
-    OUT.mkdir(parents=True, exist_ok=True)
-    for name, fn in (("synthesis", synthesis), ("boundary", boundary), ("transfer", transfer), ("fields", fields)):
-        path = OUT / f"affine-{name}.jpg"
-        save_image(path, fn())
-        print(path)
-    return 0
+# %%
+# Synthesis
+# ---------
+# Procedural scales, a basket weave and brick, synthesized by the paper's pipeline (eight
+# candidates) and by weft's default (with the neighbours' transforms and refinement), with the SNR
+# of each against the original (Fig. 4b).
+
+save_image("affine-synthesis.jpg", synthesis())
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+# %%
+# Boundary matching
+# -----------------
+# The same transforms with the analysis translations, new translations by partial correlation,
+# and by the shaker box, with the total boundary error (Fig. 4b-d).
+
+save_image("affine-boundary.jpg", boundary())
+
+
+# %%
+# Transfer by swapping the prototype
+# ----------------------------------
+# A colour prototype swapped into the scales' transforms (Fig. 5 top), the same prototype with
+# recomputed transforms, and textures transferred onto a photo that keeps its lowpass and colour,
+# without and with the shaker box (Fig. 5 middle and bottom).
+
+save_image("affine-transfer.jpg", transfer())
+
+
+# %%
+# Transform fields
+# ----------------
+# Textures synthesized from parametric transform fields (swirl, zoom, rotate), the shaker box
+# providing the translations (Fig. 6).
+
+save_image("affine-fields.jpg", fields())
