@@ -30,8 +30,6 @@ METRIC_FULL = 0  # the codes of weft.core.fast.METRICS
 METRIC_TARGET = 1
 METRIC_ARTISTIC = 2
 
-_MAX_CANDIDATES = 64
-
 
 @njit(cache=True, nogil=True, inline="always")
 def _next(state):
@@ -91,7 +89,8 @@ def coherent_rows(src, src_mean, tgt, tgt_mean, res, pos, allowed, mask, res_off
     use_res = metric != METRIC_TARGET
     use_tgt = has_target and metric != METRIC_ARTISTIC and (metric == METRIC_TARGET or target_weight > 0.0)
     t_w = 1.0 if metric == METRIC_TARGET else target_weight
-    cand = np.empty(_MAX_CANDIDATES, np.int64)
+    # one candidate per causal neighbour, plus the random and the location-specific one
+    cand = np.empty(n_res + 2, np.int64)
     lo_y, hi_y, lo_x, hi_x = h, Hs - h - 1, h, Ws - h - 1
     for y in range(y0, y1):
         for x in range(W):

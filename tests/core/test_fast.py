@@ -218,3 +218,28 @@ def test_metric_codes_match_the_kernel():
     from weft.core.fast import METRICS
 
     assert METRICS == {"full": kernel.METRIC_FULL, "target": kernel.METRIC_TARGET, "artistic": kernel.METRIC_ARTISTIC}
+
+
+@pytest.mark.slow
+def test_the_largest_neighbourhoods_stay_inside_the_kernels_buffers(tmp_path):
+    """n = 13 and 15 (the top of the slider) in every metric, with numba's bounds checks on: an index
+    past a buffer raises instead of silently corrupting memory."""
+    import os
+    import subprocess
+    import sys
+
+    script = (
+        "import numpy as np\n"
+        "from weft.core.examples import example\n"
+        "from weft.core.fast import transfer\n"
+        "from weft.core.image import load_image, resize\n"
+        "src = load_image(example('gravel')).image[:96, :96]\n"
+        "tgt = resize(load_image(example('camera')).image, (64, 64), interpolation='area')\n"
+        "for n in (13, 15):\n"
+        "    for metric in ('full', 'target', 'artistic'):\n"
+        "        out = transfer(src, tgt, n=n, metric=metric, p=0.1, rng=3)\n"
+        "        assert out.shape == tgt.shape and set(np.unique(out)) <= set(np.unique(src)), (n, metric)\n"
+        "print('ok')\n")
+    env = {**os.environ, "NUMBA_BOUNDSCHECK": "1", "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]
