@@ -208,23 +208,38 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
 
 def _check_output(output: str, inputs: Sequence[str]) -> Path:
+    """Everything about ``-o`` that can be checked before the work: its format, its folder, and that
+    it is none of the files the run reads (compared by device and inode: another path to an input,
+    through a link or a second mount of its folder, is the input)."""
+    from weft.core.readfile import file_key, kind_of, shown
+
     out = Path(output)
+    name = shown(output)
     if out.suffix.lower() not in SAVE_EXTENSIONS:
-        raise WeftError(f"{output}: cannot save this format (use {', '.join(SAVE_EXTENSIONS)})")
-    if out.is_dir():
-        raise WeftError(f"{output}: is a directory")
+        raise WeftError(f"{name}: cannot save this format (use {', '.join(SAVE_EXTENSIONS)})")
+    try:
+        kind = kind_of(os.stat(out).st_mode)
+    except FileNotFoundError:
+        kind = None
+    except OSError as e:  # a symbolic link loop, a folder in the path that is a file, no permission
+        raise WeftError(f"{name}: cannot write there ({e.strerror or e})") from None
+    if kind == "a directory":
+        raise WeftError(f"{name}: is a directory")
+    if kind is not None:
+        raise WeftError(f"{name}: is {kind}, not an image file; not replaced")
     parent = out.parent if str(out.parent) else Path(".")
     if not parent.is_dir():
-        raise WeftError(f"{output}: folder {parent} does not exist")
-    real_out = os.path.realpath(out)
+        raise WeftError(f"{name}: folder {shown(parent)} does not exist")
+    key = file_key(out)
     for src in inputs:
-        if os.path.realpath(src) == real_out:
-            raise WeftError(f"{output}: refusing to overwrite the input file {src}")
+        if file_key(src) == key:
+            raise WeftError(f"{name}: refusing to overwrite the input file {shown(src)}")
     return out
 
 
 def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
-             args: argparse.Namespace, region: tuple[int, int, int] | None = None) -> int:
+             args: argparse.Namespace, region: tuple[int, int, int] | None = None,
+             read_too: Sequence[str] = ()) -> int:
     from weft.core import registry
     from weft.core.image import save_image
     from weft.core.run import output_recipe, render
@@ -233,7 +248,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     # typed parameters (a method's own command line) or their JSON form (a recipe's, read at its edge)
     params = params_dict if isinstance(params_dict, Params) else method.params.from_dict(params_dict)
     bit_depth = _parse_bit_depth(args) if args.bit_depth is not None else None  # None: see below
-    out = _check_output(args.output, list(input_paths.values()))
+    out = _check_output(args.output, [*input_paths.values(), *read_too])  # read_too: the recipe file
     if bit_depth == 16 and out.suffix.lower() in (".jpg", ".jpeg"):
         raise WeftError(f"{args.output}: JPEG cannot hold 16 bits per channel (use .png or .tif)")
     if seed is None:
@@ -337,7 +352,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         else:
             seed = recipe.seed
         region = Square.parse(args.region) if args.region is not None else recipe.region
-        return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region)
+        return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region, read_too=[args.recipe])
 
     method = registry.get(args.method)
 
@@ -401,7 +416,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise UsageError("weft: no command given (see 'weft --help')")
         return _dispatch(args)
     except WeftError as e:
-        print(f"weft: {e}".replace("weft: weft", "weft"), file=sys.stderr)
+        from weft.core.readfile import one_line
+
+        print(one_line(f"weft: {e}".replace("weft: weft", "weft")), file=sys.stderr)
         return 2
     except MemoryError:
         print("weft: out of memory (try a smaller size or a smaller input)", file=sys.stderr)
@@ -412,7 +429,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as e:  # a bug in weft, not bad input: still one line unless asked for more
         if os.environ.get("WEFT_DEBUG"):
             raise
-        print(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)", file=sys.stderr)
+        from weft.core.readfile import one_line
+
+        print(one_line(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)"),
+              file=sys.stderr)
         return 1
 
 

@@ -28,6 +28,7 @@ import numpy as np
 
 from .errors import GeometryError, InvalidParameter
 from .jsonio import MAX_FILE_BYTES
+from .readfile import read_regular, shown
 
 MAX_SIDE = 16384
 
@@ -189,16 +190,15 @@ def read_json_or_file(text_or_path: str | os.PathLike, what: str) -> tuple[Any, 
     if text.lstrip().startswith("{"):
         source, raw = f"{what} (inline JSON)", text
     else:
-        source = text if text.isprintable() else repr(text)
+        source = shown(text)
         try:
-            if os.path.getsize(text) > MAX_FILE_BYTES:
-                raise GeometryError(f"{source}: too large for a {what} file (the limit is "
-                                    f"{MAX_FILE_BYTES // 2**20} MB); not read")
-            raw = Path(text).read_text(encoding="utf-8-sig")
+            raw = read_regular(text, MAX_FILE_BYTES, f"{what} file", error=GeometryError).decode("utf-8-sig")
         except FileNotFoundError:
             raise GeometryError(f"{source}: no such {what} file") from None
         except IsADirectoryError:
             raise GeometryError(f"{source}: is a directory, not a {what} file") from None
+        except GeometryError:
+            raise
         except (OSError, UnicodeDecodeError, ValueError) as e:
             raise GeometryError(f"{source}: cannot read {what} ({getattr(e, 'strerror', None) or e})") from None
     try:  # NaN is let through here: the line checks then say which line has it

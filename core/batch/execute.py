@@ -413,12 +413,14 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
 
 def _ship(item: Item) -> Item:
     """The item with its input files' bytes attached (read here, on the client)."""
+    from ..errors import ImageError
     from ..image.files import _os_error
+    from ..readfile import open_regular
 
     shipped = {}
     for name, path in item.inputs.items():
         try:
-            with open(path, "rb") as f:
+            with open_regular(path, "image file", error=ImageError) as f:
                 shipped[name] = f.read()
         except OSError as e:
             raise _os_error(path, e) from None
