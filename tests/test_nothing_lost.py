@@ -154,3 +154,38 @@ def test_a_rerun_redoes_an_output_cut_short_or_damaged(tmp_path, capsys):
     code, out, err = _run(argv, capsys)
     assert code == 0 and err == "2 written, 1 already done\n"
     assert [p.read_bytes() for p in outs] == whole
+
+
+def _bomb_png(path: Path, width: int, height: int) -> None:
+    """A small PNG whose header claims ``width`` x ``height`` pixels (a decompression bomb's header)."""
+    import struct
+    import zlib
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64))
+                     + chunk(b"IEND", b""))
+
+
+def test_one_bomb_frame_fails_alone_and_the_rest_are_written(tmp_path, capsys):
+    argv = _fast_batch(tmp_path)
+    _bomb_png(tmp_path / "frames" / "f9.png", 60000, 60000)
+    code, out, err = _run(argv, capsys)
+    lines = err.strip().splitlines()
+    assert code == 1, err
+    assert lines[-1] == ("3 written, 1 failed: f9.png: 60000x60000 = 3600.0 megapixels exceeds the limit of "
+                         "50 megapixels (set WEFT_MAX_PIXELS to raise it)")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f0.png", "f1.png", "f2.png"]
+
+
+def test_a_frame_too_large_for_memory_fails_alone(tmp_path, capsys, monkeypatch):
+    argv = _fast_batch(tmp_path)
+    save_image(tmp_path / "frames" / "f3.png", np.zeros((400, 400, 3), np.float32))
+    # the good frames (40x48) fit in this much memory by the fast method's estimate; the 400x400 one does not
+    monkeypatch.setattr("weft.core.batch.prepare.available_memory", lambda: 1_000_000)
+    code, out, err = _run(argv[:-3] + ["-q"], capsys)  # default workers: as many as fit
+    assert code == 1, err
+    assert err.strip().splitlines()[-1].startswith("3 written, 1 failed: f3.png: needs about")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f0.png", "f1.png", "f2.png"]

@@ -18,7 +18,8 @@ from typing import Any, Callable, Mapping
 from ..errors import Cancelled, WeftError
 from ..jobs import CancelToken
 from ..limits import LimitError, _bytes
-from .prepare import BatchProgress, Item, Outcome, Plan, Summary, check_memory, item_memory
+from .prepare import (BatchProgress, Item, Outcome, Plan, Summary, check_memory, item_memory, too_large_alone,
+                      workers_that_fit)
 
 #: Times an item is started before a worker dying under it fails the item (Dask's default too).
 MAX_ATTEMPTS = 3
@@ -328,6 +329,13 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
             on_outcome(Outcome(item.index, item.label, item.output, "skipped"))
     todo = collections.deque(plan_.todo)
     t0 = time.monotonic()
+    if todo and pool is None and not scheduler:  # an item too large even alone fails alone; the rest run
+        alone = too_large_alone(todo)
+        for item, reason in alone:
+            _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
+                    item, summary, state, on_outcome, progress)
+        refused = {item.index for item, _ in alone}
+        todo = collections.deque(item for item in todo if item.index not in refused)
     if not todo:
         return summary
     own = pool is None
@@ -336,6 +344,8 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
             pool = DaskPool(scheduler, plan_.method)
         else:
             n = min(workers or default_workers(), len(todo))
+            if workers is None:  # not asked for: as many as fit in memory
+                n = workers_that_fit(todo, n)
             check_memory(todo, n)
             pool = LocalPool(n, plan_.method)
     try:

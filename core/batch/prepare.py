@@ -443,6 +443,53 @@ def item_memory(items: Iterable[Item]) -> tuple[float, str]:
     return best, label
 
 
+def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> list[tuple[Item, str]]:
+    """The items that cannot run even alone, each with its one-line reason: an input whose header
+    claims more pixels than the pixel limit, or an estimated peak memory above ``available`` (default:
+    what the system has available now). They fail by themselves; the rest of the batch runs."""
+    from .. import registry
+    from ..image import get_max_pixels
+
+    items = list(items)
+    if not items:
+        return []
+    method = registry.get(items[0].method)
+    params = method.params.from_dict(items[0].params) if method.memory is not None else None
+    available = available_memory() if available is None else available
+    limit = get_max_pixels()
+    alone = []
+    for item in items:
+        shapes = {name: _header_shape(path) for name, path in item.inputs.items()}
+        big = next(((name, s) for name, s in shapes.items() if s is not None and s[0] * s[1] > limit), None)
+        if big is not None:
+            name, (h, w) = big[0], big[1][:2]
+            alone.append((item, f"{shown(item.inputs[name])}: {w}x{h} = {w * h / 1e6:.1f} megapixels exceeds the "
+                                f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)"))
+            continue
+        if params is None or available is None or any(s is None for s in shapes.values()):
+            continue
+        if item.region is not None:
+            first = method.inputs[0].name
+            shapes[first] = (item.region[2], item.region[2]) + tuple(shapes[first][2:])
+        try:
+            need = float(method.memory(shapes, params))
+        except (WeftError, KeyError, TypeError, ValueError):
+            continue
+        if need > available:
+            alone.append((item, f"needs about {_bytes(need)} of memory, {_bytes(available)} is available: "
+                                "make its inputs smaller"))
+    return alone
+
+
+def workers_that_fit(items: Iterable[Item], workers: int, *, available: int | None = None) -> int:
+    """At most ``workers``, as many as fit in memory at once (at least 1) by the largest item's estimate."""
+    need, _ = item_memory(items)
+    available = available_memory() if available is None else available
+    if not need or available is None:
+        return workers
+    return max(1, min(workers, int(available // need)))
+
+
 def check_memory(items: Iterable[Item], workers: int, *, available: int | None = None,
                  option: str = "--workers") -> None:
     """Refuse up front a batch whose largest item's estimate times ``workers`` exceeds ``available``
