@@ -20,6 +20,7 @@ import json
 import math
 import numbers
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, NamedTuple
@@ -67,7 +68,7 @@ class Square(NamedTuple):
         if isinstance(text, str):
             shown = text
             try:
-                values = tuple(int(p) for p in text.replace(" ", "").split(","))
+                values = tuple(whole_number(p) for p in text.replace(" ", "").split(","))
             except ValueError:
                 values = ()
         else:
@@ -168,6 +169,17 @@ def as_lines(value: Any, key: str) -> np.ndarray:
         if not all(math.isfinite(float(v)) for v in line):
             raise GeometryError(f"{key}[{i}] = {_short(line)} has a NaN or infinite coordinate")
     return np.array(value, dtype=np.float64).reshape(-1, 4)
+
+
+_WHOLE = re.compile(r"[+-]?[0-9]+")
+
+
+def whole_number(text: str) -> int:
+    """``text`` as a whole number written in ASCII digits (an optional sign): ``int`` alone would also
+    take ``1_000`` and other scripts' digits. ``ValueError`` otherwise."""
+    if not _WHOLE.fullmatch(text):
+        raise ValueError(f"not a whole number: {text!r}")
+    return int(text)
 
 
 def as_size(value: Any, key: str) -> tuple[int, int]:
@@ -626,7 +638,7 @@ class Margins(NamedTuple):
         values: tuple = ()
         try:
             if isinstance(text, str):
-                values = tuple(int(p) for p in text.replace(" ", "").split(","))
+                values = tuple(whole_number(p) for p in text.replace(" ", "").split(","))
             elif not any(isinstance(v, (bool, np.bool_)) for v in text):
                 values = tuple(int(v) for v in text)
                 if any(v != w for v, w in zip(values, text)):

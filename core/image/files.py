@@ -12,7 +12,9 @@ import errno
 import io
 import numbers
 import os
+import re
 import stat
+import sys
 import struct
 import tempfile
 import threading
@@ -236,6 +238,88 @@ def _damaged(name: str, reason: str) -> str | None:
     return None
 
 
+_CODEC_LOCK = threading.Lock()
+# Lines the image libraries print themselves (on the process's stderr, below Python).
+_CODEC_LINE = re.compile(r"^(libpng (warning|error)|Corrupt JPEG data|Premature end of JPEG|Warning:|Invalid SOS|"
+                         r"Bogus |Unsupported marker|TIFF|.*: (Warning|Error), )")
+# libjpeg's warnings that mean the scan (the pixels) is damaged; stray bytes before the end marker
+# (a few, after a whole scan) are harmless and are not among them.
+_JPEG_DAMAGE = re.compile(r"premature end of data segment|Premature end of JPEG file|bad Huffman code|"
+                          r"must resync|Invalid SOS|extraneous bytes before marker 0xd[0-7]")
+_JPEG_STRAY = re.compile(r"(\d+) extraneous bytes before marker 0xd9")
+_STRAY_BYTES_OK = 16
+
+
+@contextlib.contextmanager
+def _codec_output(said: list[str]):
+    """Collect what the C image libraries print on file descriptor 2 while decoding (libpng's
+    "IDAT: CRC error", libjpeg's "Corrupt JPEG data: ...") into ``said`` instead of the terminal:
+    weft says what is wrong in one line of its own. Anything else written there meanwhile (another
+    thread's line) is passed on."""
+    with _CODEC_LOCK:
+        try:
+            sys.stderr.flush()
+            saved = os.dup(2)
+        except (OSError, ValueError, AttributeError):
+            yield
+            return
+        try:
+            sink = tempfile.TemporaryFile()
+        except OSError:
+            os.close(saved)
+            yield
+            return
+        try:
+            os.dup2(sink.fileno(), 2)
+            try:
+                yield
+            finally:
+                os.dup2(saved, 2)
+            sink.seek(0)
+            text = sink.read(1 << 16).decode("utf-8", "replace")
+        finally:
+            os.close(saved)
+            sink.close()
+    other = []
+    for line in text.splitlines():
+        (said if _CODEC_LINE.match(line) else other).append(line)
+    if other:
+        with contextlib.suppress(OSError, ValueError):
+            os.write(2, ("\n".join(other) + "\n").encode("utf-8", "replace"))
+
+
+def _scan_damage(said: list[str]) -> str | None:
+    """libjpeg's words for a damaged scan among ``said``, or None when the pixels are whole."""
+    for line in said:
+        if _JPEG_DAMAGE.search(line):
+            return line.removeprefix("Corrupt JPEG data: ")
+        stray = _JPEG_STRAY.search(line)
+        if stray and int(stray.group(1)) > _STRAY_BYTES_OK:
+            return f"the scan ends {stray.group(1)} bytes before its end marker"
+    return None
+
+
+def _tiff_size(f) -> tuple[int, int] | None:
+    """(width, height) from a classic TIFF's first directory (tags 256 and 257), or None."""
+    head = f.read(8)
+    if len(head) < 8 or head[:4] not in (b"II*\0", b"MM\0*"):
+        return None
+    end = "<" if head[:2] == b"II" else ">"
+    f.seek(struct.unpack(end + "I", head[4:])[0])
+    raw = f.read(2)
+    if len(raw) < 2:
+        return None
+    count = struct.unpack(end + "H", raw)[0]
+    entries = f.read(12 * count)
+    found = {}
+    for i in range(len(entries) // 12):
+        tag, kind, n = struct.unpack(end + "HHI", entries[12 * i:12 * i + 8])
+        if tag in (256, 257) and n == 1 and kind in (3, 4):
+            value = entries[12 * i + 8:12 * i + 12]
+            found[tag] = struct.unpack(end + ("H" if kind == 3 else "I"), value[:2 if kind == 3 else 4])[0]
+    return (found[256], found[257]) if 256 in found and 257 in found and min(found.values()) > 0 else None
+
+
 def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: str | None = None,
                alpha: bool = False) -> Loaded:
     """Load PNG, JPEG, TIFF, BMP, WebP or GIF (8 or 16 bits per sample) as float32 in [0, 1].
@@ -277,11 +361,20 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
         with open_regular(name, "image file", error=ImageError) as f:
             if os.fstat(f.fileno()).st_size == 0:
                 raise ImageError(f"{shown(name)}: empty file", path=name)
-            im, animated = _pil_open(open(os.dup(f.fileno()), "rb"))  # Pillow closes what it is given
-            with im:
-                fmt, (width, height), src_mode = im.format or "unknown", im.size, im.mode
-                had_alpha = src_mode in _ALPHA_MODES or "transparency" in im.info
-                orientation = _exif_orientation(im)
+            try:
+                im, animated = _pil_open(open(os.dup(f.fileno()), "rb"))  # Pillow closes what it is given
+            except UnidentifiedImageError:
+                f.seek(0)
+                size = _tiff_size(f)  # a TIFF Pillow has no mode for (float RGB): OpenCV decodes it
+                if size is None:
+                    raise
+                im, animated = None, False
+                fmt, (width, height), src_mode, had_alpha, orientation = "TIFF", size, "RGB", False, 1
+            if im is not None:
+                with im:
+                    fmt, (width, height), src_mode = im.format or "unknown", im.size, im.mode
+                    had_alpha = src_mode in _ALPHA_MODES or "transparency" in im.info
+                    orientation = _exif_orientation(im)
             if width * height > limit:
                 raise ImageError(f"{shown(name)}: {width}x{height} = {width * height / 1e6:.1f} megapixels exceeds the "
                                  f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS or max_pixels to raise it)",
@@ -299,27 +392,34 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
             problem = _damaged(name, _one_line(e)) or f"corrupt image header ({_one_line(e)})"
         raise ImageError(f"{shown(name)}: {problem}", path=name) from e
 
+    said: list[str] = []
     try:
-        arr = None
-        if alpha and had_alpha:
-            grey = src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] == 4)
-            kept = _decode_alpha(data, grey, orientation)
-            if kept is not None:
-                return _loaded_alpha(kept, name, fmt, orientation, src_mode, animated, mode)
-        with contextlib.suppress(cv2.error):
-            arr = cv2.imdecode(data, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)  # applies EXIF orientation
-        if arr is None:  # OpenCV could not: truncated, corrupt, or a variant only Pillow reads
-            try:
-                arr = _decode_pillow(data)
-            except Exception as e:  # noqa: BLE001
-                raise ImageError(f"{shown(name)}: truncated or corrupt {fmt} data ({_one_line(e)})", path=name) from e
-        elif arr.ndim == 3:
-            arr = arr[..., 2::-1]  # BGR(A) -> RGB
+        kept = arr = None
+        with _codec_output(said):  # the codecs' own lines (libpng, libjpeg, libtiff) are ours to word
+            if alpha and had_alpha:
+                grey = src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] == 4)
+                kept = _decode_alpha(data, grey, orientation)
+            if kept is None:
+                with contextlib.suppress(cv2.error):
+                    arr = cv2.imdecode(data, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)  # applies EXIF orientation
+                if arr is None:  # OpenCV could not: truncated, corrupt, or a variant only Pillow reads
+                    try:
+                        arr = _decode_pillow(data)
+                    except Exception as e:  # noqa: BLE001
+                        raise ImageError(f"{shown(name)}: truncated or corrupt {fmt} data ({_one_line(e)})",
+                                         path=name) from e
+                elif arr.ndim == 3:
+                    arr = arr[..., 2::-1]  # BGR(A) -> RGB
+        damage = _scan_damage(said) if fmt == "JPEG" else None
+        if damage is not None:
+            raise ImageError(f"{shown(name)}: truncated or corrupt JPEG data ({damage})", path=name)
+        if kept is not None:
+            return _loaded_alpha(kept, name, fmt, orientation, src_mode, animated, mode)
         if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] == 3)):
             raise ValueError(f"unexpected decoder output of shape {arr.shape}")
         if arr.dtype not in (np.uint8, np.uint16):
-            raise ImageError(f"{shown(name)}: unsupported sample type {arr.dtype} (only 8- and 16-bit images are supported)",
-                             path=name)
+            raise ImageError(f"{shown(name)}: unsupported sample type {arr.dtype} (only 8- and 16-bit images are "
+                             "supported: save it with 8 or 16 bits per sample)", path=name)
         # OpenCV expands grey+alpha to three equal channels; Pillow calls 16-bit grey+alpha PNG "RGBA",
         # so for PNG the IHDR colour type (0 grey, 4 grey+alpha) decides.
         if arr.ndim == 3 and (src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] in (0, 4))):
