@@ -65,7 +65,7 @@ def open_regular(path: str | os.PathLike, what: str = "file", *, error: type[Wef
     name = os.fsdecode(path)
     kind = kind_of(os.stat(name).st_mode)
     if kind is not None and kind != "a directory":
-        raise error(f"{shown(name)}: is {kind}, not a {what}")
+        raise error(f"{shown(name)}: is {kind}, not {_a(what)}")
     if kind == "a directory":
         raise IsADirectoryError(21, "Is a directory", name)
     fd = os.open(name, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
@@ -75,7 +75,7 @@ def open_regular(path: str | os.PathLike, what: str = "file", *, error: type[Wef
         if kind == "a directory":
             raise IsADirectoryError(21, "Is a directory", name)
         if kind is not None:
-            raise error(f"{shown(name)}: is {kind}, not a {what}")
+            raise error(f"{shown(name)}: is {kind}, not {_a(what)}")
         if hasattr(os, "set_blocking"):
             os.set_blocking(fd, True)
         return open(fd, "rb")
@@ -93,11 +93,15 @@ def read_regular(path: str | os.PathLike, limit: int, what: str = "file", *,
     with open_regular(name, what, error=error) as f:
         size = os.fstat(f.fileno()).st_size
         if size > limit:
-            raise error(f"{shown(name)}: {_size(size)} is too large for a {what} (the limit is {_size(limit)}); not read")
+            raise error(f"{shown(name)}: {_size(size)} is too large for {_a(what)} (the limit is {_size(limit)}); not read")
         data = f.read(limit + 1)
     if len(data) > limit:
-        raise error(f"{shown(name)}: too large for a {what} (the limit is {_size(limit)}); not read")
+        raise error(f"{shown(name)}: too large for {_a(what)} (the limit is {_size(limit)}); not read")
     return data
+
+
+def _a(what: str) -> str:
+    return ("an " if what[:1].lower() in "aeiou" else "a ") + what
 
 
 def _size(n: int) -> str:

@@ -23,7 +23,7 @@ from typing import Mapping
 from .errors import ImageError, WeftError
 from .geometry import Square
 from .params import Params, Recipe, relative_path
-from .readfile import open_regular, shown
+from .readfile import kind_of, open_regular, shown
 
 
 def load_recipe(path: str) -> Recipe:
@@ -77,7 +77,9 @@ def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) 
     params = method.params.from_dict(recipe.params, base=base)
     for name, path in recipe.inputs.items():
         if name not in supplied and not os.path.exists(path):
-            raise WeftError(f"the {name} image {path} does not exist")
+            raise WeftError(f"the {name} image {shown(path)} does not exist")
+        if name not in supplied and (kind := kind_of(os.stat(path).st_mode)) is not None:
+            raise WeftError(f"the {name} image {shown(path)} is {kind}, not an image file")
     return params.to_dict()
 
 

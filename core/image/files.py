@@ -688,13 +688,17 @@ def read_recipe(path: str | os.PathLike) -> str | None:
                 key, _, rest = body.partition(b"\0")
                 if key != _RECIPE_KEY or crc != struct.pack(">I", zlib.crc32(kind + body)):
                     continue
-                with contextlib.suppress(ValueError, IndexError, zlib.error):
+                try:
                     if kind == b"tEXt":
                         return rest.decode("latin-1")
                     if kind == b"zTXt":
                         return _inflate(rest[1:], MAX_FILE_BYTES, too_large, name).decode("latin-1")
                     text = rest[2:].split(b"\0", 2)[2]  # skip language tag and translated keyword
                     return (_inflate(text, MAX_FILE_BYTES, too_large, name) if rest[0] else text).decode("utf-8")
+                except ImageError:
+                    raise
+                except (ValueError, IndexError, zlib.error):
+                    continue
     except OSError as e:
         raise _os_error(name, e) from e
     return None
