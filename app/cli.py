@@ -242,6 +242,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
              read_too: Sequence[str] = ()) -> int:
     from weft.core import registry
     from weft.core.image import save_image
+    from weft.core.image.files import remove_stale_temporaries
     from weft.core.run import output_recipe, render
 
     method = registry.get(method_name)
@@ -275,6 +276,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
         jpeg = out.suffix.lower() in (".jpg", ".jpeg")
         bit_depth = info.bit_depth if info is not None and not jpeg else 8
     recipe = output_recipe(method, params, input_paths, seed, region, out)
+    remove_stale_temporaries([out])  # a killed earlier run's half-written file beside it
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if args.report:
         h, w = result.image.shape[:2]

@@ -189,3 +189,25 @@ def test_a_frame_too_large_for_memory_fails_alone(tmp_path, capsys, monkeypatch)
     assert code == 1, err
     assert err.strip().splitlines()[-1].startswith("3 written, 1 failed: f3.png: needs about")
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f0.png", "f1.png", "f2.png"]
+
+
+def test_a_killed_writers_temporary_files_are_removed_on_the_next_run(tmp_path, capsys):
+    from weft.core.image.files import _writer_tag
+
+    argv = _fast_batch(tmp_path)
+    assert _run(argv, capsys)[0] == 0
+    out = tmp_path / "out"
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()  # a process of this machine that no longer runs
+    host = _writer_tag().split("-")[0]
+    killed = out / f".f0.png.ab12CD_9.{host}-{dead.pid}.tmp"  # what a batch killed mid-write leaves
+    older = out / ".f1.png.zz8Yq1Xw.tmp"  # an older weft's name, untouched for an hour
+    alive = out / f".f2.png.Qw3rTy7u.{host}-{os.getpid()}.tmp"  # a writer still at work: kept
+    foreign = out / ".notes.txt.ab12CD_9.tmp"  # not one of this batch's outputs: kept
+    for p in (killed, older, alive, foreign):
+        p.write_bytes(b"half an image")
+    os.utime(older, (1e9, 1e9))
+    os.utime(foreign, (1e9, 1e9))
+    code, _, err = _run(argv, capsys)
+    assert code == 0 and err == "0 written, 3 already done\n"
+    assert sorted(p.name for p in out.iterdir()) == sorted([alive.name, foreign.name, "f0.png", "f1.png", "f2.png"])

@@ -321,8 +321,11 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
     LimitError
         The batch needs more memory than the workers have (nothing was run).
     """
+    from ..image.files import remove_stale_temporaries
+
     summary = Summary(total=len(plan_.items))
     state = BatchProgress(summary.total, len(plan_.skipped))
+    remove_stale_temporaries(item.output for item in plan_.items)  # a killed earlier run's half-written files
     for item in plan_.skipped:
         summary.skipped += 1
         if on_outcome is not None:
