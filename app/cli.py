@@ -14,21 +14,34 @@ time only (no imports, no image I/O).
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
-import secrets
+import signal
 import sys
 import threading
-import time
-from pathlib import Path
-from typing import Sequence
 
-from weft.core import __version__
-from weft.core.errors import Cancelled, WeftError
-from weft.core.params import Params, specs
 
-from .options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
+def _interrupted_while_starting(signum, frame) -> None:
+    """Ctrl-C while the modules below load (before ``main`` can catch it): one line, no traceback."""
+    sys.stderr.write("weft: cancelled\n")
+    sys.stderr.flush()
+    os._exit(130)
+
+
+if signal.getsignal(signal.SIGINT) is signal.default_int_handler and threading.current_thread() is threading.main_thread():
+    signal.signal(signal.SIGINT, _interrupted_while_starting)
+
+import argparse  # noqa: E402 (after the start-up Ctrl-C handler)
+import json  # noqa: E402
+import secrets  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Sequence  # noqa: E402
+
+from weft.core import __version__  # noqa: E402 (after the start-up Ctrl-C handler)
+from weft.core.errors import Cancelled, WeftError  # noqa: E402
+from weft.core.params import Params, specs  # noqa: E402
+
+from .options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int  # noqa: E402
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -436,6 +449,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(one_line(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)"),
               file=sys.stderr)
         return 1
+
+
+if signal.getsignal(signal.SIGINT) is _interrupted_while_starting:
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # loaded: from here on main() catches Ctrl-C
 
 
 if __name__ == "__main__":

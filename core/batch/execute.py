@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import collections
 import concurrent.futures as cf
+import contextlib
 import multiprocessing
 import os
 import secrets
@@ -133,12 +134,38 @@ def _exit_with_parent(parent: int) -> None:
             os._exit(1)
 
 
+@contextlib.contextmanager
+def _interrupts_held():
+    """Ctrl-C held back while worker processes are started. SIGINT is blocked in this thread, so a
+    spawned worker inherits it blocked and a Ctrl-C meant for the client (the terminal sends it to
+    every process of the group) never interrupts the worker's start-up with a traceback (its
+    initializer then ignores it); and the client's own handler only notes it (another thread may
+    take the signal), to raise once the worker is launched, never half-way through launching it."""
+    import signal
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending = []
+    handler = signal.signal(signal.SIGINT, lambda signum, frame: pending.append(signum))
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.signal(signal.SIGINT, handler)
+    if pending and callable(handler):
+        handler(signal.SIGINT, None)
+
+
 def _init_local_worker(method_name: str, cancel_event, parent: int | None = None) -> None:
     """Local pool worker start: Ctrl-C is the client's to handle; kernels are loaded once."""
     import signal
 
     global _cancel_event
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # blocked by _interrupts_held; ignored now
     _cancel_event = cancel_event
     if parent is not None:
         threading.Thread(target=_exit_with_parent, args=(parent,), name="weft-batch-parent", daemon=True).start()
@@ -160,7 +187,8 @@ class LocalPool:
         self.workers = workers
         self.method = method
         self.ctx = multiprocessing.get_context("spawn")
-        self.cancel_event = self.ctx.Event()
+        with _interrupts_held():  # (the first semaphore starts multiprocessing's resource tracker)
+            self.cancel_event = self.ctx.Event()
         self.executor = None
         self.restarts = 0  # times a dead worker took the pool down and it was started again
         self.threads = max(1, default_workers() // workers)
@@ -169,13 +197,20 @@ class LocalPool:
     def _start(self) -> None:
         self.executor = cf.ProcessPoolExecutor(self.workers, mp_context=self.ctx, initializer=_init_local_worker,
                                                initargs=(self.method, self.cancel_event, os.getpid()))
-        if self.workers > 1:
-            # One worker loads the kernels before the others start: on a first run (no numba cache
-            # yet) it compiles them once and the others load its cache, instead of every worker
-            # compiling the same kernels at once (24 fast transfers on 2 workers with a fresh
-            # NUMBA_CACHE_DIR, whole command: 7.2 -> 5.2 s; warm cache 4.45 -> 4.44 s, medians of 3 at load
-            # ~4). The executor starts a process per submit.
-            self.executor.submit(_pid_after, 0.0).result()
+        if self.workers > 1:  # (the executor starts a process per submit: each under _interrupts_held)
+            try:
+                self._first_worker()
+            except BaseException:  # Ctrl-C while it starts: end it now, before the client goes
+                self.terminate()
+                raise
+
+    def _first_worker(self) -> None:
+        """One worker loads the kernels before the others start: on a first run (no numba cache yet)
+        it compiles them once and the others load its cache, instead of every worker compiling the
+        same kernels at once. The executor starts a process per submit."""
+        with _interrupts_held():
+            future = self.executor.submit(_pid_after, 0.0)
+        future.result()
 
     @property
     def slots(self) -> int:
@@ -185,11 +220,14 @@ class LocalPool:
         """Start every worker now and wait until each has loaded its kernels; their process ids."""
         seen: set[int] = set()
         while len(seen) < self.workers:  # each worker takes at most one short task while others are free
-            seen.update(f.result() for f in [self.executor.submit(_pid_after, 0.05) for _ in range(self.workers)])
+            with _interrupts_held():
+                futures = [self.executor.submit(_pid_after, 0.05) for _ in range(self.workers)]
+            seen.update(f.result() for f in futures)
         return sorted(seen)
 
     def submit(self, item: Item):
-        return self.executor.submit(run_item, replace(item, threads=self.threads))
+        with _interrupts_held():
+            return self.executor.submit(run_item, replace(item, threads=self.threads))
 
     def wait(self, futures, timeout: float):
         done, _ = cf.wait(futures, timeout=timeout, return_when=cf.FIRST_COMPLETED)
@@ -215,6 +253,20 @@ class LocalPool:
 
     def close(self) -> None:
         self.executor.shutdown(wait=True, cancel_futures=True)
+
+    def terminate(self) -> None:
+        """Stop at once (Ctrl-C): every worker is ended (SIGTERM) where it is, a running item's output
+        is lost whole (writes are atomic), and a worker still starting never prints a traceback."""
+        processes = list((getattr(self.executor, "_processes", None) or {}).values())
+        processes += [p for p in multiprocessing.active_children() if p not in processes]
+        for p in processes:
+            with contextlib.suppress(Exception):
+                p.terminate()
+        for p in processes:
+            with contextlib.suppress(Exception):
+                p.join(5)
+        with contextlib.suppress(Exception):
+            self.executor.shutdown(wait=False, cancel_futures=True)
 
 
 class DaskPool:
@@ -415,12 +467,22 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                         todo.appendleft(item)
                 pool.after_death()
     except KeyboardInterrupt:
-        pool.cancel(inflight)
+        if isinstance(pool, LocalPool):
+            pool.terminate()
+        else:
+            pool.cancel(inflight)
         raise
     finally:
         summary.seconds = time.monotonic() - t0
         if own:
-            pool.close()
+            try:
+                pool.close()
+            except KeyboardInterrupt:  # Ctrl-C while waiting for the workers to end (one still starting)
+                if isinstance(pool, LocalPool):
+                    pool.terminate()
+                raise
+            except Exception:  # noqa: BLE001 - (after terminate(): nothing left to wait for)
+                pass
     return summary
 
 
