@@ -30,6 +30,28 @@ def _interrupted_while_starting(signum, frame) -> None:
 if signal.getsignal(signal.SIGINT) is signal.default_int_handler and threading.current_thread() is threading.main_thread():
     signal.signal(signal.SIGINT, _interrupted_while_starting)
 
+
+def _address_space_limit() -> int | None:
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    except (ImportError, OSError, ValueError, AttributeError):
+        return None
+    return None if soft == resource.RLIM_INFINITY or soft < 0 else int(soft)
+
+
+#: The least address space (``ulimit -v``) weft runs its methods in: below it, loading the numerical
+#: libraries fails in many ways, and SciPy's OpenBLAS can retry a failing allocation forever.
+MIN_ADDRESS_SPACE = 768 * 2**20
+
+
+if _address_space_limit() is not None:
+    # Under ulimit -v every thread's stack and every BLAS thread's buffers take address space: the
+    # numerical libraries get one thread each (set before numpy loads), or they fail to start theirs.
+    for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(_name, "1")
+
 import argparse  # noqa: E402 (after the start-up Ctrl-C handler)
 import json  # noqa: E402
 import secrets  # noqa: E402
@@ -422,6 +444,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         from weft.app.gui import run_gui
 
         return run_gui(images=argv)
+    limit = _address_space_limit()
+    if limit is not None and limit < MIN_ADDRESS_SPACE and not any(a in ("-h", "--help", "--version") for a in argv):
+        print(f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB is below the "
+              f"{MIN_ADDRESS_SPACE // 2**20} MiB weft needs to load its libraries (raise it with ulimit -v)",
+              file=sys.stderr)
+        return 2
     try:
         from weft.core import registry
 
@@ -436,7 +464,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(one_line(f"weft: {e}".replace("weft: weft", "weft")), file=sys.stderr)
         return 2
     except MemoryError:
-        print("weft: out of memory (try a smaller size or a smaller input)", file=sys.stderr)
+        limit = _address_space_limit()
+        under = f" under the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB" if limit is not None else ""
+        print(f"weft: out of memory{under} (try a smaller size or a smaller input)", file=sys.stderr)
         return 2
     except (KeyboardInterrupt, Cancelled):
         print("weft: cancelled", file=sys.stderr)
@@ -444,6 +474,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as e:  # a bug in weft, not bad input: still one line unless asked for more
         if os.environ.get("WEFT_DEBUG"):
             raise
+        limit = _address_space_limit()
+        if limit is not None:  # libraries fail in many ways when an allocation or a load is refused
+            from weft.core.readfile import one_line
+
+            print(one_line(f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB "
+                           f"is too small for this job ({type(e).__name__}: {e})")[:400], file=sys.stderr)
+            return 2
         from weft.core.readfile import one_line
 
         print(one_line(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)"),
