@@ -306,6 +306,8 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     notice = registry.kernel_cache_notice()
     if notice is not None and not args.quiet:
         print(f"weft: {notice}", file=sys.stderr)
+    for repair in registry.kernel_cache_repairs() if not args.quiet else ():
+        print(f"weft: {repair}", file=sys.stderr)
     if bit_depth is None:  # not asked for: 8, or the bit depth of the input the method names (fill: the image)
         info = infos.get(method.depth_from) if method.depth_from else None
         jpeg = out.suffix.lower() in (".jpg", ".jpeg")
@@ -355,6 +357,7 @@ def _warm_up_all(args: argparse.Namespace) -> int:
                 continue
             if r["notice"]:
                 notices.add(r["notice"])
+            notices.update(r.get("repairs") or ())
             what = (f"compiled {r['compiled']} function{'s' if r['compiled'] != 1 else ''}" if r["compiled"]
                     else "loaded from the cache")
             say(f"{name:8} {what} in {r['seconds']:.1f} s")
