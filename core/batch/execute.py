@@ -3,6 +3,7 @@ Dask pool behind one interface, and :func:`run` (see :mod:`weft.core.batch`)."""
 
 from __future__ import annotations
 
+import asyncio
 import collections
 import concurrent.futures as cf
 import contextlib
@@ -30,6 +31,20 @@ IN_FLIGHT_PER_WORKER = 2
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
 #: How long to try reaching a Dask scheduler before giving up.
 CONNECT_TIMEOUT = "10s"
+#: Environment variable: seconds to wait for a Dask scheduler to have a worker.
+WORKER_TIMEOUT_ENV = "WEFT_DASK_WORKER_TIMEOUT"
+
+
+def _worker_timeout() -> float:
+    try:
+        value = float(os.environ.get(WORKER_TIMEOUT_ENV, ""))
+    except ValueError:
+        return 30.0
+    return value if value > 0 else 30.0
+
+
+#: Seconds to wait for a Dask scheduler to have at least one worker (``WEFT_DASK_WORKER_TIMEOUT``).
+WORKER_TIMEOUT = _worker_timeout()
 
 # --------------------------------------------------------------------------------------------------
 # One item, on a worker
@@ -277,10 +292,24 @@ class DaskPool:
             from distributed import Client
         except ImportError:
             raise WeftError("a scheduler address needs Dask: pip install -e '.[cluster]'") from None
+        import logging
+
+        # distributed logs a lost connection with tracebacks; weft says what happened in one line
+        for name in ("distributed", "tornado"):
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        self.address = address
         try:
             self.client = Client(address, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError, ValueError) as e:
-            raise WeftError(f"cannot reach the Dask scheduler at {address} ({_one_line(e)})") from None
+        except Exception as e:  # noqa: BLE001 - OSError, TimeoutError; TypeError/ValueError for tls:// without
+            # certificates; ImportError for ucx:// without ucx-py
+            raise WeftError(f"cannot reach the Dask scheduler at {address} ({type(e).__name__}: {_one_line(e)})"
+                            ) from None
+        try:
+            self.client.wait_for_workers(1, timeout=WORKER_TIMEOUT)
+        except Exception:  # noqa: BLE001 - (TimeoutError, or the scheduler went away meanwhile)
+            self.close()
+            raise WeftError(f"the Dask scheduler at {address} has no workers (waited {WORKER_TIMEOUT:g} s; "
+                            f"set {WORKER_TIMEOUT_ENV} to wait longer)") from None
         self.method = method
         totals: dict[str, int] = collections.Counter()
         for addr, info in self.workers().items():
@@ -313,7 +342,7 @@ class DaskPool:
 
         try:
             done, _ = wait(list(futures), timeout=timeout, return_when="FIRST_COMPLETED")
-        except TimeoutError:
+        except Exception:  # noqa: BLE001 - a timeout, or the connection lost (run() checks lost())
             return set()
         return done
 
@@ -328,11 +357,17 @@ class DaskPool:
     def after_death(self) -> None:
         pass  # Dask has already retried the item on other workers
 
+    def lost(self) -> bool:
+        """Whether the connection to the scheduler is gone (the scheduler was stopped or killed)."""
+        return getattr(self.client, "status", "running") not in ("running", "connecting", "newly-created")
+
     def cancel(self, futures) -> None:
-        self.client.cancel(list(futures))
+        with contextlib.suppress(Exception):
+            self.client.cancel(list(futures))
 
     def close(self) -> None:
-        self.client.close()
+        with contextlib.suppress(Exception):
+            self.client.close(timeout=5)
 
 
 def scheduler_address(given: str | None) -> str | None:
@@ -438,6 +473,14 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                                 item, summary, state, on_outcome, progress)
                         continue
                 inflight[pool.submit(item)] = item
+            if isinstance(pool, DaskPool) and pool.lost():  # every item not done fails with the reason
+                reason = f"the Dask scheduler at {pool.address} was lost before it was done"
+                for item in [*inflight.values(), *todo]:
+                    _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
+                            item, summary, state, on_outcome, progress)
+                inflight.clear()
+                todo.clear()
+                break
             died = []
             for future in pool.wait(inflight, timeout=0.2):
                 item = inflight.pop(future)
@@ -446,8 +489,11 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                 except WorkerDied:
                     died.append(item)
                     continue
-                except cf.CancelledError:
-                    continue
+                except (cf.CancelledError, asyncio.CancelledError):
+                    if not (isinstance(pool, DaskPool) and pool.lost()):
+                        continue
+                    outcome = Outcome(item.index, item.label, item.output, "failed",
+                                      error=f"the Dask scheduler at {pool.address} was lost before it was done")
                 except Exception as e:  # noqa: BLE001 - e.g. a Dask communication error: this item's
                     outcome = Outcome(item.index, item.label, item.output, "failed", error=_one_line(e))
                 _finish(outcome, item, summary, state, on_outcome, progress)
