@@ -127,3 +127,15 @@ def test_extend_takes_ascii_digits_only(tmp_path, capfd, text):
     assert code == 2 and err.count("\n") == 1 and "must be L,T,R,B" in err
     code, out, err = _run(["quilt", image, *QUILT[:-1], "--seed", text.split(",")[0], "-o", tmp_path / "o.png"], capfd)
     assert code == 2 and "must be an integer" in err
+
+
+def test_weft_run_on_a_jpeg_says_only_png_exports_carry_a_recipe(tmp_path, capfd):
+    data, _ = _jpeg()
+    cat = _write(tmp_path / "cat.jpg", data)
+    code, out, err = _run(["run", cat, "-o", tmp_path / "o.png"], capfd)
+    assert (code, err) == (2, f"weft: {cat}: a JPEG image carries no recipe; only PNGs exported by weft "
+                              "(and .json recipe files) do\n")
+    plain = tmp_path / "plain.png"
+    save_image(plain, np.zeros((8, 8, 3), np.float32))
+    code, out, err = _run(["run", plain, "-o", tmp_path / "o.png"], capfd)
+    assert (code, err) == (2, f"weft: {plain}: this PNG carries no weft recipe (only PNGs exported by weft do)\n")
