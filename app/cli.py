@@ -277,7 +277,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
              read_too: Sequence[str] = ()) -> int:
     from weft.core import registry
     from weft.core.image import save_image
-    from weft.core.image.files import remove_stale_temporaries
+    from weft.core.image.temporaries import remove_stale_temporaries
     from weft.core.run import output_recipe, render
 
     method = registry.get(method_name)

@@ -192,7 +192,7 @@ def test_a_frame_too_large_for_memory_fails_alone(tmp_path, capsys, monkeypatch)
 
 
 def test_a_killed_writers_temporary_files_are_removed_on_the_next_run(tmp_path, capsys):
-    from weft.core.image.files import _writer_tag
+    from weft.core.image.temporaries import _writer_tag
 
     argv = _fast_batch(tmp_path)
     assert _run(argv, capsys)[0] == 0

@@ -408,7 +408,7 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
     LimitError
         The batch needs more memory than the workers have (nothing was run).
     """
-    from ..image.files import remove_stale_temporaries
+    from ..image.temporaries import remove_stale_temporaries
 
     summary = Summary(total=len(plan_.items))
     state = BatchProgress(summary.total, len(plan_.skipped))

@@ -12,13 +12,10 @@ import errno
 import io
 import numbers
 import os
-import re
 import stat
-import sys
 import struct
 import tempfile
 import threading
-import time
 import warnings
 import zlib
 from dataclasses import dataclass
@@ -31,6 +28,8 @@ from PIL import Image, UnidentifiedImageError
 
 from ..errors import ImageError, InvalidParameter, WeftError
 from ..readfile import open_regular, shown
+from .codec_output import _codec_output, _scan_damage
+from .temporaries import _writer_tag
 from .colour import _check_float_image, luminance
 
 # A corrupt file is reported once, by us, as one line: OpenCV's own warnings would add a second.
@@ -236,67 +235,6 @@ def _damaged(name: str, reason: str) -> str | None:
         for magic, fmt in _SIGNATURES.items():
             if head.startswith(magic):
                 return f"truncated or corrupt {fmt} data ({reason})"
-    return None
-
-
-_CODEC_LOCK = threading.Lock()
-# Lines the image libraries print themselves (on the process's stderr, below Python).
-_CODEC_LINE = re.compile(r"^(libpng (warning|error)|Corrupt JPEG data|Premature end of JPEG|Warning:|Invalid SOS|"
-                         r"Bogus |Unsupported marker|TIFF|.*: (Warning|Error), )")
-# libjpeg's warnings that mean the scan (the pixels) is damaged; stray bytes before the end marker
-# (a few, after a whole scan) are harmless and are not among them.
-_JPEG_DAMAGE = re.compile(r"premature end of data segment|Premature end of JPEG file|bad Huffman code|"
-                          r"must resync|Invalid SOS|extraneous bytes before marker 0xd[0-7]")
-_JPEG_STRAY = re.compile(r"(\d+) extraneous bytes before marker 0xd9")
-_STRAY_BYTES_OK = 16
-
-
-@contextlib.contextmanager
-def _codec_output(said: list[str]):
-    """Collect what the C image libraries print on file descriptor 2 while decoding (libpng's
-    "IDAT: CRC error", libjpeg's "Corrupt JPEG data: ...") into ``said`` instead of the terminal:
-    weft says what is wrong in one line of its own. Anything else written there meanwhile (another
-    thread's line) is passed on."""
-    with _CODEC_LOCK:
-        try:
-            sys.stderr.flush()
-            saved = os.dup(2)
-        except (OSError, ValueError, AttributeError):
-            yield
-            return
-        try:
-            sink = tempfile.TemporaryFile()
-        except OSError:
-            os.close(saved)
-            yield
-            return
-        try:
-            os.dup2(sink.fileno(), 2)
-            try:
-                yield
-            finally:
-                os.dup2(saved, 2)
-            sink.seek(0)
-            text = sink.read(1 << 16).decode("utf-8", "replace")
-        finally:
-            os.close(saved)
-            sink.close()
-    other = []
-    for line in text.splitlines():
-        (said if _CODEC_LINE.match(line) else other).append(line)
-    if other:
-        with contextlib.suppress(OSError, ValueError):
-            os.write(2, ("\n".join(other) + "\n").encode("utf-8", "replace"))
-
-
-def _scan_damage(said: list[str]) -> str | None:
-    """libjpeg's words for a damaged scan among ``said``, or None when the pixels are whole."""
-    for line in said:
-        if _JPEG_DAMAGE.search(line):
-            return line.removeprefix("Corrupt JPEG data: ")
-        stray = _JPEG_STRAY.search(line)
-        if stray and int(stray.group(1)) > _STRAY_BYTES_OK:
-            return f"the scan ends {stray.group(1)} bytes before its end marker"
     return None
 
 
@@ -568,68 +506,6 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
         if tmp is not None:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
-
-
-#: A temporary file of :func:`atomic_write_bytes` untouched this long is a dead writer's, whoever wrote it.
-STALE_TEMPORARY_SECONDS = 600.0
-
-
-def _writer_tag() -> str:
-    """This process on this machine, in a temporary file's name: ``{host hash}-{pid}``."""
-    import socket
-
-    return f"{zlib.crc32(socket.gethostname().encode('utf-8', 'replace')):08x}-{os.getpid()}"
-
-
-def remove_stale_temporaries(paths) -> list[str]:
-    """Remove what a killed :func:`atomic_write_bytes` left beside the given output paths: their
-    ``.{name}.XXXXXXXX[.{host}-{pid}].tmp`` files whose writer is gone, that is written by a process
-    of this machine that no longer runs, or untouched for :data:`STALE_TEMPORARY_SECONDS` (a writer
-    elsewhere, or an older weft). Another writer's file in progress is left alone. Returns the
-    removed paths; never raises."""
-    host = _writer_tag().split("-")[0]
-    by_folder: dict[str, set[str]] = {}
-    for p in paths:
-        folder, name = os.path.split(os.path.abspath(os.fsdecode(p)))
-        by_folder.setdefault(folder, set()).add(name)
-    removed = []
-    now = time.time()
-    for folder, names in by_folder.items():
-        try:
-            entries = os.listdir(folder)
-        except OSError:
-            continue
-        for entry in entries:
-            m = _TEMPORARY.match(entry)
-            if m is None or m.group(1) not in names:
-                continue
-            full = os.path.join(folder, entry)
-            try:
-                st = os.lstat(full)
-                if not stat.S_ISREG(st.st_mode):
-                    continue
-                dead = m.group(2) == host and not _running(int(m.group(3)))
-                if dead or now - st.st_mtime > STALE_TEMPORARY_SECONDS:
-                    os.unlink(full)
-                    removed.append(full)
-            except OSError:
-                continue
-    return removed
-
-
-_TEMPORARY = re.compile(r"^\.(.+)\.[A-Za-z0-9_]{8}(?:\.([0-9a-f]{8})-([0-9]+))?\.tmp$", re.DOTALL)
-
-
-def _running(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OSError, OverflowError):
-        return True
-    return True
 
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
