@@ -97,6 +97,7 @@ def run_batch(args: argparse.Namespace) -> int:
     from weft.app.options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
     from weft.core import batch
     from weft.core.errors import WeftError
+    from weft.core.readfile import one_line
 
     bit_depth = _parse_bit_depth(args) if args.bit_depth is not None else None  # None: per item, as `weft METHOD`
     seed = _parse_int(args.seed, "seed", 0, 2**63 - 1)
@@ -113,8 +114,8 @@ def run_batch(args: argparse.Namespace) -> int:
         if args.report:
             print(json.dumps(outcome.report()), flush=True)
         if outcome.status == "failed":
-            bar.say(f"weft: {outcome.label}: {outcome.error}" if not outcome.error.startswith("/")
-                    else f"weft: {outcome.error}")
+            bar.say(one_line(f"weft: {outcome.label}: {outcome.error}" if not outcome.error.startswith("/")
+                             else f"weft: {outcome.error}"))
 
     t0 = time.monotonic()
     try:
@@ -124,5 +125,5 @@ def run_batch(args: argparse.Namespace) -> int:
     summary.seconds = time.monotonic() - t0
     if args.report:
         print(json.dumps(summary.report()), flush=True)
-    print(summary.line(), file=sys.stderr, flush=True)
+    print(one_line(summary.line()), file=sys.stderr, flush=True)
     return 1 if summary.failed else 0

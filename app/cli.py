@@ -14,22 +14,57 @@ time only (no imports, no image I/O).
 
 from __future__ import annotations
 
-import argparse
-import dataclasses
-import json
 import os
-import secrets
+import signal
 import sys
 import threading
-import time
-from pathlib import Path
-from typing import Sequence
 
-from weft.core import __version__
-from weft.core.errors import Cancelled, WeftError
-from weft.core.params import Params, specs
 
-from .options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
+def _interrupted_while_starting(signum, frame) -> None:
+    """Ctrl-C while the modules below load (before ``main`` can catch it): one line, no traceback."""
+    sys.stderr.write("weft: cancelled\n")
+    sys.stderr.flush()
+    os._exit(130)
+
+
+if signal.getsignal(signal.SIGINT) is signal.default_int_handler and threading.current_thread() is threading.main_thread():
+    signal.signal(signal.SIGINT, _interrupted_while_starting)
+
+
+def _address_space_limit() -> int | None:
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    except (ImportError, OSError, ValueError, AttributeError):
+        return None
+    return None if soft == resource.RLIM_INFINITY or soft < 0 else int(soft)
+
+
+#: The least address space (``ulimit -v``) weft runs its methods in: below it, loading the numerical
+#: libraries fails in many ways, and SciPy's OpenBLAS can retry a failing allocation forever.
+MIN_ADDRESS_SPACE = 768 * 2**20
+
+
+if _address_space_limit() is not None:
+    # Under ulimit -v every thread's stack and every BLAS thread's buffers take address space: the
+    # numerical libraries get one thread each (set before numpy loads), or they fail to start theirs.
+    for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(_name, "1")
+
+import argparse  # noqa: E402 (after the start-up Ctrl-C handler)
+import dataclasses  # noqa: E402
+import json  # noqa: E402
+import secrets  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Sequence  # noqa: E402
+
+from weft.core import __version__  # noqa: E402 (after the start-up Ctrl-C handler)
+from weft.core.errors import Cancelled, WeftError  # noqa: E402
+from weft.core.params import Params, specs  # noqa: E402
+
+from .options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int  # noqa: E402
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -244,33 +279,49 @@ def _suggest(method, params: Params, inputs: dict[str, str], args: argparse.Name
 
 
 def _check_output(output: str, inputs: Sequence[str]) -> Path:
+    """Everything about ``-o`` that can be checked before the work: its format, its folder, and that
+    it is none of the files the run reads (compared by device and inode: another path to an input,
+    through a link or a second mount of its folder, is the input)."""
+    from weft.core.readfile import file_key, kind_of, shown
+
     out = Path(output)
+    name = shown(output)
     if out.suffix.lower() not in SAVE_EXTENSIONS:
-        raise WeftError(f"{output}: cannot save this format (use {', '.join(SAVE_EXTENSIONS)})")
-    if out.is_dir():
-        raise WeftError(f"{output}: is a directory")
+        raise WeftError(f"{name}: cannot save this format (use {', '.join(SAVE_EXTENSIONS)})")
+    try:
+        kind = kind_of(os.stat(out).st_mode)
+    except FileNotFoundError:
+        kind = None
+    except OSError as e:  # a symbolic link loop, a folder in the path that is a file, no permission
+        raise WeftError(f"{name}: cannot write there ({e.strerror or e})") from None
+    if kind == "a directory":
+        raise WeftError(f"{name}: is a directory")
+    if kind is not None:
+        raise WeftError(f"{name}: is {kind}, not an image file; not replaced")
     parent = out.parent if str(out.parent) else Path(".")
     if not parent.is_dir():
-        raise WeftError(f"{output}: folder {parent} does not exist")
-    real_out = os.path.realpath(out)
+        raise WeftError(f"{name}: folder {shown(parent)} does not exist")
+    key = file_key(out)
     for src in inputs:
-        if os.path.realpath(src) == real_out:
-            raise WeftError(f"{output}: refusing to overwrite the input file {src}")
+        if file_key(src) == key:
+            raise WeftError(f"{name}: refusing to overwrite the input file {shown(src)}")
     return out
 
 
 def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
-             args: argparse.Namespace, region: tuple[int, int, int] | None = None, extra: dict | None = None) -> int:
+             args: argparse.Namespace, region: tuple[int, int, int] | None = None, extra: dict | None = None,
+             read_too: Sequence[str] = ()) -> int:
     from weft.core import registry
     from weft.core.image import save_image
+    from weft.core.image.temporaries import remove_stale_temporaries
     from weft.core.run import output_recipe, render
 
     method = registry.get(method_name)
     # typed parameters (a method's own command line) or their JSON form (a recipe's, read at its edge)
     params = params_dict if isinstance(params_dict, Params) else method.params.from_dict(params_dict)
     bit_depth = _parse_bit_depth(args) if args.bit_depth is not None else None  # None: see below
-    out = _check_output(args.output, list(input_paths.values()))
-    save_lines = _check_lines_file(method, params, getattr(args, "save_lines", None), [*input_paths.values(), out])
+    out = _check_output(args.output, [*input_paths.values(), *read_too])  # read_too: the recipe file
+    save_lines = _check_lines_file(method, params, getattr(args, "save_lines", None), [*input_paths.values(), *read_too, out])
     if bit_depth == 16 and out.suffix.lower() in (".jpg", ".jpeg"):
         raise WeftError(f"{args.output}: JPEG cannot hold 16 bits per channel (use .png or .tif)")
     if seed is None:
@@ -292,6 +343,8 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     notice = registry.kernel_cache_notice()
     if notice is not None and not args.quiet:
         print(f"weft: {notice}", file=sys.stderr)
+    for repair in registry.kernel_cache_repairs() if not args.quiet else ():
+        print(f"weft: {repair}", file=sys.stderr)
     if bit_depth is None:  # not asked for: 8, or the bit depth of the input the method names (fill: the image)
         info = infos.get(method.depth_from) if method.depth_from else None
         jpeg = out.suffix.lower() in (".jpg", ".jpeg")
@@ -299,6 +352,7 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     recipe = output_recipe(method, params, input_paths, seed, region, out)
     if args.bit_depth is not None:  # asked for (or a recipe's): recorded, so weft run writes it again
         recipe = dataclasses.replace(recipe, bit_depth=bit_depth)
+    remove_stale_temporaries([out])  # a killed earlier run's half-written file beside it
     save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if save_lines is not None:
         from weft.core.image import atomic_write_bytes
@@ -326,7 +380,10 @@ def _check_lines_file(method, params: Params, path: str | None, others: Sequence
     parent = target.parent if str(target.parent) else Path(".")
     if target.is_dir() or not parent.is_dir():
         raise WeftError(f"{path}: " + ("is a directory" if target.is_dir() else f"folder {parent} does not exist"))
-    if any(os.path.realpath(o) == os.path.realpath(target) for o in others):
+    from weft.core.readfile import file_key
+
+    key = file_key(target)  # by device and inode: another path to an input is that input
+    if any(file_key(o) == key for o in others):
         raise WeftError(f"{path}: refusing to overwrite an input or the output")
     return target, lines
 
@@ -365,6 +422,7 @@ def _warm_up_all(args: argparse.Namespace) -> int:
                 continue
             if r["notice"]:
                 notices.add(r["notice"])
+            notices.update(r.get("repairs") or ())
             what = (f"compiled {r['compiled']} function{'s' if r['compiled'] != 1 else ''}" if r["compiled"]
                     else "loaded from the cache")
             say(f"{name:8} {what} in {r['seconds']:.1f} s")
@@ -402,7 +460,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         if args.bit_depth is None and recipe.bit_depth is not None and \
                 Path(args.output).suffix.lower() not in (".jpg", ".jpeg"):
             args.bit_depth = str(recipe.bit_depth)  # the depth the recipe's output was written at
-        return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region)
+        return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region, read_too=[args.recipe])
 
     method = registry.get(args.method)
 
@@ -461,6 +519,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         from weft.app.gui import run_gui
 
         return run_gui(images=argv)
+    limit = _address_space_limit()
+    if limit is not None and limit < MIN_ADDRESS_SPACE and not any(a in ("-h", "--help", "--version") for a in argv):
+        print(f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB is below the "
+              f"{MIN_ADDRESS_SPACE // 2**20} MiB weft needs to load its libraries (raise it with ulimit -v)",
+              file=sys.stderr)
+        return 2
     try:
         from weft.core import registry
 
@@ -470,10 +534,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise UsageError("weft: no command given (see 'weft --help')")
         return _dispatch(args)
     except WeftError as e:
-        print(f"weft: {e}".replace("weft: weft", "weft"), file=sys.stderr)
+        from weft.core.readfile import one_line
+
+        print(one_line(f"weft: {e}".replace("weft: weft", "weft")), file=sys.stderr)
         return 2
     except MemoryError:
-        print("weft: out of memory (try a smaller size or a smaller input)", file=sys.stderr)
+        limit = _address_space_limit()
+        under = f" under the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB" if limit is not None else ""
+        print(f"weft: out of memory{under} (try a smaller size or a smaller input)", file=sys.stderr)
         return 2
     except (KeyboardInterrupt, Cancelled):
         print("weft: cancelled", file=sys.stderr)
@@ -481,8 +549,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as e:  # a bug in weft, not bad input: still one line unless asked for more
         if os.environ.get("WEFT_DEBUG"):
             raise
-        print(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)", file=sys.stderr)
+        limit = _address_space_limit()
+        if limit is not None:  # libraries fail in many ways when an allocation or a load is refused
+            from weft.core.readfile import one_line
+
+            print(one_line(f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB "
+                           f"is too small for this job ({type(e).__name__}: {e})")[:400], file=sys.stderr)
+            return 2
+        from weft.core.readfile import one_line
+
+        print(one_line(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)"),
+              file=sys.stderr)
         return 1
+
+
+if signal.getsignal(signal.SIGINT) is _interrupted_while_starting:
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # loaded: from here on main() catches Ctrl-C
 
 
 if __name__ == "__main__":

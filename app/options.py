@@ -11,10 +11,11 @@ def parse_int(text: str | None, name: str, lo: int, hi: int) -> int | None:
     """``text`` as an integer in ``lo..hi`` (None stays None); ``WeftError`` naming the option."""
     if text is None:
         return None
+    from weft.core.geometry import whole_number
     from weft.core.params import out_of_range
 
     try:
-        value = int(text)
+        value = whole_number(text.strip())
     except ValueError:
         raise WeftError(f"parameter '{name}' = {text!r} must be an integer") from None
     if not lo <= value <= hi:

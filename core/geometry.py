@@ -20,6 +20,7 @@ import json
 import math
 import numbers
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, NamedTuple
@@ -28,6 +29,7 @@ import numpy as np
 
 from .errors import GeometryError, InvalidParameter
 from .jsonio import MAX_FILE_BYTES
+from .readfile import read_regular, shown
 
 MAX_SIDE = 16384
 
@@ -66,7 +68,7 @@ class Square(NamedTuple):
         if isinstance(text, str):
             shown = text
             try:
-                values = tuple(int(p) for p in text.replace(" ", "").split(","))
+                values = tuple(whole_number(p) for p in text.replace(" ", "").split(","))
             except ValueError:
                 values = ()
         else:
@@ -169,6 +171,17 @@ def as_lines(value: Any, key: str) -> np.ndarray:
     return np.array(value, dtype=np.float64).reshape(-1, 4)
 
 
+_WHOLE = re.compile(r"[+-]?[0-9]+")
+
+
+def whole_number(text: str) -> int:
+    """``text`` as a whole number written in ASCII digits (an optional sign): ``int`` alone would also
+    take ``1_000`` and other scripts' digits. ``ValueError`` otherwise."""
+    if not _WHOLE.fullmatch(text):
+        raise ValueError(f"not a whole number: {text!r}")
+    return int(text)
+
+
 def as_size(value: Any, key: str) -> tuple[int, int]:
     """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not)."""
     if (not isinstance(value, (list, tuple)) or len(value) != 2
@@ -189,16 +202,15 @@ def read_json_or_file(text_or_path: str | os.PathLike, what: str) -> tuple[Any, 
     if text.lstrip().startswith("{"):
         source, raw = f"{what} (inline JSON)", text
     else:
-        source = text if text.isprintable() else repr(text)
+        source = shown(text)
         try:
-            if os.path.getsize(text) > MAX_FILE_BYTES:
-                raise GeometryError(f"{source}: too large for a {what} file (the limit is "
-                                    f"{MAX_FILE_BYTES // 2**20} MB); not read")
-            raw = Path(text).read_text(encoding="utf-8-sig")
+            raw = read_regular(text, MAX_FILE_BYTES, f"{what} file", error=GeometryError).decode("utf-8-sig")
         except FileNotFoundError:
             raise GeometryError(f"{source}: no such {what} file") from None
         except IsADirectoryError:
             raise GeometryError(f"{source}: is a directory, not a {what} file") from None
+        except GeometryError:
+            raise
         except (OSError, UnicodeDecodeError, ValueError) as e:
             raise GeometryError(f"{source}: cannot read {what} ({getattr(e, 'strerror', None) or e})") from None
     try:  # NaN is let through here: the line checks then say which line has it
@@ -626,7 +638,7 @@ class Margins(NamedTuple):
         values: tuple = ()
         try:
             if isinstance(text, str):
-                values = tuple(int(p) for p in text.replace(" ", "").split(","))
+                values = tuple(whole_number(p) for p in text.replace(" ", "").split(","))
             elif not any(isinstance(v, (bool, np.bool_)) for v in text):
                 values = tuple(int(v) for v in text)
                 if any(v != w for v, w in zip(values, text)):

@@ -7,6 +7,7 @@ import os
 from typing import Any
 
 from .errors import WeftError
+from .readfile import read_regular, shown
 
 MAX_FILE_BYTES = 10 * 1024 * 1024
 """The largest recipe or session weft reads (real ones are a few kB): a larger file is refused unread."""
@@ -38,28 +39,24 @@ def parse_json(text: str) -> Any:
 
 def read_json_file(path: str | os.PathLike, what: str) -> Any:
     """Read a weft JSON file (``what``: "recipe", "weft session"); one-line ``WeftError`` naming the
-    file if it is missing, a folder, larger than :data:`MAX_FILE_BYTES`, not UTF-8 text or not JSON."""
+    file if it is missing, a folder, a named pipe or a device (refused unread, without blocking),
+    larger than :data:`MAX_FILE_BYTES`, not UTF-8 text or not JSON."""
     name = os.fsdecode(path)
-    limit = f"the limit is {MAX_FILE_BYTES // 2**20} MB"
     try:
-        with open(name, "rb") as f:
-            size = os.fstat(f.fileno()).st_size
-            raw = f.read(MAX_FILE_BYTES + 1) if size <= MAX_FILE_BYTES else b""
+        raw = read_regular(name, MAX_FILE_BYTES, f"{what} file")
     except FileNotFoundError:
-        raise WeftError(f"{name}: no such {what} file") from None
+        raise WeftError(f"{shown(name)}: no such {what} file") from None
     except IsADirectoryError:
-        raise WeftError(f"{name}: is a directory, not a {what} file") from None
+        raise WeftError(f"{shown(name)}: is a directory, not a {what} file") from None
     except (OSError, ValueError) as e:  # ValueError: a NUL in the name
-        raise WeftError(f"{name}: cannot read {what} ({getattr(e, 'strerror', None) or e})") from None
-    if size > MAX_FILE_BYTES:
-        raise WeftError(f"{name}: {size / 2**20:.1f} MB is too large for a {what} file ({limit}); not read")
-    if len(raw) > MAX_FILE_BYTES:  # grew since, or a device without a size
-        raise WeftError(f"{name}: too large for a {what} file ({limit}); not read")
+        if isinstance(e, WeftError):
+            raise
+        raise WeftError(f"{shown(name)}: cannot read {what} ({getattr(e, 'strerror', None) or e})") from None
     try:
         text = raw.decode("utf-8-sig")  # a byte-order mark (Windows editors) is not an error
     except UnicodeDecodeError as e:
-        raise WeftError(f"{name}: not a {what} file (not UTF-8 JSON text: byte {e.start} is 0x{raw[e.start]:02x})") from None
+        raise WeftError(f"{shown(name)}: not a {what} file (not UTF-8 JSON text: byte {e.start} is 0x{raw[e.start]:02x})") from None
     try:
         return parse_json(text)
     except WeftError as e:
-        raise WeftError(f"{name}: not a {what} file ({e})") from None
+        raise WeftError(f"{shown(name)}: not a {what} file ({e})") from None

@@ -4,8 +4,9 @@ Three checks, each one line when it refuses (``LimitError``, a ``WeftError``):
 
 * :func:`check_output_size`: an output may not have more pixels than an input may
   (:func:`weft.core.image.get_max_pixels`, 50 Mpx unless ``WEFT_MAX_PIXELS`` says otherwise).
-* :func:`check_memory`: a method's estimate of its peak memory must fit in the memory the system
-  has available (``MemAvailable`` of ``/proc/meminfo``; no check where it cannot be read).
+* :func:`check_memory`: a method's estimate of its peak memory must fit in the memory available
+  (:func:`available_memory`: the system's, a container's control-group limit, ``ulimit -v``,
+  whichever is smallest; no check where none can be read).
 * :func:`check_duration`: a method's estimate of its running time on this machine must not exceed
   :func:`get_max_seconds` (10 minutes unless ``WEFT_MAX_SECONDS`` or :func:`set_max_seconds` says
   otherwise). Patch-search methods (quilting, NFPT) cost one or more DFTs of the whole source per
@@ -65,16 +66,137 @@ def set_max_seconds(seconds: float | None) -> None:
     _max_seconds_override = None if seconds is None else _positive(seconds, "max_seconds")
 
 
+_PROC = "/proc"
+_CGROUP_FS = "/sys/fs/cgroup"
+
+
 def available_memory() -> int | None:
-    """Bytes of memory available to a new allocation (Linux ``MemAvailable``), or ``None`` if unknown."""
+    """Bytes of memory a new allocation can have now, or ``None`` if unknown: the smallest of the
+    system's ``MemAvailable`` (``/proc/meminfo``), the headroom under every memory limit of the
+    control groups this process is in (cgroup v2 ``memory.max`` minus ``memory.current``, v1
+    ``memory.limit_in_bytes`` minus ``memory.usage_in_bytes``; reclaimable file cache counted as
+    free; the limits of parent groups apply too), and the address space left under ``ulimit -v``
+    (``RLIMIT_AS`` minus this process's ``VmSize``)."""
+    found = [v for v in (_meminfo_available(), _cgroup_available(), _address_space_left()) if v is not None]
+    return max(0, min(found)) if found else None
+
+
+def _meminfo_available() -> int | None:
     try:
-        with open("/proc/meminfo", encoding="ascii") as f:
+        with open(os.path.join(_PROC, "meminfo"), encoding="ascii") as f:
             for line in f:
                 if line.startswith("MemAvailable:"):
                     return int(line.split()[1]) * 1024
     except (OSError, ValueError, IndexError):
         return None
     return None
+
+
+def _read_int(path: str) -> int | None:
+    try:
+        with open(path, encoding="ascii") as f:
+            text = f.read(64).strip()
+    except (OSError, UnicodeDecodeError):
+        return None
+    if text == "max":
+        return None
+    try:
+        return int(text)
+    except ValueError:
+        return None
+
+
+def _stat_value(path: str, key: str) -> int:
+    try:
+        with open(path, encoding="ascii") as f:
+            for line in f:
+                name, _, value = line.partition(" ")
+                if name == key:
+                    return int(value)
+    except (OSError, ValueError, UnicodeDecodeError):
+        pass
+    return 0
+
+
+def _cgroup_folders() -> list[tuple[str, int]]:
+    """(folder, cgroup version) of every memory control group this process is in, and their parents
+    as far as they are mounted here (inside a container the mount's root is the container's group)."""
+    try:
+        with open(os.path.join(_PROC, "self", "cgroup"), encoding="utf-8") as f:
+            lines = f.read(1 << 16).splitlines()
+    except (OSError, UnicodeDecodeError):
+        return []
+    folders = []
+    for line in lines:
+        parts = line.split(":", 2)
+        if len(parts) != 3:
+            continue
+        _, controllers, path = parts
+        if controllers == "":
+            roots, version = [_CGROUP_FS, os.path.join(_CGROUP_FS, "unified")], 2
+        elif "memory" in controllers.split(","):
+            roots, version = [os.path.join(_CGROUP_FS, "memory")], 1
+        else:
+            continue
+        rel = path.strip("/")
+        for root in roots:
+            steps = rel.split("/") if rel else []
+            for depth in range(len(steps), -1, -1):
+                folders.append((os.path.join(root, *steps[:depth]), version))
+    return folders
+
+
+def _cgroup_available() -> int | None:
+    best = None
+    for folder, version in _cgroup_folders():
+        if version == 2:
+            limit = _read_int(os.path.join(folder, "memory.max"))
+            used = _read_int(os.path.join(folder, "memory.current"))
+            cache = _stat_value(os.path.join(folder, "memory.stat"), "inactive_file")
+        else:
+            limit = _read_int(os.path.join(folder, "memory.limit_in_bytes"))
+            used = _read_int(os.path.join(folder, "memory.usage_in_bytes"))
+            cache = _stat_value(os.path.join(folder, "memory.stat"), "total_inactive_file")
+        if limit is None or used is None or limit >= 2**60:  # v1 writes "no limit" as about 2**63
+            continue
+        left = limit - max(0, used - cache)
+        best = left if best is None else min(best, left)
+    return best
+
+
+def _address_space_left() -> int | None:
+    """Bytes of address space left under ``ulimit -v`` (``RLIMIT_AS``), or None without such a limit."""
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    except (ImportError, OSError, ValueError, AttributeError):
+        return None
+    if soft == resource.RLIM_INFINITY or soft < 0:
+        return None
+    return soft - _vm_size()
+
+
+def address_space_limit() -> int | None:
+    """``ulimit -v`` in bytes (the soft ``RLIMIT_AS``), or None when there is none."""
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    except (ImportError, OSError, ValueError, AttributeError):
+        return None
+    return None if soft == resource.RLIM_INFINITY or soft < 0 else int(soft)
+
+
+def _vm_size() -> int:
+    try:
+        with open(os.path.join(_PROC, "self", "status"), encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmSize:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
 
 
 def _duration(seconds: float) -> str:

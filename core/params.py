@@ -39,7 +39,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .errors import InvalidParameter, WeftError
-from .geometry import MAX_SIDE, Square
+from .geometry import MAX_SIDE, Square, whole_number
 from .jsonio import MAX_FILE_BYTES, parse_json, read_json_file  # noqa: F401 (re-exported)
 
 KINDS = ("int", "float", "bool", "choice", "size", "str", "geometry")
@@ -154,11 +154,13 @@ class Spec:
             return None
         if self.kind == "int":
             try:
-                value: Any = int(text)
+                value: Any = whole_number(text.strip())
             except ValueError:
                 raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be an integer", name=self.name, value=text) from None
         elif self.kind == "float":
             try:
+                if not text.isascii() or "_" in text:  # float() also takes 1_0.5 and other scripts' digits
+                    raise ValueError
                 value = float(text)
             except ValueError:
                 raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be a number", name=self.name, value=text) from None
@@ -202,9 +204,9 @@ def parse_size(text: str, name: str = "size") -> tuple[int, int]:
     parts = text.lower().replace("×", "x").split("x")
     try:
         if len(parts) == 1:
-            w = h = int(parts[0])
+            w = h = whole_number(parts[0].strip())
         elif len(parts) == 2:
-            w, h = int(parts[0]), int(parts[1])
+            w, h = whole_number(parts[0].strip()), whole_number(parts[1].strip())
         else:
             raise ValueError
     except ValueError:

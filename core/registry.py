@@ -227,7 +227,7 @@ def warm_up_report(name: str) -> dict[str, Any]:
     with watch_compiles() as watch:
         warm_up(name)
     return {"method": name, "seconds": time.perf_counter() - t0, "compiled": watch.count,
-            "notice": kernel_cache_notice()}
+            "notice": kernel_cache_notice(), "repairs": kernel_cache_repairs()}
 
 
 class CompileWatch:
@@ -304,6 +304,20 @@ def note_kernel_cache(message: str) -> None:
     """Called by ``weft.core._kernels`` when numba's cache cannot be used (kept once)."""
     if message not in _cache_notes:
         _cache_notes.append(message)
+
+
+_cache_repairs: list[str] = []
+
+
+def note_kernel_cache_repair(message: str) -> None:
+    """Called by ``weft.core._kernels`` when it dropped a damaged cache entry (kept once)."""
+    if message not in _cache_repairs:
+        _cache_repairs.append(message)
+
+
+def kernel_cache_repairs() -> list[str]:
+    """One-line notices of damaged kernel cache entries dropped (and compiled again) in this process."""
+    return list(_cache_repairs)
 
 
 def kernel_cache_notice() -> str | None:

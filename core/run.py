@@ -14,6 +14,7 @@ functions, so a batch output is byte for byte what ``weft run`` gives for that i
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from pathlib import Path
@@ -22,24 +23,35 @@ from typing import Mapping
 from .errors import ImageError, WeftError
 from .geometry import Square
 from .params import Params, Recipe, relative_path
+from .readfile import kind_of, open_regular, shown
 
 
 def load_recipe(path: str) -> Recipe:
     """A recipe from a ``.json`` file or from the ``weft-recipe`` chunk of a PNG weft exported; its
-    relative input paths are resolved against the file's folder. One-line ``WeftError`` naming the file."""
+    relative input paths are resolved against the file's folder. One-line ``WeftError`` naming the
+    file; an image of another format is told that only PNG exports (and ``.json`` files) carry a recipe."""
     from .image import read_recipe
+    from .image.files import _SIGNATURES
 
     p = Path(path)
+    name = shown(path)
     if not p.exists():
-        raise WeftError(f"{path}: no such file")
-    if p.suffix.lower() == ".png":
+        raise WeftError(f"{name}: no such file")
+    head = b""
+    with contextlib.suppress(OSError, WeftError), open_regular(p, "recipe file") as f:
+        head = f.read(8)
+    if head.startswith(b"\x89PNG"):
         text = read_recipe(p)
         if text is None:
-            raise WeftError(f"{path}: this PNG carries no weft recipe")
+            raise WeftError(f"{name}: this PNG carries no weft recipe (only PNGs exported by weft do)")
         try:
             return Recipe.from_json(text, base=p.resolve().parent)
         except WeftError as e:
-            raise WeftError(f"{path}: {e}") from None
+            raise WeftError(f"{name}: {e}") from None
+    fmt = next((fmt for magic, fmt in _SIGNATURES.items() if head.startswith(magic)), None)
+    if fmt is not None:
+        raise WeftError(f"{name}: a {fmt} image carries no recipe; only PNGs exported by weft (and .json "
+                        f"recipe files) do")
     return Recipe.load(p)
 
 
@@ -65,7 +77,9 @@ def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) 
     params = method.params.from_dict(recipe.params, base=base)
     for name, path in recipe.inputs.items():
         if name not in supplied and not os.path.exists(path):
-            raise WeftError(f"the {name} image {path} does not exist")
+            raise WeftError(f"the {name} image {shown(path)} does not exist")
+        if name not in supplied and (kind := kind_of(os.stat(path).st_mode)) is not None:
+            raise WeftError(f"the {name} image {shown(path)} is {kind}, not an image file")
     return params.to_dict()
 
 

@@ -208,7 +208,9 @@ def test_memory_for_all_workers_is_checked_up_front(scene, capsys, monkeypatch):
     monkeypatch.setattr("weft.core.batch.prepare.available_memory", lambda: 50_000)
     code, _, err = run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
                         tmp / "out/{stem}.png", "--workers", "1"], capsys)
-    assert code == 2 and "make the inputs smaller (even one item does not fit)" in err
+    # every item too large even alone: each fails by itself (exit 1), nothing is run or written
+    assert code == 1 and not (tmp / "out").exists()
+    assert err.strip().splitlines()[-1].startswith("0 written, 5 failed: frame_1.png: needs about 0 MiB of memory")
 
 
 def test_shipped_inputs_and_outputs_give_the_same_files(scene, capsys):

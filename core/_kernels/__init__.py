@@ -18,6 +18,10 @@ reports compilations; it is the only place that knows about numba's caching mach
 * **Safe concurrent saves.** numba's cache saves a new signature by rewriting the function's index
   and a numbered data file, without a lock; weft takes a file lock around each save (POSIX), so
   processes compiling at once (``weft warm-up``'s workers) cannot cross their files.
+* **Damaged cache files are repaired.** An index or data file that cannot be read back (cut short
+  by a power cut) made every run of its method fail with ``EOFError: Ran out of input``, and
+  ``weft warm-up`` too; such files are removed, the kernel is compiled again and saved, and
+  :func:`weft.core.registry.kernel_cache_repairs` says so in one line.
 * **Compile events.** numba announces every real compilation (a cache miss, never a cache load) as
   a ``numba:compile`` event; we forward their start and end to :mod:`weft.core.registry`, which lets a
   front end say "preparing ... — first run only" exactly while a compile happens, and leave the
@@ -170,6 +174,75 @@ def _install_save_lock() -> None:
         _caching.IndexDataCacheFile.save = _save_locked
 
 
+_DAMAGED_NOTICE = "numba's cache of {what} could not be read (damaged: {why}); it was dropped and compiled again"
+
+
+def _drop_damaged(cache_file, error: BaseException) -> None:
+    """Remove a function's cache files (its index and every data file) that could not be read (cut
+    short by a power cut, overwritten) and say so once; numba then compiles and saves it afresh."""
+    base = cache_file._index_name[:-len(".nbi")]
+    try:
+        names = [n for n in os.listdir(cache_file._cache_path)
+                 if n == cache_file._index_name or (n.startswith(base + ".") and n.endswith(".nbc"))]
+    except OSError:
+        names = []
+    for name in names:
+        try:
+            os.unlink(os.path.join(cache_file._cache_path, name))
+        except OSError:
+            pass
+    what = base.split("-")[0]
+    _registry.note_kernel_cache_repair(_DAMAGED_NOTICE.format(what=what, why=type(error).__name__))
+
+
+_original_load_index = _caching.IndexDataCacheFile._load_index
+_original_load_data = _caching.IndexDataCacheFile._load_data
+_original_load_overload = _caching.Cache.load_overload
+
+
+def _load_index_or_drop(self):
+    """numba's ``_load_index``, but an index that cannot be unpickled (``EOFError: Ran out of input``
+    for a truncated file) is dropped and read as empty, instead of failing every run for good."""
+    try:
+        return _original_load_index(self)
+    except (OSError, MemoryError):
+        raise
+    except Exception as e:  # noqa: BLE001 - a damaged pickle raises many kinds
+        _drop_damaged(self, e)
+        return {}
+
+
+def _load_data_or_drop(self, name):
+    """numba's ``_load_data``; a data file that cannot be unpickled is dropped with its index and
+    reported to numba as missing (``OSError``), which it treats as a cache miss."""
+    try:
+        return _original_load_data(self, name)
+    except (OSError, MemoryError):
+        raise
+    except Exception as e:  # noqa: BLE001
+        _drop_damaged(self, e)
+        raise OSError(f"damaged cache file {name}") from None
+
+
+def _load_overload_or_drop(self, sig, target_context):
+    """``Cache.load_overload``; an entry that unpickles but cannot be rebuilt into code is dropped
+    (and compiled again by the caller, as for any cache miss)."""
+    try:
+        return _original_load_overload(self, sig, target_context)
+    except (OSError, MemoryError):
+        raise
+    except Exception as e:  # noqa: BLE001
+        _drop_damaged(self._cache_file, e)
+        return None
+
+
+def _install_cache_repair() -> None:
+    if _caching.IndexDataCacheFile._load_index is not _load_index_or_drop:
+        _caching.IndexDataCacheFile._load_index = _load_index_or_drop
+        _caching.IndexDataCacheFile._load_data = _load_data_or_drop
+        _caching.Cache.load_overload = _load_overload_or_drop
+
+
 class _CompileListener(_event.Listener):
     """Forwards numba's ``numba:compile`` events to the registry, saying which are a thread's outermost
     (a kernel compiles the kernels it calls inside its own compile)."""
@@ -191,6 +264,7 @@ class _CompileListener(_event.Listener):
 _install_fallback_locator()
 _install_no_cache_fallback()
 _install_save_lock()
+_install_cache_repair()
 if not getattr(_registry, "_compile_listener_installed", False):
     _event.register("numba:compile", _CompileListener())
     _registry._compile_listener_installed = True

@@ -3,8 +3,10 @@ Dask pool behind one interface, and :func:`run` (see :mod:`weft.core.batch`)."""
 
 from __future__ import annotations
 
+import asyncio
 import collections
 import concurrent.futures as cf
+import contextlib
 import multiprocessing
 import os
 import secrets
@@ -18,7 +20,8 @@ from typing import Any, Callable, Mapping
 from ..errors import Cancelled, WeftError
 from ..jobs import CancelToken
 from ..limits import LimitError, _bytes
-from .prepare import BatchProgress, Item, Outcome, Plan, Summary, check_memory, item_memory
+from .prepare import (BatchProgress, Item, Outcome, Plan, Summary, check_memory, item_memory, too_large_alone,
+                      workers_that_fit)
 
 #: Times an item is started before a worker dying under it fails the item (Dask's default too).
 MAX_ATTEMPTS = 3
@@ -28,6 +31,20 @@ IN_FLIGHT_PER_WORKER = 2
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
 #: How long to try reaching a Dask scheduler before giving up.
 CONNECT_TIMEOUT = "10s"
+#: Environment variable: seconds to wait for a Dask scheduler to have a worker.
+WORKER_TIMEOUT_ENV = "WEFT_DASK_WORKER_TIMEOUT"
+
+
+def _worker_timeout() -> float:
+    try:
+        value = float(os.environ.get(WORKER_TIMEOUT_ENV, ""))
+    except ValueError:
+        return 30.0
+    return value if value > 0 else 30.0
+
+
+#: Seconds to wait for a Dask scheduler to have at least one worker (``WEFT_DASK_WORKER_TIMEOUT``).
+WORKER_TIMEOUT = _worker_timeout()
 
 # --------------------------------------------------------------------------------------------------
 # One item, on a worker
@@ -132,12 +149,38 @@ def _exit_with_parent(parent: int) -> None:
             os._exit(1)
 
 
+@contextlib.contextmanager
+def _interrupts_held():
+    """Ctrl-C held back while worker processes are started. SIGINT is blocked in this thread, so a
+    spawned worker inherits it blocked and a Ctrl-C meant for the client (the terminal sends it to
+    every process of the group) never interrupts the worker's start-up with a traceback (its
+    initializer then ignores it); and the client's own handler only notes it (another thread may
+    take the signal), to raise once the worker is launched, never half-way through launching it."""
+    import signal
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending = []
+    handler = signal.signal(signal.SIGINT, lambda signum, frame: pending.append(signum))
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.signal(signal.SIGINT, handler)
+    if pending and callable(handler):
+        handler(signal.SIGINT, None)
+
+
 def _init_local_worker(method_name: str, cancel_event, parent: int | None = None) -> None:
     """Local pool worker start: Ctrl-C is the client's to handle; kernels are loaded once."""
     import signal
 
     global _cancel_event
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # blocked by _interrupts_held; ignored now
     _cancel_event = cancel_event
     if parent is not None:
         threading.Thread(target=_exit_with_parent, args=(parent,), name="weft-batch-parent", daemon=True).start()
@@ -159,7 +202,8 @@ class LocalPool:
         self.workers = workers
         self.method = method
         self.ctx = multiprocessing.get_context("spawn")
-        self.cancel_event = self.ctx.Event()
+        with _interrupts_held():  # (the first semaphore starts multiprocessing's resource tracker)
+            self.cancel_event = self.ctx.Event()
         self.executor = None
         self.restarts = 0  # times a dead worker took the pool down and it was started again
         self.threads = max(1, default_workers() // workers)
@@ -168,13 +212,20 @@ class LocalPool:
     def _start(self) -> None:
         self.executor = cf.ProcessPoolExecutor(self.workers, mp_context=self.ctx, initializer=_init_local_worker,
                                                initargs=(self.method, self.cancel_event, os.getpid()))
-        if self.workers > 1:
-            # One worker loads the kernels before the others start: on a first run (no numba cache
-            # yet) it compiles them once and the others load its cache, instead of every worker
-            # compiling the same kernels at once (24 fast transfers on 2 workers with a fresh
-            # NUMBA_CACHE_DIR, whole command: 7.2 -> 5.2 s; warm cache 4.45 -> 4.44 s, medians of 3 at load
-            # ~4). The executor starts a process per submit.
-            self.executor.submit(_pid_after, 0.0).result()
+        if self.workers > 1:  # (the executor starts a process per submit: each under _interrupts_held)
+            try:
+                self._first_worker()
+            except BaseException:  # Ctrl-C while it starts: end it now, before the client goes
+                self.terminate()
+                raise
+
+    def _first_worker(self) -> None:
+        """One worker loads the kernels before the others start: on a first run (no numba cache yet)
+        it compiles them once and the others load its cache, instead of every worker compiling the
+        same kernels at once. The executor starts a process per submit."""
+        with _interrupts_held():
+            future = self.executor.submit(_pid_after, 0.0)
+        future.result()
 
     @property
     def slots(self) -> int:
@@ -184,11 +235,14 @@ class LocalPool:
         """Start every worker now and wait until each has loaded its kernels; their process ids."""
         seen: set[int] = set()
         while len(seen) < self.workers:  # each worker takes at most one short task while others are free
-            seen.update(f.result() for f in [self.executor.submit(_pid_after, 0.05) for _ in range(self.workers)])
+            with _interrupts_held():
+                futures = [self.executor.submit(_pid_after, 0.05) for _ in range(self.workers)]
+            seen.update(f.result() for f in futures)
         return sorted(seen)
 
     def submit(self, item: Item):
-        return self.executor.submit(run_item, replace(item, threads=self.threads))
+        with _interrupts_held():
+            return self.executor.submit(run_item, replace(item, threads=self.threads))
 
     def wait(self, futures, timeout: float):
         done, _ = cf.wait(futures, timeout=timeout, return_when=cf.FIRST_COMPLETED)
@@ -215,6 +269,20 @@ class LocalPool:
     def close(self) -> None:
         self.executor.shutdown(wait=True, cancel_futures=True)
 
+    def terminate(self) -> None:
+        """Stop at once (Ctrl-C): every worker is ended (SIGTERM) where it is, a running item's output
+        is lost whole (writes are atomic), and a worker still starting never prints a traceback."""
+        processes = list((getattr(self.executor, "_processes", None) or {}).values())
+        processes += [p for p in multiprocessing.active_children() if p not in processes]
+        for p in processes:
+            with contextlib.suppress(Exception):
+                p.terminate()
+        for p in processes:
+            with contextlib.suppress(Exception):
+                p.join(5)
+        with contextlib.suppress(Exception):
+            self.executor.shutdown(wait=False, cancel_futures=True)
+
 
 class DaskPool:
     """A Dask distributed client on ``address``: the items are ``client.submit(run_item, item)``."""
@@ -224,10 +292,24 @@ class DaskPool:
             from distributed import Client
         except ImportError:
             raise WeftError("a scheduler address needs Dask: pip install -e '.[cluster]'") from None
+        import logging
+
+        # distributed logs a lost connection with tracebacks; weft says what happened in one line
+        for name in ("distributed", "tornado"):
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        self.address = address
         try:
             self.client = Client(address, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError, ValueError) as e:
-            raise WeftError(f"cannot reach the Dask scheduler at {address} ({_one_line(e)})") from None
+        except Exception as e:  # noqa: BLE001 - OSError, TimeoutError; TypeError/ValueError for tls:// without
+            # certificates; ImportError for ucx:// without ucx-py
+            raise WeftError(f"cannot reach the Dask scheduler at {address} ({type(e).__name__}: {_one_line(e)})"
+                            ) from None
+        try:
+            self.client.wait_for_workers(1, timeout=WORKER_TIMEOUT)
+        except Exception:  # noqa: BLE001 - (TimeoutError, or the scheduler went away meanwhile)
+            self.close()
+            raise WeftError(f"the Dask scheduler at {address} has no workers (waited {WORKER_TIMEOUT:g} s; "
+                            f"set {WORKER_TIMEOUT_ENV} to wait longer)") from None
         self.method = method
         totals: dict[str, int] = collections.Counter()
         for addr, info in self.workers().items():
@@ -260,7 +342,7 @@ class DaskPool:
 
         try:
             done, _ = wait(list(futures), timeout=timeout, return_when="FIRST_COMPLETED")
-        except TimeoutError:
+        except Exception:  # noqa: BLE001 - a timeout, or the connection lost (run() checks lost())
             return set()
         return done
 
@@ -275,11 +357,17 @@ class DaskPool:
     def after_death(self) -> None:
         pass  # Dask has already retried the item on other workers
 
+    def lost(self) -> bool:
+        """Whether the connection to the scheduler is gone (the scheduler was stopped or killed)."""
+        return getattr(self.client, "status", "running") not in ("running", "connecting", "newly-created")
+
     def cancel(self, futures) -> None:
-        self.client.cancel(list(futures))
+        with contextlib.suppress(Exception):
+            self.client.cancel(list(futures))
 
     def close(self) -> None:
-        self.client.close()
+        with contextlib.suppress(Exception):
+            self.client.close(timeout=5)
 
 
 def scheduler_address(given: str | None) -> str | None:
@@ -320,14 +408,24 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
     LimitError
         The batch needs more memory than the workers have (nothing was run).
     """
+    from ..image.temporaries import remove_stale_temporaries
+
     summary = Summary(total=len(plan_.items))
     state = BatchProgress(summary.total, len(plan_.skipped))
+    remove_stale_temporaries(item.output for item in plan_.items)  # a killed earlier run's half-written files
     for item in plan_.skipped:
         summary.skipped += 1
         if on_outcome is not None:
             on_outcome(Outcome(item.index, item.label, item.output, "skipped"))
     todo = collections.deque(plan_.todo)
     t0 = time.monotonic()
+    if todo and pool is None and not scheduler:  # an item too large even alone fails alone; the rest run
+        alone = too_large_alone(todo)
+        for item, reason in alone:
+            _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
+                    item, summary, state, on_outcome, progress)
+        refused = {item.index for item, _ in alone}
+        todo = collections.deque(item for item in todo if item.index not in refused)
     if not todo:
         return summary
     own = pool is None
@@ -336,6 +434,8 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
             pool = DaskPool(scheduler, plan_.method)
         else:
             n = min(workers or default_workers(), len(todo))
+            if workers is None:  # not asked for: as many as fit in memory
+                n = workers_that_fit(todo, n)
             check_memory(todo, n)
             pool = LocalPool(n, plan_.method)
     try:
@@ -373,6 +473,14 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                                 item, summary, state, on_outcome, progress)
                         continue
                 inflight[pool.submit(item)] = item
+            if isinstance(pool, DaskPool) and pool.lost():  # every item not done fails with the reason
+                reason = f"the Dask scheduler at {pool.address} was lost before it was done"
+                for item in [*inflight.values(), *todo]:
+                    _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
+                            item, summary, state, on_outcome, progress)
+                inflight.clear()
+                todo.clear()
+                break
             died = []
             for future in pool.wait(inflight, timeout=0.2):
                 item = inflight.pop(future)
@@ -381,8 +489,11 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                 except WorkerDied:
                     died.append(item)
                     continue
-                except cf.CancelledError:
-                    continue
+                except (cf.CancelledError, asyncio.CancelledError):
+                    if not (isinstance(pool, DaskPool) and pool.lost()):
+                        continue
+                    outcome = Outcome(item.index, item.label, item.output, "failed",
+                                      error=f"the Dask scheduler at {pool.address} was lost before it was done")
                 except Exception as e:  # noqa: BLE001 - e.g. a Dask communication error: this item's
                     outcome = Outcome(item.index, item.label, item.output, "failed", error=_one_line(e))
                 _finish(outcome, item, summary, state, on_outcome, progress)
@@ -402,23 +513,35 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                         todo.appendleft(item)
                 pool.after_death()
     except KeyboardInterrupt:
-        pool.cancel(inflight)
+        if isinstance(pool, LocalPool):
+            pool.terminate()
+        else:
+            pool.cancel(inflight)
         raise
     finally:
         summary.seconds = time.monotonic() - t0
         if own:
-            pool.close()
+            try:
+                pool.close()
+            except KeyboardInterrupt:  # Ctrl-C while waiting for the workers to end (one still starting)
+                if isinstance(pool, LocalPool):
+                    pool.terminate()
+                raise
+            except Exception:  # noqa: BLE001 - (after terminate(): nothing left to wait for)
+                pass
     return summary
 
 
 def _ship(item: Item) -> Item:
     """The item with its input files' bytes attached (read here, on the client)."""
+    from ..errors import ImageError
     from ..image.files import _os_error
+    from ..readfile import open_regular
 
     shipped = {}
     for name, path in item.inputs.items():
         try:
-            with open(path, "rb") as f:
+            with open_regular(path, "image file", error=ImageError) as f:
                 shipped[name] = f.read()
         except OSError as e:
             raise _os_error(path, e) from None

@@ -16,6 +16,7 @@ from typing import Any, Iterable, Mapping, Sequence
 
 from ..errors import WeftError
 from ..limits import LimitError, _bytes, available_memory
+from ..readfile import file_key, kind_of, open_regular, shown
 
 #: File extensions a folder given to ``--over`` contributes (what :func:`weft.core.image.load_image` reads).
 IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp", ".gif")
@@ -209,7 +210,7 @@ def _format(pattern: str, values: dict) -> str:
 
 
 def _png_bit_depth(path: str) -> int | None:
-    with open(path, "rb") as f:
+    with open_regular(path, "PNG file") as f:
         head = f.read(26)
     return head[24] if len(head) == 26 and head[12:16] == b"IHDR" else None
 
@@ -228,13 +229,16 @@ def _item_bit_depth(method, inputs: Mapping[str, str], output: str, asked: int |
 
 
 def _done_already(item: Item) -> bool:
-    """The output exists, is a PNG of the item's bit depth and carries exactly the item's recipe."""
+    """The output exists, is a whole PNG (every chunk's CRC checked, up to its end: an interrupted copy
+    is not done) of the item's bit depth and carries exactly the item's recipe."""
     from ..image import read_recipe
+    from ..image.files import png_is_whole
 
     if not item.output.lower().endswith(".png") or not os.path.isfile(item.output):
         return False
     try:
-        return read_recipe(item.output) == item.recipe and _png_bit_depth(item.output) == item.bit_depth
+        return (read_recipe(item.output) == item.recipe and _png_bit_depth(item.output) == item.bit_depth
+                and png_is_whole(item.output))
     except (WeftError, OSError):
         return False
 
@@ -295,6 +299,7 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     from .. import registry
     from ..run import check_recipe, load_recipe, output_recipe
 
+    own_file = recipe is None  # the recipe is read from recipe_path: that file is an input too
     if recipe is None:
         recipe = load_recipe(recipe_path)
     base = Path(recipe_path).resolve().parent
@@ -338,23 +343,37 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     fixed = {k: str(Path(v).resolve()) for k, v in recipe.inputs.items() if k not in lists}
     rows = []
     seen: dict[str, str] = {}
-    all_inputs = set(os.path.realpath(p) for p in fixed.values())
+    # Files are compared by identity (device and inode): an output path that reaches an input (or the
+    # recipe file) through another mount of its folder or a link would overwrite it.
+    read = {file_key(p): p for p in fixed.values()}
     for files in lists.values():
-        all_inputs.update(os.path.realpath(p) for p in files)
+        read.update((file_key(p), p) for p in files)
+    if own_file:
+        read[file_key(recipe_path)] = recipe_path
+    keys: dict[tuple, str] = {}
     for i in range(n):
         over_files = {name: lists[name][i] for name in lists}
         values = {"stem": Path(over_files[first]).stem, "name": Path(over_files[first]).name, "index": i,
                   **{name: Path(path).stem for name, path in over_files.items()}}
         out = os.path.abspath(_format(pattern, values))
         label = os.path.basename(over_files[first])
-        if out in seen:
-            raise WeftError(f"pattern {pattern!r} gives {out} for both {seen[out]} and {label}: "
-                            "add {index} or {stem} so every item has its own output")
-        seen[out] = label
-        if os.path.realpath(out) in all_inputs:
-            raise WeftError(f"pattern {pattern!r}: refusing to overwrite the input file {out}")
-        if os.path.isdir(out):
-            raise WeftError(f"pattern {pattern!r} gives {out}, which is a folder")
+        key = file_key(out)
+        if out in seen or key in keys:
+            raise WeftError(f"pattern {pattern!r} gives {shown(out)} for both {shown(seen.get(out) or keys[key])} "
+                            f"and {shown(label)}: add {{index}} or {{stem}} so every item has its own output")
+        seen[out] = keys[key] = label
+        if key in read:
+            what = "recipe" if own_file and read[key] == recipe_path else "input"
+            raise WeftError(f"pattern {pattern!r}: refusing to overwrite the {what} file {shown(read[key])} "
+                            f"(as {shown(out)})")
+        try:
+            kind = kind_of(os.stat(out).st_mode)
+        except FileNotFoundError:
+            kind = None
+        except OSError as e:
+            raise WeftError(f"pattern {pattern!r} gives {shown(out)}: cannot write there ({e.strerror or e})") from None
+        if kind is not None:
+            raise WeftError(f"pattern {pattern!r} gives {shown(out)}, which is {kind}")
         inputs = {**fixed, **{k: str(Path(v).resolve()) for k, v in over_files.items()}}
         inputs = {spec.name: inputs[spec.name] for spec in method.inputs if spec.name in inputs}
         rows.append((i, label, inputs, out))
@@ -385,7 +404,8 @@ def _header_shape(path: str) -> tuple[int, ...] | None:
     from ..image.files import _GREY_MODES, _pil_open
 
     try:
-        im, _ = _pil_open(path)
+        with open_regular(path, "image file") as f:
+            im, _ = _pil_open(open(os.dup(f.fileno()), "rb"))
         with im:
             w, h = im.size
             return (h, w) if im.mode in _GREY_MODES else (h, w, 3)
@@ -421,6 +441,53 @@ def item_memory(items: Iterable[Item]) -> tuple[float, str]:
         if need > best:
             best, label = need, item.label
     return best, label
+
+
+def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> list[tuple[Item, str]]:
+    """The items that cannot run even alone, each with its one-line reason: an input whose header
+    claims more pixels than the pixel limit, or an estimated peak memory above ``available`` (default:
+    what the system has available now). They fail by themselves; the rest of the batch runs."""
+    from .. import registry
+    from ..image import get_max_pixels
+
+    items = list(items)
+    if not items:
+        return []
+    method = registry.get(items[0].method)
+    params = method.params.from_dict(items[0].params) if method.memory is not None else None
+    available = available_memory() if available is None else available
+    limit = get_max_pixels()
+    alone = []
+    for item in items:
+        shapes = {name: _header_shape(path) for name, path in item.inputs.items()}
+        big = next(((name, s) for name, s in shapes.items() if s is not None and s[0] * s[1] > limit), None)
+        if big is not None:
+            name, (h, w) = big[0], big[1][:2]
+            alone.append((item, f"{shown(item.inputs[name])}: {w}x{h} = {w * h / 1e6:.1f} megapixels exceeds the "
+                                f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)"))
+            continue
+        if params is None or available is None or any(s is None for s in shapes.values()):
+            continue
+        if item.region is not None:
+            first = method.inputs[0].name
+            shapes[first] = (item.region[2], item.region[2]) + tuple(shapes[first][2:])
+        try:
+            need = float(method.memory(shapes, params))
+        except (WeftError, KeyError, TypeError, ValueError):
+            continue
+        if need > available:
+            alone.append((item, f"needs about {_bytes(need)} of memory, {_bytes(available)} is available: "
+                                "make its inputs smaller"))
+    return alone
+
+
+def workers_that_fit(items: Iterable[Item], workers: int, *, available: int | None = None) -> int:
+    """At most ``workers``, as many as fit in memory at once (at least 1) by the largest item's estimate."""
+    need, _ = item_memory(items)
+    available = available_memory() if available is None else available
+    if not need or available is None:
+        return workers
+    return max(1, min(workers, int(available // need)))
 
 
 def check_memory(items: Iterable[Item], workers: int, *, available: int | None = None,

@@ -8,6 +8,7 @@ Every failure is an :class:`~weft.core.errors.ImageError` whose message is one l
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import numbers
 import os
@@ -25,7 +26,10 @@ import cv2
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
-from ..errors import ImageError, InvalidParameter
+from ..errors import ImageError, InvalidParameter, WeftError
+from ..readfile import open_regular, shown
+from .codec_output import _codec_output, _scan_damage
+from .temporaries import _writer_tag
 from .colour import _check_float_image, luminance
 
 # A corrupt file is reported once, by us, as one line: OpenCV's own warnings would add a second.
@@ -175,7 +179,9 @@ def _one_line(err: BaseException) -> str:
 def _os_error(name: str, err: OSError) -> ImageError:
     problem = {FileNotFoundError: "no such file", IsADirectoryError: "is a directory",
                PermissionError: "permission denied"}.get(type(err), f"cannot read ({err.strerror or _one_line(err)})")
-    return ImageError(f"{name}: {problem}", path=name)
+    if getattr(err, "errno", None) == errno.ELOOP:
+        problem = "a symbolic link loop"
+    return ImageError(f"{shown(name)}: {problem}", path=name)
 
 
 def _pil_open(source) -> tuple[Image.Image, bool]:
@@ -224,12 +230,33 @@ def _decode_pillow(data: np.ndarray) -> np.ndarray:
 
 def _damaged(name: str, reason: str) -> str | None:
     """A header Pillow could not read: name the format when the file starts with a known signature."""
-    with contextlib.suppress(OSError), open(name, "rb") as f:
+    with contextlib.suppress(OSError, ImageError), open_regular(name, error=ImageError) as f:
         head = f.read(4)
         for magic, fmt in _SIGNATURES.items():
             if head.startswith(magic):
                 return f"truncated or corrupt {fmt} data ({reason})"
     return None
+
+
+def _tiff_size(f) -> tuple[int, int] | None:
+    """(width, height) from a classic TIFF's first directory (tags 256 and 257), or None."""
+    head = f.read(8)
+    if len(head) < 8 or head[:4] not in (b"II*\0", b"MM\0*"):
+        return None
+    end = "<" if head[:2] == b"II" else ">"
+    f.seek(struct.unpack(end + "I", head[4:])[0])
+    raw = f.read(2)
+    if len(raw) < 2:
+        return None
+    count = struct.unpack(end + "H", raw)[0]
+    entries = f.read(12 * count)
+    found = {}
+    for i in range(len(entries) // 12):
+        tag, kind, n = struct.unpack(end + "HHI", entries[12 * i:12 * i + 8])
+        if tag in (256, 257) and n == 1 and kind in (3, 4):
+            value = entries[12 * i + 8:12 * i + 12]
+            found[tag] = struct.unpack(end + ("H" if kind == 3 else "I"), value[:2 if kind == 3 else 4])[0]
+    return (found[256], found[257]) if 256 in found and 257 in found and min(found.values()) > 0 else None
 
 
 def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: str | None = None,
@@ -270,20 +297,29 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
                                name="mode", value=mode)
     limit = get_max_pixels() if max_pixels is None else _check_limit(max_pixels)
     try:
-        st = os.stat(name)
-        if stat.S_ISDIR(st.st_mode):
-            raise IsADirectoryError(21, "Is a directory")
-        if st.st_size == 0:
-            raise ImageError(f"{name}: empty file", path=name)
-        im, animated = _pil_open(name)
-        with im:
-            fmt, (width, height), src_mode = im.format or "unknown", im.size, im.mode
-            had_alpha = src_mode in _ALPHA_MODES or "transparency" in im.info
-            orientation = _exif_orientation(im)
-        if width * height > limit:
-            raise ImageError(f"{name}: {width}x{height} = {width * height / 1e6:.1f} megapixels exceeds the limit of "
-                             f"{limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS or max_pixels to raise it)", path=name)
-        data = np.fromfile(name, dtype=np.uint8)
+        with open_regular(name, "image file", error=ImageError) as f:
+            if os.fstat(f.fileno()).st_size == 0:
+                raise ImageError(f"{shown(name)}: empty file", path=name)
+            try:
+                im, animated = _pil_open(open(os.dup(f.fileno()), "rb"))  # Pillow closes what it is given
+            except UnidentifiedImageError:
+                f.seek(0)
+                size = _tiff_size(f)  # a TIFF Pillow has no mode for (float RGB): OpenCV decodes it
+                if size is None:
+                    raise
+                im, animated = None, False
+                fmt, (width, height), src_mode, had_alpha, orientation = "TIFF", size, "RGB", False, 1
+            if im is not None:
+                with im:
+                    fmt, (width, height), src_mode = im.format or "unknown", im.size, im.mode
+                    had_alpha = src_mode in _ALPHA_MODES or "transparency" in im.info
+                    orientation = _exif_orientation(im)
+            if width * height > limit:
+                raise ImageError(f"{shown(name)}: {width}x{height} = {width * height / 1e6:.1f} megapixels exceeds the "
+                                 f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS or max_pixels to raise it)",
+                                 path=name)
+            f.seek(0)
+            data = np.fromfile(f, dtype=np.uint8)
     except ImageError:
         raise
     except Exception as e:  # noqa: BLE001 - Pillow raises many kinds on corrupt headers
@@ -293,40 +329,47 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
             problem = _damaged(name, "cannot read the header") or "not an image file (cannot identify format)"
         else:
             problem = _damaged(name, _one_line(e)) or f"corrupt image header ({_one_line(e)})"
-        raise ImageError(f"{name}: {problem}", path=name) from e
+        raise ImageError(f"{shown(name)}: {problem}", path=name) from e
 
+    said: list[str] = []
     try:
-        arr = None
-        if alpha and had_alpha:
-            grey = src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] == 4)
-            kept = _decode_alpha(data, grey, orientation)
-            if kept is not None:
-                return _loaded_alpha(kept, name, fmt, orientation, src_mode, animated, mode)
-        with contextlib.suppress(cv2.error):
-            arr = cv2.imdecode(data, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)  # applies EXIF orientation
-        if arr is None:  # OpenCV could not: truncated, corrupt, or a variant only Pillow reads
-            try:
-                arr = _decode_pillow(data)
-            except Exception as e:  # noqa: BLE001
-                raise ImageError(f"{name}: truncated or corrupt {fmt} data ({_one_line(e)})", path=name) from e
-        elif arr.ndim == 3:
-            arr = arr[..., 2::-1]  # BGR(A) -> RGB
+        kept = arr = None
+        with _codec_output(said):  # the codecs' own lines (libpng, libjpeg, libtiff) are ours to word
+            if alpha and had_alpha:
+                grey = src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] == 4)
+                kept = _decode_alpha(data, grey, orientation)
+            if kept is None:
+                with contextlib.suppress(cv2.error):
+                    arr = cv2.imdecode(data, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)  # applies EXIF orientation
+                if arr is None:  # OpenCV could not: truncated, corrupt, or a variant only Pillow reads
+                    try:
+                        arr = _decode_pillow(data)
+                    except Exception as e:  # noqa: BLE001
+                        raise ImageError(f"{shown(name)}: truncated or corrupt {fmt} data ({_one_line(e)})",
+                                         path=name) from e
+                elif arr.ndim == 3:
+                    arr = arr[..., 2::-1]  # BGR(A) -> RGB
+        damage = _scan_damage(said) if fmt == "JPEG" else None
+        if damage is not None:
+            raise ImageError(f"{shown(name)}: truncated or corrupt JPEG data ({damage})", path=name)
+        if kept is not None:
+            return _loaded_alpha(kept, name, fmt, orientation, src_mode, animated, mode)
         if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] == 3)):
             raise ValueError(f"unexpected decoder output of shape {arr.shape}")
         if arr.dtype not in (np.uint8, np.uint16):
-            raise ImageError(f"{name}: unsupported sample type {arr.dtype} (only 8- and 16-bit images are supported)",
-                             path=name)
+            raise ImageError(f"{shown(name)}: unsupported sample type {arr.dtype} (only 8- and 16-bit images are "
+                             "supported: save it with 8 or 16 bits per sample)", path=name)
         # OpenCV expands grey+alpha to three equal channels; Pillow calls 16-bit grey+alpha PNG "RGBA",
         # so for PNG the IHDR colour type (0 grey, 4 grey+alpha) decides.
         if arr.ndim == 3 and (src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] in (0, 4))):
             arr = arr[..., 0]
         image = arr.astype(np.float32, order="C") / np.float32(np.iinfo(arr.dtype).max)
     except MemoryError:
-        raise ImageError(f"{name}: not enough memory to decode {width}x{height} pixels", path=name) from None
+        raise ImageError(f"{shown(name)}: not enough memory to decode {width}x{height} pixels", path=name) from None
     except ImageError:
         raise
     except Exception as e:  # noqa: BLE001 - never let a raw cv2/numpy error escape
-        raise ImageError(f"{name}: cannot decode {fmt} data ({_one_line(e)})", path=name) from e
+        raise ImageError(f"{shown(name)}: cannot decode {fmt} data ({_one_line(e)})", path=name) from e
 
     notes = [text for cond, text in [
         (orientation != 1, f"EXIF orientation {orientation} applied"), (had_alpha, "alpha channel dropped"),
@@ -351,11 +394,12 @@ def file_bit_depth(path: str | os.PathLike) -> int | None:
     (``Method.depth_from``) and no bit depth was asked for."""
     name = os.fsdecode(path)
     try:
-        with open(name, "rb") as f:
+        with open_regular(name, error=ImageError) as f:
             head = f.read(26)
-        if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
-            return 16 if head[24] == 16 else 8
-        im, _ = _pil_open(name)
+            if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
+                return 16 if head[24] == 16 else 8
+            f.seek(0)
+            im, _ = _pil_open(open(os.dup(f.fileno()), "rb"))
         with im:
             if im.mode.startswith("I;16"):
                 return 16
@@ -439,10 +483,10 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     """
     path = Path(path)
     if not path.parent.is_dir():
-        raise ImageError(f"{path}: cannot write (folder {path.parent} does not exist)", path=str(path))
+        raise ImageError(f"{shown(path)}: cannot write (folder {path.parent} does not exist)", path=str(path))
     tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=f".{_writer_tag()}.tmp")
         with os.fdopen(fd, "wb") as f:
             f.write(data)
             f.flush()
@@ -457,7 +501,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
         os.replace(tmp, path)
         tmp = None
     except OSError as e:
-        raise ImageError(f"{path}: cannot write ({e.strerror or _one_line(e)})", path=str(path)) from e
+        raise ImageError(f"{shown(path)}: cannot write ({e.strerror or _one_line(e)})", path=str(path)) from e
     finally:
         if tmp is not None:
             with contextlib.suppress(OSError):
@@ -583,11 +627,16 @@ def read_recipe(path: str | os.PathLike) -> str | None:
     """The ``weft-recipe`` text (tEXt, zTXt or iTXt chunk) of a PNG file, parsed by hand.
 
     Returns ``None`` when the file is not a PNG or has no such chunk (chunks with a bad CRC or
-    that cannot be decoded are skipped). Raises :class:`ImageError` when the file cannot be read.
+    that cannot be decoded are skipped). Raises :class:`ImageError` when the file cannot be read, is
+    not a regular file (a named pipe, a device: refused unread), or its recipe is larger than
+    ``weft.core.jsonio.MAX_FILE_BYTES`` stored or inflated (a compressed chunk is inflated only that far).
     """
+    from ..jsonio import MAX_FILE_BYTES
+
     name = os.fsdecode(path)
+    too_large = f"{shown(name)}: recipe is longer than the {MAX_FILE_BYTES // 2**20} MB limit"
     try:
-        with open(name, "rb") as f:
+        with open_regular(name, "PNG file", error=ImageError) as f:
             if f.read(8) != _PNG_SIGNATURE:
                 return None
             while len(head := f.read(8)) == 8 and head[4:] != b"IEND":
@@ -595,17 +644,64 @@ def read_recipe(path: str | os.PathLike) -> str | None:
                 if kind not in (b"tEXt", b"zTXt", b"iTXt"):
                     f.seek(length + 4, os.SEEK_CUR)
                     continue
+                if length > MAX_FILE_BYTES + 100:
+                    if f.read(len(_RECIPE_KEY) + 1) == _RECIPE_KEY + b"\0":
+                        raise ImageError(too_large, path=name)
+                    f.seek(length + 4 - len(_RECIPE_KEY) - 1, os.SEEK_CUR)
+                    continue
                 body, crc = f.read(length), f.read(4)
                 key, _, rest = body.partition(b"\0")
                 if key != _RECIPE_KEY or crc != struct.pack(">I", zlib.crc32(kind + body)):
                     continue
-                with contextlib.suppress(ValueError, IndexError, zlib.error):
+                try:
                     if kind == b"tEXt":
                         return rest.decode("latin-1")
                     if kind == b"zTXt":
-                        return zlib.decompress(rest[1:]).decode("latin-1")
+                        return _inflate(rest[1:], MAX_FILE_BYTES, too_large, name).decode("latin-1")
                     text = rest[2:].split(b"\0", 2)[2]  # skip language tag and translated keyword
-                    return (zlib.decompress(text) if rest[0] else text).decode("utf-8")
+                    return (_inflate(text, MAX_FILE_BYTES, too_large, name) if rest[0] else text).decode("utf-8")
+                except ImageError:
+                    raise
+                except (ValueError, IndexError, zlib.error):
+                    continue
     except OSError as e:
         raise _os_error(name, e) from e
     return None
+
+
+def png_is_whole(path: str | os.PathLike) -> bool:
+    """Whether ``path`` is a whole PNG file: a regular file, the signature, every chunk with its
+    stated length and a matching CRC, up to the IEND chunk. A file cut short (an interrupted copy) or
+    with a flipped byte anywhere is not. Reads the file through once; never raises."""
+    try:
+        with open_regular(path, "PNG file", error=ImageError) as f:
+            if f.read(8) != _PNG_SIGNATURE:
+                return False
+            while len(head := f.read(8)) == 8:
+                length, kind = struct.unpack(">I4s", head)
+                crc = zlib.crc32(kind)
+                left = length
+                while left:
+                    block = f.read(min(left, 1 << 20))
+                    if not block:
+                        return False
+                    crc, left = zlib.crc32(block, crc), left - len(block)
+                if f.read(4) != struct.pack(">I", crc):
+                    return False
+                if kind == b"IEND":
+                    return True
+    except (OSError, WeftError):
+        return False
+    return False
+
+
+def _inflate(data: bytes, limit: int, too_large: str, name: str) -> bytes:
+    """zlib-inflate ``data`` to at most ``limit`` bytes; ``ImageError(too_large)`` past that, so a
+    small chunk that would inflate to gigabytes costs no more than ``limit`` of memory."""
+    inflater = zlib.decompressobj()
+    out = inflater.decompress(data, limit + 1)
+    if len(out) > limit:
+        raise ImageError(too_large, path=name)
+    if not inflater.eof:
+        raise zlib.error("incomplete compressed data")
+    return out

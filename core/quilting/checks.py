@@ -51,6 +51,11 @@ def _finish(img: np.ndarray, channels: int) -> np.ndarray:
 #: Seconds per source position per block for choosing a position and pasting (rule, cut), besides
 #: the DFTs: ~1 ns on the 2-core machine (fitted to ``python -m benchmarks.estimates``).
 SELECT_SECONDS_PER_POSITION = 1e-9
+#: Seconds per block besides its DFTs and position choice (overlap costs, the cut, pasting, the
+#: Python around them), ``SECONDS_PER_BLOCK + SECONDS_PER_BLOCK_SIDE * block``: what dominates small
+#: blocks (fitted to ``python -m benchmarks.limits``, ``benchmarks/results/limits.json``).
+SECONDS_PER_BLOCK = 4e-4
+SECONDS_PER_BLOCK_SIDE = 1.4e-4
 #: Bytes per output pixel of a job's peak memory (canvas, previous pass, correspondence maps and
 #: preview copies, float32; measured with /usr/bin/time -v on `weft quilt` of a 256x256 texture: 2048x2048
 #: synthesis 245 MB peak RSS, transfer 477 MB, of which ~100 MB are Python, NumPy, OpenCV and numba
@@ -68,8 +73,8 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
     Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel
     and the inverse; a transfer adds its correspondence and previous-pass spectra, computed on a
     second thread one row ahead, so they do not add up) plus a position choice over every source
-    position. ``passes`` are the (block, overlap) of each pass. Against real runs (``python -m
-    benchmarks.estimates``) it comes within 0.8..1.8x.
+    position, plus a fixed cost per block (:data:`SECONDS_PER_BLOCK`). ``passes`` are the (block,
+    overlap) of each pass. Fitted to real runs (``python -m benchmarks.limits``).
     """
     from ..limits import dft_seconds
 
@@ -81,7 +86,8 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
     for block, overlap in passes:
         blocks = _blocks(height, width, block, overlap, tile)
         positions = (h - block + 1) * (w - block + 1)
-        total += blocks * ((channels + 1) * dft + SELECT_SECONDS_PER_POSITION * positions)
+        total += blocks * ((channels + 1) * dft + SELECT_SECONDS_PER_POSITION * positions
+                            + SECONDS_PER_BLOCK + SECONDS_PER_BLOCK_SIDE * block)
     return total
 
 

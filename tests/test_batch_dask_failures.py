@@ -1,0 +1,119 @@
+"""Dask failures in one line each: an address weft cannot use (tls:// without certificates, ucx://
+without UCX), a scheduler with no workers (a time limit, not a silent wait), and a scheduler killed
+mid-batch (the summary of what was written, the rest failed with the reason, no traceback)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+distributed = pytest.importorskip("distributed")
+
+from weft.app.cli import main  # noqa: E402
+from weft.core.batch import execute  # noqa: E402
+
+from .test_batch import make_frames, scene, slow_scene  # noqa: E402,F401  (fixtures)
+
+DASK = Path(sys.executable).with_name("dask")
+
+
+def _run(argv, capfd):
+    code = main([str(a) for a in argv])
+    out, err = capfd.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("address", ["tls://127.0.0.1:1", "ucx://127.0.0.1:1"])
+def test_an_address_weft_cannot_use_is_one_line(scene, capfd, address):
+    tmp, _ = scene
+    code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
+                           tmp / "o" / "{stem}.png", "--scheduler", address], capfd)
+    assert code == 2 and err.count("\n") == 1 and err.startswith(f"weft: cannot reach the Dask scheduler at {address} ")
+    assert "internal error" not in err
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _start(args: list[str], tmp: Path) -> subprocess.Popen:
+    return subprocess.Popen([str(DASK), *args], cwd=tmp, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+
+
+def _wait_for_scheduler(address: str) -> None:
+    host, port = address.removeprefix("tcp://").rsplit(":", 1)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            socket.create_connection((host, int(port)), timeout=1).close()
+            return
+        except OSError:
+            time.sleep(0.1)
+    raise AssertionError("the scheduler did not start")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
+def test_a_scheduler_without_workers_is_a_time_limit_not_a_silent_wait(scene, capfd, monkeypatch, tmp_path):
+    tmp, _ = scene
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+                        "--dashboard-address", ":0"], tmp_path)
+    try:
+        _wait_for_scheduler(address)
+        monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)
+        code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
+                               tmp / "o" / "{stem}.png", "--scheduler", address], capfd)
+        assert code == 2 and err == (f"weft: the Dask scheduler at {address} has no workers (waited 2 s; set "
+                                     "WEFT_DASK_WORKER_TIMEOUT to wait longer)\n")
+    finally:
+        os.killpg(scheduler.pid, signal.SIGKILL)
+        scheduler.wait()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
+def test_a_scheduler_killed_mid_batch_ends_with_the_summary(slow_scene, capfd, tmp_path):
+    tmp, _ = slow_scene
+    recipe, frames = tmp / "look.json", tmp / "frames"
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+                        "--dashboard-address", ":0"], tmp_path)
+    worker = None
+    try:
+        _wait_for_scheduler(address)
+        worker = _start(["worker", address, "--nthreads", "1", "--nworkers", "1", "--no-dashboard"], tmp_path)
+        out_dir = tmp / "killed"
+
+        def kill_when_one_is_written():
+            deadline = time.monotonic() + 240
+            while time.monotonic() < deadline and not (out_dir.is_dir() and any(out_dir.glob("*.png"))):
+                time.sleep(0.05)
+            os.killpg(scheduler.pid, signal.SIGKILL)
+
+        import threading
+
+        killer = threading.Thread(target=kill_when_one_is_written, daemon=True)
+        killer.start()
+        code, out, err = _run(["batch", recipe, "--over", "target", frames, "-o", out_dir / "{stem}.png",
+                               "--scheduler", address, "-q"], capfd)
+        killer.join()
+        lines = err.strip().splitlines()
+        assert code == 1 and "Traceback" not in err and "internal error" not in err, err
+        assert "written" in lines[-1] and "was lost before it was done" in lines[-1], err
+    finally:
+        for p in (scheduler, worker):
+            if p is not None:
+                with __import__("contextlib").suppress(ProcessLookupError):
+                    os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
