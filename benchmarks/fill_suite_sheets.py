@@ -35,8 +35,7 @@ def contact_sheet(path: Path, inputs, weft: np.ndarray, peer: np.ndarray | None,
     panels = [("input", shown), ("weft", _rgb(weft)), (f"best peer: {peer_name}", None if peer is None else _rgb(peer)),
               ("truth", _rgb(inputs.truth))]
     ch, cw = box[0].stop - box[0].start, box[1].stop - box[1].start
-    scale = min(PANEL / max(ch, cw), 2 * PANEL / 3 / max(1, min(ch, cw)) if ch != cw else PANEL / ch)
-    scale = max(scale, 120 / cw)  # a panel at least 120 px wide, so its label reads
+    scale = max(PANEL / max(ch, cw), 120 / cw)  # a panel at least 120 px wide, so its label reads
     size = (max(1, round(cw * scale)), max(1, round(ch * scale)))
     label = 14
     sheet = Image.new("RGB", (4 * size[0] + 3 * 4, size[1] + 2 * label), (40, 40, 40))
