@@ -219,3 +219,21 @@ def test_fill_takes_no_region(files, tmp_path, capsys):
     with pytest.raises(WeftError, match="weft fill takes no --region"):
         render(registry.get("fill"), FillParams(), {"image": str(paths["grey"]), "mask": str(paths["mask"])}, 1,
                region=(0, 0, 40))
+
+
+def test_a_photo_given_as_the_mask_is_refused(files, tmp_path, capsys):
+    """A colour photo passed as --mask (or --source-mask) is one line and exit 2; a painted mask
+    with soft (anti-aliased) edges is still a mask."""
+    import cv2
+
+    paths, hole = files
+    o = tmp_path / "out.png"
+    _refused(capsys, ["fill", paths["colour"], "--mask", paths["colour"], "-o", o, "-q"], o,
+             "colour.png", "the mask is not black and white", "% of its pixels are grey or coloured")
+    _refused(capsys, ["fill", paths["colour"], "--mask", paths["mask"], "--source-mask", paths["grey"], "-o", o, "-q"],
+             o, "grey.png", "the source mask is not black and white")
+    soft = cv2.GaussianBlur(hole.astype(np.float32), (9, 9), 2.0)
+    assert ((soft > 0.1) & (soft < 0.9)).any()
+    save_image(tmp_path / "soft.png", soft)
+    code, _, err = run(["fill", paths["colour"], "--mask", tmp_path / "soft.png", "-o", o, "-q"], capsys)
+    assert code == 0, err

@@ -63,7 +63,30 @@ def _mask_bits(mask, shape: tuple[int, int], what: str, against: str) -> np.ndar
     if m.shape[:2] != tuple(shape):
         raise _error(ImageError, f"the {what.replace('_', ' ')} is {m.shape[1]}x{m.shape[0]} but the {against} is "
                      f"{shape[1]}x{shape[0]}; they must be the same size", what)
-    return Mask.from_image(m.astype(np.float32), what).bits if m.dtype != bool else m
+    if m.dtype == bool:
+        return m
+    _black_and_white(m, what)
+    return Mask.from_image(m.astype(np.float32), what).bits
+
+
+#: A mask is refused when more than this share of its pixels is neither nearly black nor nearly white
+#: (or is coloured): a photo given as the mask, not a painted mask with soft edges.
+MAX_GREY_SHARE = 0.25
+
+
+def _black_and_white(m: np.ndarray, what: str) -> None:
+    """Refuse a mask that is not nearly black and white (a photo passed by mistake)."""
+    arr = np.asarray(m, dtype=np.float32)
+    if arr.ndim == 3 and arr.shape[2] in (2, 4):  # a transparent pixel reads as black
+        arr = arr[..., :-1] * arr[..., -1:]
+    grey = arr if arr.ndim == 2 else arr.mean(axis=2)
+    odd = (grey > 0.1) & (grey < 0.9)
+    if arr.ndim == 3 and arr.shape[2] >= 3:
+        odd |= (arr.max(axis=2) - arr.min(axis=2)) > 0.1
+    share = float(odd.mean())
+    if share > MAX_GREY_SHARE:
+        raise _error(ImageError, f"the {what.replace('_', ' ')} is not black and white: {share:.0%} of its pixels are "
+                     "grey or coloured (white = fill, black = keep; was a photo given as the mask?)", what)
 
 
 def _margins(params: FillParams, w: int, h: int) -> Margins | None:
