@@ -173,6 +173,9 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         hole = transparent.copy()
         named = "alpha"
     margins = _margins(params, w, h)
+    inner = _interior(hole) if hole.any() else None
+    if inner is not None and inner.any() and (margins is not None or (params.engine == "auto" and (hole & ~inner).any())):
+        return _by_region(image, hole, inner, params, source_mask, texture, rng, progress, cancel)
     if margins is None and named is None:
         raise WeftError("nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size "
                         "(--size WxH), or an image with transparent pixels")
@@ -318,6 +321,52 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     if margins:
         figures["extend"] = margins.to_json()
     return np.ascontiguousarray(out, dtype=np.float32), figures
+
+
+def _interior(hole: np.ndarray) -> np.ndarray:
+    """The connected regions of ``hole`` (8-connected) that do not touch the picture's border."""
+    n, labels = cv2.connectedComponents(hole.astype(np.uint8), connectivity=8)
+    touches = np.zeros(n, bool)
+    touches[np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])] = True
+    return hole & ~touches[labels]
+
+
+def _by_region(image, hole, inner, params, source_mask, texture, rng, progress, cancel) -> tuple[np.ndarray, dict]:
+    """Fill the hole's interior regions first, on the picture as given (no margins), then its regions
+    along the border and the margins: growing the canvas does not change the engine or the pixels
+    inside an interior hole, and each kind of region gets the engine that suits it."""
+    first_params = params.replace(extend=None, size=None)
+    inside, fig1 = fill_image(image, inner, params=first_params, source_mask=source_mask, texture=texture, rng=rng,
+                              progress=_scaled(progress, 0, 2), cancel=cancel)
+    rest = hole & ~inner
+    if not rest.any() and _margins(params, hole.shape[1], hole.shape[0]) is None:
+        return inside, fig1
+    out, fig2 = fill_image(inside, rest, params=params, source_mask=source_mask, texture=texture, rng=rng,
+                           progress=_scaled(progress, 1, 2), cancel=cancel)
+    figures = dict(fig2)
+    if fig1["engine"] != fig2["engine"]:
+        figures["engine"] = f"{fig1['engine']} inside, {fig2['engine']} along the border"
+    figures["hole_pixels"] = fig1["hole_pixels"] + fig2["hole_pixels"]
+    figures["hole_fraction"] = round(figures["hole_pixels"] / float(np.prod(out.shape[:2])), 4)
+    if "edges_continued" in fig1:
+        figures["edges_continued"] = fig1["edges_continued"] + fig2.get("edges_continued", 0)
+    return out, figures
+
+
+def _scaled(progress, part: int, parts: int):
+    """A progress callback that reports a pass's fraction as part ``part`` of ``parts`` equal passes."""
+    if progress is None:
+        return None
+    from ..jobs import Progress
+
+    def report(p: Progress) -> None:
+        total = max(1, p.total)
+        progress(p._replace(done=part * total + p.done, total=parts * total))
+
+    for attr in ("wants_preview", "preview_interval"):
+        if hasattr(progress, attr):
+            setattr(report, attr, getattr(progress, attr))
+    return report
 
 
 def engine_text(params: FillParams) -> str:
