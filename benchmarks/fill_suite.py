@@ -315,10 +315,16 @@ def main(argv: list[str] | None = None) -> int:
     sheets = None if args.quick else (args.sheets or (RESULTS / "fill_suite" if full else args.cache / "sheets"))
     variants = [v for v in args.variants.split(",") if v]
     rows: list[dict[str, Any]] = []
+    partial = args.cache / "rows.jsonl"  # each case's rows as it ends, for a run that is cut short
+    args.cache.mkdir(parents=True, exist_ok=True)
+    partial.write_text("")
     for case in cases:
         print(f"{case.name} ({case.half}) ...", file=sys.stderr, flush=True)
-        rows += run_case(case, repeats=1 if args.quick else args.repeats, variants=variants, cache=args.cache,
-                         reuse=args.reuse_peers, sheets=sheets)
+        new = run_case(case, repeats=1 if args.quick else args.repeats, variants=variants, cache=args.cache,
+                       reuse=args.reuse_peers, sheets=sheets)
+        rows += new
+        with partial.open("a") as f:
+            f.write("".join(json.dumps(r, default=float) + "\n" for r in new))
     agg = aggregate(rows)
     machine = {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
                "cores": os.cpu_count(), "python": platform.python_version(),

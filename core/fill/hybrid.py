@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..jobs import ProgressReporter
 from ..params import as_rng
 from .quilt import fill_quilt
 
@@ -44,8 +45,8 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
     the hole and those pixels with :func:`~weft.core.fill.patchmatch.refine_patchmatch`
     (``refine_patch``, ``iterations``), copying only from source pixels outside them.
 
-    ``progress(done, total)`` counts the quilting's filled pixels, then one unit per refine
-    iteration; ``cancel`` is checked by both. Every pixel outside the hole and the band equals the
+    ``progress`` (:class:`weft.core.jobs.Progress`) counts the quilting's filled pixels, then one
+    unit per refine iteration; ``cancel`` is checked by both. Every pixel outside the hole and the band equals the
     input exactly. Raises as :func:`~weft.core.fill.quilt.fill_quilt` does.
     """
     from .band import band_region
@@ -56,13 +57,13 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
     total = max(1, int(holes.sum()))
     span = total + int(iterations)
 
-    def quilt_progress(done, _total):
-        if progress is not None:
-            progress(done, span)
+    report = ProgressReporter(progress, "fill", span)
+
+    def quilt_progress(p):
+        report.update(int(p.fraction * total))
 
     def refine_progress(p):
-        if progress is not None:
-            progress(total + int(round(p.fraction * iterations)), span)
+        report.update(total + int(round(p.fraction * iterations)))
 
     quilted = fill_quilt(image, holes, source, patch=patch, rng=gen, progress=quilt_progress, cancel=cancel,
                          band=band, cuttable=cuttable, refine=False)  # (its own refine follows)

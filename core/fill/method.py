@@ -10,32 +10,14 @@ import numpy as np
 from ..errors import ImageError, InvalidParameter, WeftError
 from ..geometry import MARGINS, MASK, Margins, Mask
 from ..image import validate_image
-from ..jobs import ProgressReporter
 from ..limits import check_output_size
 from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
 from .common import neighbourhood, touches_border, whole_patches
+from .engines import TABLE
 from .params import ANCHORS, BORDER_BLOCK, DEFAULT_PATCH, FillParams, auto_engine
-from .quilt import is_colour, refines
-
-
-def _engine(name: str):
-    if name == "quilt":
-        from .quilt import fill_quilt
-
-        return fill_quilt
-    if name == "pixel":
-        from .pixel import fill_pixel
-
-        return fill_pixel
-    if name == "hybrid":
-        from .hybrid import fill_hybrid
-
-        return fill_hybrid
-    from .patchmatch import fill_patchmatch
-
-    return fill_patchmatch
+from .quilt import is_colour
 
 
 def _error(cls, message: str, input: str | None = None, **kw):
@@ -259,26 +241,17 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         work, work_hole, work_src = big, big_hole, big_src
     else:
         work, work_hole, work_src = colour, hole, src_region
-    reporter = ProgressReporter(progress, f"fill ({params.engine})", 100)
-
-    def engine_progress(done: int, total: int) -> None:
-        reporter.update(int(100 * done // max(1, total)))
-
     extra = {}
-    if params.engine in ("quilt", "hybrid", "patchmatch") and params.band > 0:
-        # the quilting cut may run through the band's known pixels (gravel and brick, two holes each,
-        # seeds 1-3: brick coherence 0.51 -> 0.44 and 0.54 -> 0.45 of the truth's, seam +0.16 -> +0.13
-        # and +0.38 -> +0.23 from the truth's; gravel 0.60/0.64 -> 0.61/0.57, seam -0.07/-0.29 -> -0.10/-0.36)
-        # the image's own band (never its transparent pixels), on the engine's canvas: a band worked
-        # out there would also take the image's last rows and columns beside a texture's gap
+    engine = TABLE[params.engine]
+    if engine.cuttable and params.band > 0:
+        # the engine may change the band's known pixels (a quilting cut through them, or a refine that
+        # re-synthesises them): the image's own band (never its transparent pixels), on the engine's
+        # canvas (a band worked out there would also take the image's last rows beside a texture's gap)
         from .band import band_region
 
         cut = np.zeros(work_hole.shape, dtype=bool)
         cut[:ch, :cw] = band_region(hole, params.band, exclude=transparent) & ~hole
         extra = {"cuttable": cut}
-    # quilt and pixel report progress(done, total); the PatchMatch engine reports weft.core.jobs.Progress
-    # itself (its ProgressReporter), so it gets the method's callback as it is
-    engine_report = progress if params.engine == "patchmatch" else engine_progress
     # a small hole in a large picture: the engine fills the hole's neighbourhood alone
     near = neighbourhood(work_hole, work_src, patch) if texture is None else None
     part = (slice(None), slice(None)) if near is None else near
@@ -288,18 +261,16 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
 
         engine_kw["guide"], continued = structure_guide(work[part], work_hole[part],
                                                         ~work_hole[part] & ~transparent[part])
-    filled = _engine(params.engine)(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
-                                    progress=engine_report, cancel=cancel, **engine_kw)
+    filled = engine.function()(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
+                               progress=progress, cancel=cancel, **engine_kw)
     if near is not None:
         whole = np.array(work, dtype=np.float32)
         whole[near] = filled
         filled = whole
     filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
     out3 = filled if filled.ndim == 3 else filled[..., None]
-    # (the refine of hybrid, patchmatch and quilt on colour pictures re-synthesises the band itself;
-    # whether quilt refined is asked of the part it filled, as it asked itself)
-    refined = params.engine in ("hybrid", "patchmatch") or (params.engine == "quilt"
-                                                           and refines(work[part], work_hole[part]))
+    # (whether the engine re-synthesised the band is asked of the part it filled, as it asked itself)
+    refined = engine.resynthesises_band(work[part], work_hole[part])
     if not refined:
         written = hole
         if extra:  # the band's known pixels the quilting cut ran through: the seam lies beside them
@@ -429,7 +400,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 
-#: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting
+#: The studio's description of fill, as the studio shows it (``METHOD.studio``): painting
 #: the mask previews the region around the stroke (``preview_around``); the optional ``texture`` is
 #: fill's own (``own_inputs``: the texture the studio has open for quilt and fast is not a source).
 STUDIO = Studio(

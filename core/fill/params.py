@@ -10,30 +10,23 @@ import numpy as np
 from ..errors import InvalidParameter
 from ..geometry import MAX_SIDE, Margins
 from ..params import Params, param
+from .engines import TABLE
 
 #: Where the image goes on a larger ``--size`` canvas.
 ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-left", "bottom", "bottom-right")
 
 
-#: The engines `--engine` offers (each a function of one signature, see the package docstring), and
-#: ``auto``, which picks one of them for the picture (:func:`auto_engine`).
-ENGINES = ("auto", "patchmatch", "quilt", "pixel", "hybrid")
-#: The default engine: ``auto``, the pick that measures best on each of issue 15's cases (see the
-#: package docstring for the figures).
+#: The engines `--engine` offers (:data:`weft.core.fill.engines.TABLE`), and ``auto``, which picks one
+#: of them for the picture (:func:`auto_engine`).
+ENGINES = ("auto", *TABLE)
+#: The default engine.
 DEFAULT_ENGINE = "auto"
 #: Each engine's patch side when ``patch`` is not given.
-DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7, "hybrid": 48}
+DEFAULT_PATCH = {name: e.patch for name, e in TABLE.items()}
 #: The quilt's block when ``patch`` is not given and the hole runs along the canvas border more than
 #: 24 px deep (an uncrop, an extended canvas, a rectification's wide transparent border): at most a
 #: third of the canvas's smaller side. With 24-px blocks an extension a few blocks deep drifts from
-#: the picture's structure block by block (the bundled brick's right 82 px grown back, seeds 0-5: bricks without joints,
-#: coherence 1.38, seam +1.75 over the truth's); with 48: 0.76 and +0.13, in 57 ms against 136. On
-#: the benchmark's 256 -> 384 uncrop 0.73 -> 0.81 (G'MIC's 1.55), seam -0.08..+0.09 from the truth's,
-#: 300 -> 189 ms; one-sided extensions of gravel 4.03 -> 2.67 and grass 4.86 -> 4.13. On colour
-#: pictures (the quilt and its refine) the right third of the bundled chelsea grown back: seam
-#: +0.34 -> -0.06 over the truth's (medians of seeds 0-5), perspective-frontal coherence 0.87 -> 0.55;
-#: wood-grain (112 px wide: a 37-px block) lost the visible seam at the join, though its coherence
-#: went 2.38 -> 3.66.
+#: the picture's structure block by block (bricks without joints).
 BORDER_BLOCK = 48
 #: ``structure``'s values (:mod:`weft.core.fill.structure`): the edges a hole cuts are continued
 #: whenever ``patchmatch`` fills from the picture itself (``auto``, the default), always (``yes``:
@@ -46,12 +39,8 @@ class FillParams(Params):
     """Parameters of ``weft fill``."""
 
     engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
-                        help="auto: patchmatch for a hole inside a colour picture, quilt otherwise (grey "
-                             "pictures, holes along the border, uncrop); "
-                             "quilt: blocks in fill-front order with min-cut seams (Efros & Freeman); "
-                             "pixel: coherent pixel synthesis (Ashikhmin)"
-                             "; patchmatch: multi-scale patch search with voting"
-                             "; hybrid: quilt, then full-resolution patch search refines the seams")
+                        help="auto: the engine that suits the hole's surroundings; "
+                             + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()))
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
                        help="patch side in pixels (quilt, hybrid: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
                             "default per engine, smaller on a small image: "

@@ -309,7 +309,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     source : bool (H, W), optional: the pixels whose blocks may be copied (default ``~hole``).
     patch : int >= 3, the block side ``B`` (at most the image's smaller side).
     rng : seed or ``np.random.Generator``: same seed, same output.
-    progress : ``progress(done, total)`` in filled pixels, called when the percentage changes.
+    progress : gets :class:`weft.core.jobs.Progress` (stage ``"fill"``, in filled pixels) when the percentage changes.
     cancel : a ``CancelToken``, checked before every block.
     band : int >= 0, default 0: known pixels within this many px of the hole may be cut into (above).
     cuttable : bool (H, W) or None: the known pixels that may be cut into, given instead of ``band``
