@@ -156,7 +156,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         named = "alpha"
     margins = _margins(params, w, h)
     inner = _interior(hole) if hole.any() else None
-    if inner is not None and inner.any() and (margins is not None or (params.engine == "auto" and (hole & ~inner).any())):
+    if margins is not None and inner is not None and inner.any():
         return _by_region(image, hole, inner, params, source_mask, texture, rng, progress, cancel)
     if margins is None and named is None:
         raise WeftError("nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size "
@@ -305,7 +305,7 @@ def _interior(hole: np.ndarray) -> np.ndarray:
 def _by_region(image, hole, inner, params, source_mask, texture, rng, progress, cancel) -> tuple[np.ndarray, dict]:
     """Fill the hole's interior regions first, on the picture as given (no margins), then its regions
     along the border and the margins: growing the canvas does not change the engine or the pixels
-    inside an interior hole, and each kind of region gets the engine that suits it."""
+    inside an interior hole."""
     first_params = params.replace(extend=None, size=None)
     inside, fig1 = fill_image(image, inner, params=first_params, source_mask=source_mask, texture=texture, rng=rng,
                               progress=_scaled(progress, 0, 2), cancel=cancel)

@@ -39,7 +39,7 @@ class FillParams(Params):
     """Parameters of ``weft fill``."""
 
     engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
-                        help="auto: the engine that suits the hole's surroundings; "
+                        help="auto: hybrid (patchmatch with --structure yes); "
                              + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()))
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
                        help="patch side in pixels (quilt, hybrid: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
@@ -105,14 +105,9 @@ def structure_value(value):
 
 
 def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto") -> str:
-    """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (its guide is that engine's), and
-    for a hole inside a colour picture (removing an
-    object from a photo: coherence 4.45 against quilt's 5.40 on issue 15's photo, seeds 0-4), unless
-    the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.24,
-    brick 1.05 against 1.35) and for holes along the canvas border, an uncrop's (0.81 against 0.85,
-    seeds 0-4 medians, in a quarter of the time: 0.27 against 1.01 s in the benchmark's run)."""
-    from .patchmatch import MAX_PATCH
-
-    if structure == "yes" or (colour_picture and not hole_on_border and (patch is None or patch <= MAX_PATCH)):
-        return "patchmatch"
-    return "quilt"
+    """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (the edge guide is that
+    engine's), else ``hybrid`` (quilting, then full-resolution patch search), on grey and colour
+    pictures, holes and uncrops alike: on the fill suite's tuning half it was the most coherent
+    engine in most cases and had the fewest defects (``python -m benchmarks.fill_suite``). The
+    picture's kind and the hole's place are accepted for the callers that pass them, and unused."""
+    return "patchmatch" if structure == "yes" else "hybrid"

@@ -27,7 +27,6 @@ Every pixel outside the hole (and ``cuttable``) is returned exactly as given.
 
 from __future__ import annotations
 
-import os
 from typing import Callable
 
 import numpy as np
@@ -36,7 +35,7 @@ from ..errors import ImageError
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
 from .common import touches_border, whole_patches
-from .search import (MAX_PATCH, MIN_PATCH, STEPS_FIRST, Flat, check_inputs, em, rarity, refine_band,
+from .search import (MAX_PATCH, MIN_PATCH, STEPS_FIRST, Flat, check_inputs, em, refine_band,
                      refine_patchmatch, vote_mode)
 
 __all__ = ["fill_patchmatch", "refine_patchmatch", "refine_band", "MIN_PATCH", "MAX_PATCH"]
@@ -68,8 +67,6 @@ _GUIDE_WEIGHT = 1.0
 # the inexact patches whose distance is at least this percentile of theirs
 _FINAL_REFINE, _FINAL_WORST = 3, 50
 _FINAL_REFINE_GUIDED = 4
-# the coarsest level's cost for copying a rare source patch (an eye, a nose) more than once
-REPEAT_PENALTY = float(os.environ.get("WEFT_REPEAT", "0"))
 
 
 def _halve(img: np.ndarray, hole: np.ndarray, source: np.ndarray):
@@ -236,8 +233,6 @@ def fill_patchmatch(
         im = lv.img
         if li == n - 1:
             fl = Flat(im, lv.hole, lv.source, p, conf=lv.conf, fixed=fixed)
-            if REPEAT_PENALTY > 0:
-                fl.rarity = rarity(im[..., :min(3, nch)], lv.source, p)
             sy, sx = _random_matches(fl, gen)
         else:
             fixed = None  # the guide steers the coarsest level's layout only
@@ -256,8 +251,7 @@ def fill_patchmatch(
                 report.update(done0 + _it + 1)
 
             em(fl, im, lv.hole, sy, sx, dist, iterations=schedule[li], gen=gen, steps_first=STEPS_FIRST,
-                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step, fixed=fixed,
-                repeat=REPEAT_PENALTY if li == n - 1 else 0.0)
+                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step, fixed=fixed)
             done += schedule[li]
     res = pyramid[0].img[..., :nch]
     if out.ndim == 2:

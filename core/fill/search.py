@@ -108,8 +108,6 @@ class Flat:
         self.ty, self.tx = ty.astype(np.int64), tx.astype(np.int64)
         self.tmap = np.full(touches.shape, -1, np.int64)
         self.tmap[ty, tx] = np.arange(len(ty))
-        self.penalty = None  # (hv, wv) float64 or None: a cost added to every source corner's distance
-        self.rarity = None  # (hv, wv) or None: each source patch's colour rarity, 0..1 (repetition_cost)
         self.weights = None  # (N, P * C) float32: the target patches' confidences, a pixel's repeated per channel
         self.mean_conf = None  # (N,) float64: their means over the patch
         if conf is not None:
@@ -131,46 +129,14 @@ class Flat:
         d = self.gather(sy, sx)  # a fresh copy (fancy indexing): worked on in place
         np.subtract(targets, d, out=d)
         if self.weights is None:
-            out = np.einsum("nk,nk->n", d, d)
-        else:
-            np.multiply(d, d, out=d)  # (a three-operand einsum is 1.6x slower than squaring, then two)
-            out = np.einsum("nk,nk->n", self.weights[k], d)
-        return out if self.penalty is None else out + self.penalty[sy, sx]
+            return np.einsum("nk,nk->n", d, d)
+        np.multiply(d, d, out=d)  # (a three-operand einsum is 1.6x slower than squaring, then two)
+        return np.einsum("nk,nk->n", self.weights[k], d)
 
     def normalized(self, dist: np.ndarray) -> np.ndarray:
         """Distances per patch pixel (and per unit of confidence), for the vote's weights."""
         p2 = self.p * self.p
         return dist / p2 if self.mean_conf is None else dist / (self.mean_conf * p2)
-
-
-def _repetition_cost(fl: Flat, sy: np.ndarray, sx: np.ndarray, dist: np.ndarray, weight: float) -> np.ndarray:
-    """A cost per source corner: ``weight`` x the median match distance x how many times the current
-    matches copy that patch x its colours' rarity (``fl.rarity``, 1 when unset), so a distinctive
-    detail (an eye, a nose) beside the hole is not copied into it again and again."""
-    hv, wv = fl.valid.shape
-    p = fl.p
-    corners = np.zeros((hv, wv), np.float64)
-    np.add.at(corners, (sy, sx), 1.0)
-    pad = np.zeros((hv + 2 * (p - 1), wv + 2 * (p - 1)), np.float64)
-    pad[p - 1:p - 1 + hv, p - 1:p - 1 + wv] = corners
-    per_pixel = box_sum(pad, p)  # each pixel's uses: the matched corners up to p - 1 above and left of it
-    uses = box_sum(per_pixel, p) / float(p ** 4)  # how many times each source patch is copied, by its corner
-    scale = float(np.median(dist)) if len(dist) else 0.0
-    rare = fl.rarity if fl.rarity is not None else 1.0
-    return weight * scale * rare * uses
-
-
-def rarity(img: np.ndarray, source: np.ndarray, p: int) -> np.ndarray:
-    """How rare each source patch's colours are among the source's (0 common .. ~1 rarest), by corner."""
-    q = np.clip((img * 6).astype(np.int64), 0, 5)
-    code = q[..., 0] * 36 + q[..., 1] * 6 + q[..., 2] if img.shape[2] >= 3 else q[..., 0]
-    counts = np.bincount(code[source], minlength=216).astype(np.float64)
-    share = counts / max(1.0, counts.sum())
-    r = -np.log2(np.maximum(share[code], 1e-6))
-    r = np.where(source, r, 0.0)
-    lo, hi = (percentile(r[source], 50), percentile(r[source], 99)) if source.any() else (0.0, 1.0)
-    r = np.clip((r - lo) / max(hi - lo, 1e-6), 0.0, 1.0)
-    return box_sum(r, p) / float(p * p)
 
 
 def _try(fl: Flat, targets, act, sy, sx, dist, cy, cx, ok, bias: float = 0.0) -> None:
@@ -388,7 +354,7 @@ def refine_patchmatch(
 def em(fl: Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.ndarray, dist: np.ndarray, *,
         iterations: int, gen: np.random.Generator, steps_first: tuple[int, ...], shrink: int, bias: float,
         worst: float, cancel: CancelToken | None, on_iteration: Callable[[int], None],
-        last_stride: int | None = None, fixed: slice | None = None, repeat: float = 0.0) -> None:
+        last_stride: int | None = None, fixed: slice | None = None) -> None:
     """EM iterations on ``img`` (the array ``fl`` views), improving the matches (``sy``, ``sx``, their
     ``dist``) of ``fl``'s target patches and writing the hole's pixels, in place. Each iteration:
     (E) the inexact patches (a distance above 0; with ``worst``, at least that percentile of their
@@ -406,11 +372,7 @@ def em(fl: Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.ndarr
     for it in range(iterations):
         if cancel is not None:
             cancel.raise_if_cancelled()
-        if repeat > 0 and changed is not None:  # every distance carries the new repetition cost
-            fl.penalty = _repetition_cost(fl, sy, sx, dist, repeat)
-            everyone = np.arange(len(fl.ty))
-            dist[:] = fl.dist(fl.gather(fl.ty, fl.tx), everyone, sy, sx)
-        elif changed is not None:  # the vote changed pixels: the distances of the patches over them are stale
+        if changed is not None:  # the vote changed pixels: the distances of the patches over them are stale
             stale = np.nonzero(box_sum(changed, p)[fl.ty, fl.tx] > 0.5)[0]
             dist[stale] = fl.dist(fl.gather(fl.ty[stale], fl.tx[stale]), stale, sy[stale], sx[stale])
         inexact_d = dist[dist > 0.0]
