@@ -90,7 +90,7 @@ def test_rgba_transparent_region_is_the_hole(files, tmp_path, capsys):
     assert _untouched(result, source, hole)
 
 
-@pytest.mark.parametrize("engine", ["quilt", "pixel"])
+@pytest.mark.parametrize("engine", ["quilt", "hybrid"])
 def test_extend_uncrops(files, tmp_path, capsys, engine):
     paths, _ = files
     out_path = tmp_path / "out.png"

@@ -35,10 +35,9 @@ import numpy as np
 from ..geometry import Margins
 from .method import METHOD, fill_image, warm_up
 from .params import ANCHORS, DEFAULT_ENGINE, DEFAULT_PATCH, ENGINES, FillParams, structure_value
-from .pixel import fill_pixel
 from .quilt import fill_quilt
 
-__all__ = ["ANCHORS", "DEFAULT_ENGINE", "DEFAULT_PATCH", "ENGINES", "FillParams", "METHOD", "fill", "fill_pixel",
+__all__ = ["ANCHORS", "DEFAULT_ENGINE", "DEFAULT_PATCH", "ENGINES", "FillParams", "METHOD", "fill",
            "fill_quilt", "warm_up"]
 
 
@@ -55,7 +54,7 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
     size, anchor : ``(width, height)`` of a larger canvas, and where the image sits on it
         (:data:`ANCHORS`); not with ``extend``.
     engine : ``"auto"`` (the default, :data:`DEFAULT_ENGINE`: ``patchmatch`` for a hole inside a colour
-        picture, ``quilt`` otherwise), ``"quilt"``, ``"pixel"``, ``"patchmatch"`` or ``"hybrid"``.
+        ``hybrid``; ``patchmatch`` with ``structure`` = yes), ``"hybrid"``, ``"quilt"`` or ``"patchmatch"``.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
     structure : continue the strong edges that cross the hole along smooth curves
         (:mod:`weft.core.fill.structure`): ``"auto"`` (the default) whenever the ``patchmatch`` engine

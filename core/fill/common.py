@@ -1,5 +1,5 @@
 """What every fill engine shares: checking its arguments (the common signature of
-``fill_patchmatch``, ``fill_quilt`` and ``fill_pixel``), the fill-front order and the progress count."""
+``fill_patchmatch``, ``fill_quilt`` and ``fill_hybrid``), the fill-front order and the progress count."""
 
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ def onion_order(hole: np.ndarray) -> np.ndarray:
     from scipy.ndimage import distance_transform_edt
 
     # exact and the same on every call (OpenCV's precise transform varies in its last bit between
-    # calls, which reordered ties and broke the pixel engine's determinism under a seed)
+    # calls, which reordered ties and broke determinism under a seed)
     # (the image's border is not a known pixel: an uncrop grows from the image inwards-out)
     dist = distance_transform_edt(hole) if hole.any() and not hole.all() else np.zeros(hole.shape)
     ys, xs = np.nonzero(hole)

@@ -47,10 +47,6 @@ def _always(_image: np.ndarray, _hole: np.ndarray) -> bool:
     return True
 
 
-def _never(_image: np.ndarray, _hole: np.ndarray) -> bool:
-    return False
-
-
 #: The engines, by ``--engine`` name (``auto`` picks one of them: :func:`weft.core.fill.params.auto_engine`).
 TABLE: dict[str, Engine] = {
     e.name: e for e in (
@@ -58,7 +54,6 @@ TABLE: dict[str, Engine] = {
                "patchmatch:fill_patchmatch", True, _always),
         Engine("quilt", "blocks in fill-front order with min-cut seams (Efros & Freeman)", 24,
                "quilt:fill_quilt", True, _quilt_refines),
-        Engine("pixel", "coherent pixel synthesis (Ashikhmin)", 7, "pixel:fill_pixel", False, _never),
         Engine("hybrid", "quilt with 48-px blocks, then full-resolution patch search refines the seams", 48,
                "hybrid:fill_hybrid", True, _always),
     )

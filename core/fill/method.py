@@ -99,10 +99,8 @@ def _run_patch(params: FillParams, ch: int, cw: int, *, hole: np.ndarray | None 
     patch = params.resolved_patch()
     if params.patch is None and params.engine == "quilt" and _deep_border(hole, margins):
         patch = max(patch, min(BORDER_BLOCK, min(ch, cw) // 3))
-    if params.engine == "pixel":
-        patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
     if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
-        patch = max(3, min(ch, cw) // 2) | (1 if params.engine == "pixel" else 0)
+        patch = max(3, min(ch, cw) // 2)
     if params.patch is None and params.engine == "hybrid":  # its 48-px block: at most a third of a small image
         patch = min(patch, max(3, min(ch, cw) // 3))
     return patch
@@ -218,7 +216,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     if params.patch is None and not whole_patches(src_region, patch).any():
         side = _largest_square(src_region)  # a default patch shrinks to the largest the source holds
         if side >= 3:
-            patch = side if params.engine != "pixel" or side % 2 else side - 1
+            patch = side
     if not whole_patches(src_region, patch).any():
         side = _largest_square(src_region)
         raise _error(WeftError, f"too little to copy from: the {engine_text(params)} needs at least one whole "
@@ -352,15 +350,14 @@ def _run(inputs: Mapping[str, np.ndarray], params: FillParams, *, rng=None, prog
 
 
 def warm_up() -> None:
-    """Load (or compile) the kernels a fill can use, on tiny inputs, so that no run compiles: the
-    pixel engine's (grey and colour). The quilt and patchmatch engines and the blend band run in
-    numpy (:mod:`weft.core.fill.cut`, :mod:`weft.core.fill.patchmatch`) and have none."""
+    """A tiny default fill, grey and colour, so that a first run loads nothing more: every engine runs
+    in numpy and OpenCV (no numba kernel to compile)."""
     rng = np.random.default_rng(0)
     img = rng.random((24, 24), dtype=np.float32)
     hole = np.zeros((24, 24), dtype=bool)
     hole[8:16, 8:16] = True
     for image in (img, np.repeat(img[..., None], 3, axis=2)):
-        fill_image(image, hole, params=FillParams(engine="pixel", patch=5), rng=0)
+        fill_image(image, hole, params=FillParams(patch=5), rng=0)
 
 
 def _memory(shapes: Mapping[str, tuple[int, ...]], params: FillParams) -> float:

@@ -21,6 +21,9 @@ ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-le
 ENGINES = ("auto", *TABLE)
 #: The default engine.
 DEFAULT_ENGINE = "auto"
+#: Engines of earlier versions, dropped because another measured better everywhere, and what their
+#: recipes now run.
+RETIRED = {"pixel": "auto"}
 #: Each engine's patch side when ``patch`` is not given.
 DEFAULT_PATCH = {name: e.patch for name, e in TABLE.items()}
 #: The quilt's block when ``patch`` is not given and the hole runs along the canvas border more than
@@ -78,9 +81,12 @@ class FillParams(Params):
     @classmethod
     def from_dict(cls, data, *, base=None) -> "FillParams":
         """As :meth:`Params.from_dict`, ``structure`` read by :func:`structure_value` (recipes and
-        sessions of the round in which it was an on/off switch wrote ``true`` / ``false``)."""
+        sessions of the round in which it was an on/off switch wrote ``true`` / ``false``), and an
+        engine since dropped (:data:`RETIRED`) read as the one that replaced it."""
         if isinstance(data, Mapping) and "structure" in data:
             data = {**data, "structure": structure_value(data["structure"])}
+        if isinstance(data, Mapping) and data.get("engine") in RETIRED:  # a recipe of an engine since dropped
+            data = {**data, "engine": RETIRED[data["engine"]]}
         return super().from_dict(data, base=base)
 
     def continues_edges(self, texture: bool = False) -> bool:
