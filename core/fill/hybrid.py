@@ -4,7 +4,7 @@
    default, twice the quilt engine's: fewer seams inside the hole) cut along minimum-error seams, the
    cut free to run through the known pixels of the blend band: straight structure such as brick
    mortar continues through the hole.
-2. :func:`weft.core.fill.patchmatch.refine_patchmatch` then runs EM / PatchMatch iterations at full
+2. :func:`weft.core.fill.search.refine_patchmatch` then runs EM / PatchMatch iterations at full
    resolution from that fill over the hole *and the band* (no pyramid, so nothing is re-invented from
    a blurred estimate): every 7x7 patch touching them gets its nearest patch of the known pixels
    beyond the band (the blocks' own sources are found exactly), and every pixel is copied through the
@@ -26,11 +26,8 @@ from ..jobs import ProgressReporter
 from ..params import as_rng
 from .quilt import fill_quilt
 
-#: The quilting block of the hybrid engine (its ``patch``): twice the quilt engine's 24. With the
-#: quilt engine as it is now, seeds 0-4 medians (``python -m benchmarks.fill --engine hybrid
-#: [--patch 24]``), coherence with 48 / 24-px blocks: gravel 7.64 / 7.72, brick 1.03 / 0.97, photo
-#: 5.56 / 5.12, uncrop 0.68 / 0.63, and 24 takes 1.2-1.6x the time in-process (photo 0.11 / 0.18 s):
-#: 48 stays, the engine being the quicker of the refined ones.
+#: The quilting block of the hybrid engine (its ``patch``): twice the quilt engine's 24, so the hole
+#: holds fewer seams, and the engine is quicker than with 24.
 BLOCK = 48
 #: The refine's patch side (the coherence metric's window).
 REFINE_PATCH = 7
