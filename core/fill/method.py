@@ -376,11 +376,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     """What an unset ``patch`` resolves to with inputs of these shapes (the studio shows it beside its
     box, and the variations grid centres its range on it): the patch the run takes (the engine's
     default, fitted to a small canvas; the quilt's border block for margins over 24 px); for
-    ``auto``, that of the engine it runs for a hole inside a picture of this shape (``patchmatch``'s
-    in a colour picture or with ``structure`` = yes, ``quilt``'s in a grey one or when the canvas is
-    extended). From shapes alone a colour picture whose hole touches its border, or whose hole's
-    surroundings are grey, resolves to ``patchmatch``'s patch where the run takes ``quilt``'s (the
-    run's figures say which). Nothing before an image is open."""
+    ``auto``, that of the engine it runs (:func:`auto_engine`). Nothing before an image is open."""
     shape = shapes.get("image")
     if params.patch is not None or shape is None:
         return {}
