@@ -45,7 +45,7 @@ class FillParams(Params):
                         help="auto: hybrid (patchmatch with --structure yes); "
                              + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()))
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
-                       help="patch side in pixels (quilt, hybrid: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
+                       help="patch side in pixels (quilt, hybrid: the block; patchmatch: at most 63); "
                             "default per engine, smaller on a small image: "
                             + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items())
                             + f" ({BORDER_BLOCK} for an uncrop more than 24 px deep)")
