@@ -54,7 +54,7 @@ TABLE: dict[str, Engine] = {
                "patchmatch:fill_patchmatch", True, _always),
         Engine("quilt", "blocks in fill-front order with min-cut seams (Efros & Freeman)", 24,
                "quilt:fill_quilt", True, _quilt_refines),
-        Engine("hybrid", "quilt with 48-px blocks, then full-resolution patch search refines the seams", 48,
+        Engine("hybrid", "quilt with 64-px blocks, then full-resolution patch search refines the seams", 64,
                "hybrid:fill_hybrid", True, _always),
     )
 }

@@ -1,6 +1,6 @@
 """The ``hybrid`` fill engine: the quilting engine's fill, refined by full-resolution patch search.
 
-1. :func:`weft.core.fill.quilt.fill_quilt` lays the hole out in large verbatim blocks (48 px by
+1. :func:`weft.core.fill.quilt.fill_quilt` lays the hole out in large verbatim blocks (64 px by
    default, twice the quilt engine's: fewer seams inside the hole) cut along minimum-error seams, the
    cut free to run through the known pixels of the blend band: straight structure such as brick
    mortar continues through the hole.
@@ -28,11 +28,11 @@ from .quilt import fill_quilt
 
 #: The quilting block of the hybrid engine (its ``patch``): twice the quilt engine's 24, so the hole
 #: holds fewer seams, and the engine is quicker than with 24.
-BLOCK = 48
+BLOCK = 64
 #: The refine's patch side (the coherence metric's window).
 REFINE_PATCH = 7
 #: EM iterations of the refine.
-REFINE_ITERATIONS = 3
+REFINE_ITERATIONS = 5
 
 
 def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0,

@@ -65,7 +65,7 @@ One block at a time, until no pixel of the hole is left:
    on most, so the seams move to where the copies agree, without averaging. Each iteration searches
    only the inexact patches at or above the median of their distances (``REFINE_WORST``). The method
    then runs no Poisson band: the refine re-synthesises the band. One iteration is what the time
-   allows; the ``hybrid`` engine runs more (it is the quilt with 48-px blocks and three).
+   allows; the ``hybrid`` engine runs more (it is the quilt with 64-px blocks and five).
 
 Blocks are copied only from the original known pixels (never from filled ones), so errors cannot
 feed on themselves.

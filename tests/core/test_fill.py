@@ -245,7 +245,7 @@ def test_auto_runs_hybrid_everywhere_and_patchmatch_for_the_edge_guide(gravel):
 
 def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
     """The studio's "auto" patch (beside its box, and the centre of a variations range) is the patch
-    of the engine that runs: the hybrid's 48-px block (at most a third of a small canvas) for holes
+    of the engine that runs: the hybrid's 64-px block (at most a third of a small canvas) for holes
     and uncrops; a named engine its own; a patch given is not resolved."""
     from weft.core.fill.method import STUDIO, fill_image
 
@@ -257,11 +257,11 @@ def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
         _, figures = fill_image(image, mask, params=params, rng=0)
         assert resolved == {"patch": figures["patch"]}, (image.shape, params.engine)
     assert STUDIO.resolved(FillParams(extend=(0, 0, 30, 0)), {"image": gravel.shape}) == {"patch": 32}
-    assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 48}
+    assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 64}
     assert STUDIO.resolved(FillParams(engine="patchmatch"), {"image": (300, 400, 3)}) == {"patch": 7}
     assert STUDIO.resolved(FillParams(engine="quilt", extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 24}
     assert STUDIO.resolved(FillParams(engine="quilt", extend=(0, 0, 40, 0)), {"image": (300, 400, 3)}) == {"patch": 48}
-    assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 48}
+    assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 64}
     assert STUDIO.resolved(FillParams(patch=9), {"image": (96, 120, 3)}) == {}
     assert STUDIO.resolved(FillParams(), {}) == {}
 
@@ -534,10 +534,10 @@ def test_a_small_hole_in_a_large_picture_is_filled_from_its_neighbourhood(engine
     near = neighbourhood(hole, ~hole, 24)
     m = NEAR + 48
     assert near == (slice(500 - m, 520 + m), slice(700 - m, 720 + m))
-    patch = FillParams(engine=engine).resolved_patch()
+    patch = 48 if engine == "hybrid" else FillParams(engine=engine).resolved_patch()
     near = neighbourhood(hole, ~hole, patch)
-    out = fill(img, hole, engine=engine, seed=3)
-    alone = fill(img[near], hole[near], engine=engine, seed=3)
+    out = fill(img, hole, engine=engine, patch=patch, seed=3)
+    alone = fill(img[near], hole[near], engine=engine, patch=patch, seed=3)
     assert np.array_equal(out[near], alone)
     outside = np.ones((1024, 1024), bool)
     outside[near] = False
