@@ -53,7 +53,7 @@ from typing import Any, Callable
 import numpy as np
 
 PEERS_SCRIPT = Path(__file__).resolve().with_name("fill_peers.py")
-WEFT_ENGINES = ("patchmatch", "quilt", "pixel", "hybrid")
+WEFT_ENGINES = ("patchmatch", "quilt", "hybrid")
 BAND = 2  # px around the hole inside which weft may change known pixels (the method's default band)
 
 

@@ -65,7 +65,7 @@ def test_fill_a_mask(files, tmp_path, capsys, which):
     assert code == 0, err
     line = json.loads(out)
     assert line["hole_pixels"] == int(hole.sum()) and line["size"] == [72, 72]
-    assert line["engine"] == ("patchmatch" if which == "colour" else "quilt")  # auto: a hole inside a colour picture
+    assert line["engine"] == "hybrid"  # auto
     image, result = load_image(paths[which]), load_image(out_path)
     assert result.info.bit_depth == (16 if which == "grey16" else 8)  # the output keeps the image's depth
     assert result.image.shape == image.image.shape
@@ -90,7 +90,7 @@ def test_rgba_transparent_region_is_the_hole(files, tmp_path, capsys):
     assert _untouched(result, source, hole)
 
 
-@pytest.mark.parametrize("engine", ["quilt", "pixel"])
+@pytest.mark.parametrize("engine", ["quilt", "hybrid"])
 def test_extend_uncrops(files, tmp_path, capsys, engine):
     paths, _ = files
     out_path = tmp_path / "out.png"
@@ -219,3 +219,21 @@ def test_fill_takes_no_region(files, tmp_path, capsys):
     with pytest.raises(WeftError, match="weft fill takes no --region"):
         render(registry.get("fill"), FillParams(), {"image": str(paths["grey"]), "mask": str(paths["mask"])}, 1,
                region=(0, 0, 40))
+
+
+def test_a_photo_given_as_the_mask_is_refused(files, tmp_path, capsys):
+    """A colour photo passed as --mask (or --source-mask) is one line and exit 2; a painted mask
+    with soft (anti-aliased) edges is still a mask."""
+    import cv2
+
+    paths, hole = files
+    o = tmp_path / "out.png"
+    _refused(capsys, ["fill", paths["colour"], "--mask", paths["colour"], "-o", o, "-q"], o,
+             "colour.png", "the mask is not black and white", "% of its pixels are grey or coloured")
+    _refused(capsys, ["fill", paths["colour"], "--mask", paths["mask"], "--source-mask", paths["grey"], "-o", o, "-q"],
+             o, "grey.png", "the source mask is not black and white")
+    soft = cv2.GaussianBlur(hole.astype(np.float32), (9, 9), 2.0)
+    assert ((soft > 0.1) & (soft < 0.9)).any()
+    save_image(tmp_path / "soft.png", soft)
+    code, _, err = run(["fill", paths["colour"], "--mask", tmp_path / "soft.png", "-o", o, "-q"], capsys)
+    assert code == 0, err

@@ -5,42 +5,13 @@
 ``--extend L,T,R,B`` or ``--size WxH --anchor ...`` grows the canvas and fills the new border (uncrop).
 With no mask, an image's transparent pixels (alpha < 50 %) are the hole.
 
-Engines (``--engine``), all with one signature ``fill_x(image, hole, source=None, *, patch, rng,
-progress, cancel)`` and the guarantee that every pixel outside the hole is returned unchanged (the
-quilt engine's cut may also run through the known pixels of the blend band, when the method gives it
-``band`` or ``cuttable``; :mod:`weft.core.fill.band` then re-solves that band):
-
-* ``quilt`` (:func:`weft.core.fill.quilt.fill_quilt`) -- the quilting paper's hole filling: blocks in
-  fill-front order, SSD over known pixels only, minimum-error cut;
-* ``pixel`` (:func:`weft.core.fill.pixel.fill_pixel`) -- Ashikhmin-style coherent pixel synthesis in
-  onion order with the hole's neighbourhood as the constraint;
-* ``patchmatch`` (:func:`weft.core.fill.patchmatch.fill_patchmatch`) -- multi-scale
-  patch search with voting (Wexler et al., Barnes et al.);
-* ``hybrid`` (:func:`weft.core.fill.hybrid.fill_hybrid`) -- the quilt engine with 48-px blocks, then
-  :func:`weft.core.fill.patchmatch.refine_patchmatch` (full-resolution patch search and voting from
-  that fill) over the hole and the blend band.
-
-``patchmatch`` and ``hybrid`` are given the band too (``cuttable``) and re-synthesise it with the
-hole; the method then runs no Poisson blend for them.
-
-**The default engine is** :data:`~weft.core.fill.params.DEFAULT_ENGINE`, ``auto``
-(:func:`~weft.core.fill.params.auto_engine`): ``patchmatch`` for a hole inside a colour picture,
-with the edge guide of :mod:`weft.core.fill.structure` (``structure`` ``auto``), ``quilt``
-otherwise; the figures name the engine that ran. Measured on the fill benchmark's cases (seeds 0-4 medians,
-``python -m benchmarks.fill --seeds 0-4``; coherence / detail / seam against the truth's): on the
-photo ``patchmatch`` is the most coherent of weft's engines (without the guide 4.45 / 1.02 / -0.04
-against ``quilt``'s 5.40 / 1.08 / +0.01); with the guide, which continues the saucer's rim where
-patch search alone drips it, 5.05 / 1.00 / +0.05 (at the benchmark's seed 4.78 against G'MIC's
-6.58 and 1.2x shift-map's 4.99), in a whole process of 0.34-0.35 s against G'MIC's 0.36-0.37 s
-(interleaved, medians of 15, two rounds); on the grey textures and the uncrop ``quilt`` is the
-more coherent (gravel 9.01 against 9.24, brick 1.05 against 1.35, uncrop 0.81 against 0.85) and
-the quicker (0.19-0.27 s whole processes),
-and it keeps brick mortar straight where ``patchmatch`` bends it. ``hybrid`` (quilt with 48-px
-blocks, then the refine) is more coherent than ``quilt`` on the textures but leaves a red ghost of
-the spoon's handle on the photo (coherence 5.56 there, in 0.28 s against G'MIC's 0.38 s in the
-benchmark run); ``pixel`` is the least coherent everywhere. Neither ``quilt`` nor ``patchmatch``
-loads numba: a fill's first run costs what the second does. The README's "Fill and extend against
-the peers" has the tables and the pictures.
+Engines (``--engine``): the table :data:`weft.core.fill.engines.TABLE` says what each is, its default
+patch and how the method runs it; every engine returns every pixel outside the hole unchanged (but
+the blend band's, when it takes them). The shared patch search (PatchMatch and EM voting) is
+:mod:`weft.core.fill.search`. ``auto`` (the default, :func:`~weft.core.fill.params.auto_engine`)
+runs ``hybrid``, or ``patchmatch`` when the edge guide is asked for (``structure`` yes); the figures
+name the engine that ran. The suite that chose it is ``python -m benchmarks.fill_suite`` (its results in
+``benchmarks/results/fill_suite.json``).
 
 **Known pixels** are never changed except within the blend band (``--band``, default 2 px): the
 quilting engine's minimum-error cut may run through the known pixels within ``band`` px of the hole,
@@ -64,10 +35,9 @@ import numpy as np
 from ..geometry import Margins
 from .method import METHOD, fill_image, warm_up
 from .params import ANCHORS, DEFAULT_ENGINE, DEFAULT_PATCH, ENGINES, FillParams, structure_value
-from .pixel import fill_pixel
 from .quilt import fill_quilt
 
-__all__ = ["ANCHORS", "DEFAULT_ENGINE", "DEFAULT_PATCH", "ENGINES", "FillParams", "METHOD", "fill", "fill_pixel",
+__all__ = ["ANCHORS", "DEFAULT_ENGINE", "DEFAULT_PATCH", "ENGINES", "FillParams", "METHOD", "fill",
            "fill_quilt", "warm_up"]
 
 
@@ -84,7 +54,7 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
     size, anchor : ``(width, height)`` of a larger canvas, and where the image sits on it
         (:data:`ANCHORS`); not with ``extend``.
     engine : ``"auto"`` (the default, :data:`DEFAULT_ENGINE`: ``patchmatch`` for a hole inside a colour
-        picture, ``quilt`` otherwise), ``"quilt"``, ``"pixel"``, ``"patchmatch"`` or ``"hybrid"``.
+        ``hybrid``; ``patchmatch`` with ``structure`` = yes), ``"hybrid"``, ``"quilt"`` or ``"patchmatch"``.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
     structure : continue the strong edges that cross the hole along smooth curves
         (:mod:`weft.core.fill.structure`): ``"auto"`` (the default) whenever the ``patchmatch`` engine

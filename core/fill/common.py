@@ -1,5 +1,5 @@
 """What every fill engine shares: checking its arguments (the common signature of
-``fill_patchmatch``, ``fill_quilt`` and ``fill_pixel``), the fill-front order and the progress count."""
+``fill_patchmatch``, ``fill_quilt`` and ``fill_hybrid``), the fill-front order and the progress count."""
 
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ def onion_order(hole: np.ndarray) -> np.ndarray:
     from scipy.ndimage import distance_transform_edt
 
     # exact and the same on every call (OpenCV's precise transform varies in its last bit between
-    # calls, which reordered ties and broke the pixel engine's determinism under a seed)
+    # calls, which reordered ties and broke determinism under a seed)
     # (the image's border is not a known pixel: an uncrop grows from the image inwards-out)
     dist = distance_transform_edt(hole) if hole.any() and not hole.all() else np.zeros(hole.shape)
     ys, xs = np.nonzero(hole)
@@ -115,16 +115,16 @@ def onion_order(hole: np.ndarray) -> np.ndarray:
 
 
 class Progress:
-    """Calls ``progress(done, total)`` when the percentage changes, and checks ``cancel``."""
+    """An engine's progress in units of work: ``report(done)`` checks ``cancel`` and sends
+    :class:`weft.core.jobs.Progress` (stage ``"fill"``) to ``progress`` when the percentage changes."""
 
     def __init__(self, progress, cancel, total: int):
-        self.progress, self.cancel, self.total = progress, cancel, max(1, int(total))
-        self.last = -1
+        from ..jobs import ProgressReporter
+
+        self.cancel, self.total = cancel, max(1, int(total))
+        self.reporter = ProgressReporter(progress, "fill", self.total)
 
     def __call__(self, done: int) -> None:
         if self.cancel is not None:
             self.cancel.raise_if_cancelled()
-        pct = int(100 * min(done, self.total) / self.total)
-        if self.progress is not None and pct != self.last:
-            self.last = pct
-            self.progress(min(done, self.total), self.total)
+        self.reporter.update(min(int(done), self.total))

@@ -1,10 +1,10 @@
 """The ``hybrid`` fill engine: the quilting engine's fill, refined by full-resolution patch search.
 
-1. :func:`weft.core.fill.quilt.fill_quilt` lays the hole out in large verbatim blocks (48 px by
+1. :func:`weft.core.fill.quilt.fill_quilt` lays the hole out in large verbatim blocks (64 px by
    default, twice the quilt engine's: fewer seams inside the hole) cut along minimum-error seams, the
    cut free to run through the known pixels of the blend band: straight structure such as brick
    mortar continues through the hole.
-2. :func:`weft.core.fill.patchmatch.refine_patchmatch` then runs EM / PatchMatch iterations at full
+2. :func:`weft.core.fill.search.refine_patchmatch` then runs EM / PatchMatch iterations at full
    resolution from that fill over the hole *and the band* (no pyramid, so nothing is re-invented from
    a blurred estimate): every 7x7 patch touching them gets its nearest patch of the known pixels
    beyond the band (the blocks' own sources are found exactly), and every pixel is copied through the
@@ -22,19 +22,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..jobs import ProgressReporter
 from ..params import as_rng
 from .quilt import fill_quilt
 
-#: The quilting block of the hybrid engine (its ``patch``): twice the quilt engine's 24. With the
-#: quilt engine as it is now, seeds 0-4 medians (``python -m benchmarks.fill --engine hybrid
-#: [--patch 24]``), coherence with 48 / 24-px blocks: gravel 7.64 / 7.72, brick 1.03 / 0.97, photo
-#: 5.56 / 5.12, uncrop 0.68 / 0.63, and 24 takes 1.2-1.6x the time in-process (photo 0.11 / 0.18 s):
-#: 48 stays, the engine being the quicker of the refined ones.
-BLOCK = 48
+#: The quilting block of the hybrid engine (its ``patch``): twice the quilt engine's 24, so the hole
+#: holds fewer seams, and the engine is quicker than with 24.
+BLOCK = 64
 #: The refine's patch side (the coherence metric's window).
 REFINE_PATCH = 7
 #: EM iterations of the refine.
-REFINE_ITERATIONS = 3
+REFINE_ITERATIONS = 5
 
 
 def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0,
@@ -44,8 +42,8 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
     the hole and those pixels with :func:`~weft.core.fill.patchmatch.refine_patchmatch`
     (``refine_patch``, ``iterations``), copying only from source pixels outside them.
 
-    ``progress(done, total)`` counts the quilting's filled pixels, then one unit per refine
-    iteration; ``cancel`` is checked by both. Every pixel outside the hole and the band equals the
+    ``progress`` (:class:`weft.core.jobs.Progress`) counts the quilting's filled pixels, then one
+    unit per refine iteration; ``cancel`` is checked by both. Every pixel outside the hole and the band equals the
     input exactly. Raises as :func:`~weft.core.fill.quilt.fill_quilt` does.
     """
     from .band import band_region
@@ -56,13 +54,13 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
     total = max(1, int(holes.sum()))
     span = total + int(iterations)
 
-    def quilt_progress(done, _total):
-        if progress is not None:
-            progress(done, span)
+    report = ProgressReporter(progress, "fill", span)
+
+    def quilt_progress(p):
+        report.update(int(p.fraction * total))
 
     def refine_progress(p):
-        if progress is not None:
-            progress(total + int(round(p.fraction * iterations)), span)
+        report.update(total + int(round(p.fraction * iterations)))
 
     quilted = fill_quilt(image, holes, source, patch=patch, rng=gen, progress=quilt_progress, cancel=cancel,
                          band=band, cuttable=cuttable, refine=False)  # (its own refine follows)

@@ -10,32 +10,14 @@ import numpy as np
 from ..errors import ImageError, InvalidParameter, WeftError
 from ..geometry import MARGINS, MASK, Margins, Mask
 from ..image import validate_image
-from ..jobs import ProgressReporter
 from ..limits import check_output_size
 from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
 from .common import neighbourhood, touches_border, whole_patches
+from .engines import TABLE
 from .params import ANCHORS, BORDER_BLOCK, DEFAULT_PATCH, FillParams, auto_engine
-from .quilt import is_colour, refines
-
-
-def _engine(name: str):
-    if name == "quilt":
-        from .quilt import fill_quilt
-
-        return fill_quilt
-    if name == "pixel":
-        from .pixel import fill_pixel
-
-        return fill_pixel
-    if name == "hybrid":
-        from .hybrid import fill_hybrid
-
-        return fill_hybrid
-    from .patchmatch import fill_patchmatch
-
-    return fill_patchmatch
+from .quilt import is_colour
 
 
 def _error(cls, message: str, input: str | None = None, **kw):
@@ -63,7 +45,30 @@ def _mask_bits(mask, shape: tuple[int, int], what: str, against: str) -> np.ndar
     if m.shape[:2] != tuple(shape):
         raise _error(ImageError, f"the {what.replace('_', ' ')} is {m.shape[1]}x{m.shape[0]} but the {against} is "
                      f"{shape[1]}x{shape[0]}; they must be the same size", what)
-    return Mask.from_image(m.astype(np.float32), what).bits if m.dtype != bool else m
+    if m.dtype == bool:
+        return m
+    _black_and_white(m, what)
+    return Mask.from_image(m.astype(np.float32), what).bits
+
+
+#: A mask is refused when more than this share of its pixels is neither nearly black nor nearly white
+#: (or is coloured): a photo given as the mask, not a painted mask with soft edges.
+MAX_GREY_SHARE = 0.25
+
+
+def _black_and_white(m: np.ndarray, what: str) -> None:
+    """Refuse a mask that is not nearly black and white (a photo passed by mistake)."""
+    arr = np.asarray(m, dtype=np.float32)
+    if arr.ndim == 3 and arr.shape[2] in (2, 4):  # a transparent pixel reads as black
+        arr = arr[..., :-1] * arr[..., -1:]
+    grey = arr if arr.ndim == 2 else arr.mean(axis=2)
+    odd = (grey > 0.1) & (grey < 0.9)
+    if arr.ndim == 3 and arr.shape[2] >= 3:
+        odd |= (arr.max(axis=2) - arr.min(axis=2)) > 0.1
+    share = float(odd.mean())
+    if share > MAX_GREY_SHARE:
+        raise _error(ImageError, f"the {what.replace('_', ' ')} is not black and white: {share:.0%} of its pixels are "
+                     "grey or coloured (white = fill, black = keep; was a photo given as the mask?)", what)
 
 
 def _margins(params: FillParams, w: int, h: int) -> Margins | None:
@@ -94,10 +99,8 @@ def _run_patch(params: FillParams, ch: int, cw: int, *, hole: np.ndarray | None 
     patch = params.resolved_patch()
     if params.patch is None and params.engine == "quilt" and _deep_border(hole, margins):
         patch = max(patch, min(BORDER_BLOCK, min(ch, cw) // 3))
-    if params.engine == "pixel":
-        patch |= 1  # the pixel engine's neighbourhood is centred: an even side is used as the next odd one
     if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
-        patch = max(3, min(ch, cw) // 2) | (1 if params.engine == "pixel" else 0)
+        patch = max(3, min(ch, cw) // 2)
     if params.patch is None and params.engine == "hybrid":  # its 48-px block: at most a third of a small image
         patch = min(patch, max(3, min(ch, cw) // 3))
     return patch
@@ -150,6 +153,9 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         hole = transparent.copy()
         named = "alpha"
     margins = _margins(params, w, h)
+    inner = _interior(hole) if hole.any() else None
+    if margins is not None and inner is not None and inner.any():
+        return _by_region(image, hole, inner, params, source_mask, texture, rng, progress, cancel)
     if margins is None and named is None:
         raise WeftError("nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size "
                         "(--size WxH), or an image with transparent pixels")
@@ -210,7 +216,7 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     if params.patch is None and not whole_patches(src_region, patch).any():
         side = _largest_square(src_region)  # a default patch shrinks to the largest the source holds
         if side >= 3:
-            patch = side if params.engine != "pixel" or side % 2 else side - 1
+            patch = side
     if not whole_patches(src_region, patch).any():
         side = _largest_square(src_region)
         raise _error(WeftError, f"too little to copy from: the {engine_text(params)} needs at least one whole "
@@ -233,26 +239,17 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         work, work_hole, work_src = big, big_hole, big_src
     else:
         work, work_hole, work_src = colour, hole, src_region
-    reporter = ProgressReporter(progress, f"fill ({params.engine})", 100)
-
-    def engine_progress(done: int, total: int) -> None:
-        reporter.update(int(100 * done // max(1, total)))
-
     extra = {}
-    if params.engine in ("quilt", "hybrid", "patchmatch") and params.band > 0:
-        # the quilting cut may run through the band's known pixels (gravel and brick, two holes each,
-        # seeds 1-3: brick coherence 0.51 -> 0.44 and 0.54 -> 0.45 of the truth's, seam +0.16 -> +0.13
-        # and +0.38 -> +0.23 from the truth's; gravel 0.60/0.64 -> 0.61/0.57, seam -0.07/-0.29 -> -0.10/-0.36)
-        # the image's own band (never its transparent pixels), on the engine's canvas: a band worked
-        # out there would also take the image's last rows and columns beside a texture's gap
+    engine = TABLE[params.engine]
+    if engine.cuttable and params.band > 0:
+        # the engine may change the band's known pixels (a quilting cut through them, or a refine that
+        # re-synthesises them): the image's own band (never its transparent pixels), on the engine's
+        # canvas (a band worked out there would also take the image's last rows beside a texture's gap)
         from .band import band_region
 
         cut = np.zeros(work_hole.shape, dtype=bool)
         cut[:ch, :cw] = band_region(hole, params.band, exclude=transparent) & ~hole
         extra = {"cuttable": cut}
-    # quilt and pixel report progress(done, total); the PatchMatch engine reports weft.core.jobs.Progress
-    # itself (its ProgressReporter), so it gets the method's callback as it is
-    engine_report = progress if params.engine == "patchmatch" else engine_progress
     # a small hole in a large picture: the engine fills the hole's neighbourhood alone
     near = neighbourhood(work_hole, work_src, patch) if texture is None else None
     part = (slice(None), slice(None)) if near is None else near
@@ -262,18 +259,16 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
 
         engine_kw["guide"], continued = structure_guide(work[part], work_hole[part],
                                                         ~work_hole[part] & ~transparent[part])
-    filled = _engine(params.engine)(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
-                                    progress=engine_report, cancel=cancel, **engine_kw)
+    filled = engine.function()(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
+                               progress=progress, cancel=cancel, **engine_kw)
     if near is not None:
         whole = np.array(work, dtype=np.float32)
         whole[near] = filled
         filled = whole
     filled = np.asarray(filled, dtype=np.float32)[:ch, :cw]
     out3 = filled if filled.ndim == 3 else filled[..., None]
-    # (the refine of hybrid, patchmatch and quilt on colour pictures re-synthesises the band itself;
-    # whether quilt refined is asked of the part it filled, as it asked itself)
-    refined = params.engine in ("hybrid", "patchmatch") or (params.engine == "quilt"
-                                                           and refines(work[part], work_hole[part]))
+    # (whether the engine re-synthesised the band is asked of the part it filled, as it asked itself)
+    refined = engine.resynthesises_band(work[part], work_hole[part])
     if not refined:
         written = hole
         if extra:  # the band's known pixels the quilting cut ran through: the seam lies beside them
@@ -297,6 +292,52 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     return np.ascontiguousarray(out, dtype=np.float32), figures
 
 
+def _interior(hole: np.ndarray) -> np.ndarray:
+    """The connected regions of ``hole`` (8-connected) that do not touch the picture's border."""
+    n, labels = cv2.connectedComponents(hole.astype(np.uint8), connectivity=8)
+    touches = np.zeros(n, bool)
+    touches[np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])] = True
+    return hole & ~touches[labels]
+
+
+def _by_region(image, hole, inner, params, source_mask, texture, rng, progress, cancel) -> tuple[np.ndarray, dict]:
+    """Fill the hole's interior regions first, on the picture as given (no margins), then its regions
+    along the border and the margins: growing the canvas does not change the engine or the pixels
+    inside an interior hole."""
+    first_params = params.replace(extend=None, size=None)
+    inside, fig1 = fill_image(image, inner, params=first_params, source_mask=source_mask, texture=texture, rng=rng,
+                              progress=_scaled(progress, 0, 2), cancel=cancel)
+    rest = hole & ~inner
+    if not rest.any() and _margins(params, hole.shape[1], hole.shape[0]) is None:
+        return inside, fig1
+    out, fig2 = fill_image(inside, rest, params=params, source_mask=source_mask, texture=texture, rng=rng,
+                           progress=_scaled(progress, 1, 2), cancel=cancel)
+    figures = dict(fig2)
+    if fig1["engine"] != fig2["engine"]:
+        figures["engine"] = f"{fig1['engine']} inside, {fig2['engine']} along the border"
+    figures["hole_pixels"] = fig1["hole_pixels"] + fig2["hole_pixels"]
+    figures["hole_fraction"] = round(figures["hole_pixels"] / float(np.prod(out.shape[:2])), 4)
+    if "edges_continued" in fig1:
+        figures["edges_continued"] = fig1["edges_continued"] + fig2.get("edges_continued", 0)
+    return out, figures
+
+
+def _scaled(progress, part: int, parts: int):
+    """A progress callback that reports a pass's fraction as part ``part`` of ``parts`` equal passes."""
+    if progress is None:
+        return None
+    from ..jobs import Progress
+
+    def report(p: Progress) -> None:
+        total = max(1, p.total)
+        progress(p._replace(done=part * total + p.done, total=parts * total))
+
+    for attr in ("wants_preview", "preview_interval"):
+        if hasattr(progress, attr):
+            setattr(report, attr, getattr(progress, attr))
+    return report
+
+
 def engine_text(params: FillParams) -> str:
     return f"{params.engine} engine"
 
@@ -310,15 +351,14 @@ def _run(inputs: Mapping[str, np.ndarray], params: FillParams, *, rng=None, prog
 
 
 def warm_up() -> None:
-    """Load (or compile) the kernels a fill can use, on tiny inputs, so that no run compiles: the
-    pixel engine's (grey and colour). The quilt and patchmatch engines and the blend band run in
-    numpy (:mod:`weft.core.fill.cut`, :mod:`weft.core.fill.patchmatch`) and have none."""
+    """A tiny default fill, grey and colour, so that a first run loads nothing more: every engine runs
+    in numpy and OpenCV (no numba kernel to compile)."""
     rng = np.random.default_rng(0)
     img = rng.random((24, 24), dtype=np.float32)
     hole = np.zeros((24, 24), dtype=bool)
     hole[8:16, 8:16] = True
     for image in (img, np.repeat(img[..., None], 3, axis=2)):
-        fill_image(image, hole, params=FillParams(engine="pixel", patch=5), rng=0)
+        fill_image(image, hole, params=FillParams(patch=5), rng=0)
 
 
 #: Peak bytes a fill adds per canvas pixel, by case, fitted to measured runs (``python -m
@@ -384,11 +424,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     """What an unset ``patch`` resolves to with inputs of these shapes (the studio shows it beside its
     box, and the variations grid centres its range on it): the patch the run takes (the engine's
     default, fitted to a small canvas; the quilt's border block for margins over 24 px); for
-    ``auto``, that of the engine it runs for a hole inside a picture of this shape (``patchmatch``'s
-    in a colour picture or with ``structure`` = yes, ``quilt``'s in a grey one or when the canvas is
-    extended). From shapes alone a colour picture whose hole touches its border, or whose hole's
-    surroundings are grey, resolves to ``patchmatch``'s patch where the run takes ``quilt``'s (the
-    run's figures say which). Nothing before an image is open."""
+    ``auto``, that of the engine it runs (:func:`auto_engine`). Nothing before an image is open."""
     shape = shapes.get("image")
     if params.patch is not None or shape is None:
         return {}
@@ -410,7 +446,7 @@ def _always(params) -> bool:
     return True
 
 
-#: The studio's description of fill, as issue 15's interface fixes it (``METHOD.studio``): painting
+#: The studio's description of fill, as the studio shows it (``METHOD.studio``): painting
 #: the mask previews the region around the stroke (``preview_around``); the optional ``texture`` is
 #: fill's own (``own_inputs``: the texture the studio has open for quilt and fast is not a source).
 STUDIO = Studio(

@@ -10,30 +10,26 @@ import numpy as np
 from ..errors import InvalidParameter
 from ..geometry import MAX_SIDE, Margins
 from ..params import Params, param
+from .engines import TABLE
 
 #: Where the image goes on a larger ``--size`` canvas.
 ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-left", "bottom", "bottom-right")
 
 
-#: The engines `--engine` offers (each a function of one signature, see the package docstring), and
-#: ``auto``, which picks one of them for the picture (:func:`auto_engine`).
-ENGINES = ("auto", "patchmatch", "quilt", "pixel", "hybrid")
-#: The default engine: ``auto``, the pick that measures best on each of issue 15's cases (see the
-#: package docstring for the figures).
+#: The engines `--engine` offers (:data:`weft.core.fill.engines.TABLE`), and ``auto``, which picks one
+#: of them for the picture (:func:`auto_engine`).
+ENGINES = ("auto", *TABLE)
+#: The default engine.
 DEFAULT_ENGINE = "auto"
+#: Engines of earlier versions, dropped because another measured better everywhere, and what their
+#: recipes now run.
+RETIRED = {"pixel": "auto"}
 #: Each engine's patch side when ``patch`` is not given.
-DEFAULT_PATCH = {"patchmatch": 7, "quilt": 24, "pixel": 7, "hybrid": 48}
+DEFAULT_PATCH = {name: e.patch for name, e in TABLE.items()}
 #: The quilt's block when ``patch`` is not given and the hole runs along the canvas border more than
 #: 24 px deep (an uncrop, an extended canvas, a rectification's wide transparent border): at most a
 #: third of the canvas's smaller side. With 24-px blocks an extension a few blocks deep drifts from
-#: the picture's structure block by block (the bundled brick's right 82 px grown back, seeds 0-5: bricks without joints,
-#: coherence 1.38, seam +1.75 over the truth's); with 48: 0.76 and +0.13, in 57 ms against 136. On
-#: the benchmark's 256 -> 384 uncrop 0.73 -> 0.81 (G'MIC's 1.55), seam -0.08..+0.09 from the truth's,
-#: 300 -> 189 ms; one-sided extensions of gravel 4.03 -> 2.67 and grass 4.86 -> 4.13. On colour
-#: pictures (the quilt and its refine) the right third of the bundled chelsea grown back: seam
-#: +0.34 -> -0.06 over the truth's (medians of seeds 0-5), perspective-frontal coherence 0.87 -> 0.55;
-#: wood-grain (112 px wide: a 37-px block) lost the visible seam at the join, though its coherence
-#: went 2.38 -> 3.66.
+#: the picture's structure block by block (bricks without joints).
 BORDER_BLOCK = 48
 #: ``structure``'s values (:mod:`weft.core.fill.structure`): the edges a hole cuts are continued
 #: whenever ``patchmatch`` fills from the picture itself (``auto``, the default), always (``yes``:
@@ -46,14 +42,10 @@ class FillParams(Params):
     """Parameters of ``weft fill``."""
 
     engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
-                        help="auto: patchmatch for a hole inside a colour picture, quilt otherwise (grey "
-                             "pictures, holes along the border, uncrop); "
-                             "quilt: blocks in fill-front order with min-cut seams (Efros & Freeman); "
-                             "pixel: coherent pixel synthesis (Ashikhmin)"
-                             "; patchmatch: multi-scale patch search with voting"
-                             "; hybrid: quilt, then full-resolution patch search refines the seams")
+                        help="auto: hybrid (patchmatch with --structure yes); "
+                             + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()))
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
-                       help="patch side in pixels (quilt, hybrid: the block; pixel: the neighbourhood, odd; patchmatch: at most 63); "
+                       help="patch side in pixels (quilt, hybrid: the block; patchmatch: at most 63); "
                             "default per engine, smaller on a small image: "
                             + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items())
                             + f" ({BORDER_BLOCK} for an uncrop more than 24 px deep)")
@@ -89,9 +81,12 @@ class FillParams(Params):
     @classmethod
     def from_dict(cls, data, *, base=None) -> "FillParams":
         """As :meth:`Params.from_dict`, ``structure`` read by :func:`structure_value` (recipes and
-        sessions of the round in which it was an on/off switch wrote ``true`` / ``false``)."""
+        sessions of the round in which it was an on/off switch wrote ``true`` / ``false``), and an
+        engine since dropped (:data:`RETIRED`) read as the one that replaced it."""
         if isinstance(data, Mapping) and "structure" in data:
             data = {**data, "structure": structure_value(data["structure"])}
+        if isinstance(data, Mapping) and data.get("engine") in RETIRED:  # a recipe of an engine since dropped
+            data = {**data, "engine": RETIRED[data["engine"]]}
         return super().from_dict(data, base=base)
 
     def continues_edges(self, texture: bool = False) -> bool:
@@ -116,14 +111,9 @@ def structure_value(value):
 
 
 def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto") -> str:
-    """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (its guide is that engine's), and
-    for a hole inside a colour picture (removing an
-    object from a photo: coherence 4.45 against quilt's 5.40 on the fill benchmark's photo, seeds 0-4), unless
-    the patch asked for is beyond its 63 px; ``quilt`` on grey pictures (gravel 9.01 against 9.24,
-    brick 1.05 against 1.35) and for holes along the canvas border, an uncrop's (0.81 against 0.85,
-    seeds 0-4 medians, in a quarter of the time: 0.27 against 1.01 s in the benchmark's run)."""
-    from .patchmatch import MAX_PATCH
-
-    if structure == "yes" or (colour_picture and not hole_on_border and (patch is None or patch <= MAX_PATCH)):
-        return "patchmatch"
-    return "quilt"
+    """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (the edge guide is that
+    engine's), else ``hybrid`` (quilting, then full-resolution patch search), on grey and colour
+    pictures, holes and uncrops alike: on the fill suite's tuning half it was the most coherent
+    engine in most cases and had the fewest defects (``python -m benchmarks.fill_suite``). The
+    picture's kind and the hole's place are accepted for the callers that pass them, and unused."""
+    return "patchmatch" if structure == "yes" else "hybrid"

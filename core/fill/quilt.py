@@ -10,9 +10,8 @@ One block at a time, until no pixel of the hole is left:
    multiplied by ``1 + DATA * g / G`` (``g`` the mean gradient magnitude of the window's original
    known pixels, ``G`` that of the whole known region): edges that run into the hole are continued
    before the flat regions beside them grow over them (Criminisi et al.'s data term, simplified).
-   On the photo case (a spoon over a saucer's rim, seeds 0-4 medians) it took the seam figure from
-   0.21 under the truth's to 0.02 and coherence 6.35 -> 6.09, at no cost in time; on grey brick it
-   took coherence 1.04 -> 1.35, so grey images (and RGB ones without chroma) keep the count alone.
+   Grey images (and RGB ones without chroma) keep the count alone: there the term pulled the front
+   along texture edges.
 2. **SSD over known pixels only.** The window's known and filled pixels are the template; the cost
    of every source position is the masked sum of squared differences over them, all colour channels
    (``sum M I^2 - 2 sum M T I + sum M T^2``: two ``cv2.matchTemplate`` correlations, the source's
@@ -20,35 +19,26 @@ One block at a time, until no pixel of the hole is left:
    ``B x B`` block lies in the source region (the known pixels, or ``source``). The SSD alone prefers
    flat blocks (a flat block of the right mean costs half as much as a textured one half a period
    off), which smeared a photo's hole; so ``DETAIL * n * (sigma_block - sigma_template)^2`` is added,
-   ``sigma`` the standard deviation over the template's known pixels (one more correlation). On
-   two holes each of gravel, brick and the cat photo (seeds 1-2) it moved detail from 0.95/0.85,
-   0.83/0.94, 0.70/0.60 to 1.13/0.95, 0.78/0.99, 0.71/0.77 of the truth's and the seam excess from
-   -0.09/-0.38, +0.11/+0.16, -0.18/-0.36 to -0.04/-0.22, +0.05/+0.01, -0.16/-0.17, for coherence
-   0.50-0.62 -> 0.42-0.62 of the truth's. A block is picked at random among those within
+   ``sigma`` the standard deviation over the template's known pixels (one more correlation), so a
+   fill keeps its texture's detail. A block is picked at random among those within
    ``(1 + EPSILON)`` times the best cost (E&F §2.1's rule).
 3. **Locality.** Blocks are searched only within ``REACH`` px of the window, as Resynthesizer and
    Criminisi et al. prefer sources near the hole: the matches near a hole are the likeliest
-   continuation, and the search costs ~3x less on a 320 px image. Where that holds no whole block
+   continuation, and the search costs less. Where that holds no whole block
    (the middle of a hole wider than ``2 REACH``), the reach doubles until one does, and the whole
-   source is searched only when even that fails (e.g. a ``--texture``): a 170 px brush stroke across
-   a 4096² picture (the studio's painting benchmark) sent its middle windows to the whole 16 Mpx
-   source, and its fill took 62 s; 6.3 s now (median of 3, in-process; with ``np.argmax`` over the
-   whole fill front per block instead of :class:`_Front`'s strip maxima, 23 s under cProfile, 13 s
-   of it in ``argmax``).
+   source is searched only when even that fails (e.g. a ``--texture``), so a long stroke across a
+   large picture does not search the whole picture for each of its windows.
 4. **Coarse colour guide** (colour images only). The hole is filled by diffusion (``cv2.inpaint``,
    Telea) at 1/``GUIDE_SCALE`` scale; for the window's *unknown* pixels, ``GUIDE`` times the SSD
    between the chroma (colour less its grey mean) of that guide and of the blurred source block
    is added (two more correlations): which material goes where in the hole (wood, not the
    saucer's red or the coffee), not its texture, which the known pixels' SSD matches. Grey images
-   have no chroma and no guide (a grey guide pulled blocks towards flat ones: brick coherence
-   1.07 -> 1.28).
+   have no chroma and no guide (a grey guide pulled blocks towards flat ones).
 5. **Continuing a copy.** Where earlier blocks already wrote into the window, the blocks that
    continue their copies (same source offset; the ``CONTINUE`` most frequent in the window) are
    candidates too, and the cheapest is taken when it costs at most ``(1 + COHERE)`` times the
    best: neighbouring blocks then form one verbatim copy with no seam between them, as a
-   shift-map's labels do. The judge ``fill_coherence`` (distance of every 7x7 window to the
-   nearest known one) is ~0 inside a copy and high across a seam: on gravel's hole interior
-   (windows 6+ px inside) the quilt without it scored 8.8, shift-map 0.9.
+   shift-map's labels do (a seam costs the judge ``fill_coherence`` most, the inside of a copy ~0).
    On grey pictures (a grey one stored as RGB too) a copy is not continued into a **thin gap**
    without a check: where none of the window's unknown pixels lies more than ``GAP_WIDTH`` px from
    a valued one (the last row of blocks, between filled rows and the hole's edge), the overlap
@@ -58,25 +48,6 @@ One block at a time, until no pixel of the hole is left:
    ``GAP`` times the SSD between that and the source block blurred by ``GAP_SIGMA`` (over the
    gap's pixels) is added to every cost, and the continuation is taken only if it still costs at
    most ``(1 + COHERE)`` times the best of those; the block picked otherwise is E&F's as before.
-   On the benchmark's brick box (ending 5 px above a mortar line), seeds 0-14, the seam figure less
-   the truth's was +0.26 at seeds 1 and 9 (a second mortar line along the box's lower edge) and
-   -0.03..+0.06 elsewhere; now -0.04..+0.05 at every seed, and such a line is left at 5 of the 15
-   seeds (5, 8, 11, 13, 14; 7 before, by eye), a stub of one at 6 and 12, drawn by blocks whose gap
-   is not thin. Seeds 0-5 medians: brick coherence 1.06, gravel 9.02, uncrop 0.73, all unchanged.
-   Adding the gap cost to every block's choice, not only the continuation's, did as well on the
-   benchmark's brick but made a 96 px brick crop's fill less coherent (median 3.07 -> 3.52, against
-   3.15 for the continuation alone; ``hybrid``'s 2.50 -> 3.36, with a mortar stub of its own);
-   weight 10 pulled blocks towards flat ones; a sigma of 0.75 or 3 did as well as 1.5.
-   Where the short courses left come from (seed 5): a chain of continued copies 93 px up the wall
-   carries a mortar line to 15 px above the real one (rows 194-200), and the last row's windows hold
-   only the 5 brick rows between the box and that line, so no cost sees the two lines together. Not
-   kept (seeds 0-14 brick, 0-4 gravel and uncrop): also matching 4 or 8 px of the known and filled
-   pixels around the block (its SSD only, the block pasted as before): gravel 9.01 -> 8.5-8.6 but
-   brick 1.06 -> 1.19-1.29 (the goal's bound 1.27), short courses still drawn (by eye); blocks of
-   32, 40 or 48 px: brick 1.14 / 0.96 / 1.13, but at 40 short courses at 5 seeds and floating mortar
-   stubs at 6 more, at 48 stubs in the right column at 6 seeds; the texture's dominant offsets
-   (peaks of the masked autocorrelation of its gradients) as continuation candidates: brick
-   unchanged (the hand-laid courses are no lattice: peak 0.17), uncrop 0.81 -> 0.76.
 6. **Minimum-error cut.** On each side of the window that holds pixels filled by earlier blocks (an
    overlap strip of ``B // 3`` pixels), E&F's dynamic-programming cut
    runs over the squared difference between those pixels and the new block (one path per side, in
@@ -87,22 +58,14 @@ One block at a time, until no pixel of the hole is left:
    hole count as filled ones: the cut may run through them, so a block can meet the known texture
    a little outside the hole where they agree best; every other known pixel is never written.
 
-7. **Refine** (colour pictures only). The block seams inside the hole cost the judge most (on the
-   photo case, the windows 9+ px inside the spoon's bowl scored 6.9 against 2.8 for the
-   ``patchmatch`` engine's large copies). :func:`weft.core.fill.patchmatch.refine_patchmatch` then
-   runs ``REFINE`` EM iteration(s) at full resolution over the hole and the band: every 7x7 patch
-   touching them gets its nearest patch of the known pixels beyond the band, and every pixel is
-   copied through the offset the covering patches agree on most, so the seams move to where the
-   copies agree, without averaging. Each iteration searches only the inexact patches at or above
-   the median of their distances (``REFINE_WORST``): the judge's mean is dominated by the worst
-   windows. The method then runs no Poisson band: the refine re-synthesises the band. Seeds 0-4
-   medians on the photo, coherence / in-process ms (alternating, one process, quiet machine): no
-   refine 6.09 / 130 (with the Poisson band); 1 iteration, worse half 5.40 / 150; 1, all 5.30 /
-   165; 2, worse half 5.25 / 168; 3, all 5.12. One iteration is what the time goal affords: the
-   whole process then costs what it did before the refine (the quilt got ~20 ms faster), which was
-   already G'MIC's to within 0.01-0.02 s. On grey textures the refine brought gravel 8.78 -> 7.9 and
-   brick 1.04 -> 0.99 but cost 20-40 ms of a ~0.22 s process, their whole margin under G'MIC's
-   time, and they meet the other goals without it.
+7. **Refine** (colour pictures only). The block seams inside the hole cost the judge most:
+   :func:`weft.core.fill.search.refine_band` runs ``REFINE`` EM iteration(s) at full resolution
+   over the hole and the band: every 7x7 patch touching them gets its nearest patch of the known
+   pixels beyond the band, and every pixel is copied through the offset the covering patches agree
+   on most, so the seams move to where the copies agree, without averaging. Each iteration searches
+   only the inexact patches at or above the median of their distances (``REFINE_WORST``). The method
+   then runs no Poisson band: the refine re-synthesises the band. One iteration is what the time
+   allows; the ``hybrid`` engine runs more (it is the quilt with 64-px blocks and five).
 
 Blocks are copied only from the original known pixels (never from filled ones), so errors cannot
 feed on themselves.
@@ -309,7 +272,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     source : bool (H, W), optional: the pixels whose blocks may be copied (default ``~hole``).
     patch : int >= 3, the block side ``B`` (at most the image's smaller side).
     rng : seed or ``np.random.Generator``: same seed, same output.
-    progress : ``progress(done, total)`` in filled pixels, called when the percentage changes.
+    progress : gets :class:`weft.core.jobs.Progress` (stage ``"fill"``, in filled pixels) when the percentage changes.
     cancel : a ``CancelToken``, checked before every block.
     band : int >= 0, default 0: known pixels within this many px of the hole may be cut into (above).
     cuttable : bool (H, W) or None: the known pixels that may be cut into, given instead of ``band``

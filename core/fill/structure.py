@@ -1,9 +1,7 @@
 """Edges continued across a hole: the guide of ``weft fill --structure`` (the ``patchmatch`` engine).
 
 Patch search continues an edge that crosses a hole the way the patches beside it run: a curved edge
-(a saucer's rim under a removed spoon) runs on straight and then turns in a corner, or drips. Issue
-15's photo, seeds 0-4: the rim bulged or dripped red into the shadow at every seed, and nothing
-inside the search removed it (the attempts are listed in :mod:`weft.core.fill.patchmatch`). This
+(a saucer's rim under a removed spoon) runs on straight and then turns in a corner, or drips. This
 module finds the edges that enter the hole, pairs those that are two ends of one edge, joins each
 pair by a smooth curve, and returns a guide: a channel that says, for every pixel, on which side of
 that structure it lies and how near. The engine matches it like a colour on its coarsest level,
@@ -14,12 +12,9 @@ and the finer levels refine that layout (:func:`fill_patchmatch`'s ``guide``).
    (Gaussian, sigma ``_SMOOTH``) so the hole makes none; its thresholds are the 92nd and 75th
    percentiles of the gradient magnitude within 20 px of the hole (the strong edges of the hole's
    surroundings, whatever the picture's contrast). Pixels within 2 px of the hole are dropped.
-   A weak edge is not found: on the studio's 300x200 coffee, the saucer's upper left rim against
-   the dark wood is below those thresholds, and a hole over it continues nothing. Each colour
-   channel's gradient instead of the luminance's (the largest per pixel) found more edges, and on
-   issue 15's photo paired the shadow's too: no red beyond the rim (3-9 px against 58-98), but the
-   shadow washed out into tan patches (coherence 6.91 against 5.50, both matched on every level);
-   not kept.
+   A weak edge is not found (a rim against dark wood of a similar luminance continues nothing).
+   The luminance's gradient, not each colour channel's: the channels' found more edges, the
+   shadow's among them, and the fill washed the shadow out.
 2. **Entries**: every edge of at least 12 pixels that comes within 4 px of the hole enters it at its
    pixel nearest the hole, in the direction of the principal axis of its pixels within 14 px (a
    line-like piece only: the variance along the axis at least 3 times that across), pointed at
@@ -42,31 +37,13 @@ and the finer levels refine that layout (:func:`fill_patchmatch`'s ``guide``).
    pixel the side of its nearest pixel of that edge's structure (+1 or -1) times
    ``max(0, 1 - d / reach)``, ``d`` the distance to it: 1 on the structure, 0 beyond ``reach``.
    One channel per edge, not one for all: a side is only a convention of each edge's curve, and
-   near two parallel edges (a rim and its shadow's edge) one channel flipped sign half-way between
-   them, a band that no source beside the edges matched (a red piece of rim left floating in the
-   shadow, on one of 18 random holes in six of scikit-image's photos; with a channel per edge the
-   rim ran on).
+   near two parallel edges (a rim and its shadow's edge) one channel flips sign half-way between
+   them, a band that no source beside the edges matches.
 
-``reach`` 48 px: the measured trade on issue 15's photo (seeds 0-4, the guide then matched on every
-pyramid level with weight 1 at full confidence; without the guide coherence 4.45 and the drip at
-every seed): 12 px left thin red slivers beside the rim at every seed (the drip moved beyond the
-guide's reach); 24, 36 and 48 px continued the rim at every seed (coherence medians 5.34, 5.42,
-5.50), but 24 left a red fleck at the shadow's corner (seed 1) and copied the saucer's white
-highlights into the wood (seeds 1 and 4), 36 one such highlight (seed 4), 48 none: the wider the
-guide, the more of the hole knows which side of the rim it lies on. A weight of 0.3 or 0.5 (measured
-at a reach of 24 and 16 px) brought the slivers back at 2-3 seeds. Since the guide is matched on the
-coarsest level only (seeds 0-9 medians, 12 / 8 EM iterations, 3 final refine iterations): 32 px
-5.13, 48 5.01, 64 5.28, 96 5.56. Other shapes of the channel, matched on every level, seeds 0-4
-medians against the ramp's 5.50: a side step of 0.5 or 0.3 with a ramp over the last 8-24 px
-5.35-5.85; the ramp squared 5.35; the guide ignored in target pixels beyond the reach 5.38; the
-plain fill first, then the guide's fill redone within 12 or 24 px of the edge 5.08 / 5.43, with the
-drip left beyond the 12-px band. No peer continues this rim either (G'MIC ends it in a blob,
-shift-map in a vertical bar, pypatchmatch in a red smear). On textures the guide pairs the texture's
-own edges at random (issue 15's gravel and brick, the benchmark's seed, against ``patchmatch``
-alone: 9.24 -> 9.38 and 1.28 -> 1.76, 4 and 3 edges continued; 11.02 and 2.47 when it was matched on
-every level); ``auto`` fills grey pictures with the quilt, which does not run it. ``weft fill
---structure auto`` (the default) runs it whenever the ``patchmatch`` engine fills from the picture
-itself: see :mod:`weft.core.fill.patchmatch` for what it does to other photos.
+``reach`` 48 px: the wider the guide, the more of the hole knows which side of the rim it lies on;
+narrower ones left thin slivers of the rim's colour beside it, wider ones held too much of the fill
+to the edge. On textures the guide pairs the texture's own edges at random, so it runs only where
+``patchmatch`` fills a photo's hole (``--structure auto``) or when asked (``yes``).
 """
 
 from __future__ import annotations

@@ -8,13 +8,14 @@ import pytest
 from weft.core import metrics
 from weft.core.errors import InvalidParameter, WeftError
 from weft.core.examples import example
-from weft.core.fill import ENGINES, FillParams, fill, fill_pixel, fill_quilt
+from weft.core.fill import ENGINES, FillParams, fill, fill_quilt
+from weft.core.fill.hybrid import fill_hybrid
 from weft.core.fill.band import band_region, blend_band
 from weft.core.image import load_image
 
 from .fill_cases import brick, gravel, square_hole  # noqa: F401 (fixtures)
 
-ENGINE_FUNCS = {"quilt": fill_quilt, "pixel": fill_pixel}
+ENGINE_FUNCS = {"quilt": fill_quilt, "hybrid": fill_hybrid}
 
 
 @pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))
@@ -67,7 +68,7 @@ def test_engine_copies_only_from_the_source(brick):
     assert marked[64:].min() > 0.0
     out = fill_quilt(marked, hole, source, patch=12, rng=0)
     assert out[hole].min() > 0.0  # no pixel came from the blackened, non-source rows
-    out = fill_pixel(marked, hole, source, patch=5, rng=0)
+    out = fill_hybrid(marked, hole, source, patch=12, rng=0)
     assert out[hole].min() > 0.0
 
 
@@ -171,10 +172,19 @@ def test_onion_order_is_the_same_on_every_call():
         assert np.array_equal(onion_order(hole), first)
 
 
-def test_pixel_engine_same_seed_same_pixels_in_one_process(gravel):
+def test_a_recipe_of_the_dropped_pixel_engine_still_runs(gravel):
+    """``pixel`` was dropped (the hybrid measured better on every suite case it was run on); a recipe
+    that names it runs the default engine, and the command line refuses it in one line."""
+    from weft.core.errors import InvalidParameter
+
+    params = FillParams.from_dict({"engine": "pixel", "patch": 5})
+    assert params.engine == "auto"
     hole = square_hole(gravel.shape, 20, 50, 10, 70)
-    runs = [fill(gravel, hole, engine="pixel", patch=3, seed=558) for _ in range(6)]
-    assert all(np.array_equal(r, runs[0]) for r in runs)
+    from weft.core.fill.method import fill_image
+
+    assert np.array_equal(fill(gravel, hole, patch=5, seed=3), fill_image(gravel, hole, params=params, rng=3)[0])
+    with pytest.raises(InvalidParameter, match="engine"):
+        FillParams(engine="pixel")
 
 
 def test_python_api_refusals(gravel):
@@ -197,14 +207,14 @@ def test_python_api_refusals(gravel):
 
 
 def test_engines_listed():
-    assert {"auto", "quilt", "pixel", "patchmatch", "hybrid"} == set(ENGINES)
+    assert {"auto", "quilt", "patchmatch", "hybrid"} == set(ENGINES)
     assert FillParams().engine == "auto"
 
 
-def test_auto_runs_patchmatch_inside_a_colour_picture_and_quilt_otherwise(gravel):
+def test_auto_runs_hybrid_everywhere_and_patchmatch_for_the_edge_guide(gravel):
     """``auto`` (the default) is the engine it names in the figures, and its pixels are that
-    engine's: patchmatch for a hole inside a colour picture; quilt for a grey picture, a colour
-    picture stored grey as RGB, a hole along the border or an uncrop, and a patch beyond 63 px."""
+    engine's: hybrid for a hole inside a colour or grey picture, a hole along the border, an uncrop
+    and a large patch; patchmatch when ``structure`` = yes asks for the edge guide."""
     big = np.ascontiguousarray(load_image(example("chelsea")).image[:160, :200])
     photo = big[:96, :120]
     assert photo.ndim == 3
@@ -213,12 +223,13 @@ def test_auto_runs_patchmatch_inside_a_colour_picture_and_quilt_otherwise(gravel
     border = np.zeros(photo.shape[:2], bool)
     border[:, :20] = True
     cases = [
-        ("patchmatch", photo, dict(mask=hole)),
-        ("quilt", gravel, dict(mask=square_hole(gravel.shape))),
-        ("quilt", grey_rgb, dict(mask=square_hole(gravel.shape))),
-        ("quilt", photo, dict(mask=border)),
-        ("quilt", photo, dict(extend=(0, 0, 16, 0))),
-        ("quilt", big, dict(mask=square_hole(big.shape, 70, 100, 80, 120), patch=64)),
+        ("hybrid", photo, dict(mask=hole)),
+        ("hybrid", gravel, dict(mask=square_hole(gravel.shape))),
+        ("hybrid", grey_rgb, dict(mask=square_hole(gravel.shape))),
+        ("hybrid", photo, dict(mask=border)),
+        ("hybrid", photo, dict(extend=(0, 0, 16, 0))),
+        ("hybrid", big, dict(mask=square_hole(big.shape, 70, 100, 80, 120), patch=64)),
+        ("patchmatch", photo, dict(mask=hole, structure="yes")),
     ]
     from weft.core.fill.method import fill_image
     from weft.core.geometry import Margins
@@ -229,14 +240,13 @@ def test_auto_runs_patchmatch_inside_a_colour_picture_and_quilt_otherwise(gravel
             kw["extend"] = Margins.coerce(kw["extend"])
         out, figures = fill_image(image, mask, params=FillParams(**kw), rng=2)
         assert figures["engine"] == expected, (expected, kw)
-        assert np.array_equal(out, fill(image, mask, engine=expected, seed=2, **kw))
+        assert np.array_equal(out, fill(image, mask, seed=2, **{"engine": expected, **kw}))
 
 
 def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
     """The studio's "auto" patch (beside its box, and the centre of a variations range) is the patch
-    of the engine that runs: a colour picture's hole gets patchmatch's 7 px, a grey one quilt's 24,
-    an uncrop more than 24 px deep quilt's border block (48, at most a third of the canvas), a
-    narrower one 24; a named engine its own; a patch given is not resolved."""
+    of the engine that runs: the hybrid's 64-px block (at most a third of a small canvas) for holes
+    and uncrops; a named engine its own; a patch given is not resolved."""
     from weft.core.fill.method import STUDIO, fill_image
 
     colour = np.ascontiguousarray(load_image(example("chelsea")).image[:96, :120])
@@ -247,10 +257,11 @@ def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
         _, figures = fill_image(image, mask, params=params, rng=0)
         assert resolved == {"patch": figures["patch"]}, (image.shape, params.engine)
     assert STUDIO.resolved(FillParams(extend=(0, 0, 30, 0)), {"image": gravel.shape}) == {"patch": 32}
-    assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 7}
-    assert STUDIO.resolved(FillParams(extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 24}
-    assert STUDIO.resolved(FillParams(extend=(0, 0, 40, 0)), {"image": (300, 400, 3)}) == {"patch": 48}
-    assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 48}
+    assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 64}
+    assert STUDIO.resolved(FillParams(engine="patchmatch"), {"image": (300, 400, 3)}) == {"patch": 7}
+    assert STUDIO.resolved(FillParams(engine="quilt", extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 24}
+    assert STUDIO.resolved(FillParams(engine="quilt", extend=(0, 0, 40, 0)), {"image": (300, 400, 3)}) == {"patch": 48}
+    assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 64}
     assert STUDIO.resolved(FillParams(patch=9), {"image": (96, 120, 3)}) == {}
     assert STUDIO.resolved(FillParams(), {}) == {}
 
@@ -337,9 +348,9 @@ def test_a_default_patch_fits_a_small_image_and_an_even_pixel_patch_is_the_next_
         out = fill(small, hole, engine=engine, seed=0, band=0)
         assert np.array_equal(out[~hole], small[~hole]) and np.isfinite(out).all()
     half = np.zeros((20, 20), bool)
-    half[:, 8:] = True  # the source is 8 px wide: an 8x8 patch would fit, the 9x9 neighbourhood does not
-    with pytest.raises(WeftError, match="needs at least one whole 9x9 patch"):  # --patch 8: a 9x9 neighbourhood
-        fill(small, half, engine="pixel", patch=8)
+    half[:, 8:] = True  # the source is 8 px wide: a 9x9 patch does not fit
+    with pytest.raises(WeftError, match="needs at least one whole 9x9 patch"):
+        fill(small, half, engine="quilt", patch=9)
     with pytest.raises(InvalidParameter, match="parameter 'patch' = 64 is outside 3..63 for the patchmatch engine"):
         FillParams(engine="patchmatch", patch=64)
 
@@ -524,10 +535,10 @@ def test_a_small_hole_in_a_large_picture_is_filled_from_its_neighbourhood(engine
     near = neighbourhood(hole, ~hole, 24)
     m = NEAR + 48
     assert near == (slice(500 - m, 520 + m), slice(700 - m, 720 + m))
-    patch = FillParams(engine=engine).resolved_patch()
+    patch = 48 if engine == "hybrid" else FillParams(engine=engine).resolved_patch()
     near = neighbourhood(hole, ~hole, patch)
-    out = fill(img, hole, engine=engine, seed=3)
-    alone = fill(img[near], hole[near], engine=engine, seed=3)
+    out = fill(img, hole, engine=engine, patch=patch, seed=3)
+    alone = fill(img[near], hole[near], engine=engine, patch=patch, seed=3)
     assert np.array_equal(out[near], alone)
     outside = np.ones((1024, 1024), bool)
     outside[near] = False
@@ -553,8 +564,8 @@ def test_a_grey_neighbourhood_of_a_colour_picture_is_blended_as_the_engine_fille
     hole = np.zeros((1024, 1024), bool)
     hole[600:630, 700:730] = True
     near = neighbourhood(hole, ~hole, 24)
-    out = fill(img, hole, seed=2)
-    assert np.array_equal(out[near], fill(img[near], hole[near], seed=2))
+    out = fill(img, hole, seed=2, engine="quilt")
+    assert np.array_equal(out[near], fill(img[near], hole[near], seed=2, engine="quilt"))
 
 
 def test_quilt_draws_no_mortar_line_into_a_thin_gap(monkeypatch):
@@ -630,16 +641,16 @@ def test_an_extension_along_the_border_is_quilted_with_larger_blocks():
     hole = np.zeros((h, w), dtype=bool)
     hole[:, cut:] = True
     truth = metrics.fill_seam(full, hole)
-    out, figures = fill_image_figures(full[:, :cut], extend=(0, 0, w - cut, 0), seed=0)
+    out, figures = fill_image_figures(full[:, :cut], extend=(0, 0, w - cut, 0), seed=0, engine="quilt")
     assert figures["patch"] == BORDER_BLOCK and out.shape == full.shape
     assert abs(metrics.fill_seam(out, hole) - truth) <= 0.3
-    small, _ = fill_image_figures(full[:, :cut], extend=(0, 0, w - cut, 0), seed=0, patch=24)
+    small, _ = fill_image_figures(full[:, :cut], extend=(0, 0, w - cut, 0), seed=0, patch=24, engine="quilt")
     assert metrics.fill_seam(small, hole) - truth > 1.0
     from weft.core.fill.method import fill_image
 
     dab = np.zeros((h, w), dtype=bool)
     dab[:12, 100:130] = True  # a small hole on the border keeps the 24-px block
-    assert fill_image(full, dab, params=FillParams(), rng=0)[1]["patch"] == 24
+    assert fill_image(full, dab, params=FillParams(engine="quilt"), rng=0)[1]["patch"] == 24
 
 
 def fill_image_figures(image, seed, **params):

@@ -160,9 +160,10 @@ def test_hybrid_quality_bounds(case, gravel, brick):
 def test_hybrid_engine_function_reports_progress_to_the_end(gravel):
     hole = square_hole(gravel.shape)
     seen = []
-    out = fill_hybrid(gravel, hole, patch=16, rng=0, progress=lambda d, t: seen.append((d, t)))
+    out = fill_hybrid(gravel, hole, patch=16, rng=0, progress=lambda p: seen.append((p.done, p.total, p.stage)))
     assert np.array_equal(out[~hole], gravel[~hole])
-    assert seen and seen[-1][0] == seen[-1][1] and [d for d, _ in seen] == sorted(d for d, _ in seen)
+    assert seen and seen[-1][0] == seen[-1][1] and [d for d, _, _ in seen] == sorted(d for d, _, _ in seen)
+    assert {s for _, _, s in seen} == {"fill"}  # one progress protocol: weft.core.jobs.Progress
 
 
 def test_hybrid_uncrop_keeps_the_image(brick):

@@ -49,11 +49,11 @@ RUNS = {
     "rectify": [({"photo": image("perspective")}, {"lines": LINES, "warp": "lines"})],
     "fill": [({"image": image("gravel", 64, 64), "mask": np.pad(np.ones((20, 24), np.float32), ((20, 24), (16, 24)))},
               {}),
-             ({"image": image("chelsea", 48, 48)}, {"extend": [8, 0, 8, 4], "engine": "pixel"}),
+             ({"image": image("chelsea", 48, 48)}, {"extend": [8, 0, 8, 4], "engine": "quilt"}),
              ({"image": np.dstack([image("brick", 48, 48), np.pad(np.zeros((16, 16), np.float32), 16,
                                                                   constant_values=1)])}, {"patch": 9, "band": 3}),
              ({"image": image("gravel", 48, 48), "mask": np.pad(np.ones((16, 16), np.float32), 16),
-               "texture": image("brick", 40, 40)}, {"engine": "pixel", "patch": 5}),
+               "texture": image("brick", 40, 40)}, {"engine": "hybrid", "patch": 8}),
              ({"image": image("chelsea", 64, 64), "mask": np.pad(np.ones((16, 20), np.float32), ((20, 28), (20, 24)))},
               {"engine": "patchmatch"})],
     "blend": [({"foreground": image("gravel", 64, 64), "background": image("camera", 64, 64),
@@ -88,7 +88,13 @@ def _signatures(method: str) -> tuple[dict, dict]:
     return out["before"], out["after"]
 
 
-@pytest.mark.parametrize("method", ["quilt", "nfpt", "affine", "fast", "rectify", "blend", "fill"])
+def test_fill_runs_no_kernel_at_all():
+    """Every fill engine runs in numpy and OpenCV: warm-up and the runs load no numba kernel."""
+    before, after = _signatures("fill")
+    assert before == {} and after == {}
+
+
+@pytest.mark.parametrize("method", ["quilt", "nfpt", "affine", "fast", "rectify", "blend"])
 def test_a_run_after_warm_up_compiles_nothing_and_each_kernel_once(method):
     before, after = _signatures(method)
     assert before, "warm_up() loaded no kernel"
