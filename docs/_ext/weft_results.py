@@ -47,6 +47,7 @@ class Suite:
     command: str = ""
     about: str = ""
     keep: Callable[[dict], bool] | None = None
+    rows: Callable[[dict], list[dict]] | None = None  # the table's rows made from the whole file
 
 
 def _size(v) -> str:
@@ -112,6 +113,76 @@ SUITES: dict[str, Suite] = {
 }
 
 
+def _fill_aggregates(half: str) -> Callable[[dict], list[dict]]:
+    def rows(data: dict) -> list[dict]:
+        return [{"tool": tool, **figures} for tool, figures in data["aggregates"][half].items()]
+    return rows
+
+
+def _fill_cases(data: dict) -> list[dict]:
+    return [{**r, "defects": ", ".join(r.get("defects") or []) or "none"}
+            for r in data["rows"] if r.get("tool") == "weft" and r.get("half") == "check"]
+
+
+def _rectify_rows(data: dict) -> list[dict]:
+    return [{"detector": who, "kind": kind, **figures}
+            for who, kinds in data["aggregates"].items() for kind, figures in kinds.items()]
+
+
+def _limits_rows(data: dict) -> list[dict]:
+    out = []
+    for case in ("uncrop_colour", "uncrop_grey", "hole"):
+        for run in data["fill"].get(case, []):
+            out.append({"job": f"fill, {case.replace('_', ' ')}", "side": run["side"], "seconds": run["seconds"],
+                        "added_mib": run["added_bytes"] / 2**20})
+    for kind, runs in data.get("quilting", {}).items():
+        for run in runs if isinstance(runs, list) else ():
+            out.append({"job": f"quilting {kind}, block {run.get('block')}", "seconds": run["seconds"],
+                        "added_mib": run["peak_bytes"] / 2**20})
+    return out
+
+
+_FILL_AGG = (
+    Column("tool", "tool"), Column("cases", "cases"), Column("coherence_median", "coherence, median", "{:.2f}"),
+    Column("coherence_worst", "coherence, worst", "{:.2f}"), Column("defects", "cases with a defect"),
+    Column("known_changed_cases", "cases with known pixels changed beyond the band"),
+    Column("time_median_s", "whole process s, median", "{:.2f}"),
+    Column("within_gmic_time", "cases within G'MIC's time"),
+)
+
+SUITES.update({
+    "fill_suite": Suite(_FILL_AGG, "python -m benchmarks.fill_suite",
+                        "The fill suite's check half (cases the defaults were not chosen on): each tool's "
+                        "coherence (lower is better), its defects (detail below 0.8x or above 1.25x the "
+                        "truth's, a seam more than 0.15 from the truth's, coherence over 1.2x the best "
+                        "peer's) and its whole-process time.", rows=_fill_aggregates("check")),
+    "fill_suite/tuning": Suite(_FILL_AGG, "python -m benchmarks.fill_suite",
+                               "The tuning half, on which the defaults were chosen.",
+                               rows=_fill_aggregates("tuning")),
+    "fill_suite/cases": Suite((
+        Column("case", "case"), Column("note", "what it is"), Column("coherence", "coherence", "{:.2f}"),
+        Column("detail_ratio", "detail / truth's", "{:.2f}"), Column("seam_diff", "seam - truth's", "{:+.2f}"),
+        Column("process_s", "s", "{:.2f}"), Column("defects", "defects")),
+        "python -m benchmarks.fill_suite", "weft's default on each case of the check half.", rows=_fill_cases),
+    "rectify_suggest": Suite((
+        Column("detector", "detector"), Column("kind", "cases"), Column("cases", "n"),
+        Column("success", "success", _pct), Column("wrong_warps", "wrong warps"), Column("refused", "refused"),
+        Column("median_angle_err_deg", "angle error, median deg", "{:.2f}"),
+        Column("median_aspect_err", "aspect error, median", "{:.1%}"),
+        Column("median_ms_per_mp", "ms per megapixel", "{:.0f}"), Column("first_run_ms", "first call ms", "{:.0f}")),
+        "python -m benchmarks.rectify_suggest",
+        "Suggested feature lines on perspective views with a known homography (straight structure, textures "
+        "without straight lines, and noise that must be refused), against a plain baseline (Hough lines and "
+        "the two largest clusters). Success: the rectified result is within a similarity of the truth (right "
+        "angle within 1 deg, aspect within 2 %).", rows=_rectify_rows),
+    "limits": Suite((
+        Column("job", "job"), Column("side", "canvas side px"), Column("seconds", "s", "{:.1f}"),
+        Column("added_mib", "memory added MiB", "{:.0f}")),
+        "python -m benchmarks.limits",
+        "The runs the up-front memory and time checks are fitted to.", rows=_limits_rows),
+})
+
+
 def _parts(name: str) -> tuple[str, str, str]:
     """``FILE[/VIEW][:KEY=VALUE]`` -> (file stem, description name, filter)."""
     head, _, flt = name.partition(":")
@@ -132,7 +203,10 @@ def load(suite: str) -> dict | None:
         return None
     if isinstance(data, list):
         data = {"rows": data}
-    if not isinstance(data, dict) or not isinstance(data.get("rows"), list):
+    if not isinstance(data, dict):
+        return None
+    data.setdefault("rows", [])  # a suite whose table is made from other keys (Suite.rows)
+    if not isinstance(data["rows"], list):
         return None
     data["rows"] = [r for r in data["rows"] if isinstance(r, dict)]
     return data
@@ -176,7 +250,11 @@ def render(name: str) -> list[str]:
     if data is None:
         return [f".. note:: No results file ``benchmarks/results/{base}.json`` yet: "
                 f"run ``{command}`` to make it.", ""]
-    rows = data["rows"]
+    try:
+        rows = suite.rows(data) if suite and suite.rows else data["rows"]
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return [f".. note:: ``benchmarks/results/{base}.json`` does not have the figures this table "
+                f"shows: run ``{command}`` again.", ""]
     if flt and "=" in flt:
         key, value = flt.split("=", 1)
         rows = [r for r in rows if str(r.get(key)) == value]

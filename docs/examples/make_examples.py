@@ -2,6 +2,8 @@
 
 * ``coffee-spoon-mask.png``: a mask of the spoon on the saucer of ``resources/coffee.png`` (white =
   the hole to fill): its bowl and handle, grown by 2 px, as a brush would paint it.
+* ``coffee-no-cup-area.png``: a sampling area (white = where fill may copy from): all of
+  ``resources/coffee.png`` but the cup, so no piece of the cup is copied into the spoon's place.
 * ``frames/frame_0.png`` ... ``frame_3.png``: four 160x120 frames of a slow pan over
   ``resources/perspective-frontal.png``, the clip a batch example renders.
 * ``oval-mask.png``: a soft-edged oval over the astronaut's face in ``resources/astronaut.png``
@@ -34,6 +36,13 @@ def spoon_mask() -> np.ndarray:
     return cv2.dilate(mask, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (5, 5)))
 
 
+def no_cup_area() -> np.ndarray:
+    coffee = cv2.imread(str(RESOURCES / "coffee.png"))
+    area = np.full(coffee.shape[:2], 255, np.uint8)
+    cv2.ellipse(area, (145, 75), (62, 68), 0, 0, 360, 0, thickness=-1)
+    return area
+
+
 def frames(count: int = 4) -> list[np.ndarray]:
     wall = cv2.imread(str(RESOURCES / "perspective-frontal.png"))
     return [cv2.resize(wall[40:280, 24 * i:24 * i + 320], (160, 120), interpolation=cv2.INTER_AREA)
@@ -49,6 +58,7 @@ def oval_mask() -> np.ndarray:
 def main() -> None:
     cv2.imwrite(str(HERE / "coffee-spoon-mask.png"), spoon_mask())
     cv2.imwrite(str(HERE / "oval-mask.png"), oval_mask())
+    cv2.imwrite(str(HERE / "coffee-no-cup-area.png"), no_cup_area())
     floor = {"quad": [[150, 170], [330, 170], [470, 350], [10, 350]], "size": [480, 360]}
     (HERE / "floor.json").write_text(json.dumps(floor) + "\n")
     (HERE / "frames").mkdir(exist_ok=True)
