@@ -117,3 +117,41 @@ def test_a_scheduler_killed_mid_batch_ends_with_the_summary(slow_scene, capfd, t
                 with __import__("contextlib").suppress(ProcessLookupError):
                     os.killpg(p.pid, signal.SIGKILL)
                 p.wait()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
+def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_scene, capfd, tmp_path, monkeypatch):
+    tmp, _ = slow_scene
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+                        "--dashboard-address", ":0"], tmp_path)
+    worker = None
+    try:
+        _wait_for_scheduler(address)
+        worker = _start(["worker", address, "--nthreads", "1", "--nworkers", "1", "--no-dashboard"], tmp_path)
+        monkeypatch.setattr(execute, "WORKER_TIMEOUT", 3.0)
+        out_dir = tmp / "orphaned"
+
+        def kill_the_worker_when_one_is_written():
+            deadline = time.monotonic() + 240
+            while time.monotonic() < deadline and not (out_dir.is_dir() and any(out_dir.glob("*.png"))):
+                time.sleep(0.05)
+            os.killpg(worker.pid, signal.SIGKILL)
+
+        import threading
+
+        killer = threading.Thread(target=kill_the_worker_when_one_is_written, daemon=True)
+        killer.start()
+        code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
+                               out_dir / "{stem}.png", "--scheduler", address, "-q"], capfd)
+        killer.join()
+        lines = err.strip().splitlines()
+        assert code == 1 and "Traceback" not in err, err
+        assert "written" in lines[-1] and "had no workers left for 3 s" in lines[-1], err
+    finally:
+        for p in (scheduler, worker):
+            if p is not None:
+                with __import__("contextlib").suppress(ProcessLookupError):
+                    os.killpg(p.pid, signal.SIGKILL)
+                p.wait()

@@ -357,6 +357,19 @@ class DaskPool:
     def after_death(self) -> None:
         pass  # Dask has already retried the item on other workers
 
+    def idle_without_workers(self) -> float:
+        """Seconds since the cluster was last seen with a worker (checked at most every second)."""
+        now = time.monotonic()
+        if now - getattr(self, "_checked", 0.0) >= 1.0:
+            self._checked = now
+            try:
+                has = bool(self.workers())
+            except Exception:  # noqa: BLE001 - the scheduler gone: lost() says so
+                has = True
+            if has or not hasattr(self, "_seen"):
+                self._seen = now
+        return now - self._seen
+
     def lost(self) -> bool:
         """Whether the connection to the scheduler is gone (the scheduler was stopped or killed)."""
         return getattr(self.client, "status", "running") not in ("running", "connecting", "newly-created")
@@ -473,8 +486,12 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                                 item, summary, state, on_outcome, progress)
                         continue
                 inflight[pool.submit(item)] = item
-            if isinstance(pool, DaskPool) and pool.lost():  # every item not done fails with the reason
-                reason = f"the Dask scheduler at {pool.address} was lost before it was done"
+            no_workers = isinstance(pool, DaskPool) and pool.idle_without_workers() > WORKER_TIMEOUT
+            if isinstance(pool, DaskPool) and (pool.lost() or no_workers):  # every item not done fails
+                reason = (f"the Dask scheduler at {pool.address} had no workers left for {WORKER_TIMEOUT:g} s"
+                          if no_workers and not pool.lost()
+                          else f"the Dask scheduler at {pool.address} was lost before it was done")
+                pool.cancel(inflight)
                 for item in [*inflight.values(), *todo]:
                     _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
                             item, summary, state, on_outcome, progress)
