@@ -33,6 +33,7 @@ from PySide6.QtWidgets import QFileDialog
 from weft.core import registry
 from weft.core.errors import WeftError
 from weft.core.jobs import JobResult, JobRunner
+from weft.core.readfile import file_key
 from weft.core.studio import MASK, SQUARE
 from weft.core.image import atomic_write_bytes, save_image
 
@@ -167,10 +168,10 @@ class FileActions(QObject):
         p = Path(path)
         if p.suffix.lower() not in (".png", ".jpg", ".jpeg", ".tif", ".tiff"):
             p = p.with_suffix(".png")
-        for item in self.doc.inputs.values():
-            if item.path and Path(item.path).resolve() == p.resolve():
-                self.show_message(f"{p.name}: refusing to overwrite an input image")
-                return False
+        key = file_key(p)  # by device and inode: another path to an input (a link, a second mount) is it
+        if any(item.path and file_key(item.path) == key for item in self.doc.inputs.values()):
+            self.show_message(f"{p.name}: refusing to overwrite an input image")
+            return False
         if p.exists() and not self._confirm(f"{p.name} exists. Replace it?"):
             self.show_message(f"{p.name}: not exported (the existing file is kept)")
             return False
@@ -234,7 +235,7 @@ class FileActions(QObject):
         masks = {}
         for name, mask in shown.masks.items():
             file = beside.with_name(f"{beside.stem}.{name}.png")
-            if any(item.path and Path(item.path).resolve() == file.resolve() for item in self.doc.inputs.values()):
+            if any(item.path and file_key(item.path) == file_key(file) for item in self.doc.inputs.values()):
                 raise WeftError(f"{file.name}: refusing to overwrite an input image with the {name.replace('_', ' ')}")
             masks[file] = (name, mask)
             inputs[name] = str(file.resolve())

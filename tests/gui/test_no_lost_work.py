@@ -315,3 +315,18 @@ def test_export_over_an_input_is_refused_without_asking(window, tmp_path, monkey
     assert window.export_result(str(texture)) is False
     assert asked == [] and texture.read_bytes() == before
     assert len(messages) == 1 and "texture.png" in messages[0] and "input" in messages[0]
+
+
+def test_export_over_an_input_through_another_name_is_refused(window, tmp_path, monkeypatch):
+    """A hard link (or a second mount of the folder) is the input under another path."""
+    texture = tmp_path / "texture.png"
+    save_image(texture, window.doc.image("texture"))
+    window.doc.set_input("texture", str(texture), window.doc.image("texture"))
+    other = tmp_path / "other"
+    other.mkdir()
+    alias = other / "same-file.png"
+    os.link(texture, alias)
+    before = texture.read_bytes()
+    asked = answer(monkeypatch, True)
+    assert window.export_result(str(alias)) is False
+    assert asked == [] and texture.read_bytes() == before
