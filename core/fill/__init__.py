@@ -53,8 +53,9 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
     extend : ``Margins`` or ``(left, top, right, bottom)`` or ``"L,T,R,B"``: pixels added (and filled).
     size, anchor : ``(width, height)`` of a larger canvas, and where the image sits on it
         (:data:`ANCHORS`); not with ``extend``.
-    engine : ``"auto"`` (the default, :data:`DEFAULT_ENGINE`: ``patchmatch`` for a hole inside a colour
-        ``hybrid``; ``patchmatch`` with ``structure`` = yes), ``"hybrid"``, ``"quilt"`` or ``"patchmatch"``.
+    engine : ``"auto"`` (the default, :data:`DEFAULT_ENGINE`: ``patchmatch`` with the edge guide where
+        it finds edges crossing a hole inside a colour picture, else ``hybrid``; ``patchmatch`` with
+        ``structure`` = yes), ``"hybrid"``, ``"quilt"`` or ``"patchmatch"``.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
     structure : continue the strong edges that cross the hole along smooth curves
         (:mod:`weft.core.fill.structure`): ``"auto"`` (the default) whenever the ``patchmatch`` engine

@@ -175,13 +175,23 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         if alpha is not None:
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
+    pending = None  # auto's edge guide: (part, guide, edges continued)
     if params.engine == "auto":  # the figures and messages name the engine that runs
         # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
         # large picture (a colour corner far from a hole in a grey region does not make it a photo)
         known = ~hole & ~transparent
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
-        params = params.replace(engine=auto_engine(picture, touches_border(hole), params.patch, params.structure))
+        on_border = touches_border(hole)
+        edges = None
+        if (texture is None and params.structure == "auto"
+                and auto_engine(picture, on_border, params.patch, params.structure, True) == "patchmatch"):
+            # whether the edge guide finds edges to continue decides; on the part patchmatch would
+            # fill, so that its run takes this guide
+            found = _edge_guide(colour, hole, transparent, params.replace(engine="patchmatch"), ch, cw)
+            edges = found[2] > 0
+            pending = found
+        params = params.replace(engine=auto_engine(picture, on_border, params.patch, params.structure, edges))
     patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
@@ -255,10 +265,13 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     part = (slice(None), slice(None)) if near is None else near
     engine_kw = {k: v[part] for k, v in extra.items()}
     if structure:  # the edges entering the hole, continued across it (None: none pair up)
-        from .structure import structure_guide
+        if pending is not None and pending[0] == part and work is colour:
+            engine_kw["guide"], continued = pending[1], pending[2]
+        else:
+            from .structure import structure_guide
 
-        engine_kw["guide"], continued = structure_guide(work[part], work_hole[part],
-                                                        ~work_hole[part] & ~transparent[part])
+            engine_kw["guide"], continued = structure_guide(work[part], work_hole[part],
+                                                            ~work_hole[part] & ~transparent[part])
     filled = engine.function()(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
                                progress=progress, cancel=cancel, **engine_kw)
     if near is not None:
@@ -290,6 +303,20 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     if margins:
         figures["extend"] = margins.to_json()
     return np.ascontiguousarray(out, dtype=np.float32), figures
+
+
+def _edge_guide(colour: np.ndarray, hole: np.ndarray, transparent: np.ndarray, params: FillParams,
+                ch: int, cw: int) -> tuple[tuple[slice, slice], np.ndarray | None, int]:
+    """``(part, guide, edges continued)``: the structure guide of ``hole`` on the part of the canvas a
+    run of ``params.engine`` fills (:func:`neighbourhood` of its patch; the whole canvas when that is
+    most of it), from the known pixels that are not transparent."""
+    from .structure import structure_guide
+
+    known = ~hole & ~transparent
+    near = neighbourhood(hole, known, _run_patch(params, ch, cw, hole=hole))
+    part = (slice(None), slice(None)) if near is None else near
+    guide, n = structure_guide(colour[part], hole[part], known[part])
+    return part, guide, n
 
 
 def _interior(hole: np.ndarray) -> np.ndarray:
@@ -424,7 +451,9 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     """What an unset ``patch`` resolves to with inputs of these shapes (the studio shows it beside its
     box, and the variations grid centres its range on it): the patch the run takes (the engine's
     default, fitted to a small canvas; the quilt's border block for margins over 24 px); for
-    ``auto``, that of the engine it runs (:func:`auto_engine`). Nothing before an image is open."""
+    ``auto``, that of the engine it runs on shapes alone (:func:`auto_engine` with no edges looked
+    for: the hybrid's; a hole whose edges the guide continues runs patchmatch's). Nothing before an
+    image is open."""
     shape = shapes.get("image")
     if params.patch is not None or shape is None:
         return {}

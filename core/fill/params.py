@@ -42,7 +42,8 @@ class FillParams(Params):
     """Parameters of ``weft fill``."""
 
     engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
-                        help="auto: hybrid (patchmatch with --structure yes); "
+                        help="auto: patchmatch with the edge guide where it finds edges crossing a hole inside a "
+                             "colour picture (always with --structure yes), else hybrid; "
                              + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()))
     patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
                        help="patch side in pixels (quilt, hybrid: the block; patchmatch: at most 63); "
@@ -110,10 +111,22 @@ def structure_value(value):
     return value
 
 
-def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto") -> str:
-    """The engine ``auto`` runs: ``patchmatch`` with ``structure`` = yes (the edge guide is that
-    engine's), else ``hybrid`` (quilting, then full-resolution patch search), on grey and colour
-    pictures, holes and uncrops alike: on the fill suite's tuning half it was the most coherent
-    engine in most cases and had the fewest defects (``python -m benchmarks.fill_suite``). The
-    picture's kind and the hole's place are accepted for the callers that pass them, and unused."""
-    return "patchmatch" if structure == "yes" else "hybrid"
+def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto",
+                edges: bool | None = None) -> str:
+    """The engine ``auto`` runs: ``patchmatch`` with the edge guide where that guide has edges to
+    continue (``edges``: at least one pair of edges crossing the hole, as
+    :func:`weft.core.fill.structure.structure_guide` pairs them) in a colour picture's hole that
+    does not touch the border, with ``structure`` = auto and a ``patch`` that engine takes (none
+    given, or at most its largest); ``patchmatch`` with ``structure`` = yes;
+    else ``hybrid`` (quilting, then full-resolution patch search). Patch search guided along the
+    edges continues a rim or a horizon a removed object cut; the hybrid's blocks fill textures and
+    structureless holes more coherently (``python -m benchmarks.fill_suite``). ``edges`` = None
+    (not looked for, e.g. when only the inputs' shapes are known) counts as none."""
+    from .patchmatch import MAX_PATCH
+
+    if structure == "yes":
+        return "patchmatch"
+    if (structure == "auto" and colour_picture and not hole_on_border and edges
+            and (patch is None or patch <= MAX_PATCH)):
+        return "patchmatch"
+    return "hybrid"

@@ -211,10 +211,11 @@ def test_engines_listed():
     assert FillParams().engine == "auto"
 
 
-def test_auto_runs_hybrid_everywhere_and_patchmatch_for_the_edge_guide(gravel):
+def test_auto_runs_hybrid_where_no_edges_cross_and_patchmatch_for_the_edge_guide(gravel):
     """``auto`` (the default) is the engine it names in the figures, and its pixels are that
-    engine's: hybrid for a hole inside a colour or grey picture, a hole along the border, an uncrop
-    and a large patch; patchmatch when ``structure`` = yes asks for the edge guide."""
+    engine's: hybrid for a hole inside a colour picture that cuts no edge the guide pairs, inside a
+    grey picture, along the border, an uncrop and a large patch; patchmatch when ``structure`` = yes
+    asks for the edge guide (where the guide finds edges: tests/core/test_fill_structure.py)."""
     big = np.ascontiguousarray(load_image(example("chelsea")).image[:160, :200])
     photo = big[:96, :120]
     assert photo.ndim == 3

@@ -221,3 +221,21 @@ def test_the_studio_shows_the_patch_the_structure_run_takes():
 
     assert STUDIO.auto(FillParams(), {"image": (96, 96)}) == {"patch": 32}
     assert STUDIO.auto(FillParams(structure="yes"), {"image": (96, 96)}) == {"patch": 7}
+
+
+def test_auto_runs_patchmatch_with_the_guide_where_it_finds_edges_to_continue():
+    """``auto`` (the default engine): a colour picture's hole that cuts an edge (the disc's rim) is
+    filled by patchmatch with the edge guide (the same pixels as asking for them); a hole inside the
+    plain disc, the grey picture's rim, a hole on the border and ``structure`` = no get hybrid."""
+    img, _ = _picture()
+    rim = _hole_on(80, 225, 16)
+    out, f = fill_image(img, rim, params=FillParams(), rng=1)
+    asked, _ = fill_image(img, rim, params=FillParams(engine="patchmatch", structure="yes"), rng=1)
+    assert f["engine"] == "patchmatch" and f["edges_continued"] == 1 and np.array_equal(out, asked)
+    ground = _hole_on(40, 225, 12)
+    border = np.zeros(rim.shape, bool)
+    border[:, :14] = True
+    for image, hole, kw in ((img, ground, {}), (img[..., 0], rim, {}), (img, border, {}),
+                            (img, rim, {"structure": "no"})):
+        _, f = fill_image(image, hole, params=FillParams(**kw), rng=1)
+        assert f["engine"] == "hybrid" and "edges_continued" not in f, kw
