@@ -31,20 +31,12 @@ if signal.getsignal(signal.SIGINT) is signal.default_int_handler and threading.c
     signal.signal(signal.SIGINT, _interrupted_while_starting)
 
 
-def _address_space_limit() -> int | None:
-    try:
-        import resource
-
-        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
-    except (ImportError, OSError, ValueError, AttributeError):
-        return None
-    return None if soft == resource.RLIM_INFINITY or soft < 0 else int(soft)
-
-
 #: The least address space (``ulimit -v``) weft runs its methods in: below it, loading the numerical
 #: libraries fails in many ways, and SciPy's OpenBLAS can retry a failing allocation forever.
 MIN_ADDRESS_SPACE = 768 * 2**20
 
+
+from weft.core.limits import address_space_limit as _address_space_limit  # noqa: E402 (stdlib only)
 
 if _address_space_limit() is not None:
     # Under ulimit -v every thread's stack and every BLAS thread's buffers take address space: the
