@@ -171,7 +171,7 @@ def _principal_candidates(fl: Flat, img: np.ndarray, gen: np.random.Generator, k
     sample = fl.gather(vy[pick], vx[pick]).astype(np.float64)
     sample -= sample.mean(axis=0)
     v = np.ones(sample.shape[1]) / np.sqrt(sample.shape[1])  # the principal axis by power iteration
-    for _ in range(12):  # (numpy's SVD of the sample took 1.4 s on the loaded 2-core machine: BLAS threads)
+    for _ in range(12):  # (not numpy's SVD, whose BLAS threads made it far slower)
         v = np.dot(np.dot(sample, v), sample)
         v /= max(float(np.sqrt(np.dot(v, v))), 1e-30)
     axis = v.reshape(fl.p, fl.p, fl.c).astype(np.float32)

@@ -253,7 +253,7 @@ def test_a_colour_uncrop_too_large_for_memory_is_refused_up_front(tmp_path, caps
     small = _colour_png(tmp_path, 96)
     code = cli.main(["fill", str(small), "--size", "600x600", "-o", str(tmp_path / "o.png"), "-q"])
     err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1, err  # measured: +667 MiB at 600x600 from 96x96 colour
+    assert code == 2 and err.count("\n") == 1, err
     assert err.startswith("weft: fill of a 600x600 canvas (uncrop) needs about ") and "500 MiB is available" in err
     assert not (tmp_path / "o.png").exists()
 
@@ -263,7 +263,7 @@ def test_a_colour_uncrop_too_long_is_refused_up_front(tmp_path, capsys, monkeypa
     small = _colour_png(tmp_path, 96)
     code = cli.main(["fill", str(small), "--size", "600x600", "-o", str(tmp_path / "o.png"), "-q"])
     err = capsys.readouterr().err
-    assert code == 2 and err.count("\n") == 1 and "would take about" in err, err  # measured 15.9 s
+    assert code == 2 and err.count("\n") == 1 and "would take about" in err, err
     assert not (tmp_path / "o.png").exists()
 
 
@@ -275,5 +275,5 @@ def test_small_quilting_blocks_count_their_per_block_cost(tmp_path, capsys):
     code = cli.main(["quilt", str(tmp_path / "t.png"), "--size", "300x300", "--block", "4", "--overlap", "1",
                      "-o", str(tmp_path / "o.png"), "-q"])
     err = capsys.readouterr().err
-    assert code == 2 and "would take about" in err and err.count("\n") == 1, err  # measured 12-17 s
+    assert code == 2 and "would take about" in err and err.count("\n") == 1, err
     assert not (tmp_path / "o.png").exists()
