@@ -310,12 +310,21 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.DockWidgetArea.LeftDockWidgetArea, dock)
         self.examples_dock = dock
 
+    def _show_status(self, text: str) -> None:
+        """The status message, whole when it fits beside the read-outs: a short message takes its
+        width from the result's figures (those are elided first), a long one is elided too."""
+        bar = self.statusBar()
+        room = bar.width() - self.pixel_label.width() - self.zoom_label.sizeHint().width() - 40
+        wanted = self.status_label.fontMetrics().horizontalAdvance(text) + 8 if text else 0
+        self.status_label.setMinimumWidth(max(0, min(wanted, int(room * 0.75))))
+        self.status_label.set_full_text(text)
+
     def _build_status(self) -> None:
         # The status bar's message is shown by status_label, the first permanent widget (stretching,
         # elided, the whole text in its tooltip), so it never runs under the pixel read-out: QStatusBar
         # paints its own message only left of its first permanent widget, i.e. nowhere.
         self.status_label = ElidedLabel()
-        self.statusBar().messageChanged.connect(self.status_label.set_full_text)
+        self.statusBar().messageChanged.connect(self._show_status)
         self.statusBar().addPermanentWidget(self.status_label, 3)
         # the shown result's figures stay in a widget of their own: a menu's or a tooltip's status
         # tip replaces (then clears) the status message, never them
