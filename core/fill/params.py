@@ -21,8 +21,7 @@ ANCHORS = ("center", "top-left", "top", "top-right", "left", "right", "bottom-le
 ENGINES = ("auto", *TABLE)
 #: The default engine.
 DEFAULT_ENGINE = "auto"
-#: Engines of earlier versions, dropped because another measured better everywhere, and what their
-#: recipes now run.
+#: Engines of earlier versions and what their recipes now run.
 RETIRED = {"pixel": "auto"}
 #: Each engine's patch side when ``patch`` is not given.
 DEFAULT_PATCH = {name: e.patch for name, e in TABLE.items()}
@@ -32,8 +31,9 @@ DEFAULT_PATCH = {name: e.patch for name, e in TABLE.items()}
 #: the picture's structure block by block (bricks without joints).
 BORDER_BLOCK = 48
 #: ``structure``'s values (:mod:`weft.core.fill.structure`): the edges a hole cuts are continued
-#: whenever ``patchmatch`` fills from the picture itself (``auto``, the default), always (``yes``:
-#: ``auto`` then runs ``patchmatch``) or never (``no``).
+#: where ``auto``'s engine rule finds edges to pair across an interior hole of a colour picture
+#: (``auto``, the default; it then runs ``patchmatch``), always (``yes``: ``auto`` then runs
+#: ``patchmatch``) or never (``no``).
 STRUCTURE = ("auto", "yes", "no")
 
 

@@ -37,15 +37,12 @@ class QuiltParams(Params):
     The papers leave the block to the user: "the block size must be big enough to capture the
     relevant structures in the texture, but small enough so that the interaction between these
     structures is left up to the algorithm" (E&F §2.1). A sample is usually cropped around a few of
-    its elements, so the default scales with it: 7/16 of the side holds the whole bricks of the
-    peers' brick_128 sample (the quilting benchmark's T1: coherence 0.0358 → 0.0266 over seeds 0–9 against a fixed
-    32) while one block stays under a fifth of the sample's area, so no verbatim region nears the
-    quarter of the sample the verbatim goal allows; the cap keeps the output of a large sample from
-    being a few large copies of it. With a block of 48 or more the min-cut seam rule cuts 24
-    candidates (tol 6) instead of 8: the wider overlap has room for a cut along the texture's joints
-    and the extra candidates find it (T1 at block 56: coherence 0.0275 with tol 2, 0.0266 with 6);
-    at block 32 they cost 40 % more time and lowered nothing (quilt-mincut-512: 0.0255 / 0.0056
-    with tol 2, 0.0261 / 0.0077 with 6).
+    its elements, so the default scales with it: 7/16 of the side holds whole bricks of a brick
+    sample while one block stays under a fifth of the sample's area, so no verbatim region nears a
+    quarter of the sample; the cap keeps the output of a large sample from being a few large copies
+    of it. With a block of 48 or more the min-cut seam rule weighs 24 candidates (tol 6) instead of
+    8: the wider overlap has room for a cut along the texture's joints, and the extra candidates find
+    it; at smaller blocks they cost time and gain nothing (the quilting benchmark's figures).
     """
 
     mode: str = param("mincut", choices=MODES,
