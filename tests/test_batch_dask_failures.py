@@ -4,11 +4,13 @@ mid-batch (the summary of what was written, the rest failed with the reason, no 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -62,96 +64,78 @@ def _wait_for_scheduler(address: str) -> None:
     raise AssertionError("the scheduler did not start")
 
 
+@contextlib.contextmanager
+def _cluster(tmp: Path, workers: int):
+    """A local Dask scheduler (and ``workers`` worker processes of one thread each), killed on the
+    way out: ``(address, scheduler process, worker process or None)``."""
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+                        "--dashboard-address", ":0"], tmp)
+    worker = None
+    try:
+        _wait_for_scheduler(address)
+        if workers:
+            worker = _start(["worker", address, "--nthreads", "1", "--nworkers", str(workers), "--no-dashboard"], tmp)
+        yield address, scheduler, worker
+    finally:
+        for p in (scheduler, worker):
+            if p is not None:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+
+
+def _kill_when_one_is_written(out_dir: Path, process: subprocess.Popen) -> threading.Thread:
+    """A thread that kills ``process`` once the batch has written its first output."""
+    def kill():
+        deadline = time.monotonic() + 240
+        while time.monotonic() < deadline and not (out_dir.is_dir() and any(out_dir.glob("*.png"))):
+            time.sleep(0.05)
+        os.killpg(process.pid, signal.SIGKILL)
+
+    killer = threading.Thread(target=kill, daemon=True)
+    killer.start()
+    return killer
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
 def test_a_scheduler_without_workers_is_a_time_limit_not_a_silent_wait(scene, capfd, monkeypatch, tmp_path):
     tmp, _ = scene
-    address = f"tcp://127.0.0.1:{_free_port()}"
-    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                        "--dashboard-address", ":0"], tmp_path)
-    try:
-        _wait_for_scheduler(address)
+    with _cluster(tmp_path, workers=0) as (address, _scheduler, _worker):
         monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)
         code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
                                tmp / "o" / "{stem}.png", "--scheduler", address], capfd)
         assert code == 2 and err == (f"weft: the Dask scheduler at {address} has no workers (waited 2 s; set "
                                      "WEFT_DASK_WORKER_TIMEOUT to wait longer)\n")
-    finally:
-        os.killpg(scheduler.pid, signal.SIGKILL)
-        scheduler.wait()
 
 
 @pytest.mark.slow
 @pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
 def test_a_scheduler_killed_mid_batch_ends_with_the_summary(slow_scene, capfd, tmp_path):
     tmp, _ = slow_scene
-    recipe, frames = tmp / "look.json", tmp / "frames"
-    address = f"tcp://127.0.0.1:{_free_port()}"
-    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                        "--dashboard-address", ":0"], tmp_path)
-    worker = None
-    try:
-        _wait_for_scheduler(address)
-        worker = _start(["worker", address, "--nthreads", "1", "--nworkers", "1", "--no-dashboard"], tmp_path)
+    with _cluster(tmp_path, workers=1) as (address, scheduler, _worker):
         out_dir = tmp / "killed"
-
-        def kill_when_one_is_written():
-            deadline = time.monotonic() + 240
-            while time.monotonic() < deadline and not (out_dir.is_dir() and any(out_dir.glob("*.png"))):
-                time.sleep(0.05)
-            os.killpg(scheduler.pid, signal.SIGKILL)
-
-        import threading
-
-        killer = threading.Thread(target=kill_when_one_is_written, daemon=True)
-        killer.start()
-        code, out, err = _run(["batch", recipe, "--over", "target", frames, "-o", out_dir / "{stem}.png",
-                               "--scheduler", address, "-q"], capfd)
+        killer = _kill_when_one_is_written(out_dir, scheduler)
+        code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
+                               out_dir / "{stem}.png", "--scheduler", address, "-q"], capfd)
         killer.join()
         lines = err.strip().splitlines()
         assert code == 1 and "Traceback" not in err and "internal error" not in err, err
         assert "written" in lines[-1] and "was lost before it was done" in lines[-1], err
-    finally:
-        for p in (scheduler, worker):
-            if p is not None:
-                with __import__("contextlib").suppress(ProcessLookupError):
-                    os.killpg(p.pid, signal.SIGKILL)
-                p.wait()
 
 
 @pytest.mark.slow
 @pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
 def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_scene, capfd, tmp_path, monkeypatch):
     tmp, _ = slow_scene
-    address = f"tcp://127.0.0.1:{_free_port()}"
-    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                        "--dashboard-address", ":0"], tmp_path)
-    worker = None
-    try:
-        _wait_for_scheduler(address)
-        worker = _start(["worker", address, "--nthreads", "1", "--nworkers", "1", "--no-dashboard"], tmp_path)
+    with _cluster(tmp_path, workers=1) as (address, _scheduler, worker):
         monkeypatch.setattr(execute, "WORKER_TIMEOUT", 3.0)
         out_dir = tmp / "orphaned"
-
-        def kill_the_worker_when_one_is_written():
-            deadline = time.monotonic() + 240
-            while time.monotonic() < deadline and not (out_dir.is_dir() and any(out_dir.glob("*.png"))):
-                time.sleep(0.05)
-            os.killpg(worker.pid, signal.SIGKILL)
-
-        import threading
-
-        killer = threading.Thread(target=kill_the_worker_when_one_is_written, daemon=True)
-        killer.start()
+        killer = _kill_when_one_is_written(out_dir, worker)
         code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
                                out_dir / "{stem}.png", "--scheduler", address, "-q"], capfd)
         killer.join()
         lines = err.strip().splitlines()
         assert code == 1 and "Traceback" not in err, err
         assert "written" in lines[-1] and "had no workers left for 3 s" in lines[-1], err
-    finally:
-        for p in (scheduler, worker):
-            if p is not None:
-                with __import__("contextlib").suppress(ProcessLookupError):
-                    os.killpg(p.pid, signal.SIGKILL)
-                p.wait()
