@@ -312,12 +312,14 @@ class MainWindow(QMainWindow):
 
     def _show_status(self, text: str) -> None:
         """The status message, whole when it fits beside the read-outs: a short message takes its
-        width from the result's figures (those are elided first), a long one is elided too."""
+        width from the result's figures (those are elided first), a long one is elided too; with no
+        message the figures have the room."""
         bar = self.statusBar()
         room = bar.width() - self.pixel_label.width() - self.zoom_label.sizeHint().width() - 40
         wanted = self.status_label.fontMetrics().horizontalAdvance(text) + 8 if text else 0
         self.status_label.setMinimumWidth(max(0, min(wanted, int(room * 0.75))))
         self.status_label.set_full_text(text)
+        self.status_label.setVisible(bool(text))  # no message: the result's figures take its room
 
     def _build_status(self) -> None:
         # The status bar's message is shown by status_label, the first permanent widget (stretching,
@@ -331,6 +333,7 @@ class MainWindow(QMainWindow):
         self.result_label = ElidedLabel()
         self.result_label.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         self.statusBar().addPermanentWidget(self.result_label, 2)
+        self.status_label.hide()  # (until there is a message)
         self.pixel_label = QLabel("")
         # the read-out keeps its own room (a typical read-out's width), so moving the mouse does not
         # shift the message, and a longer read-out is elided rather than pushed into it
