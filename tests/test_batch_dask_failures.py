@@ -139,3 +139,33 @@ def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_sce
         lines = err.strip().splitlines()
         assert code == 1 and "Traceback" not in err, err
         assert "written" in lines[-1] and "had no workers left for 3 s" in lines[-1], err
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
+def test_a_result_lost_with_its_worker_fails_instead_of_waiting_forever(tmp_path, monkeypatch):
+    # The window the batch can fall into: an item done, its worker killed before the result is fetched.
+    monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)
+    with _cluster(tmp_path, workers=1) as (address, _scheduler, worker):
+        pool = execute.DaskPool(address, "quilt")
+        try:
+            future = pool.client.submit(sum, [1, 2], pure=False)
+            distributed.wait([future])
+            os.killpg(worker.pid, signal.SIGKILL)
+            worker.wait()
+            raised: list[BaseException] = []
+
+            def fetch():
+                try:
+                    pool.outcome(future)
+                except BaseException as e:  # noqa: BLE001 - handed to the test's thread
+                    raised.append(e)
+
+            fetcher = threading.Thread(target=fetch, daemon=True)
+            fetcher.start()
+            fetcher.join(120)  # a bound on a regression (it would wait forever), not a timing
+            assert not fetcher.is_alive(), "fetching a lost result waited for a worker forever"
+            assert len(raised) == 1 and isinstance(raised[0], execute.WeftError), raised
+            assert str(raised[0]) == f"the Dask scheduler at {address} had no workers left for 2 s"
+        finally:
+            pool.close()

@@ -347,12 +347,20 @@ class DaskPool:
         return done
 
     def outcome(self, future) -> Outcome:
+        """The item's outcome. A finished item's result lives on its worker: if that worker died
+        before we fetched it, Dask recomputes it and would wait for a worker forever, so wait in
+        short steps and give up once the cluster is gone (``WeftError`` saying why)."""
         from distributed import KilledWorker
 
-        try:
-            return future.result()
-        except KilledWorker:
-            raise WorkerDied() from None
+        while True:
+            try:
+                return future.result(timeout=1)
+            except KilledWorker:
+                raise WorkerDied() from None
+            except TimeoutError:
+                reason = self.gone()
+                if reason:
+                    raise WeftError(reason) from None
 
     def after_death(self) -> None:
         pass  # Dask has already retried the item on other workers
@@ -373,6 +381,15 @@ class DaskPool:
     def lost(self) -> bool:
         """Whether the connection to the scheduler is gone (the scheduler was stopped or killed)."""
         return getattr(self.client, "status", "running") not in ("running", "connecting", "newly-created")
+
+    def gone(self) -> str | None:
+        """Why no item can finish any more (the scheduler lost, or no worker for ``WORKER_TIMEOUT``
+        seconds), or None while the cluster can still run them."""
+        if self.lost():
+            return f"the Dask scheduler at {self.address} was lost before it was done"
+        if self.idle_without_workers() > WORKER_TIMEOUT:
+            return f"the Dask scheduler at {self.address} had no workers left for {WORKER_TIMEOUT:g} s"
+        return None
 
     def cancel(self, futures) -> None:
         with contextlib.suppress(Exception):
@@ -486,11 +503,8 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                                 item, summary, state, on_outcome, progress)
                         continue
                 inflight[pool.submit(item)] = item
-            no_workers = isinstance(pool, DaskPool) and pool.idle_without_workers() > WORKER_TIMEOUT
-            if isinstance(pool, DaskPool) and (pool.lost() or no_workers):  # every item not done fails
-                reason = (f"the Dask scheduler at {pool.address} had no workers left for {WORKER_TIMEOUT:g} s"
-                          if no_workers and not pool.lost()
-                          else f"the Dask scheduler at {pool.address} was lost before it was done")
+            reason = pool.gone() if isinstance(pool, DaskPool) else None
+            if reason:  # every item not done fails
                 pool.cancel(inflight)
                 for item in [*inflight.values(), *todo]:
                     _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
