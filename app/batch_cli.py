@@ -17,34 +17,60 @@ BATCH_DESCRIPTION = (
     "Apply a recipe (.json, or a PNG exported by weft) to many files: each --over list replaces one input of "
     "the recipe file by file (several lists zip together). Runs on local processes, or on a Dask cluster "
     "with --scheduler. Items whose output already exists with the same recipe are skipped, so a re-run "
-    "resumes an interrupted batch.")
+    "resumes an interrupted batch."
+)
 
 
 def add_batch_parser(sub) -> None:
     b = sub.add_parser("batch", help=BATCH_HELP, description=BATCH_DESCRIPTION)
     b.add_argument("recipe", metavar="RECIPE", help="recipe JSON file, or a PNG exported by weft")
-    b.add_argument("--over", nargs=2, action="append", metavar=("INPUT", "FILES"), required=True,
-                   help="the recipe input the files replace (e.g. target), and a folder, a glob ('frames/*.png', "
-                        "quoted) or a file; repeat to zip several lists")
-    b.add_argument("-o", "--output", required=True, metavar="PATTERN",
-                   help="output path per item: {stem} and {name} of the (first) --over file, {index} (from 0, "
-                        "e.g. {index:04d}), {INPUT} the stem of that input's file; .png outputs carry their recipe")
+    b.add_argument(
+        "--over",
+        nargs=2,
+        action="append",
+        metavar=("INPUT", "FILES"),
+        required=True,
+        help="the recipe input the files replace (e.g. target), and a folder, a glob ('frames/*.png', "
+        "quoted) or a file; repeat to zip several lists",
+    )
+    b.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="PATTERN",
+        help="output path per item: {stem} and {name} of the (first) --over file, {index} (from 0, "
+        "e.g. {index:04d}), {INPUT} the stem of that input's file; .png outputs carry their recipe",
+    )
     b.add_argument("--workers", metavar="N", help="local worker processes (default: the number of cores)")
-    b.add_argument("--scheduler", metavar="ADDRESS",
-                   help="run on this Dask scheduler (tcp://HOST:8786; default: $DASK_SCHEDULER_ADDRESS, else local)")
-    b.add_argument("--ship-inputs", action="store_true",
-                   help="read the input files here and send their bytes to the workers (no shared folder needed)")
-    b.add_argument("--ship-outputs", action="store_true",
-                   help="workers send each encoded output back and this process writes it (by default the "
-                        "workers write the output paths themselves, which they must then share)")
+    b.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on this Dask scheduler (tcp://HOST:8786; default: $DASK_SCHEDULER_ADDRESS, else local)",
+    )
+    b.add_argument(
+        "--ship-inputs",
+        action="store_true",
+        help="read the input files here and send their bytes to the workers (no shared folder needed)",
+    )
+    b.add_argument(
+        "--ship-outputs",
+        action="store_true",
+        help="workers send each encoded output back and this process writes it (by default the "
+        "workers write the output paths themselves, which they must then share)",
+    )
     b.add_argument("--seed", metavar="N", help="instead of the recipe's seed")
-    b.add_argument("--seed-per-item", action="store_true",
-                   help="item i gets seed + i (default: every item the same seed, a consistent look across frames)")
+    b.add_argument(
+        "--seed-per-item",
+        action="store_true",
+        help="item i gets seed + i (default: every item the same seed, a consistent look across frames)",
+    )
     b.add_argument("--force", action="store_true", help="redo items whose output already exists with the same recipe")
-    b.add_argument("--bit-depth", metavar="BITS",
-                   help="8 or 16 bits per channel (16: PNG, TIFF); default 8 (fill: each item's image's own)")
-    b.add_argument("--report", action="store_true",
-                   help="print one JSON line per item and a summary line on stdout")
+    b.add_argument(
+        "--bit-depth",
+        metavar="BITS",
+        help="8 or 16 bits per channel (16: PNG, TIFF); default 8 (fill: each item's image's own)",
+    )
+    b.add_argument("--report", action="store_true", help="print one JSON line per item and a summary line on stdout")
     b.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     b.set_defaults(method=None)
 
@@ -94,7 +120,8 @@ class _BatchBar:
 
 
 def run_batch(args: argparse.Namespace) -> int:
-    from weft.app.options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int
+    from weft.app.options import parse_bit_depth as _parse_bit_depth
+    from weft.app.options import parse_int as _parse_int
     from weft.core import batch
     from weft.core.errors import WeftError
     from weft.core.readfile import one_line
@@ -105,17 +132,30 @@ def run_batch(args: argparse.Namespace) -> int:
     scheduler = batch.scheduler_address(args.scheduler)
     if scheduler and workers is not None:
         raise WeftError("--workers sets local processes; with a Dask scheduler the cluster's workers run the items")
-    plan = batch.plan(args.recipe, [tuple(o) for o in args.over], args.output, seed=seed,
-                      seed_per_item=args.seed_per_item, force=args.force, bit_depth=bit_depth,
-                      ship_inputs=args.ship_inputs, ship_outputs=args.ship_outputs)
+    plan = batch.plan(
+        args.recipe,
+        [tuple(o) for o in args.over],
+        args.output,
+        seed=seed,
+        seed_per_item=args.seed_per_item,
+        force=args.force,
+        bit_depth=bit_depth,
+        ship_inputs=args.ship_inputs,
+        ship_outputs=args.ship_outputs,
+    )
     bar = _BatchBar(not args.quiet)
 
     def on_outcome(outcome) -> None:
         if args.report:
             print(json.dumps(outcome.report()), flush=True)
         if outcome.status == "failed":
-            bar.say(one_line(f"weft: {outcome.label}: {outcome.error}" if not outcome.error.startswith("/")
-                             else f"weft: {outcome.error}"))
+            bar.say(
+                one_line(
+                    f"weft: {outcome.label}: {outcome.error}"
+                    if not outcome.error.startswith("/")
+                    else f"weft: {outcome.error}"
+                )
+            )
 
     t0 = time.monotonic()
     try:

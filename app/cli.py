@@ -27,7 +27,10 @@ def _interrupted_while_starting(signum, frame) -> None:
     os._exit(130)
 
 
-if signal.getsignal(signal.SIGINT) is signal.default_int_handler and threading.current_thread() is threading.main_thread():
+if (
+    signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    and threading.current_thread() is threading.main_thread()
+):
     signal.signal(signal.SIGINT, _interrupted_while_starting)
 
 
@@ -49,14 +52,15 @@ import dataclasses  # noqa: E402
 import json  # noqa: E402
 import secrets  # noqa: E402
 import time  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
 from pathlib import Path  # noqa: E402
-from typing import Sequence  # noqa: E402
 
 from weft.core import __version__  # noqa: E402 (after the start-up Ctrl-C handler)
 from weft.core.errors import Cancelled, WeftError  # noqa: E402
 from weft.core.params import Params, specs  # noqa: E402
 
-from .options import parse_bit_depth as _parse_bit_depth, parse_int as _parse_int  # noqa: E402
+from .options import parse_bit_depth as _parse_bit_depth  # noqa: E402
+from .options import parse_int as _parse_int
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -149,8 +153,9 @@ class _PreparingLine:
             sys.stderr.write(text)
             sys.stderr.flush()
             self.bar.line_open = True
-        self.thread = threading.Thread(target=self._tick, args=(text, time.monotonic()), daemon=True,
-                                       name="weft-preparing")
+        self.thread = threading.Thread(
+            target=self._tick, args=(text, time.monotonic()), daemon=True, name="weft-preparing"
+        )
         self.thread.start()
 
     def _tick(self, text: str, since: float) -> None:
@@ -168,14 +173,21 @@ class _PreparingLine:
 
 
 def _add_common(p: argparse.ArgumentParser, region: bool = True) -> None:
-    p.add_argument("-o", "--output", required=True, metavar="OUT",
-                   help="output image (.png, .jpg, .tif); PNGs carry the recipe")
+    p.add_argument(
+        "-o", "--output", required=True, metavar="OUT", help="output image (.png, .jpg, .tif); PNGs carry the recipe"
+    )
     p.add_argument("--seed", metavar="N", help="random seed (default: a fresh one, recorded in the recipe)")
-    p.add_argument("--bit-depth", metavar="BITS",
-                   help="8 or 16 bits per channel (16: PNG, TIFF); default 8 (fill: the image's own)")
+    p.add_argument(
+        "--bit-depth",
+        metavar="BITS",
+        help="8 or 16 bits per channel (16: PNG, TIFF); default 8 (fill: the image's own)",
+    )
     if region:
-        p.add_argument("--region", metavar="X,Y,S",
-                       help="use only this square of the texture (top-left corner and side, pixels) as the source")
+        p.add_argument(
+            "--region",
+            metavar="X,Y,S",
+            help="use only this square of the texture (top-left corner and side, pixels) as the source",
+        )
     p.add_argument("--report", action="store_true", help="print one JSON line with the compute time and figures")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
@@ -185,9 +197,12 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     only that method's module is imported."""
     from weft.core import registry
 
-    parser = _Parser(prog="weft", description="Example-based texture synthesis and transfer. "
-                     "Without arguments, opens the desktop studio; 'weft IMAGE [TARGET]' opens it "
-                     "on those images.")
+    parser = _Parser(
+        prog="weft",
+        description="Example-based texture synthesis and transfer. "
+        "Without arguments, opens the desktop studio; 'weft IMAGE [TARGET]' opens it "
+        "on those images.",
+    )
     parser.add_argument("--version", action="version", version=f"weft {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     chosen = [registry.get(only)] if only is not None else list(registry.methods().values())
@@ -197,8 +212,13 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             if inp.is_positional:
                 p.add_argument(inp.name, metavar=inp.name.upper(), help=inp.help)
             else:
-                p.add_argument("--" + inp.name.replace("_", "-"), dest=inp.name, metavar="IMAGE",
-                               required=inp.required, help=inp.help)
+                p.add_argument(
+                    "--" + inp.name.replace("_", "-"),
+                    dest=inp.name,
+                    metavar="IMAGE",
+                    required=inp.required,
+                    help=inp.help,
+                )
         group = p.add_argument_group("method parameters")
 
         for spec in specs(method.params):
@@ -212,28 +232,41 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
                 d = spec.default
                 bits.append("default " + (f"{d[0]}x{d[1]}" if isinstance(d, tuple) else str(d)))
             metavar = spec.type.METAVAR if spec.kind == "geometry" else spec.kind.upper()
-            group.add_argument(spec.option, dest="param_" + spec.name, metavar=metavar,
-                               help="; ".join(bits).replace("%", "%%"))
+            group.add_argument(
+                spec.option, dest="param_" + spec.name, metavar=metavar, help="; ".join(bits).replace("%", "%%")
+            )
         if _lines_spec(method) is not None:
-            p.add_argument("--auto", action="store_true",
-                           help="suggest the feature lines from two families of straight lines in the photo "
-                                "(the recipe records the suggested lines; --report adds the confidence and the "
-                                "angle between the two directions)")
-            p.add_argument("--save-lines", metavar="F.json",
-                           help="also write the feature lines used (the suggestion, with --auto) to this JSON "
-                                "file: edit it and pass it back with --lines")
+            p.add_argument(
+                "--auto",
+                action="store_true",
+                help="suggest the feature lines from two families of straight lines in the photo "
+                "(the recipe records the suggested lines; --report adds the confidence and the "
+                "angle between the two directions)",
+            )
+            p.add_argument(
+                "--save-lines",
+                metavar="F.json",
+                help="also write the feature lines used (the suggestion, with --auto) to this JSON "
+                "file: edit it and pass it back with --lines",
+            )
         _add_common(p, region=method.takes_region)
         p.set_defaults(method=method.name)
-    w = sub.add_parser("warm-up", help="prepare every method's compiled kernels now (installers, render nodes, CI)",
-                       description="Compile (or load) every method's numba kernels ahead of time, in parallel "
-                       "processes (one per CPU), into numba's cache, so that no later run pays the compile. "
-                       "Prints one line per method on stdout.")
+    w = sub.add_parser(
+        "warm-up",
+        help="prepare every method's compiled kernels now (installers, render nodes, CI)",
+        description="Compile (or load) every method's numba kernels ahead of time, in parallel "
+        "processes (one per CPU), into numba's cache, so that no later run pays the compile. "
+        "Prints one line per method on stdout.",
+    )
     w.add_argument("methods", nargs="*", metavar="METHOD", help="only these methods (default: all)")
     w.add_argument("--jobs", metavar="N", help="processes at once (default: the number of CPUs)")
     w.add_argument("-q", "--quiet", action="store_true", help="print nothing (errors still print)")
     w.set_defaults(method=None)
-    r = sub.add_parser("run", help="reproduce a recipe (.json, or a PNG exported by weft)",
-                       description="Reproduce a recipe: the same method, parameters, inputs and seed.")
+    r = sub.add_parser(
+        "run",
+        help="reproduce a recipe (.json, or a PNG exported by weft)",
+        description="Reproduce a recipe: the same method, parameters, inputs and seed.",
+    )
     r.add_argument("recipe", metavar="RECIPE", help="recipe JSON file, or a PNG exported by weft")
     _add_common(r)
     r.set_defaults(method=None)
@@ -300,9 +333,16 @@ def _check_output(output: str, inputs: Sequence[str]) -> Path:
     return out
 
 
-def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], seed: int | None,
-             args: argparse.Namespace, region: tuple[int, int, int] | None = None, extra: dict | None = None,
-             read_too: Sequence[str] = ()) -> int:
+def _execute(
+    method_name: str,
+    params_dict: dict,
+    input_paths: dict[str, str],
+    seed: int | None,
+    args: argparse.Namespace,
+    region: tuple[int, int, int] | None = None,
+    extra: dict | None = None,
+    read_too: Sequence[str] = (),
+) -> int:
     from weft.core import registry
     from weft.core.image import save_image
     from weft.core.image.temporaries import remove_stale_temporaries
@@ -313,7 +353,9 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
     params = params_dict if isinstance(params_dict, Params) else method.params.from_dict(params_dict)
     bit_depth = _parse_bit_depth(args) if args.bit_depth is not None else None  # None: see below
     out = _check_output(args.output, [*input_paths.values(), *read_too])  # read_too: the recipe file
-    save_lines = _check_lines_file(method, params, getattr(args, "save_lines", None), [*input_paths.values(), *read_too, out])
+    save_lines = _check_lines_file(
+        method, params, getattr(args, "save_lines", None), [*input_paths.values(), *read_too, out]
+    )
     if bit_depth == 16 and out.suffix.lower() in (".jpg", ".jpeg"):
         raise WeftError(f"{args.output}: JPEG cannot hold 16 bits per channel (use .png or .tif)")
     if seed is None:
@@ -327,8 +369,9 @@ def _execute(method_name: str, params_dict: dict, input_paths: dict[str, str], s
             # Loading every kernel up front only keeps --report's "seconds" free of cache loads; without
             # --report a run loads (or, first time, compiles) just the kernels it uses: a cold
             # `weft affine` 3.8 -> 3.0 s, `weft nfpt` 4.7 -> 3.9 s.
-            result, seconds = render(method, params, input_paths, seed, region, progress=bar,
-                                     warm_up=args.report, infos=infos)
+            result, seconds = render(
+                method, params, input_paths, seed, region, progress=bar, warm_up=args.report, infos=infos
+            )
     finally:
         preparing.stop()
         bar.close()
@@ -396,13 +439,16 @@ def _warm_up_all(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     failed = []
     notices = set()
-    say(f"weft: warming up {len(names)} method{'s' if len(names) != 1 else ''}, "
-        f"{min(jobs, len(names))} process{'es' if min(jobs, len(names)) != 1 else ''} at once")
+    say(
+        f"weft: warming up {len(names)} method{'s' if len(names) != 1 else ''}, "
+        f"{min(jobs, len(names))} process{'es' if min(jobs, len(names)) != 1 else ''} at once"
+    )
     # "spawn": fresh interpreters (no inherited numba state or threads). Each worker warms several
     # methods in turn (quilting, the longest, first): a process per method paid Python's, numba's
     # and LLVM's start-up six times, 19.7 s of CPU against 12.2 s in one process on this machine.
-    with ProcessPoolExecutor(max_workers=min(jobs, len(names)),
-                             mp_context=multiprocessing.get_context("spawn")) as pool:
+    with ProcessPoolExecutor(
+        max_workers=min(jobs, len(names)), mp_context=multiprocessing.get_context("spawn")
+    ) as pool:
         futures = {pool.submit(registry.warm_up_report, name): name for name in names}
         for future in as_completed(futures):
             name = futures[future]
@@ -415,8 +461,11 @@ def _warm_up_all(args: argparse.Namespace) -> int:
             if r["notice"]:
                 notices.add(r["notice"])
             notices.update(r.get("repairs") or ())
-            what = (f"compiled {r['compiled']} function{'s' if r['compiled'] != 1 else ''}" if r["compiled"]
-                    else "loaded from the cache")
+            what = (
+                f"compiled {r['compiled']} function{'s' if r['compiled'] != 1 else ''}"
+                if r["compiled"]
+                else "loaded from the cache"
+            )
             say(f"{name:8} {what} in {r['seconds']:.1f} s")
     for notice in sorted(notices):
         print(f"weft: {notice}", file=sys.stderr)
@@ -449,8 +498,11 @@ def _dispatch(args: argparse.Namespace) -> int:
         else:
             seed = recipe.seed
         region = Square.parse(args.region) if args.region is not None else recipe.region
-        if args.bit_depth is None and recipe.bit_depth is not None and \
-                Path(args.output).suffix.lower() not in (".jpg", ".jpeg"):
+        if (
+            args.bit_depth is None
+            and recipe.bit_depth is not None
+            and Path(args.output).suffix.lower() not in (".jpg", ".jpeg")
+        ):
             args.bit_depth = str(recipe.bit_depth)  # the depth the recipe's output was written at
         return _execute(recipe.method, params, dict(recipe.inputs), seed, args, region, read_too=[args.recipe])
 
@@ -513,9 +565,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return run_gui(images=argv)
     limit = _address_space_limit()
     if limit is not None and limit < MIN_ADDRESS_SPACE and not any(a in ("-h", "--help", "--version") for a in argv):
-        print(f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB is below the "
-              f"{MIN_ADDRESS_SPACE // 2**20} MiB weft needs to load its libraries (raise it with ulimit -v)",
-              file=sys.stderr)
+        print(
+            f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB is below the "
+            f"{MIN_ADDRESS_SPACE // 2**20} MiB weft needs to load its libraries (raise it with ulimit -v)",
+            file=sys.stderr,
+        )
         return 2
     try:
         from weft.core import registry
@@ -545,13 +599,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         if limit is not None:  # libraries fail in many ways when an allocation or a load is refused
             from weft.core.readfile import one_line
 
-            print(one_line(f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB "
-                           f"is too small for this job ({type(e).__name__}: {e})")[:400], file=sys.stderr)
+            print(
+                one_line(
+                    f"weft: out of memory: the address-space limit (ulimit -v) of {limit / 2**20:.0f} MiB "
+                    f"is too small for this job ({type(e).__name__}: {e})"
+                )[:400],
+                file=sys.stderr,
+            )
             return 2
         from weft.core.readfile import one_line
 
-        print(one_line(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)"),
-              file=sys.stderr)
+        print(
+            one_line(f"weft: internal error: {type(e).__name__}: {e} (set WEFT_DEBUG=1 for the traceback)"),
+            file=sys.stderr,
+        )
         return 1
 
 

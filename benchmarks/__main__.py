@@ -23,11 +23,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("cases", nargs="*", metavar="CASE", help="case names (default: all)")
     ap.add_argument("--quick", action="store_true", help="smaller inputs, one timed run: a smoke test")
     ap.add_argument("--repeats", type=int, default=None, help="timed runs per case (default 5, quick 1)")
-    ap.add_argument("--json", type=Path, default=None,
-                    help="where to write the results (default benchmarks/results/methods.json)")
+    ap.add_argument(
+        "--json", type=Path, default=None, help="where to write the results (default benchmarks/results/methods.json)"
+    )
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
-    ap.add_argument("--tools", default=None,
-                    help="fill cases: only the tools whose names start with these (comma-separated, e.g. weft,G'MIC)")
+    ap.add_argument(
+        "--tools",
+        default=None,
+        help="fill cases: only the tools whose names start with these (comma-separated, e.g. weft,G'MIC)",
+    )
     ap.add_argument("--keep", type=Path, default=None, help="fill cases: copy every tool's output into this folder")
     args = ap.parse_args(argv)
     known = {**by_name(), **fill.by_name()}
@@ -56,11 +60,19 @@ def main(argv: list[str] | None = None) -> int:
             fill_rows += fill.run_fill_case(case, repeats=repeats, quick=args.quick, tools=tools, keep=args.keep)
         else:
             rows.append(run_case(case, repeats=repeats, quick=args.quick))
-    written = write_results("methods", rows + fill_rows, command=command("benchmarks", argv), quick=args.quick,
-                            path=args.json, note="compute seconds of one run (inputs decoded), median of the runs")
+    written = write_results(
+        "methods",
+        rows + fill_rows,
+        command=command("benchmarks", argv),
+        quick=args.quick,
+        path=args.json,
+        note="compute seconds of one run (inputs decoded), median of the runs",
+    )
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
-          f", load average {load:.1f}{', quick' if args.quick else ''}")
+    print(
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
+        f", load average {load:.1f}{', quick' if args.quick else ''}"
+    )
     if rows:
         print(markdown_table(rows))
     if fill_rows:

@@ -40,7 +40,6 @@ from pathlib import Path
 
 def make_frames(folder: Path, n: int) -> list[Path]:
     import cv2
-
     from weft.core.examples import example
 
     src = cv2.imread(str(example("perspective-frontal")), cv2.IMREAD_COLOR)
@@ -50,22 +49,24 @@ def make_frames(folder: Path, n: int) -> list[Path]:
     for i in range(n):
         x, y = (6 * i) % 160, (4 * i) % 120
         p = folder / f"frame_{i:04d}.png"
-        cv2.imwrite(str(p), big[y:y + 480, x:x + 640])
+        cv2.imwrite(str(p), big[y : y + 480, x : x + 640])
         paths.append(p)
     return paths
 
 
 def make_recipes(folder: Path, first_frame: Path) -> dict[str, Path]:
     import cv2
-
     from weft.core.examples import example
 
     gravel = cv2.imread(str(example("gravel")), cv2.IMREAD_GRAYSCALE)
     cv2.imwrite(str(folder / "gravel128.png"), gravel[:128, :128])
     recipes = {
         "fast": {"method": "fast", "params": {}, "inputs": {"texture": str(example("gravel"))}},
-        "quilt": {"method": "quilt", "params": {"block": 9, "overlap": 3},
-                  "inputs": {"texture": str(folder / "gravel128.png")}},
+        "quilt": {
+            "method": "quilt",
+            "params": {"block": 9, "overlap": 3},
+            "inputs": {"texture": str(folder / "gravel128.png")},
+        },
     }
     out = {}
     for name, r in recipes.items():
@@ -89,8 +90,12 @@ def time_batch(plan_factory, pool, slots: int) -> tuple[float, float, float, flo
     wall = time.perf_counter() - t0
     if summary.written != len(plan.items):
         raise SystemExit(f"batch failed: {summary.line()}")
-    return (wall, sum(o.elapsed for o in done) / (wall * slots), statistics.median(o.elapsed for o in done),
-            statistics.median(o.cpu for o in done))
+    return (
+        wall,
+        sum(o.elapsed for o in done) / (wall * slots),
+        statistics.median(o.elapsed for o in done),
+        statistics.median(o.cpu for o in done),
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -110,28 +115,44 @@ def main(argv: list[str] | None = None) -> int:
         frames = make_frames(tmp / "frames", args.frames)
         recipes = make_recipes(tmp, frames[0])
         names = [args.only] if args.only else list(recipes)
-        configs = [("local, 1 worker", 1), ("local, 2 workers", 2)] + ([] if args.no_dask else [("Dask, 2 workers", "dask")])
+        configs = [("local, 1 worker", 1), ("local, 2 workers", 2)] + (
+            [] if args.no_dask else [("Dask, 2 workers", "dask")]
+        )
         cluster = None
         if not args.no_dask:
             from distributed import LocalCluster
 
             t0 = time.perf_counter()
-            cluster = LocalCluster(processes=True, n_workers=2, threads_per_worker=1, host="127.0.0.1",
-                                   dashboard_address=None, silence_logs=50)
+            cluster = LocalCluster(
+                processes=True,
+                n_workers=2,
+                threads_per_worker=1,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=50,
+            )
             cluster_start = time.perf_counter() - t0
         for name in names:
             method = json.loads(recipes[name].read_text())["method"]
             pools, startup = {}, {}
             for label, kind in configs:  # every pool started and warm before any clock runs
                 t0 = time.perf_counter()
-                pools[label] = (batch.DaskPool(cluster.scheduler_address, method) if kind == "dask"
-                                else batch.LocalPool(kind, method))
+                pools[label] = (
+                    batch.DaskPool(cluster.scheduler_address, method)
+                    if kind == "dask"
+                    else batch.LocalPool(kind, method)
+                )
                 pools[label].ready()
                 startup[label] = time.perf_counter() - t0 + (cluster_start if kind == "dask" else 0.0)
 
             def factory(name=name):
-                return batch.plan(str(recipes[name]), [("target", str(tmp / "frames"))],
-                                  str(tmp / "out" / name / "{stem}.png"), force=True)
+                return batch.plan(
+                    str(recipes[name]),
+                    [("target", str(tmp / "frames"))],
+                    str(tmp / "out" / name / "{stem}.png"),
+                    force=True,
+                )
+
             times = {label: [] for label, _ in configs}
             busy = {label: [] for label, _ in configs}
             per_item = {label: [] for label, _ in configs}
@@ -152,25 +173,40 @@ def main(argv: list[str] | None = None) -> int:
                     pool.close()
             for label, _ in configs:
                 med = statistics.median(times[label])
-                rows.append({"recipe": name, "pool": label, "items": args.frames, "median_s": round(med, 3),
-                             "runs_s": [round(t, 3) for t in times[label]], "items_per_s": round(args.frames / med, 2),
-                             "startup_s": round(startup[label], 2), "load_avg": round(statistics.median(loads), 2),
-                             "busy": round(statistics.median(busy[label]), 3),
-                             "item_s": round(statistics.median(per_item[label]), 3),
-                             "item_cpu_s": round(statistics.median(cpu[label]), 3)})
+                rows.append(
+                    {
+                        "recipe": name,
+                        "pool": label,
+                        "items": args.frames,
+                        "median_s": round(med, 3),
+                        "runs_s": [round(t, 3) for t in times[label]],
+                        "items_per_s": round(args.frames / med, 2),
+                        "startup_s": round(startup[label], 2),
+                        "load_avg": round(statistics.median(loads), 2),
+                        "busy": round(statistics.median(busy[label]), 3),
+                        "item_s": round(statistics.median(per_item[label]), 3),
+                        "item_cpu_s": round(statistics.median(cpu[label]), 3),
+                    }
+                )
         if cluster is not None:
             cluster.close()
 
-    print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-          f"{args.frames} frames of 640x480, median of {args.repeats}")
-    print("| recipe | pool | items/s | median s | runs s | vs 1 worker | s per item on its worker | CPU s per item "
-          "| workers busy | pool start s | load avg |")
+    print(
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+        f"{args.frames} frames of 640x480, median of {args.repeats}"
+    )
+    print(
+        "| recipe | pool | items/s | median s | runs s | vs 1 worker | s per item on its worker | CPU s per item "
+        "| workers busy | pool start s | load avg |"
+    )
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in rows:
         one = next(x for x in rows if x["recipe"] == r["recipe"] and x["pool"] == "local, 1 worker")
-        print(f"| {r['recipe']} | {r['pool']} | {r['items_per_s']} | {r['median_s']} | "
-              f"{' / '.join(str(t) for t in r['runs_s'])} | {r['items_per_s'] / one['items_per_s']:.2f}x | "
-              f"{r['item_s']} | {r['item_cpu_s']} | {r['busy'] * 100:.0f} % | {r['startup_s']} | {r['load_avg']} |")
+        print(
+            f"| {r['recipe']} | {r['pool']} | {r['items_per_s']} | {r['median_s']} | "
+            f"{' / '.join(str(t) for t in r['runs_s'])} | {r['items_per_s'] / one['items_per_s']:.2f}x | "
+            f"{r['item_s']} | {r['item_cpu_s']} | {r['busy'] * 100:.0f} % | {r['startup_s']} | {r['load_avg']} |"
+        )
     for name in {r["recipe"] for r in rows}:
         by = {r["pool"]: r["items_per_s"] for r in rows if r["recipe"] == name}
         two, one, dask = by.get("local, 2 workers"), by.get("local, 1 worker"), by.get("Dask, 2 workers")
@@ -183,8 +219,13 @@ def main(argv: list[str] | None = None) -> int:
         r["vs_one_worker"] = round(r["items_per_s"] / one["items_per_s"], 2)
     from .record import command, write_results
 
-    write_results("batch", rows, command=command("benchmarks.batch", argv), path=args.json,
-                  note=f"{args.frames} frames of 640x480; median of {args.repeats} runs, the pools alternating")
+    write_results(
+        "batch",
+        rows,
+        command=command("benchmarks.batch", argv),
+        path=args.json,
+        note=f"{args.frames} frames of 640x480; median of {args.repeats} runs, the pools alternating",
+    )
     return 0
 
 

@@ -40,23 +40,59 @@ def commands(tmp: Path, python: str = sys.executable) -> dict[str, list[str]]:
 
     return {
         "studio": [python, str(Path(__file__).resolve()), "--probe-studio"],
-        "quilt --target, 3 passes": [*weft, "quilt", str(RES / "gravel.png"), "--target", str(RES / "camera.png"),
-                                     "--iterations", "3", "-o", out],
-        "nfpt 1024x768": [*weft, "nfpt", str(RES / "perspective.png"), "--lines",
-                          str(RES / "perspective-lines.json"), "--size", "1024x768", "-o", out],
+        "quilt --target, 3 passes": [
+            *weft,
+            "quilt",
+            str(RES / "gravel.png"),
+            "--target",
+            str(RES / "camera.png"),
+            "--iterations",
+            "3",
+            "-o",
+            out,
+        ],
+        "nfpt 1024x768": [
+            *weft,
+            "nfpt",
+            str(RES / "perspective.png"),
+            "--lines",
+            str(RES / "perspective-lines.json"),
+            "--size",
+            "1024x768",
+            "-o",
+            out,
+        ],
         "affine": [*weft, "affine", str(RES / "brick.png"), "-o", out],
         "fast --target": [*weft, "fast", str(RES / "gravel.png"), "--target", str(RES / "camera.png"), "-o", out],
-        "blend --mode poisson": [*weft, "blend", str(tmp / "fg.png"), str(tmp / "bg.png"), "--mask",
-                                 str(tmp / "mask.png"), "--mode", "poisson", "-o", out],
-        "rectify --warp lines": [*weft, "rectify", str(RES / "perspective.png"), "--lines",
-                                 str(RES / "perspective-lines.json"), "--warp", "lines", "-o", out],
+        "blend --mode poisson": [
+            *weft,
+            "blend",
+            str(tmp / "fg.png"),
+            str(tmp / "bg.png"),
+            "--mask",
+            str(tmp / "mask.png"),
+            "--mode",
+            "poisson",
+            "-o",
+            out,
+        ],
+        "rectify --warp lines": [
+            *weft,
+            "rectify",
+            str(RES / "perspective.png"),
+            "--lines",
+            str(RES / "perspective-lines.json"),
+            "--warp",
+            "lines",
+            "-o",
+            out,
+        ],
         "warm-up (all methods)": [*weft, "warm-up"],
     }
 
 
 def _blend_inputs(tmp: Path) -> None:
     import numpy as np
-
     from weft.core.image import load_image, save_image
 
     fg = load_image(RES / "brick.png").image[:256, :256]
@@ -66,7 +102,7 @@ def _blend_inputs(tmp: Path) -> None:
     y, x = np.mgrid[:256, :256]
     save_image(tmp / "fg.png", fg)
     save_image(tmp / "bg.png", bg)
-    save_image(tmp / "mask.png", (((x - 128) ** 2 + (y - 128) ** 2) < 80 ** 2).astype(np.float32))
+    save_image(tmp / "mask.png", (((x - 128) ** 2 + (y - 128) ** 2) < 80**2).astype(np.float32))
 
 
 def timed_run(cmd: list[str], cache: str, timeout: float = 600.0, cwd: Path = ROOT) -> dict:
@@ -75,8 +111,9 @@ def timed_run(cmd: list[str], cache: str, timeout: float = 600.0, cwd: Path = RO
     env = dict(os.environ, NUMBA_CACHE_DIR=cache, QT_QPA_PLATFORM="offscreen", COLUMNS="100")
     master, slave = pty.openpty()
     t0 = time.time()
-    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                            stderr=slave, close_fds=True)
+    proc = subprocess.Popen(
+        cmd, cwd=cwd, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave, close_fds=True
+    )
     os.close(slave)
     writes, text = [t0], b""
     out_chunks = []
@@ -115,8 +152,9 @@ def timed_run(cmd: list[str], cache: str, timeout: float = 600.0, cwd: Path = RO
     return {"seconds": seconds, "silent": max(gaps), "first_words": gaps[0], "stderr": text.decode(errors="replace")}
 
 
-def measure(names: list[str] | None = None, runs: int = 3, python: str = sys.executable, root: Path = ROOT
-            ) -> list[dict]:
+def measure(
+    names: list[str] | None = None, runs: int = 3, python: str = sys.executable, root: Path = ROOT
+) -> list[dict]:
     rows = []
     with tempfile.TemporaryDirectory(prefix="weft-cold-") as tmp_s:
         tmp = Path(tmp_s)
@@ -138,26 +176,37 @@ def measure(names: list[str] | None = None, runs: int = 3, python: str = sys.exe
             except RuntimeError as e:  # e.g. a command the measured checkout does not have
                 print(f"  {name}: {e}", file=sys.stderr)
                 continue
-            rows.append({"command": name, "runs": runs, "cold_s": round(statistics.median(cold), 2),
-                         "warm_s": round(statistics.median(warm), 2),
-                         "ratio": round(statistics.median(cold) / statistics.median(warm), 2),
-                         "cold_silent_s": round(max(silent), 2), "cold_first_words_s": round(max(first), 2),
-                         "cold_range": [round(min(cold), 2), round(max(cold), 2)],
-                         "warm_range": [round(min(warm), 2), round(max(warm), 2)]})
+            rows.append(
+                {
+                    "command": name,
+                    "runs": runs,
+                    "cold_s": round(statistics.median(cold), 2),
+                    "warm_s": round(statistics.median(warm), 2),
+                    "ratio": round(statistics.median(cold) / statistics.median(warm), 2),
+                    "cold_silent_s": round(max(silent), 2),
+                    "cold_first_words_s": round(max(first), 2),
+                    "cold_range": [round(min(cold), 2), round(max(cold), 2)],
+                    "warm_range": [round(min(warm), 2), round(max(warm), 2)],
+                }
+            )
             shutil.rmtree(cache, ignore_errors=True)
     return rows
 
 
 def markdown_table(rows: list[dict]) -> str:
-    lines = ["| command | cold s | warm s | cold / warm | first words on the terminal (cold) | longest silence (cold) |",
-             "| --- | --- | --- | --- | --- | --- |"]
+    lines = [
+        "| command | cold s | warm s | cold / warm | first words on the terminal (cold) | longest silence (cold) |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
     for r in rows:
         studio = r["command"] == "studio"
         first = "—" if studio else f"{r['cold_first_words_s']:.1f} s"
         silent = "—" if studio else f"{r['cold_silent_s']:.1f} s"
-        lines.append(f"| {r['command']} | {r['cold_s']:.1f} ({r['cold_range'][0]:.1f}–{r['cold_range'][1]:.1f}) | "
-                     f"{r['warm_s']:.1f} ({r['warm_range'][0]:.1f}–{r['warm_range'][1]:.1f}) | {r['ratio']:.1f}x | "
-                     f"{first} | {silent} |")
+        lines.append(
+            f"| {r['command']} | {r['cold_s']:.1f} ({r['cold_range'][0]:.1f}–{r['cold_range'][1]:.1f}) | "
+            f"{r['warm_s']:.1f} ({r['warm_range'][0]:.1f}–{r['warm_range'][1]:.1f}) | {r['ratio']:.1f}x | "
+            f"{first} | {silent} |"
+        )
     return "\n".join(lines)
 
 
@@ -166,7 +215,6 @@ def probe_studio() -> int:
     wall-clock time its first full result was shown, with the render and kernel-preparation times."""
     from PySide6.QtCore import QSettings, QTimer
     from PySide6.QtWidgets import QApplication
-
     from weft.app.gui.main_window import MainWindow
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
@@ -196,13 +244,19 @@ def probe_studio() -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.cold", description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.cold", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--runs", type=int, default=3, help="cold runs and warm runs per command (default 3)")
     ap.add_argument("--only", nargs="*", metavar="NAME", help="only these commands (names as in the table)")
-    ap.add_argument("--json", type=Path, default=None, help="where to write the results (default benchmarks/results/cold.json)")
-    ap.add_argument("--python", default=sys.executable,
-                    help="the interpreter whose weft is measured (e.g. another checkout's .venv/bin/python)")
+    ap.add_argument(
+        "--json", type=Path, default=None, help="where to write the results (default benchmarks/results/cold.json)"
+    )
+    ap.add_argument(
+        "--python",
+        default=sys.executable,
+        help="the interpreter whose weft is measured (e.g. another checkout's .venv/bin/python)",
+    )
     ap.add_argument("--root", type=Path, default=ROOT, help="that checkout's folder (the commands run there)")
     ap.add_argument("--probe-studio", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -213,8 +267,13 @@ def main(argv: list[str] | None = None) -> int:
     print(markdown_table(rows))
     from .record import command, write_results
 
-    write_results("cold", rows, command=command("benchmarks.cold", argv), path=args.json,
-                  note=f"cold: a fresh NUMBA_CACHE_DIR per run; median of {args.runs} runs")
+    write_results(
+        "cold",
+        rows,
+        command=command("benchmarks.cold", argv),
+        path=args.json,
+        note=f"cold: a fresh NUMBA_CACHE_DIR per run; median of {args.runs} runs",
+    )
     return 0
 
 

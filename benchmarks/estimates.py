@@ -64,10 +64,16 @@ def _cases():
         return f"nfpt synth {tex_side}² -> {out_side}², block {block}", est, run
 
     return [
-        quilt_synth(128, 512, 32), quilt_synth(256, 1024, 32), quilt_synth(512, 1024, 16),
+        quilt_synth(128, 512, 32),
+        quilt_synth(256, 1024, 32),
+        quilt_synth(512, 1024, 16),
         quilt_synth(1024, 1024, 64),
-        quilt_transfer(128, 512, 1), quilt_transfer(128, 512, 5), quilt_transfer(256, 1024, 1),
-        nfpt_synth(128, 512, 48), nfpt_synth(512, 1024, 48), nfpt_synth(256, 1024, 24),
+        quilt_transfer(128, 512, 1),
+        quilt_transfer(128, 512, 5),
+        quilt_transfer(256, 1024, 1),
+        nfpt_synth(128, 512, 48),
+        nfpt_synth(512, 1024, 48),
+        nfpt_synth(256, 1024, 24),
     ]
 
 

@@ -46,9 +46,10 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -58,6 +59,7 @@ BAND = 2  # px around the hole inside which weft may change known pixels (the me
 
 
 # ---------------------------------------------------------------------------------------------- cases
+
 
 @dataclass(frozen=True)
 class FillInputs:
@@ -79,7 +81,7 @@ class FillInputs:
             return self.image
         left, top, right, bottom = self.extend
         h, w = self.image.shape[:2]
-        return self.image[top:h - bottom, left:w - right]
+        return self.image[top : h - bottom, left : w - right]
 
 
 @dataclass(frozen=True)
@@ -100,7 +102,7 @@ def _skimage(name: str) -> np.ndarray:
 
 
 def _disc(shape, cx, cy, r) -> np.ndarray:
-    yy, xx = np.mgrid[:shape[0], :shape[1]]
+    yy, xx = np.mgrid[: shape[0], : shape[1]]
     return (xx - cx) ** 2 + (yy - cy) ** 2 <= r * r
 
 
@@ -167,8 +169,12 @@ CASES: list[FillCase] = [
     FillCase("fill-brick", build_brick, "regular: brick 320x320 (grey), a 100x60 box across two mortar lines"),
     FillCase("fill-object", build_object, "object: coffee's spoon pasted over saucer rim and wood, 320x320 colour"),
     FillCase("fill-uncrop", build_uncrop, "uncrop 256 -> 384: brick, --extend 64,64,64,64", uncrop=True),
-    FillCase("fill-preview-128", build_gravel, "the studio's reduced preview: 128x128 around a stroke of "
-             "fill-gravel, in-process, median of 20 per engine", preview=True),
+    FillCase(
+        "fill-preview-128",
+        build_gravel,
+        "the studio's reduced preview: 128x128 around a stroke of fill-gravel, in-process, median of 20 per engine",
+        preview=True,
+    ),
 ]
 
 
@@ -177,6 +183,7 @@ def by_name() -> dict[str, FillCase]:
 
 
 # ---------------------------------------------------------------------------------------------- tools
+
 
 @dataclass(frozen=True)
 class Tool:
@@ -219,18 +226,30 @@ def _weft_command(engine: str | None, *options: str):
         if engine is not None:
             cmd += ["--engine", engine]
         return cmd + [*options, "-o", str(out), "--seed", str(case.seed), "--quiet"]
+
     return command
 
 
 def _peer_command(peer: str, python: Callable[[], str]):
     def command(files, out, case, inputs):
         return [python(), str(PEERS_SCRIPT), peer, str(files["canvas"]), str(files["mask"]), str(out)]
+
     return command
 
 
 def _gmic_command(files, out, case, inputs):
-    return [shutil.which("gmic") or "gmic", "-v", "-", str(files["canvas"]), str(files["mask"]),
-            "inpaint_matchpatch[0]", "[1]", "keep[0]", "-o", str(out)]
+    return [
+        shutil.which("gmic") or "gmic",
+        "-v",
+        "-",
+        str(files["canvas"]),
+        str(files["mask"]),
+        "inpaint_matchpatch[0]",
+        "[1]",
+        "keep[0]",
+        "-o",
+        str(out),
+    ]
 
 
 def _cv2_missing() -> str | None:
@@ -246,15 +265,26 @@ def _cv2_missing() -> str | None:
 TOOLS: list[Tool] = [
     Tool("weft", _weft_command(None), weft=True),
     *[Tool(f"weft --engine {e}", _weft_command(e), weft=True, engine=e) for e in WEFT_ENGINES],
-    Tool("weft --engine patchmatch --structure no", _weft_command("patchmatch", "--structure", "no"), weft=True,
-         engine="patchmatch"),
-    Tool("G'MIC inpaint_matchpatch", _gmic_command,
-         lambda: None if shutil.which("gmic") else "gmic is not on the PATH (Debian: apt-get install gmic)"),
+    Tool(
+        "weft --engine patchmatch --structure no",
+        _weft_command("patchmatch", "--structure", "no"),
+        weft=True,
+        engine="patchmatch",
+    ),
+    Tool(
+        "G'MIC inpaint_matchpatch",
+        _gmic_command,
+        lambda: None if shutil.which("gmic") else "gmic is not on the PATH (Debian: apt-get install gmic)",
+    ),
     Tool("OpenCV xphoto shift-map", _peer_command("shiftmap", lambda: sys.executable), _cv2_missing),
-    Tool("pypatchmatch", _peer_command("pypatchmatch", peers_python),
-         lambda: _importable(peers_python(), "patchmatch")),
-    Tool("Resynthesizer (PyPI)", _peer_command("resynthesizer", peers_python),
-         lambda: _importable(peers_python(), "resynthesizer")),
+    Tool(
+        "pypatchmatch", _peer_command("pypatchmatch", peers_python), lambda: _importable(peers_python(), "patchmatch")
+    ),
+    Tool(
+        "Resynthesizer (PyPI)",
+        _peer_command("resynthesizer", peers_python),
+        lambda: _importable(peers_python(), "resynthesizer"),
+    ),
     Tool("OpenCV Telea", _peer_command("telea", lambda: sys.executable), _cv2_missing),
     Tool("OpenCV NS", _peer_command("ns", lambda: sys.executable), _cv2_missing),
 ]
@@ -274,6 +304,7 @@ def tools_named(names: list[str] | None) -> list[Tool]:
 
 # ---------------------------------------------------------------------------------------------- figures
 
+
 def _float(img: np.ndarray) -> np.ndarray:
     return img.astype(np.float32) / 255.0
 
@@ -287,8 +318,13 @@ def read_output(path: Path, like: np.ndarray) -> np.ndarray:
         if im.mode in ("I;16", "I;16B", "I"):
             arr = np.round(np.asarray(im, dtype=np.float64) / 257.0).astype(np.uint8)
         else:
-            arr = np.asarray(im.convert("L" if like.ndim == 2 and im.mode in ("L", "LA", "1", "P") else
-                                        ("RGB" if like.ndim == 3 else im.mode)))
+            arr = np.asarray(
+                im.convert(
+                    "L"
+                    if like.ndim == 2 and im.mode in ("L", "LA", "1", "P")
+                    else ("RGB" if like.ndim == 3 else im.mode)
+                )
+            )
     if like.ndim == 2 and arr.ndim == 3:
         arr = np.round(arr[..., :3].astype(np.float32).mean(axis=2)).astype(np.uint8)
     if like.ndim == 3 and arr.ndim == 2:
@@ -299,16 +335,20 @@ def read_output(path: Path, like: np.ndarray) -> np.ndarray:
 def figures(out: np.ndarray, inputs: FillInputs) -> dict[str, float]:
     """The issue's judges of one filled canvas ``out`` (uint8) and its known-pixel checks."""
     from scipy.ndimage import distance_transform_cdt
-
     from weft.core.metrics import fill_coherence, fill_detail, fill_seam
 
     hole = inputs.hole
     if out.shape != inputs.truth.shape:
-        return {"error": f"output is {out.shape[1]}x{out.shape[0]}, expected "
-                         f"{inputs.truth.shape[1]}x{inputs.truth.shape[0]}"}
+        return {
+            "error": f"output is {out.shape[1]}x{out.shape[0]}, expected "
+            f"{inputs.truth.shape[1]}x{inputs.truth.shape[0]}"
+        }
     f = _float(out)
-    row = {"coherence": fill_coherence(f, hole, _float(inputs.image)),
-           "detail": fill_detail(f, hole), "seam": fill_seam(f, hole)}
+    row = {
+        "coherence": fill_coherence(f, hole, _float(inputs.image)),
+        "detail": fill_detail(f, hole),
+        "seam": fill_seam(f, hole),
+    }
     # each known pixel's distance to the hole in 8-connected steps (1 = touching, corners included):
     # the method's band is the square neighbourhood, 2 px = every pixel of a 5x5 square around a hole pixel
     dist = distance_transform_cdt(~hole, metric="chessboard")
@@ -331,8 +371,11 @@ def truth_figures(inputs: FillInputs) -> dict[str, float]:
     from weft.core.metrics import fill_coherence, fill_detail, fill_seam
 
     f = _float(inputs.truth)
-    return {"coherence": fill_coherence(f, inputs.hole, _float(inputs.image)),
-            "detail": fill_detail(f, inputs.hole), "seam": fill_seam(f, inputs.hole)}
+    return {
+        "coherence": fill_coherence(f, inputs.hole, _float(inputs.image)),
+        "detail": fill_detail(f, inputs.hole),
+        "seam": fill_seam(f, inputs.hole),
+    }
 
 
 def goals(row: dict[str, Any], rows: list[dict[str, Any]], truth: dict[str, float], case: FillCase) -> str:
@@ -355,6 +398,7 @@ def goals(row: dict[str, Any], rows: list[dict[str, Any]], truth: dict[str, floa
 
 
 # ---------------------------------------------------------------------------------------------- running
+
 
 def write_inputs(inputs: FillInputs, folder: Path) -> dict[str, Path]:
     """The case's files: ``canvas`` (the peers' input), ``mask`` (white = fill) and ``image`` (weft's
@@ -399,18 +443,29 @@ def _run(cmd: list[str], env: dict[str, str] | None = None) -> tuple[float, int,
             rss = int(lines[-1]) * 1024 if lines and lines[-1].isdigit() else -1
     finally:
         os.unlink(rss_file)
-    lines = [ln for ln in err.decode(errors="replace").strip().splitlines()
-             if not ln.startswith("Command exited with non-zero status")]
+    lines = [
+        ln
+        for ln in err.decode(errors="replace").strip().splitlines()
+        if not ln.startswith("Command exited with non-zero status")
+    ]
     return seconds, rss, (lines[-1] if lines else f"exit {proc.returncode}") if proc.returncode else ""
 
 
-def run_tool_once(tool: Tool, case: FillCase, inputs: FillInputs, files: dict[str, Path], out: Path,
-                  env: dict[str, str] | None = None) -> tuple[float, int, str]:
+def run_tool_once(
+    tool: Tool, case: FillCase, inputs: FillInputs, files: dict[str, Path], out: Path, env: dict[str, str] | None = None
+) -> tuple[float, int, str]:
     return _run(tool.command(files, out, case, inputs), env)
 
 
-def run_fill_case(case: FillCase, *, repeats: int = 5, quick: bool = False, tools: list[Tool] | None = None,
-                  keep: Path | None = None, cold: bool = True) -> list[dict[str, Any]]:
+def run_fill_case(
+    case: FillCase,
+    *,
+    repeats: int = 5,
+    quick: bool = False,
+    tools: list[Tool] | None = None,
+    keep: Path | None = None,
+    cold: bool = True,
+) -> list[dict[str, Any]]:
     """Every tool on ``case``: the rows (one per tool, then the ground truth's)."""
     if case.preview:
         if tools is not None and not any(t.weft for t in tools):
@@ -438,8 +493,9 @@ def run_fill_case(case: FillCase, *, repeats: int = 5, quick: bool = False, tool
             for tool, row, out in live:
                 if tool.weft and tool.engine is None:
                     with tempfile.TemporaryDirectory(prefix="weft-numba-") as cache:
-                        s, _, err = run_tool_once(tool, case, inputs, files, out,
-                                                  {**os.environ, "NUMBA_CACHE_DIR": cache})
+                        s, _, err = run_tool_once(
+                            tool, case, inputs, files, out, {**os.environ, "NUMBA_CACHE_DIR": cache}
+                        )
                     if not err:
                         row["cold_s"] = s
         if not quick:  # warm-up: numba's cache, the OS's file cache
@@ -462,8 +518,12 @@ def run_fill_case(case: FillCase, *, repeats: int = 5, quick: bool = False, tool
         for tool, row, out in live:
             if "error" in row:
                 continue
-            row.update(runs=len(times[tool.name]), process_s=statistics.median(times[tool.name]),
-                       min_s=min(times[tool.name]), peak_mib=statistics.median(peaks[tool.name]) / 2**20)
+            row.update(
+                runs=len(times[tool.name]),
+                process_s=statistics.median(times[tool.name]),
+                min_s=min(times[tool.name]),
+                peak_mib=statistics.median(peaks[tool.name]) / 2**20,
+            )
             if not os.path.exists(GNU_TIME):
                 row["peak_upper_bound"] = True
             result = read_output(out, inputs.truth)
@@ -500,8 +560,11 @@ def preview_times(repeats: int = 20, engines: tuple[str | None, ...] = (None, *W
     except ImportError as e:
         return [{"case": "fill-preview-128", "tool": "weft", "size": [128, 128], "error": f"weft.core.fill: {e}"}]
     for engine in engines:
-        row: dict[str, Any] = {"case": "fill-preview-128", "tool": "weft" + (f" --engine {engine}" if engine else ""),
-                               "size": [128, 128]}
+        row: dict[str, Any] = {
+            "case": "fill-preview-128",
+            "tool": "weft" + (f" --engine {engine}" if engine else ""),
+            "size": [128, 128],
+        }
         try:
             fill(image, hole, engine=engine, seed=1)
             t = []
@@ -509,8 +572,9 @@ def preview_times(repeats: int = 20, engines: tuple[str | None, ...] = (None, *W
                 t0 = time.perf_counter()
                 out = fill(image, hole, engine=engine, seed=1)
                 t.append(time.perf_counter() - t0)
-            row.update(runs=repeats, median_ms=1000 * statistics.median(t), max_ms=1000 * max(t),
-                       hole_px=int(hole.sum()))
+            row.update(
+                runs=repeats, median_ms=1000 * statistics.median(t), max_ms=1000 * max(t), hole_px=int(hole.sum())
+            )
             from weft.core.metrics import fill_detail
 
             row["detail"] = fill_detail(out, hole)
@@ -563,8 +627,9 @@ def markdown_table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(out).rstrip()
 
 
-def seed_medians(names: list[str], seeds: range, engine: str | None = None, patch: int | None = None
-                 ) -> list[dict[str, Any]]:
+def seed_medians(
+    names: list[str], seeds: range, engine: str | None = None, patch: int | None = None
+) -> list[dict[str, Any]]:
     """Per case, in-process through ``weft.core.fill.fill`` (default band): the median over ``seeds``
     of coherence, of detail as a ratio to the truth's and of seam as a difference from the truth's,
     and the seed-by-seed coherences (the README's "over seeds 0-4" line)."""
@@ -578,12 +643,25 @@ def seed_medians(names: list[str], seeds: range, engine: str | None = None, patc
         rows = []
         for seed in seeds:
             kw = {} if inputs.extend is None else {"extend": inputs.extend}
-            filled = fill(inputs.known_part, None if inputs.extend is not None else inputs.hole, seed=seed,
-                          engine=engine, patch=patch, **kw)
+            filled = fill(
+                inputs.known_part,
+                None if inputs.extend is not None else inputs.hole,
+                seed=seed,
+                engine=engine,
+                patch=patch,
+                **kw,
+            )
             rows.append(figures(np.clip(np.rint(filled * 255), 0, 255).astype(np.uint8), inputs))
         med = lambda key: statistics.median(r[key] for r in rows)  # noqa: E731
-        out.append({"case": name, "coherence": med("coherence"), "detail": med("detail") / truth["detail"],
-                    "seam": med("seam") - truth["seam"], "each": [round(r["coherence"], 2) for r in rows]})
+        out.append(
+            {
+                "case": name,
+                "coherence": med("coherence"),
+                "detail": med("detail") / truth["detail"],
+                "seam": med("seam") - truth["seam"],
+                "each": [round(r["coherence"], 2) for r in rows],
+            }
+        )
     return out
 
 
@@ -598,5 +676,7 @@ if __name__ == "__main__":  # python -m benchmarks.fill [--seeds 0-4] [--engine 
     args = ap.parse_args()
     first, last = (int(v) for v in args.seeds.split("-"))
     for r in seed_medians(args.cases, range(first, last + 1), args.engine, args.patch):
-        print(f"{r['case']}: coherence {r['coherence']:.2f}, detail {r['detail']:.2f} of the truth's, seam "
-              f"{r['seam']:+.2f} from the truth's (seeds {args.seeds}: {r['each']})")
+        print(
+            f"{r['case']}: coherence {r['coherence']:.2f}, detail {r['detail']:.2f} of the truth's, seam "
+            f"{r['seam']:+.2f} from the truth's (seeds {args.seeds}: {r['each']})"
+        )

@@ -55,6 +55,7 @@ PEERS = ("G'MIC inpaint_matchpatch", "OpenCV xphoto shift-map", "pypatchmatch", 
 
 # ---------------------------------------------------------------------------------------------- files
 
+
 def write_inputs(inputs: SuiteInputs, folder: Path) -> dict[str, Path]:
     """``canvas`` and ``mask`` (the peers': the whole canvas, white = fill), ``image`` (weft's: the
     canvas less an uncrop's margins; RGBA with the hole transparent for an alpha case) and
@@ -88,32 +89,43 @@ def weft_command(files: dict[str, Path], out: Path, inputs: SuiteInputs, seed: i
 
 def peer_tools() -> list[tuple[str, Any, str | None]]:
     """``(name, command(files, out), why it cannot run or None)`` for each peer."""
-    gmic = (lambda f, o: _gmic_command(f, o, None, None))
+    gmic = lambda f, o: _gmic_command(f, o, None, None)
     return [
         (PEERS[0], gmic, None if shutil.which("gmic") else "gmic is not on the PATH (Debian: apt-get install gmic)"),
         (PEERS[1], lambda f, o: _peer_command("shiftmap", lambda: sys.executable)(f, o, None, None), _cv2_missing()),
-        (PEERS[2], lambda f, o: _peer_command("pypatchmatch", peers_python)(f, o, None, None),
-         _importable(peers_python(), "patchmatch")),
-        (PEERS[3], lambda f, o: _peer_command("resynthesizer", peers_python)(f, o, None, None),
-         _importable(peers_python(), "resynthesizer")),
+        (
+            PEERS[2],
+            lambda f, o: _peer_command("pypatchmatch", peers_python)(f, o, None, None),
+            _importable(peers_python(), "patchmatch"),
+        ),
+        (
+            PEERS[3],
+            lambda f, o: _peer_command("resynthesizer", peers_python)(f, o, None, None),
+            _importable(peers_python(), "resynthesizer"),
+        ),
     ]
 
 
 # -------------------------------------------------------------------------------------------- figures
 
+
 def figures(out: np.ndarray, inputs: SuiteInputs) -> dict[str, float]:
     """The judges of one filled canvas ``out`` (uint8, the truth's shape)."""
     from scipy.ndimage import distance_transform_cdt
-
     from weft.core.metrics import fill_coherence, fill_detail, fill_seam
 
     if out.shape != inputs.truth.shape:
-        return {"error": f"output is {out.shape[1]}x{out.shape[0]}, expected "
-                         f"{inputs.truth.shape[1]}x{inputs.truth.shape[0]}"}
+        return {
+            "error": f"output is {out.shape[1]}x{out.shape[0]}, expected "
+            f"{inputs.truth.shape[1]}x{inputs.truth.shape[0]}"
+        }
     f = out.astype(np.float32) / 255.0
     hole = inputs.hole
-    row = {"coherence": fill_coherence(f, hole, inputs.image.astype(np.float32) / 255.0),
-           "detail": fill_detail(f, hole), "seam": fill_seam(f, hole)}
+    row = {
+        "coherence": fill_coherence(f, hole, inputs.image.astype(np.float32) / 255.0),
+        "detail": fill_detail(f, hole),
+        "seam": fill_seam(f, hole),
+    }
     dist = distance_transform_cdt(~hole, metric="chessboard")
     diff = np.abs(out.astype(np.int16) - inputs.image.astype(np.int16))
     diff = diff.max(axis=2) if diff.ndim == 3 else diff
@@ -145,6 +157,7 @@ def judge(row: dict[str, Any], truth: dict[str, float], best_peer: float | None)
 
 # ---------------------------------------------------------------------------------------------- run
 
+
 def run_variant(inputs: SuiteInputs, variant: str, seed: int = 1) -> tuple[np.ndarray, float]:
     """In-process weft fill with ``variant`` = ``engine[:structure]``: (uint8 canvas, seconds)."""
     from weft.core.fill import FillParams
@@ -152,8 +165,9 @@ def run_variant(inputs: SuiteInputs, variant: str, seed: int = 1) -> tuple[np.nd
     from weft.core.geometry import Margins
 
     engine, _, structure = variant.partition(":")
-    params = FillParams(engine=engine, structure=structure or "auto",
-                        extend=None if inputs.extend is None else Margins(*inputs.extend))
+    params = FillParams(
+        engine=engine, structure=structure or "auto", extend=None if inputs.extend is None else Margins(*inputs.extend)
+    )
     image = inputs.part(inputs.image).astype(np.float32) / 255.0
     inner = inputs.part(inputs.hole)
     mask = None
@@ -171,8 +185,9 @@ def run_variant(inputs: SuiteInputs, variant: str, seed: int = 1) -> tuple[np.nd
     return np.clip(np.rint(out * 255), 0, 255).astype(np.uint8), seconds
 
 
-def run_case(case: SuiteCase, *, repeats: int, variants: list[str], cache: Path, reuse: bool,
-             sheets: Path | None) -> list[dict[str, Any]]:
+def run_case(
+    case: SuiteCase, *, repeats: int, variants: list[str], cache: Path, reuse: bool, sheets: Path | None
+) -> list[dict[str, Any]]:
     inputs = case.build()
     folder = cache / case.name
     files = write_inputs(inputs, folder)
@@ -236,8 +251,14 @@ def run_case(case: SuiteCase, *, repeats: int, variants: list[str], cache: Path,
     if sheets is not None and "weft" in outputs:
         from .fill_suite_sheets import contact_sheet
 
-        contact_sheet(sheets / f"{case.name}.png", inputs, outputs["weft"],
-                      outputs.get(best_name), best_name or "no peer", case.note)
+        contact_sheet(
+            sheets / f"{case.name}.png",
+            inputs,
+            outputs["weft"],
+            outputs.get(best_name),
+            best_name or "no peer",
+            case.note,
+        )
     return rows
 
 
@@ -261,7 +282,8 @@ def aggregate(rows: list[dict[str, Any]]) -> dict[str, dict[str, dict[str, Any]]
                 continue
             timed = [r for r in rs if "within_gmic_time" in r]
             out[part][tool] = {
-                "cases": len(rs), "failed": n_all - len(rs),
+                "cases": len(rs),
+                "failed": n_all - len(rs),
                 "coherence_median": statistics.median(r["coherence"] for r in rs),
                 "coherence_worst": max(r["coherence"] for r in rs),
                 "detail_ratio_median": statistics.median(r["detail_ratio"] for r in rs),
@@ -269,23 +291,31 @@ def aggregate(rows: list[dict[str, Any]]) -> dict[str, dict[str, dict[str, Any]]
                 "defects": sum(1 for r in rs if r["defects"]),
                 "known_changed_cases": sum(1 for r in rs if r["known_max"] > 0),
                 "time_median_s": statistics.median(r.get("process_s", r.get("in_process_s", 0.0)) for r in rs),
-                **({"within_gmic_time": sum(r["within_gmic_time"] for r in timed), "timed": len(timed)}
-                   if timed else {}),
+                **(
+                    {"within_gmic_time": sum(r["within_gmic_time"] for r in timed), "timed": len(timed)}
+                    if timed
+                    else {}
+                ),
             }
     return out
 
 
 def table(agg: dict[str, dict[str, Any]]) -> str:
-    lines = ["| tool | cases | coherence median | worst | detail ratio median | abs seam diff median | defects | "
-             "known px changed (cases) | time median s | <= G'MIC time |", "|---" * 10 + "|"]
+    lines = [
+        "| tool | cases | coherence median | worst | detail ratio median | abs seam diff median | defects | "
+        "known px changed (cases) | time median s | <= G'MIC time |",
+        "|---" * 10 + "|",
+    ]
     for tool, a in agg.items():
         if "not_run" in a:
             lines.append(f"| {tool} | not run: {a['not_run']} |" + " |" * 8)
             continue
         g = f"{a['within_gmic_time']}/{a['timed']}" if "timed" in a else ""
-        lines.append(f"| {tool} | {a['cases']} | {a['coherence_median']:.2f} | {a['coherence_worst']:.2f} | "
-                     f"{a['detail_ratio_median']:.2f} | {a['seam_diff_abs_median']:.2f} | {a['defects']} | "
-                     f"{a['known_changed_cases']} | {a['time_median_s']:.2f} | {g} |")
+        lines.append(
+            f"| {tool} | {a['cases']} | {a['coherence_median']:.2f} | {a['coherence_worst']:.2f} | "
+            f"{a['detail_ratio_median']:.2f} | {a['seam_diff_abs_median']:.2f} | {a['defects']} | "
+            f"{a['known_changed_cases']} | {a['time_median_s']:.2f} | {g} |"
+        )
     return "\n".join(lines)
 
 
@@ -320,20 +350,36 @@ def main(argv: list[str] | None = None) -> int:
     partial.write_text("")
     for case in cases:
         print(f"{case.name} ({case.half}) ...", file=sys.stderr, flush=True)
-        new = run_case(case, repeats=1 if args.quick else args.repeats, variants=variants, cache=args.cache,
-                       reuse=args.reuse_peers, sheets=sheets)
+        new = run_case(
+            case,
+            repeats=1 if args.quick else args.repeats,
+            variants=variants,
+            cache=args.cache,
+            reuse=args.reuse_peers,
+            sheets=sheets,
+        )
         rows += new
         with partial.open("a") as f:
             f.write("".join(json.dumps(r, default=float) + "\n" for r in new))
     agg = aggregate(rows)
-    machine = {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
-               "cores": os.cpu_count(), "python": platform.python_version(),
-               "load_average_end": os.getloadavg()[0], "shared": "2 cores shared by several engineers"}
-    doc = {"suite": "fill_suite", "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-           "machine": machine, "command": "python -m benchmarks.fill_suite " + " ".join(argv or sys.argv[1:]),
-           "repeats": 1 if args.quick else args.repeats,
-           "split": {h: [c.name for c in CASES if c.half == h] for h in ("tuning", "check")},
-           "rows": rows, "aggregates": agg}
+    machine = {
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "cores": os.cpu_count(),
+        "python": platform.python_version(),
+        "load_average_end": os.getloadavg()[0],
+        "shared": "2 cores shared by several engineers",
+    }
+    doc = {
+        "suite": "fill_suite",
+        "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "machine": machine,
+        "command": "python -m benchmarks.fill_suite " + " ".join(argv or sys.argv[1:]),
+        "repeats": 1 if args.quick else args.repeats,
+        "split": {h: [c.name for c in CASES if c.half == h] for h in ("tuning", "check")},
+        "rows": rows,
+        "aggregates": agg,
+    }
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(doc, indent=1, default=float) + "\n", encoding="utf-8")
     for part in ("tuning", "check"):

@@ -32,8 +32,12 @@ def contact_sheet(path: Path, inputs, weft: np.ndarray, peer: np.ndarray | None,
     box = _crop_box(inputs.hole)
     shown = _rgb(inputs.image).copy()
     shown[inputs.hole] = (255, 0, 255)
-    panels = [("input", shown), ("weft", _rgb(weft)), (f"best peer: {peer_name}", None if peer is None else _rgb(peer)),
-              ("truth", _rgb(inputs.truth))]
+    panels = [
+        ("input", shown),
+        ("weft", _rgb(weft)),
+        (f"best peer: {peer_name}", None if peer is None else _rgb(peer)),
+        ("truth", _rgb(inputs.truth)),
+    ]
     ch, cw = box[0].stop - box[0].start, box[1].stop - box[1].start
     scale = max(PANEL / max(ch, cw), 120 / cw)  # a panel at least 120 px wide, so its label reads
     size = (max(1, round(cw * scale)), max(1, round(ch * scale)))
@@ -42,11 +46,12 @@ def contact_sheet(path: Path, inputs, weft: np.ndarray, peer: np.ndarray | None,
     draw = ImageDraw.Draw(sheet)
     for i, (name, img) in enumerate(panels):
         x = i * (size[0] + 4)
-        draw.text((x + 2, 1), name[:max(4, size[0] // 6)], fill=(230, 230, 230))
+        draw.text((x + 2, 1), name[: max(4, size[0] // 6)], fill=(230, 230, 230))
         if img is None:
             continue
         tile = Image.fromarray(np.ascontiguousarray(img[box])).resize(
-            size, Image.NEAREST if scale >= 1 else Image.LANCZOS)
+            size, Image.NEAREST if scale >= 1 else Image.LANCZOS
+        )
         sheet.paste(tile, (x, label))
     draw.text((2, size[1] + label + 1), note[:150], fill=(200, 200, 200))
     path.parent.mkdir(parents=True, exist_ok=True)

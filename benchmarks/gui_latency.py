@@ -79,13 +79,20 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         window = _window(tmp)
         doc = window.doc
-        doc.restore(DocumentState(inputs={
-            "texture": InputImage(None, load_image(example("gravel")).image[:192, :192]),
-            "target": InputImage(None, resize(load_image(example("astronaut")).image, (640, 500)))}, method="fast"))
+        doc.restore(
+            DocumentState(
+                inputs={
+                    "texture": InputImage(None, load_image(example("gravel")).image[:192, :192]),
+                    "target": InputImage(None, resize(load_image(example("astronaut")).image, (640, 500))),
+                },
+                method="fast",
+            )
+        )
         window.renderer.final(now=True)
         _wait(app, lambda: window.renderer.last is not None and window.renderer.last.final, 30)
 
         value_of_job: dict[int, float] = {}
+
         def recording_submit(job_id, slot):
             if slot == "preview":  # the render after release is not a preview
                 value_of_job[job_id] = doc.current_params.p
@@ -129,11 +136,11 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
     return _summary(latencies, beats, values)
 
 
-def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = None, side: int = 512,
-                     picture_name: str | None = None) -> dict:
+def measure_painting(
+    values: int = 60, hz: float = 60.0, method: str | None = None, side: int = 512, picture_name: str | None = None
+) -> dict:
     from PySide6.QtCore import QEvent, QPointF, Qt
     from PySide6.QtGui import QMouseEvent
-
     from weft.app.gui.document import DocumentState, InputImage
     from weft.core import registry
     from weft.core.errors import WeftError
@@ -170,7 +177,8 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
         moved_at: list[float] = []
         dab_of_job: dict[int, int] = {}
         window.renderer.submitted.connect(
-            lambda job_id, slot: slot == "preview" and dab_of_job.__setitem__(job_id, len(moved_at) - 1))
+            lambda job_id, slot: slot == "preview" and dab_of_job.__setitem__(job_id, len(moved_at) - 1)
+        )
         latencies: list[float] = []
         pending: list[int] = []
         window.renderer.around_shown.connect(lambda s: pending.append(s.job_id))
@@ -188,16 +196,30 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
 
         def send(kind, x, y):
             pos = view.mapFromScene(QPointF(x, y))
-            etype = {"press": QEvent.Type.MouseButtonPress, "move": QEvent.Type.MouseMove,
-                     "release": QEvent.Type.MouseButtonRelease}[kind]
+            etype = {
+                "press": QEvent.Type.MouseButtonPress,
+                "move": QEvent.Type.MouseMove,
+                "release": QEvent.Type.MouseButtonRelease,
+            }[kind]
             button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
             held = Qt.MouseButton.NoButton if kind == "release" else Qt.MouseButton.LeftButton
-            QApplication.sendEvent(view.viewport(), QMouseEvent(etype, QPointF(pos), QPointF(view.viewport().mapToGlobal(pos)),
-                                                                button, held, Qt.KeyboardModifier.NoModifier))
+            QApplication.sendEvent(
+                view.viewport(),
+                QMouseEvent(
+                    etype,
+                    QPointF(pos),
+                    QPointF(view.viewport().mapToGlobal(pos)),
+                    button,
+                    held,
+                    Qt.KeyboardModifier.NoModifier,
+                ),
+            )
 
         # a wavy stroke across the middle of the picture
-        points = [(side * (0.15 + 0.7 * i / (values - 1)), side * (0.5 + 0.15 * ((i // 10) % 2 * 2 - 1) * (i % 10) / 10))
-                  for i in range(values)]
+        points = [
+            (side * (0.15 + 0.7 * i / (values - 1)), side * (0.5 + 0.15 * ((i // 10) % 2 * 2 - 1) * (i % 10) / 10))
+            for i in range(values)
+        ]
         step = 1.0 / hz
         moved_at.append(time.perf_counter())
         send("press", *points[0])
@@ -208,8 +230,16 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
             send("move", x, y)
         _wait(app, lambda: time.perf_counter() - start >= values * step + 0.5, 5)
         send("release", *points[-1])
-        _wait(app, lambda: window.renderer.last is not None and window.renderer.last.final
-              and doc.value(tool.geometry_key) is not None and not window.renderer.running(), 120)
+        _wait(
+            app,
+            lambda: (
+                window.renderer.last is not None
+                and window.renderer.last.final
+                and doc.value(tool.geometry_key) is not None
+                and not window.renderer.running()
+            ),
+            120,
+        )
         heartbeat.stop()
         window.doc.undo_stack.setClean()
         window.close()
@@ -219,7 +249,6 @@ def measure_painting(values: int = 60, hz: float = 60.0, method: str | None = No
 def _picture_file(folder: str, side: int) -> str:
     """A smooth colour picture of ``side``² px as a PNG (random values bilinearly enlarged)."""
     import numpy as np
-
     from weft.core.image import resize, save_image
 
     small = np.random.default_rng(0).random((max(2, side // 16),) * 2 + (3,), dtype=np.float32)
@@ -261,8 +290,10 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
 
             def views_show(image) -> bool:
                 views = (window.canvas_view, window.result_view)
-                return all(v.image is not None and v.image.shape[:2] == image.shape[:2]
-                           and not getattr(v, "converting", False) for v in views)
+                return all(
+                    v.image is not None and v.image.shape[:2] == image.shape[:2] and not getattr(v, "converting", False)
+                    for v in views
+                )
 
             def step(name: str, action, done, settle: float = 0.3, since=None) -> None:
                 heartbeat, beats = _heartbeat()
@@ -274,41 +305,66 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
                 steps[name].append(_stall_since(beats, since() if since is not None else t0))
 
             # a session of the picture (nothing drawn: the result view shows the picture)
-            step("session", lambda: window.open_session(session),
-                 lambda: answered and views_show(item.image) and window.result_view.image is doc.image(canvas))
+            step(
+                "session",
+                lambda: window.open_session(session),
+                lambda: answered and views_show(item.image) and window.result_view.image is doc.image(canvas),
+            )
             # File > Open of the picture (decoded off the GUI thread, then shown)
             del answered[:]
-            step("open", lambda: window.open_input(canvas, picture),
-                 lambda: doc.image(canvas) is not item.image and answered and views_show(item.image)
-                 and window.result_view.image is doc.image(canvas))
+            step(
+                "open",
+                lambda: window.open_input(canvas, picture),
+                lambda: (
+                    doc.image(canvas) is not item.image
+                    and answered
+                    and views_show(item.image)
+                    and window.result_view.image is doc.image(canvas)
+                ),
+            )
             # the method's full-size result (a small painted mask if it fills one): the stall from its arrival
             g = next((g for g in studio.geometry if g.kind == MASK), None)
             del answered[:]
             if g is not None:
-                doc.set_mask(g.key, Mask.empty(side, side).painted_line((side * 0.4, side * 0.4),
-                                                                       (side * 0.45, side * 0.42), side / 200, True),
-                             "stroke")
+                doc.set_mask(
+                    g.key,
+                    Mask.empty(side, side).painted_line(
+                        (side * 0.4, side * 0.4), (side * 0.45, side * 0.42), side / 200, True
+                    ),
+                    "stroke",
+                )
             else:
                 window.renderer.final(now=True)
-            step("result", lambda: None,
-                 lambda: bool(answered) and window.renderer.last is not None and window.renderer.last.final
-                 and window.result_view.image is window.renderer.last.image
-                 and not getattr(window.result_view, "converting", False),
-                 settle=0.5, since=lambda: answered[0])
+            step(
+                "result",
+                lambda: None,
+                lambda: (
+                    bool(answered)
+                    and window.renderer.last is not None
+                    and window.renderer.last.final
+                    and window.result_view.image is window.renderer.last.image
+                    and not getattr(window.result_view, "converting", False)
+                ),
+                settle=0.5,
+                since=lambda: answered[0],
+            )
             out = os.path.join(tmp, f"out{run}.png")
             step("export", lambda: window.export_result(out), lambda: os.path.exists(out), settle=0.2)
             doc.undo_stack.setClean()
             window.close()
             del window
-    return {"side": side, "method": method, "runs": runs,
-            **{f"{k}_stall_ms": round(statistics.median(v), 1) for k, v in steps.items()},
-            "each": steps}
+    return {
+        "side": side,
+        "method": method,
+        "runs": runs,
+        **{f"{k}_stall_ms": round(statistics.median(v), 1) for k, v in steps.items()},
+        "each": steps,
+    }
 
 
 def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") -> dict:
     from PySide6.QtCore import Qt
     from PySide6.QtTest import QTest
-
     from weft.app.gui.document import DocumentState, read_input
     from weft.core import registry
     from weft.core.geometry import Mask
@@ -326,8 +382,13 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
         doc.restore(DocumentState(inputs={studio.canvas: item}, method=method))
         g = next((g for g in studio.geometry if g.kind == MASK), None)
         if g is not None:
-            doc.set_mask(g.key, Mask.empty(side, side).painted_line((side * 0.4, side * 0.4), (side * 0.5, side * 0.45),
-                                                                   side / 60, True), "stroke")
+            doc.set_mask(
+                g.key,
+                Mask.empty(side, side).painted_line(
+                    (side * 0.4, side * 0.4), (side * 0.5, side * 0.45), side / 60, True
+                ),
+                "stroke",
+            )
         _wait(app, lambda: not window.renderer.running(), 30)
         for _run in range(runs):
             window.open_variations()
@@ -339,8 +400,15 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
             _wait(app, lambda: len(beats) > 2, 5)
             t0 = time.perf_counter()
             QTest.mouseClick(dialog.render_button, Qt.MouseButton.LeftButton)
-            _wait(app, lambda: dialog.cells and done == {k for k, b in dialog.cells.items() if b.isEnabled()}
-                  and not dialog.runner.busy(), 300)
+            _wait(
+                app,
+                lambda: (
+                    dialog.cells
+                    and done == {k for k, b in dialog.cells.items() if b.isEnabled()}
+                    and not dialog.runner.busy()
+                ),
+                300,
+            )
             seconds.append(round(time.perf_counter() - t0, 2))
             _wait(app, lambda: False, 0.1)  # the last thumbnail painted
             heartbeat.stop()
@@ -351,8 +419,14 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
             dialog.deleteLater()
         doc.undo_stack.setClean()
         window.close()
-    return {"side": side, "method": method, "runs": runs, "grid_stall_ms": round(statistics.median(stalls), 1),
-            "each": stalls, "grid_s": seconds}
+    return {
+        "side": side,
+        "method": method,
+        "runs": runs,
+        "grid_stall_ms": round(statistics.median(stalls), 1),
+        "each": stalls,
+        "grid_s": seconds,
+    }
 
 
 def _heartbeat() -> tuple[QTimer, list[float]]:
@@ -394,15 +468,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--values", type=int, default=None, help="slider values (30) or mouse moves of the stroke (60)")
     ap.add_argument("--hz", type=float, default=60.0)
     ap.add_argument("--paint", action="store_true", help="paint a mask stroke instead of moving a slider")
-    ap.add_argument("--method", default=None, help="the method: with --paint the first that previews strokes, with "
-                    "--open or --variations fill (defaults)")
-    ap.add_argument("--side", type=int, default=None, help="with --paint (512), --open or --variations (4096): the picture's side")
+    ap.add_argument(
+        "--method",
+        default=None,
+        help="the method: with --paint the first that previews strokes, with --open or --variations fill (defaults)",
+    )
+    ap.add_argument(
+        "--side", type=int, default=None, help="with --paint (512), --open or --variations (4096): the picture's side"
+    )
     ap.add_argument("--open", action="store_true", help="open a large picture: the longest GUI-thread stalls")
-    ap.add_argument("--variations", action="store_true",
-                    help="render a Variations grid of a large picture: the longest GUI-thread stall")
+    ap.add_argument(
+        "--variations",
+        action="store_true",
+        help="render a Variations grid of a large picture: the longest GUI-thread stall",
+    )
     ap.add_argument("--runs", type=int, default=5, help="with --open or --variations: the runs (median)")
-    ap.add_argument("--example", default=None, help="with --paint: the bundled example painted on (default: the "
-                    "method's own; coffee: a colour photo)")
+    ap.add_argument(
+        "--example",
+        default=None,
+        help="with --paint: the bundled example painted on (default: the method's own; coffee: a colour photo)",
+    )
     args = ap.parse_args(argv)
     if args.variations:
         kind, row = "variations", measure_variations(args.side or 4096, args.runs, args.method or "fill")
@@ -430,8 +515,12 @@ def record_row(kind: str, row: dict, argv: list[str] | None) -> None:
     order = ["slider", "paint", "open", "variations"]
     rows.append({"measure": kind, "command": command("benchmarks.gui_latency", argv), **row})
     rows.sort(key=lambda r: order.index(r["measure"]) if r.get("measure") in order else len(order))
-    write_results("gui_latency", rows, command="python -m benchmarks.gui_latency [--paint | --open | --variations]",
-                  note="the real main window, offscreen; each row is its own run, with its command")
+    write_results(
+        "gui_latency",
+        rows,
+        command="python -m benchmarks.gui_latency [--paint | --open | --variations]",
+        note="the real main window, offscreen; each row is its own run, with its command",
+    )
 
 
 if __name__ == "__main__":

@@ -24,7 +24,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
 from weft.core import metrics, registry
 from weft.core.examples import example
 from weft.core.image import load_image, luminance, resize, save_image
@@ -44,7 +43,7 @@ def prepare_inputs(case: Case) -> dict[str, np.ndarray]:
             img = load_image(example(spec.example)).image
         if spec.crop is not None:
             x, y, w, h = spec.crop
-            img = img[y:y + h, x:x + w]
+            img = img[y : y + h, x : x + w]
         if spec.resize is not None:
             img = resize(img, spec.resize, interpolation="area")
         if spec.grey:
@@ -114,7 +113,9 @@ def time_processes(case: Case, inputs: dict[str, np.ndarray], params: dict[str, 
             files[name] = Path(tmp) / f"{name}.png"
             save_image(files[name], image)
         weft_cmd = weft_command(case, files, Path(tmp) / "weft.png", params)
-        gmic_cmd = [gmic, "-v", "-", str(files["texture"]), *case.gmic, "-o", str(Path(tmp) / "gmic.png")] if gmic else None
+        gmic_cmd = (
+            [gmic, "-v", "-", str(files["texture"]), *case.gmic, "-o", str(Path(tmp) / "gmic.png")] if gmic else None
+        )
         _time_process(weft_cmd)  # warm caches (numba's on-disk cache, the OS file cache) for both
         if gmic_cmd:
             _time_process(gmic_cmd)

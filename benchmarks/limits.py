@@ -23,7 +23,6 @@ import platform
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -91,9 +90,11 @@ def _run(code: str, args: list[str]) -> tuple[dict, int]:
 
 def _median_run(code: str, args: list[str], repeat: int) -> dict:
     runs = [_run(code, args) for _ in range(repeat)]
-    return {"seconds": statistics.median(r[0]["seconds"] for r in runs),
-            "peak_bytes": int(statistics.median(r[1] for r in runs)), **{k: v for k, v in runs[0][0].items()
-                                                                          if k != "seconds"}}
+    return {
+        "seconds": statistics.median(r[0]["seconds"] for r in runs),
+        "peak_bytes": int(statistics.median(r[1] for r in runs)),
+        **{k: v for k, v in runs[0][0].items() if k != "seconds"},
+    }
 
 
 def _through_origin(x: list[float], y: list[float]) -> float:
@@ -118,9 +119,16 @@ def main(argv=None) -> int:
 
     gravel = str(example("gravel"))
     photo = str(example("astronaut")) if Path(str(example("astronaut"))).exists() else gravel
-    results: dict = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
-                                 "python": platform.python_version(), "note": "shared by other jobs"},
-                     "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "repeat": args.repeat}
+    results: dict = {
+        "machine": {
+            "platform": platform.platform(),
+            "cpus": os.cpu_count(),
+            "python": platform.python_version(),
+            "note": "shared by other jobs",
+        },
+        "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "repeat": args.repeat,
+    }
 
     base = _median_run(_FILL, [photo, "uncrop", "0"], args.repeat)
     results["fill_baseline_peak_bytes"] = base["peak_bytes"]
@@ -132,35 +140,45 @@ def main(argv=None) -> int:
             r = _median_run(_FILL, [source, "uncrop", str(n)], args.repeat)
             r.update(side=n, added_bytes=r["peak_bytes"] - base["peak_bytes"])
             uncrop.append(r)
-            print(f"fill uncrop {label} 96² -> {n}x{n}: {r['seconds']:.2f} s, +{r['added_bytes'] / 2**20:.0f} MiB",
-                  flush=True)
-        filled = [r["side"] ** 2 - 96 ** 2 for r in uncrop]
+            print(
+                f"fill uncrop {label} 96² -> {n}x{n}: {r['seconds']:.2f} s, +{r['added_bytes'] / 2**20:.0f} MiB",
+                flush=True,
+            )
+        filled = [r["side"] ** 2 - 96**2 for r in uncrop]
         fill[f"uncrop_{label}"] = uncrop
         fill[f"uncrop_{label}_bytes_per_canvas_pixel"] = _through_origin(
-            [r["side"] ** 2 for r in uncrop], [r["added_bytes"] for r in uncrop])
+            [r["side"] ** 2 for r in uncrop], [r["added_bytes"] for r in uncrop]
+        )
         fill[f"uncrop_{label}_seconds_per_filled_pixel"] = _through_origin(filled, [r["seconds"] for r in uncrop])
     hole = []
-    for n in ([800, 1600] if args.quick else [1000, 2000]):
+    for n in [800, 1600] if args.quick else [1000, 2000]:
         r = _median_run(_FILL, [photo, "hole", str(n)], args.repeat)
         r.update(side=n, added_bytes=r["peak_bytes"] - base["peak_bytes"])
         hole.append(r)
         print(f"fill 40 px hole in {n}x{n}: {r['seconds']:.2f} s, +{r['added_bytes'] / 2**20:.0f} MiB", flush=True)
     fill["hole"] = hole
-    fill["hole_bytes_per_canvas_pixel"] = _through_origin([r["side"] ** 2 for r in hole], [r["added_bytes"] for r in hole])
+    fill["hole_bytes_per_canvas_pixel"] = _through_origin(
+        [r["side"] ** 2 for r in hole], [r["added_bytes"] for r in hole]
+    )
     results["fill"] = fill
 
     quilt = []
-    for block in ([4, 8, 16] if args.quick else [4, 6, 8, 12, 16, 24, 32]):
+    for block in [4, 8, 16] if args.quick else [4, 6, 8, 12, 16, 24, 32]:
         r = _median_run(_QUILT, [gravel, "128", "300", str(block)], args.repeat)
         r.update(block=block, texture=128, out=300)
         quilt.append(r)
-        print(f"quilt 128² -> 300², block {block}: {r['seconds']:.2f} s against {r['model_dft_and_positions']:.2f} s "
-              f"modelled ({r['blocks']} blocks)", flush=True)
+        print(
+            f"quilt 128² -> 300², block {block}: {r['seconds']:.2f} s against {r['model_dft_and_positions']:.2f} s "
+            f"modelled ({r['blocks']} blocks)",
+            flush=True,
+        )
     results["quilting"] = {"synthesis": quilt, **_per_block_fit(quilt)}
     per_block = results["quilting"]
     print(json.dumps({k: v for k, v in results["fill"].items() if not isinstance(v, list)}))
-    print(f"quilting seconds per block: {per_block['seconds_per_block']:.3g} + "
-          f"{per_block['seconds_per_block_per_side']:.3g} x block")
+    print(
+        f"quilting seconds per block: {per_block['seconds_per_block']:.3g} + "
+        f"{per_block['seconds_per_block_per_side']:.3g} x block"
+    )
     RESULTS.parent.mkdir(exist_ok=True)
     RESULTS.write_text(json.dumps(results, indent=1) + "\n")
     print(f"wrote {RESULTS}")

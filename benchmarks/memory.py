@@ -27,7 +27,6 @@ LIMIT = 2 * 2**30
 
 def _inputs(folder: Path) -> dict[str, str]:
     import cv2
-
     from weft.core.examples import example
 
     picture = cv2.imread(str(example("astronaut")), cv2.IMREAD_COLOR)
@@ -87,14 +86,29 @@ def main(argv=None) -> int:
             peak = statistics.median(r[0] for r in runs)
             wall = statistics.median(r[1] for r in runs)
             each = ", ".join(f"{r[0] / 2**20:.0f}" for r in runs)
-            print(f"| {name} | {peak / 2**20:.0f} MiB | {each} | {wall:.1f} | {'yes' if peak < LIMIT else 'NO'} |",
-                  flush=True)
-            rows.append({"job": name, "peak_bytes": peak, "peak_mib": round(peak / 2**20),
-                         "runs_bytes": [r[0] for r in runs], "seconds": wall, "under_2_gib": peak < LIMIT})
+            print(
+                f"| {name} | {peak / 2**20:.0f} MiB | {each} | {wall:.1f} | {'yes' if peak < LIMIT else 'NO'} |",
+                flush=True,
+            )
+            rows.append(
+                {
+                    "job": name,
+                    "peak_bytes": peak,
+                    "peak_mib": round(peak / 2**20),
+                    "runs_bytes": [r[0] for r in runs],
+                    "seconds": wall,
+                    "under_2_gib": peak < LIMIT,
+                }
+            )
     from .record import command, write_results
 
-    write_results("memory", rows, command=command("benchmarks.memory", argv), path=args.json,
-                  note=f"peak resident set size of the whole weft process, median of {args.repeat} runs")
+    write_results(
+        "memory",
+        rows,
+        command=command("benchmarks.memory", argv),
+        path=args.json,
+        note=f"peak resident set size of the whole weft process, median of {args.repeat} runs",
+    )
     return 0 if all(r["peak_bytes"] < LIMIT for r in rows) and len(rows) == len(jobs) else 1
 
 

@@ -17,8 +17,18 @@ import statistics
 
 import numpy as np
 
-SAMPLES = ("gravel_128", "wood-grain", "cat-fur", "grass@128", "clouds@128", "hatching@128", "brick@128",
-           "gravel", "grass", "brick")
+SAMPLES = (
+    "gravel_128",
+    "wood-grain",
+    "cat-fur",
+    "grass@128",
+    "clouds@128",
+    "hatching@128",
+    "brick@128",
+    "gravel",
+    "grass",
+    "brick",
+)
 
 
 def sample(name: str) -> np.ndarray:
@@ -67,9 +77,14 @@ def main(argv=None) -> int:
         old = figures(tex, args.seeds, block=32, tol=2)
         new = figures(tex, args.seeds)
         h, w = tex.shape[:2]
-        print(f"| {name} {w}x{h} | {synth_block(tex.shape)} | " + " | ".join(
-            f"{a:.4f} → {b:.4f}" if i < 2 else f"{a:.3f} → {b:.3f}" for i, (a, b) in enumerate(zip(old, new))) + " |",
-            flush=True)
+        print(
+            f"| {name} {w}x{h} | {synth_block(tex.shape)} | "
+            + " | ".join(
+                f"{a:.4f} → {b:.4f}" if i < 2 else f"{a:.3f} → {b:.3f}" for i, (a, b) in enumerate(zip(old, new))
+            )
+            + " |",
+            flush=True,
+        )
     return 0
 
 

@@ -53,8 +53,15 @@ def command(module: str, argv: list[str] | None) -> str:
     return " ".join(["python", "-m", module, *(shlex.quote(a) for a in args)])
 
 
-def write_results(suite: str, rows: list[dict[str, Any]], *, command: str, quick: bool = False,
-                  note: str = "", path: Path | None = None) -> Path:
+def write_results(
+    suite: str,
+    rows: list[dict[str, Any]],
+    *,
+    command: str,
+    quick: bool = False,
+    note: str = "",
+    path: Path | None = None,
+) -> Path:
     """Write ``rows`` with the machine, the date and ``command`` to ``benchmarks/results/<suite>.json``.
 
     ``note`` says what the figures mean or under which conditions they were taken (e.g. a machine
@@ -67,7 +74,7 @@ def write_results(suite: str, rows: list[dict[str, Any]], *, command: str, quick
     payload = {
         "suite": suite,
         "command": command,
-        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "machine": machine(),
         "quick": quick,
         "note": note,

@@ -34,7 +34,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-
 from weft.core.errors import GeometryError
 from weft.core.examples import RESOURCES
 from weft.core.image import load_image
@@ -50,6 +49,7 @@ RESULTS = Path(__file__).resolve().parent / "results" / "rectify_suggest.json"
 
 
 # -- textures ---------------------------------------------------------------------------------------
+
 
 def _resource(name: str) -> np.ndarray:
     img = load_image(RESOURCES / name).image
@@ -84,8 +84,9 @@ def tiles(seed: int = 3) -> np.ndarray:
     for i in range(n):
         for j in range(n):
             tone = rng.uniform(0.35, 0.6)
-            img[i * side + grout // 2:(i + 1) * side - grout // 2, j * side + grout // 2:(j + 1) * side - grout // 2] = \
-                np.array([tone, tone * 0.8, tone * 0.6])
+            img[
+                i * side + grout // 2 : (i + 1) * side - grout // 2, j * side + grout // 2 : (j + 1) * side - grout // 2
+            ] = np.array([tone, tone * 0.8, tone * 0.6])
     img += rng.normal(0, 0.02, img.shape).astype(np.float32)
     return np.clip(cv2.GaussianBlur(img, (0, 0), 0.8), 0, 1)
 
@@ -118,13 +119,13 @@ def planks(seed: int = 5) -> np.ndarray:
         while x < w:
             length = int(rng.integers(300, 600))
             gx, gy = int(rng.integers(0, grain.shape[1] - 600)), int(rng.integers(0, grain.shape[0] - plank))
-            piece = grain[gy:gy + plank, gx:gx + length] * rng.uniform(0.8, 1.1)
+            piece = grain[gy : gy + plank, gx : gx + length] * rng.uniform(0.8, 1.1)
             a, b = max(x, 0), min(x + length, w)
             if b > a:
-                out[r * plank:(r + 1) * plank, a:b] = piece[:, a - x:b - x]
-                out[r * plank:(r + 1) * plank, a:min(a + 3, w)] *= 0.4
+                out[r * plank : (r + 1) * plank, a:b] = piece[:, a - x : b - x]
+                out[r * plank : (r + 1) * plank, a : min(a + 3, w)] *= 0.4
             x += length
-        out[r * plank:r * plank + 3] *= 0.4
+        out[r * plank : r * plank + 3] *= 0.4
     return np.clip(out, 0, 1)
 
 
@@ -154,16 +155,32 @@ def noise(seed: int = 6) -> np.ndarray:
     return _rgb(np.clip(grey, 0, 1), (0.8, 0.7, 0.6))
 
 
-STRAIGHT = {"brick": brick, "checkerboard": checkerboard, "tiles": tiles, "text": text, "weave": weave,
-            "planks": planks}
+STRAIGHT = {
+    "brick": brick,
+    "checkerboard": checkerboard,
+    "tiles": tiles,
+    "text": text,
+    "weave": weave,
+    "planks": planks,
+}
 WITHOUT = {"gravel": gravel, "grass": grass, "cells": cells, "wood": wood}
 REFUSE = {"noise": noise}
 
 
 # -- the camera and the scene ----------------------------------------------------------------------
 
-def camera(frontal_size: tuple[int, int], photo_size: tuple[int, int], *, tilt: float, phi: float, roll: float,
-           focal: float, cover: float = 0.55, shift=(0.0, 0.0)) -> np.ndarray:
+
+def camera(
+    frontal_size: tuple[int, int],
+    photo_size: tuple[int, int],
+    *,
+    tilt: float,
+    phi: float,
+    roll: float,
+    focal: float,
+    cover: float = 0.55,
+    shift=(0.0, 0.0),
+) -> np.ndarray:
     """Frontal pixel -> photo homography: the surface (centred on the optical axis, plus ``shift``
     in surface widths) seen by a camera turned ``tilt`` degrees about the axis at ``phi`` degrees
     from the surface's x axis, rolled ``roll`` degrees; focal length ``focal`` photo widths; the
@@ -197,17 +214,33 @@ def background(photo_size: tuple[int, int], rng: np.random.Generator) -> np.ndar
         cx, cy = (int(v) for v in rng.uniform(0, 1, 2) * (pw, ph))
         kind = rng.integers(0, 3)
         if kind == 0:
-            cv2.ellipse(img, (cx, cy), (int(rng.integers(10, 80)), int(rng.integers(10, 80))),
-                        float(rng.uniform(0, 180)), 0, 360, colour, -1, cv2.LINE_AA)
+            cv2.ellipse(
+                img,
+                (cx, cy),
+                (int(rng.integers(10, 80)), int(rng.integers(10, 80))),
+                float(rng.uniform(0, 180)),
+                0,
+                360,
+                colour,
+                -1,
+                cv2.LINE_AA,
+            )
         elif kind == 1:
-            box = cv2.boxPoints(((cx, cy), (float(rng.uniform(20, 150)), float(rng.uniform(10, 90))),
-                                 float(rng.uniform(0, 180))))
+            box = cv2.boxPoints(
+                ((cx, cy), (float(rng.uniform(20, 150)), float(rng.uniform(10, 90))), float(rng.uniform(0, 180)))
+            )
             cv2.fillPoly(img, [box.astype(np.int32)], colour, cv2.LINE_AA)
         else:
             a = rng.uniform(0, math.pi)
             ln = rng.uniform(40, 250)
-            cv2.line(img, (cx, cy), (int(cx + ln * math.cos(a)), int(cy + ln * math.sin(a))), colour,
-                     int(rng.integers(1, 5)), cv2.LINE_AA)
+            cv2.line(
+                img,
+                (cx, cy),
+                (int(cx + ln * math.cos(a)), int(cy + ln * math.sin(a))),
+                colour,
+                int(rng.integers(1, 5)),
+                cv2.LINE_AA,
+            )
     return np.clip(img, 0, 1)
 
 
@@ -234,7 +267,7 @@ def photograph(case: Case, frontal: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     shift = tuple(rng.uniform(-0.08, 0.08, 2))
     h = camera(fsize, PHOTO, tilt=case.tilt, phi=case.phi, roll=case.roll, focal=case.focal, shift=shift)
     # lighting across the surface: a linear ramp in the frontal frame
-    yy, xx = np.mgrid[0:fsize[1], 0:fsize[0]].astype(np.float32)
+    yy, xx = np.mgrid[0 : fsize[1], 0 : fsize[0]].astype(np.float32)
     a = rng.uniform(0, 2 * math.pi)
     ramp = 1.0 + 0.35 * ((xx / fsize[0] - 0.5) * math.cos(a) + (yy / fsize[1] - 0.5) * math.sin(a))
     lit = np.clip(frontal * ramp[..., None], 0, 1).astype(np.float32)
@@ -252,20 +285,44 @@ def cases() -> list[Case]:
         for j, tilt in enumerate(tilts):
             seed = 100 + 10 * i + j
             rng = np.random.default_rng(seed)
-            out.append(Case(f"{name}-{int(tilt)}", name, "straight", tilt, float(rng.uniform(20, 70)) * rng.choice([-1, 1]),
-                            float(rng.uniform(-8, 8)), float(rng.uniform(0.8, 1.5)), (0.0, 0.8, 1.5, 0.8)[j],
-                            (0.01, 0.02, 0.015, 0.03)[j], seed))
+            out.append(
+                Case(
+                    f"{name}-{int(tilt)}",
+                    name,
+                    "straight",
+                    tilt,
+                    float(rng.uniform(20, 70)) * rng.choice([-1, 1]),
+                    float(rng.uniform(-8, 8)),
+                    float(rng.uniform(0.8, 1.5)),
+                    (0.0, 0.8, 1.5, 0.8)[j],
+                    (0.01, 0.02, 0.015, 0.03)[j],
+                    seed,
+                )
+            )
     for i, name in enumerate({**WITHOUT, **REFUSE}):
         for j, tilt in enumerate((20.0, 35.0, 50.0)):
             seed = 500 + 10 * i + j
             rng = np.random.default_rng(seed)
             kind = "without" if name in WITHOUT else "refuse"
-            out.append(Case(f"{name}-{int(tilt)}", name, kind, tilt, float(rng.uniform(20, 70)) * rng.choice([-1, 1]),
-                            float(rng.uniform(-8, 8)), float(rng.uniform(0.8, 1.5)), 0.8, 0.015, seed))
+            out.append(
+                Case(
+                    f"{name}-{int(tilt)}",
+                    name,
+                    kind,
+                    tilt,
+                    float(rng.uniform(20, 70)) * rng.choice([-1, 1]),
+                    float(rng.uniform(-8, 8)),
+                    float(rng.uniform(0.8, 1.5)),
+                    0.8,
+                    0.015,
+                    seed,
+                )
+            )
     return out
 
 
 # -- scoring ----------------------------------------------------------------------------------------
+
 
 def residual(h_est: np.ndarray, h_true: np.ndarray, size: tuple[int, int]) -> tuple[float, float]:
     """Worst deviation from a right angle (degrees) and from aspect 1 (fraction) of the residual
@@ -316,8 +373,9 @@ def hough_baseline(photo: np.ndarray) -> detect.Suggestion:
         members.append(mem)
         vps.append(refine_point(lines[mem], length[mem]))
     explained = float(length[np.concatenate(members)].sum() / length.sum())
-    return detect.suggestion_from_families(seg, np.array(vps), members, explained, (w, h), source="hough",
-                                           min_confidence=0.0)
+    return detect.suggestion_from_families(
+        seg, np.array(vps), members, explained, (w, h), source="hough", min_confidence=0.0
+    )
 
 
 def run_one(fn, photo: np.ndarray, h_true: np.ndarray, repeats: int) -> dict:
@@ -339,15 +397,24 @@ def run_one(fn, photo: np.ndarray, h_true: np.ndarray, repeats: int) -> dict:
         out.update(refused=True, message=err, success=False)
         return out
     ang, asp = residual(sug.homography, h_true, sug.lines.frontal_size)
-    out.update(refused=False, angle_err_deg=round(ang, 3), aspect_err=round(asp, 4),
-               success=bool(ang <= 1.0 and asp <= 0.02), confidence=round(sug.confidence, 3),
-               angle_between_deg=round(sug.angle_deg, 1), source=sug.source, aspect=sug.aspect)
+    out.update(
+        refused=False,
+        angle_err_deg=round(ang, 3),
+        aspect_err=round(asp, 4),
+        success=bool(ang <= 1.0 and asp <= 0.02),
+        confidence=round(sug.confidence, 3),
+        angle_between_deg=round(sug.angle_deg, 1),
+        source=sug.source,
+        aspect=sug.aspect,
+    )
     return out
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks.rectify_suggest", description=__doc__.split("\n")[0])
-    ap.add_argument("--repeats", type=int, default=5, help="timed runs per case and tool (median; the first is kept too)")
+    ap.add_argument(
+        "--repeats", type=int, default=5, help="timed runs per case and tool (median; the first is kept too)"
+    )
     ap.add_argument("--json", type=Path, default=RESULTS)
     ap.add_argument("--only", default=None, help="cases whose names start with this")
     args = ap.parse_args(argv)
@@ -360,9 +427,16 @@ def main(argv: list[str] | None = None) -> int:
         if case.texture not in textures:
             textures[case.texture] = makers[case.texture]()
         photo, h_true = photograph(case, textures[case.texture])
-        row = {"case": case.name, "kind": case.kind, "tilt_deg": case.tilt, "axis_deg": round(case.phi, 1),
-               "focal_widths": round(case.focal, 2), "blur": case.blur, "noise": case.noise,
-               "megapixels": round(photo.shape[0] * photo.shape[1] / 1e6, 3)}
+        row = {
+            "case": case.name,
+            "kind": case.kind,
+            "tilt_deg": case.tilt,
+            "axis_deg": round(case.phi, 1),
+            "focal_widths": round(case.focal, 2),
+            "blur": case.blur,
+            "noise": case.noise,
+            "megapixels": round(photo.shape[0] * photo.shape[1] / 1e6, 3),
+        }
         # interleaved: the suggestion and the baseline on the same photo, one after the other
         row["weft"] = run_one(lambda p: detect.suggest_lines(p), photo, h_true, args.repeats)
         row["hough"] = run_one(hough_baseline, photo, h_true, args.repeats)
@@ -371,37 +445,62 @@ def main(argv: list[str] | None = None) -> int:
                 row[tool]["success"] = row[tool]["refused"]
         rows.append(row)
         w, b = row["weft"], row["hough"]
-        print(f"{case.name:18} {case.kind:8} weft {'ok ' if w['success'] else 'no '}"
-              f"{w.get('angle_err_deg', '-')!s:>7} {w.get('aspect_err', '-')!s:>7} {w['median_ms']:6.1f} ms "
-              f"{w.get('source', 'refused'):8} | hough {'ok ' if b['success'] else 'no '}"
-              f"{b.get('angle_err_deg', '-')!s:>7} {b.get('aspect_err', '-')!s:>7} {b['median_ms']:6.1f} ms", flush=True)
+        print(
+            f"{case.name:18} {case.kind:8} weft {'ok ' if w['success'] else 'no '}"
+            f"{w.get('angle_err_deg', '-')!s:>7} {w.get('aspect_err', '-')!s:>7} {w['median_ms']:6.1f} ms "
+            f"{w.get('source', 'refused'):8} | hough {'ok ' if b['success'] else 'no '}"
+            f"{b.get('angle_err_deg', '-')!s:>7} {b.get('aspect_err', '-')!s:>7} {b['median_ms']:6.1f} ms",
+            flush=True,
+        )
 
     def agg(kind: str, tool: str) -> dict:
         sel = [r[tool] for r in rows if r["kind"] == kind]
         if not sel:
             return {}
         ok = [r for r in sel if not r["refused"]]
-        return {"cases": len(sel), "success": round(sum(r["success"] for r in sel) / len(sel), 3),
-                "refused": sum(r["refused"] for r in sel),
-                "wrong_warps": sum(not r["refused"] and not r["success"] for r in sel),
-                "median_angle_err_deg": round(statistics.median(r["angle_err_deg"] for r in ok), 3) if ok else None,
-                "median_aspect_err": round(statistics.median(r["aspect_err"] for r in ok), 4) if ok else None,
-                "median_ms_per_mp": round(statistics.median(r["median_ms"] / rr["megapixels"]
-                                                            for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])), 1),
-                "median_cpu_ms_per_mp": round(statistics.median(r["median_cpu_ms"] / rr["megapixels"]
-                                                                for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])), 1),
-                "first_run_ms": sel[0]["first_ms"]}
+        return {
+            "cases": len(sel),
+            "success": round(sum(r["success"] for r in sel) / len(sel), 3),
+            "refused": sum(r["refused"] for r in sel),
+            "wrong_warps": sum(not r["refused"] and not r["success"] for r in sel),
+            "median_angle_err_deg": round(statistics.median(r["angle_err_deg"] for r in ok), 3) if ok else None,
+            "median_aspect_err": round(statistics.median(r["aspect_err"] for r in ok), 4) if ok else None,
+            "median_ms_per_mp": round(
+                statistics.median(
+                    r["median_ms"] / rr["megapixels"] for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])
+                ),
+                1,
+            ),
+            "median_cpu_ms_per_mp": round(
+                statistics.median(
+                    r["median_cpu_ms"] / rr["megapixels"] for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])
+                ),
+                1,
+            ),
+            "first_run_ms": sel[0]["first_ms"],
+        }
 
-    aggregates = {tool: {kind: agg(kind, tool) for kind in ("straight", "without", "refuse")} for tool in ("weft", "hough")}
-    data = {"suite": "rectify_suggest", "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-            "machine": {"platform": platform.platform(), "python": platform.python_version(), "cpus": os.cpu_count(),
-                        "processor": platform.processor() or platform.machine(), "opencv": cv2.__version__,
-                        "note": "shared by several engineers' jobs while measured (load average "
-                                f"{os.getloadavg()[0]:.1f} at the end); median_cpu_ms is the process's CPU time, "
-                                "less affected by the sharing than the wall time"},
-            "command": "python -m benchmarks.rectify_suggest" + (f" --repeats {args.repeats}" if args.repeats != 5 else ""),
-            "success_rule": "residual right angle within 1 deg and aspect within 2 % at a 3x3 grid over the frame",
-            "aggregates": aggregates, "rows": rows}
+    aggregates = {
+        tool: {kind: agg(kind, tool) for kind in ("straight", "without", "refuse")} for tool in ("weft", "hough")
+    }
+    data = {
+        "suite": "rectify_suggest",
+        "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "machine": {
+            "platform": platform.platform(),
+            "python": platform.python_version(),
+            "cpus": os.cpu_count(),
+            "processor": platform.processor() or platform.machine(),
+            "opencv": cv2.__version__,
+            "note": "shared by several engineers' jobs while measured (load average "
+            f"{os.getloadavg()[0]:.1f} at the end); median_cpu_ms is the process's CPU time, "
+            "less affected by the sharing than the wall time",
+        },
+        "command": "python -m benchmarks.rectify_suggest" + (f" --repeats {args.repeats}" if args.repeats != 5 else ""),
+        "success_rule": "residual right angle within 1 deg and aspect within 2 % at a 3x3 grid over the frame",
+        "aggregates": aggregates,
+        "rows": rows,
+    }
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(data, indent=1) + "\n")
     print(json.dumps(aggregates, indent=1))

@@ -15,8 +15,8 @@ line (:data:`METHOD`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 import numpy as np
 
@@ -62,8 +62,7 @@ def _check_mask(mask, shape: tuple[int, int], what: str = "mask") -> np.ndarray:
         raise ImageError(f"{what} must be (H, W) or (H, W, 3), not shape {m.shape}")
     if m.shape[:2] != tuple(shape):
         raise ImageError(
-            f"{what} is {m.shape[1]}x{m.shape[0]} but the images are {shape[1]}x{shape[0]}; "
-            "they must be the same size"
+            f"{what} is {m.shape[1]}x{m.shape[0]} but the images are {shape[1]}x{shape[0]}; they must be the same size"
         )
     m = validate_image(m, what)
     return luminance(m) if m.ndim == 3 else m
@@ -73,8 +72,15 @@ def _check_mask(mask, shape: tuple[int, int], what: str = "mask") -> np.ndarray:
 # Poisson blending
 
 
-def poisson_blend(target: np.ndarray, source: np.ndarray, mask: np.ndarray, *, tol: float = 1e-6,
-                  max_iter: int | None = None, wrap: bool = False) -> np.ndarray:
+def poisson_blend(
+    target: np.ndarray,
+    source: np.ndarray,
+    mask: np.ndarray,
+    *,
+    tol: float = 1e-6,
+    max_iter: int | None = None,
+    wrap: bool = False,
+) -> np.ndarray:
     """Seamless cloning: inside ``mask`` the result has ``source``'s gradients and meets ``target``.
 
     Solves the discrete Poisson equation of Pérez et al. (2003), eq. 7, on the pixels of the mask:
@@ -117,10 +123,14 @@ def poisson_blend(target: np.ndarray, source: np.ndarray, mask: np.ndarray, *, t
     m = _check_mask(mask, (h, w)) > 0.5
     if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)) or not 0 < tol < 1:
         raise InvalidParameter(f"parameter 'tol' = {tol!r} is outside 0..1", name="tol", value=tol)
-    if max_iter is not None and (isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer))
-                                 or max_iter < 1):
-        raise InvalidParameter(f"parameter 'max_iter' = {max_iter!r} must be an integer >= 1 (or None: the default)",
-                               name="max_iter", value=max_iter)
+    if max_iter is not None and (
+        isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1
+    ):
+        raise InvalidParameter(
+            f"parameter 'max_iter' = {max_iter!r} must be an integer >= 1 (or None: the default)",
+            name="max_iter",
+            value=max_iter,
+        )
     t3 = t.reshape(h, w, -1).astype(np.float64)
     s3 = s.reshape(h, w, -1).astype(np.float64)
     n = int(m.sum())
@@ -207,8 +217,9 @@ def pyramid_blend(foreground: np.ndarray, background: np.ndarray, mask: np.ndarr
     if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)):
         raise InvalidParameter(f"parameter 'levels' = {levels!r} must be an integer", name="levels", value=levels)
     if not 1 <= levels <= top:
-        raise out_of_range("levels", int(levels), 1, top, f"a {w}x{h} image has at most {top} pyramid levels",
-                           input="foreground")
+        raise out_of_range(
+            "levels", int(levels), 1, top, f"a {w}x{h} image has at most {top} pyramid levels", input="foreground"
+        )
     fg = fg.astype(np.float32)
     bg = bg.astype(np.float32)
     gm = [m.astype(np.float32)]
@@ -242,13 +253,21 @@ def pyramid_blend(foreground: np.ndarray, background: np.ndarray, mask: np.ndarr
 class BlendParams(Params):
     """Parameters of ``weft blend``."""
 
-    mode: str = param("pyramid", choices=("pyramid", "poisson"),
-                      help="how the pictures meet: pyramid = a soft Laplacian-pyramid blend that keeps each "
-                           "picture's colours; poisson = seamless cloning, the foreground takes on the background's"
-                           " colours at its edge")
-    levels: int = param(5, lo=1, hi=16, symbol="k",
-                        help="pyramid levels (pyramid mode): more levels give a wider, softer transition; at most "
-                             "log2 of the image's smaller side + 1")
+    mode: str = param(
+        "pyramid",
+        choices=("pyramid", "poisson"),
+        help="how the pictures meet: pyramid = a soft Laplacian-pyramid blend that keeps each "
+        "picture's colours; poisson = seamless cloning, the foreground takes on the background's"
+        " colours at its edge",
+    )
+    levels: int = param(
+        5,
+        lo=1,
+        hi=16,
+        symbol="k",
+        help="pyramid levels (pyramid mode): more levels give a wider, softer transition; at most "
+        "log2 of the image's smaller side + 1",
+    )
 
 
 def _run(inputs: Mapping[str, np.ndarray], params: BlendParams, *, rng=None, progress=None, cancel=None) -> Result:

@@ -30,8 +30,8 @@ Choices where the paper is silent (all documented here and in :func:`transfer`):
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Callable, Mapping
 
 import cv2
 import numpy as np
@@ -54,47 +54,104 @@ _ROWS_PER_BAND = 16
 class FastParams(Params):
     """Parameters of fast texture transfer (Ashikhmin 2003)."""
 
-    mode: str = param("auto", choices=MODES,
-                      help="what is made: transfer = the target rendered in the texture; synthesis = more texture; "
-                           "superres = the picture magnified from itself; novel = the picture restyled from itself "
-                           "(Fig. 2); auto: transfer with a target, superres with --magnify > 1, else synthesis")
-    metric: str = param("full", choices=tuple(METRICS),
-                        help="what a candidate must match: full = the result so far and the picture (eq. 1); target"
-                             " = the picture only (most faithful); artistic = tones and strokes, for drawings and "
-                             "paintings")
-    n: int = param(5, lo=3, hi=15, symbol="n", help="side of the neighbourhood compared (odd): small copies fine "
-                                                    "grain, large carries larger structures of the texture")
-    p: float = param(None, kind="float", lo=0.0, hi=1.0, optional=True, symbol="p", step=0.01,
-                     help="chance of a random candidate: 0 gives long coherent pieces of the texture, higher values"
-                          " follow the picture in smaller pieces; default 0.05 (super-resolution 0)")
-    p_l: float = param(None, kind="float", lo=0.0, hi=1.0, optional=True, symbol="p_l", step=0.01,
-                       help="chance of the candidate at the same place in the picture (x/m, y/m): higher keeps the "
-                            "original layout; default 0 (super-resolution 0.03)")
-    magnify: int = param(1, lo=1, hi=16, symbol="m",
-                         help="magnification: the result is the picture magnified m times (superres, novel); also "
-                              "the scale of the same-place candidate")
-    w: float = param(1.0, lo=0.0, hi=100.0, symbol="w", step=0.1,
-                     help="artistic metric: weight of the tones (neighbourhood averages) against the strokes; "
-                          "higher follows the picture's tones more closely")
-    target_weight: float = param(1.0, lo=0.0, hi=100.0, step=0.1,
-                                 help="full metric: weight of matching the picture against matching the result so "
-                                      "far; higher is more faithful, lower more coherent")
-    iterations: int = param(1, lo=1, hi=20, help="synthesis passes: later passes match every pixel again and smooth"
-                                                 " out early mistakes")
-    remap: bool = param(True, help="match against the texture's brightness remapped to the picture's mean and "
-                                   "contrast (Hertzmann et al.), so a dark texture can render a bright picture; the"
-                                   " output keeps the texture's own values")
-    colour: str = param("auto", choices=("auto", "target", "source"),
-                        help="colour of the result: target keeps the picture's colours (YIQ chroma); source copies "
-                             "the texture's colours")
-    size: tuple = param(None, kind="size", lo=8, hi=16384, optional=True,
-                        help="output size WIDTHxHEIGHT for synthesis; default twice the texture")
+    mode: str = param(
+        "auto",
+        choices=MODES,
+        help="what is made: transfer = the target rendered in the texture; synthesis = more texture; "
+        "superres = the picture magnified from itself; novel = the picture restyled from itself "
+        "(Fig. 2); auto: transfer with a target, superres with --magnify > 1, else synthesis",
+    )
+    metric: str = param(
+        "full",
+        choices=tuple(METRICS),
+        help="what a candidate must match: full = the result so far and the picture (eq. 1); target"
+        " = the picture only (most faithful); artistic = tones and strokes, for drawings and "
+        "paintings",
+    )
+    n: int = param(
+        5,
+        lo=3,
+        hi=15,
+        symbol="n",
+        help="side of the neighbourhood compared (odd): small copies fine "
+        "grain, large carries larger structures of the texture",
+    )
+    p: float = param(
+        None,
+        kind="float",
+        lo=0.0,
+        hi=1.0,
+        optional=True,
+        symbol="p",
+        step=0.01,
+        help="chance of a random candidate: 0 gives long coherent pieces of the texture, higher values"
+        " follow the picture in smaller pieces; default 0.05 (super-resolution 0)",
+    )
+    p_l: float = param(
+        None,
+        kind="float",
+        lo=0.0,
+        hi=1.0,
+        optional=True,
+        symbol="p_l",
+        step=0.01,
+        help="chance of the candidate at the same place in the picture (x/m, y/m): higher keeps the "
+        "original layout; default 0 (super-resolution 0.03)",
+    )
+    magnify: int = param(
+        1,
+        lo=1,
+        hi=16,
+        symbol="m",
+        help="magnification: the result is the picture magnified m times (superres, novel); also "
+        "the scale of the same-place candidate",
+    )
+    w: float = param(
+        1.0,
+        lo=0.0,
+        hi=100.0,
+        symbol="w",
+        step=0.1,
+        help="artistic metric: weight of the tones (neighbourhood averages) against the strokes; "
+        "higher follows the picture's tones more closely",
+    )
+    target_weight: float = param(
+        1.0,
+        lo=0.0,
+        hi=100.0,
+        step=0.1,
+        help="full metric: weight of matching the picture against matching the result so "
+        "far; higher is more faithful, lower more coherent",
+    )
+    iterations: int = param(
+        1, lo=1, hi=20, help="synthesis passes: later passes match every pixel again and smooth out early mistakes"
+    )
+    remap: bool = param(
+        True,
+        help="match against the texture's brightness remapped to the picture's mean and "
+        "contrast (Hertzmann et al.), so a dark texture can render a bright picture; the"
+        " output keeps the texture's own values",
+    )
+    colour: str = param(
+        "auto",
+        choices=("auto", "target", "source"),
+        help="colour of the result: target keeps the picture's colours (YIQ chroma); source copies "
+        "the texture's colours",
+    )
+    size: tuple = param(
+        None,
+        kind="size",
+        lo=8,
+        hi=16384,
+        optional=True,
+        help="output size WIDTHxHEIGHT for synthesis; default twice the texture",
+    )
 
     def check(self) -> None:
         if self.n % 2 == 0:
             raise InvalidParameter(f"parameter 'n' = {self.n} must be odd (3, 5, 7, ...)", name="n", value=self.n)
 
-    def resolved(self, has_target: bool) -> "FastParams":
+    def resolved(self, has_target: bool) -> FastParams:
         """The parameters with ``mode``, ``p``, ``p_l`` and ``colour`` made explicit."""
         mode = self.mode
         if mode == "auto":
@@ -102,11 +159,15 @@ class FastParams(Params):
         if mode == "transfer" and not has_target:
             raise InvalidParameter("mode 'transfer' needs a target image (--target)", name="mode", value=mode)
         if mode != "transfer" and has_target:
-            raise InvalidParameter(f"mode '{mode}' takes no target image; drop --target or use mode transfer",
-                                   name="mode", value=mode)
+            raise InvalidParameter(
+                f"mode '{mode}' takes no target image; drop --target or use mode transfer", name="mode", value=mode
+            )
         if self.metric in ("target", "artistic") and mode == "synthesis":
-            raise InvalidParameter(f"metric '{self.metric}' needs a target; synthesis has none (use metric full)",
-                                   name="metric", value=self.metric)
+            raise InvalidParameter(
+                f"metric '{self.metric}' needs a target; synthesis has none (use metric full)",
+                name="metric",
+                value=self.metric,
+            )
         p = self.p if self.p is not None else (0.0 if mode == "superres" else 0.05)
         p_l = self.p_l if self.p_l is not None else (0.03 if mode == "superres" else 0.0)
         colour = self.colour
@@ -133,10 +194,11 @@ def _valid_region(source_shape: tuple[int, int], n: int, mask: np.ndarray | None
     hs, ws = source_shape
     h = n // 2
     if hs < n or ws < n:
-        raise out_of_range("n", n, 3, min(hs, ws), f"the neighbourhood must fit in the source, {ws}x{hs}",
-                           input="texture")
+        raise out_of_range(
+            "n", n, 3, min(hs, ws), f"the neighbourhood must fit in the source, {ws}x{hs}", input="texture"
+        )
     allowed = np.zeros((hs, ws), dtype=np.uint8)
-    allowed[h:hs - h, h:ws - h] = 1
+    allowed[h : hs - h, h : ws - h] = 1
     if mask is not None:
         if mask.shape[:2] != (hs, ws):
             raise ImageError(f"source mask is {mask.shape[1]}x{mask.shape[0]}, the texture {ws}x{hs}: they must match")
@@ -217,8 +279,20 @@ def transfer(
     -------
     float32 array (H, W) or (H, W, 3).
     """
-    params = FastParams(mode=mode, metric=metric, n=n, p=p, p_l=p_l, magnify=magnify, w=w,
-                        target_weight=target_weight, iterations=iterations, remap=remap, colour=colour, size=size)
+    params = FastParams(
+        mode=mode,
+        metric=metric,
+        n=n,
+        p=p,
+        p_l=p_l,
+        magnify=magnify,
+        w=w,
+        target_weight=target_weight,
+        iterations=iterations,
+        remap=remap,
+        colour=colour,
+        size=size,
+    )
     out, _, _ = _transfer(texture, target, params, mask=mask, rng=rng, progress=progress, cancel=cancel)
     return out
 
@@ -280,9 +354,29 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
             if cancel is not None:
                 cancel.raise_if_cancelled()
             y1 = min(height, y0 + _ROWS_PER_BAND)
-            _k.coherent_rows(match_y, src_mean, tgt_pad, tgt_mean, res, pos, allowed, cand_mask, res_offs, rest,
-                             y0, y1, h, metric, tgt_y is not None, params.target_weight, params.w,
-                             params.p, params.p_l, m, state)
+            _k.coherent_rows(
+                match_y,
+                src_mean,
+                tgt_pad,
+                tgt_mean,
+                res,
+                pos,
+                allowed,
+                cand_mask,
+                res_offs,
+                rest,
+                y0,
+                y1,
+                h,
+                metric,
+                tgt_y is not None,
+                params.target_weight,
+                params.w,
+                params.p,
+                params.p_l,
+                m,
+                state,
+            )
             done += 1
             report.update(done, preview=lambda: _colourize(pos, src_y, texture, target, tgt_y, params.colour))
     return _colourize(pos, src_y, texture, target, tgt_y, params.colour), pos, params
@@ -294,8 +388,9 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
 BYTES_PER_OUTPUT_PIXEL = 50
 
 
-def _output_size(texture_shape: tuple[int, ...], target_shape: tuple[int, ...] | None,
-                 params: FastParams) -> tuple[int, int, str]:
+def _output_size(
+    texture_shape: tuple[int, ...], target_shape: tuple[int, ...] | None, params: FastParams
+) -> tuple[int, int, str]:
     """Width, height and what sets them (for messages) of a run on inputs of these shapes;
     ``params`` are resolved (:meth:`FastParams.resolved`)."""
     hs, ws = texture_shape[:2]
@@ -344,12 +439,27 @@ def _colourize(pos, src_y, texture, target, tgt_y, colour) -> np.ndarray:
 
 
 def _run(inputs: Mapping[str, np.ndarray], params: FastParams, *, rng=None, progress=None, cancel=None) -> Result:
-    out, pos, resolved = _transfer(inputs["texture"], inputs.get("target"), params, mask=inputs.get("mask"),
-                                   rng=rng, progress=progress, cancel=cancel)
+    out, pos, resolved = _transfer(
+        inputs["texture"],
+        inputs.get("target"),
+        params,
+        mask=inputs.get("mask"),
+        rng=rng,
+        progress=progress,
+        cancel=cancel,
+    )
     # How often a pixel continues its left neighbour's patch (flat source index one further).
     cont = np.mean(pos[:, 1:] == pos[:, :-1] + 1) if pos.shape[1] > 1 else 0.0
-    return Result(out, {"mode": resolved.mode, "metric": resolved.metric, "p": resolved.p, "p_l": resolved.p_l,
-                        "coherent_fraction": round(float(cont), 4)})
+    return Result(
+        out,
+        {
+            "mode": resolved.mode,
+            "metric": resolved.metric,
+            "p": resolved.p,
+            "p_l": resolved.p_l,
+            "coherent_fraction": round(float(cont), 4),
+        },
+    )
 
 
 def warm_up() -> None:
@@ -386,8 +496,7 @@ METHOD = Method(
     summary="fast texture transfer (Ashikhmin): live artistic styles, synthesis, super-resolution",
     params=FastParams,
     inputs=(
-        InputSpec("texture", "the source texture (for superres and novel styles: the picture itself)",
-                  min_side=3),
+        InputSpec("texture", "the source texture (for superres and novel styles: the picture itself)", min_side=3),
         InputSpec("target", "the picture to render in the texture (transfer)", required=False),
         InputSpec("mask", "source mask: candidates come only from its white part", required=False),
     ),
@@ -397,13 +506,23 @@ METHOD = Method(
     studio=Studio(
         title="Fast texture transfer (Ashikhmin)",
         canvas="texture",
-        geometry=(Geometry(SQUARE, on=("texture",),
-                           help="drag a square: the source region (the method copies only from it)"),),
-        preview_inputs=("target",), preview_params=("size",), auto=_auto, limits=_limits, idle=_idle,
+        geometry=(
+            Geometry(SQUARE, on=("texture",), help="drag a square: the source region (the method copies only from it)"),
+        ),
+        preview_inputs=("target",),
+        preview_params=("size",),
+        auto=_auto,
+        limits=_limits,
+        idle=_idle,
         compare=("target", "texture"),
-        examples={"texture": "wood-grain", "target": "astronaut"}, rank=0,
-        figures={"mode": Figure("mode"), "metric": Figure("metric"),
-                 "p": Figure("random candidates", "%", digits=2),
-                 "p_l": Figure("location candidates", "%", digits=2),
-                 "coherent_fraction": Figure("coherent pixels", "%", digits=2)}),
+        examples={"texture": "wood-grain", "target": "astronaut"},
+        rank=0,
+        figures={
+            "mode": Figure("mode"),
+            "metric": Figure("metric"),
+            "p": Figure("random candidates", "%", digits=2),
+            "p_l": Figure("location candidates", "%", digits=2),
+            "coherent_fraction": Figure("coherent pixels", "%", digits=2),
+        },
+    ),
 )

@@ -21,9 +21,10 @@ import math
 import numbers
 import os
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -33,8 +34,21 @@ from .readfile import read_regular, shown
 
 MAX_SIDE = 16384
 
-__all__ = ["Square", "FeatureLines", "LineDraft", "Mask", "MaskStroke", "paint_line", "Margins", "read_json_or_file",
-           "SQUARE", "LINES", "MASK", "MARGINS", "KINDS"]
+__all__ = [
+    "Square",
+    "FeatureLines",
+    "LineDraft",
+    "Mask",
+    "MaskStroke",
+    "paint_line",
+    "Margins",
+    "read_json_or_file",
+    "SQUARE",
+    "LINES",
+    "MASK",
+    "MARGINS",
+    "KINDS",
+]
 
 #: The kinds of geometry the studio has a tool for (a method's studio description names them per input):
 #: a square (dragged), feature lines (drawn in pairs), a mask (painted with a brush, eraser or lasso)
@@ -58,7 +72,7 @@ class Square(NamedTuple):
     METAVAR = "X,Y,S"
 
     @classmethod
-    def parse(cls, text: Any, name: str = "region") -> "Square":
+    def parse(cls, text: Any, name: str = "region") -> Square:
         """Parse ``"X,Y,S"`` (spaces ignored) or a sequence of three whole numbers.
 
         The corner must not be negative and the side at least 2; what a method needs beyond that (the
@@ -82,31 +96,38 @@ class Square(NamedTuple):
                 values = ()
             shown = ",".join(str(v) for v in text) if isinstance(text, (tuple, list)) else repr(text)
         if len(values) != 3:
-            raise InvalidParameter(f"parameter '{name}' = {shown!r} must be X,Y,SIDE (top-left corner and side of "
-                                   f"a square in pixels, e.g. 32,16,64)", name=name, value=text)
+            raise InvalidParameter(
+                f"parameter '{name}' = {shown!r} must be X,Y,SIDE (top-left corner and side of "
+                f"a square in pixels, e.g. 32,16,64)",
+                name=name,
+                value=text,
+            )
         x, y, s = values
         if x < 0 or y < 0:
-            raise InvalidParameter(f"parameter '{name}' = {x},{y},{s}: the corner {x},{y} must not be negative",
-                                   name=name, value=text)
+            raise InvalidParameter(
+                f"parameter '{name}' = {x},{y},{s}: the corner {x},{y} must not be negative", name=name, value=text
+            )
         if s < cls.MIN_SIDE:
-            raise InvalidParameter(f"parameter '{name}' = {x},{y},{s}: the side {s} must be at least {cls.MIN_SIDE}",
-                                   name=name, value=text)
+            raise InvalidParameter(
+                f"parameter '{name}' = {x},{y},{s}: the side {s} must be at least {cls.MIN_SIDE}", name=name, value=text
+            )
         return cls(x, y, s)
 
     @classmethod
-    def coerce(cls, value: Any, name: str = "region") -> "Square":
+    def coerce(cls, value: Any, name: str = "region") -> Square:
         """A Python caller's square: a ``Square``, ``(x, y, s)`` or ``"X,Y,S"``."""
         return value if isinstance(value, Square) else cls.parse(value, name)
 
     @classmethod
-    def from_json(cls, data: Any, name: str = "region", base: str | os.PathLike | None = None) -> "Square":
+    def from_json(cls, data: Any, name: str = "region", base: str | os.PathLike | None = None) -> Square:
         """``[x, y, side]`` of a recipe or session (whole numbers only); older recipes' text ``"X,Y,S"``
         is read by :meth:`parse` too."""
         if isinstance(data, str):
             return cls.parse(data, name)
         if not isinstance(data, list):
-            raise InvalidParameter(f"parameter '{name}' = {data!r} must be [x, y, side] in pixels",
-                                   name=name, value=data)
+            raise InvalidParameter(
+                f"parameter '{name}' = {data!r} must be [x, y, side] in pixels", name=name, value=data
+            )
         return cls.parse(data, name)
 
     def to_json(self) -> list[int]:
@@ -115,13 +136,14 @@ class Square(NamedTuple):
     def to_text(self) -> str:
         return f"{self.x},{self.y},{self.side}"
 
-    def check_side(self, name: str, *, minimum: int = 2, even: bool = False) -> "Square":
+    def check_side(self, name: str, *, minimum: int = 2, even: bool = False) -> Square:
         """Raise ``InvalidParameter`` unless the side is at least ``minimum`` (and even, if asked)."""
         x, y, s = self
         if s < minimum or (even and s % 2):
             need = f"even and at least {minimum}" if even else f"at least {minimum}"
-            raise InvalidParameter(f"parameter '{name}' = {x},{y},{s}: the side {s} must be {need}",
-                                   name=name, value=self)
+            raise InvalidParameter(
+                f"parameter '{name}' = {x},{y},{s}: the side {s} must be {need}", name=name, value=self
+            )
         return self
 
     def crop(self, image: np.ndarray, what: str = "texture", name: str = "region") -> np.ndarray:
@@ -129,11 +151,12 @@ class Square(NamedTuple):
         x, y, s = self
         h, w = image.shape[:2]
         if x < 0 or y < 0 or s < 1 or x + s > w or y + s > h:
-            raise InvalidParameter(f"parameter '{name}' = {x},{y},{s} leaves the {what} ({w}x{h})",
-                                   name=name, value=self)
-        return np.ascontiguousarray(image[y:y + s, x:x + s])
+            raise InvalidParameter(
+                f"parameter '{name}' = {x},{y},{s} leaves the {what} ({w}x{h})", name=name, value=self
+            )
+        return np.ascontiguousarray(image[y : y + s, x : x + s])
 
-    def scaled(self, k: float) -> "Square":
+    def scaled(self, k: float) -> Square:
         """The square in an image scaled by ``k`` (corner rounded down, side at least 1)."""
         return Square(int(self.x * k), int(self.y * k), max(1, int(round(self.side * k))))
 
@@ -164,7 +187,7 @@ def as_lines(value: Any, key: str) -> np.ndarray:
     if not isinstance(value, (list, tuple)):
         raise GeometryError(f"{key} must be a list of [x1, y1, x2, y2], not {type(value).__name__}")
     for i, line in enumerate(value):
-        if (not isinstance(line, (list, tuple, np.ndarray)) or len(line) != 4 or not all(_num(v) for v in line)):
+        if not isinstance(line, (list, tuple, np.ndarray)) or len(line) != 4 or not all(_num(v) for v in line):
             raise GeometryError(f"{key}[{i}] = {_short(line)} must be [x1, y1, x2, y2] (four numbers)")
         if not all(math.isfinite(float(v)) for v in line):
             raise GeometryError(f"{key}[{i}] = {_short(line)} has a NaN or infinite coordinate")
@@ -184,8 +207,11 @@ def whole_number(text: str) -> int:
 
 def as_size(value: Any, key: str) -> tuple[int, int]:
     """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not)."""
-    if (not isinstance(value, (list, tuple)) or len(value) != 2
-            or not all(_num(v) and math.isfinite(float(v)) and float(v) == int(v) for v in value)):
+    if (
+        not isinstance(value, (list, tuple))
+        or len(value) != 2
+        or not all(_num(v) and math.isfinite(float(v)) and float(v) == int(v) for v in value)
+    ):
         raise GeometryError(f"{key} = {_short(value)} must be [width, height] in whole pixels")
     w, h = int(value[0]), int(value[1])
     if not (2 <= w <= MAX_SIDE and 2 <= h <= MAX_SIDE):
@@ -253,8 +279,10 @@ class FeatureLines:
         img = as_lines(image_lines, "image_lines")
         fro = as_lines(frontal_lines, "frontal_lines")
         if len(img) != len(fro):
-            raise GeometryError(f"{len(img)} image_lines but {len(fro)} frontal_lines: line i of the photo "
-                                f"must match line i of the frontal frame")
+            raise GeometryError(
+                f"{len(img)} image_lines but {len(fro)} frontal_lines: line i of the photo "
+                f"must match line i of the frontal frame"
+            )
         size = as_size(frontal_size, "frontal_size")
         # (the arrays stay writeable: numba compiles a second signature of every kernel for read-only ones)
         object.__setattr__(self, "image_lines", img)
@@ -280,14 +308,17 @@ class FeatureLines:
         return self.to_json()
 
     def to_json(self) -> dict[str, Any]:
-        return {"image_lines": self.image_lines.tolist(), "frontal_lines": self.frontal_lines.tolist(),
-                "frontal_size": list(self.frontal_size)}
+        return {
+            "image_lines": self.image_lines.tolist(),
+            "frontal_lines": self.frontal_lines.tolist(),
+            "frontal_size": list(self.frontal_size),
+        }
 
     def to_text(self) -> str:
         return json.dumps(self.to_json())
 
     @classmethod
-    def from_mapping(cls, data: Any, *, source: str = "") -> "FeatureLines":
+    def from_mapping(cls, data: Any, *, source: str = "") -> FeatureLines:
         """From the parsed JSON object; GeometryError (prefixed with ``source``) naming the key."""
         prefix = f"{source}: " if source else ""
         try:
@@ -296,20 +327,23 @@ class FeatureLines:
             for key in ("image_lines", "frontal_lines", "frontal_size"):
                 if key not in data:
                     what = "[width, height]" if key == "frontal_size" else "a list of [x1, y1, x2, y2]"
-                    raise GeometryError(f"no \"{key}\" ({what})")
-            return cls(as_lines(data["image_lines"], "image_lines"), as_lines(data["frontal_lines"], "frontal_lines"),
-                       as_size(data["frontal_size"], "frontal_size"))
+                    raise GeometryError(f'no "{key}" ({what})')
+            return cls(
+                as_lines(data["image_lines"], "image_lines"),
+                as_lines(data["frontal_lines"], "frontal_lines"),
+                as_size(data["frontal_size"], "frontal_size"),
+            )
         except GeometryError as e:
             raise GeometryError(prefix + str(e)) from None
 
     @classmethod
-    def parse(cls, text: str | os.PathLike, name: str = "lines") -> "FeatureLines":
+    def parse(cls, text: str | os.PathLike, name: str = "lines") -> FeatureLines:
         """Command-line text: the JSON object itself (starts with ``{``) or a JSON file's name."""
         data, source = read_json_or_file(text, "feature-lines")
         return cls.from_mapping(data, source=source)
 
     @classmethod
-    def coerce(cls, value: Any, name: str = "lines") -> "FeatureLines":
+    def coerce(cls, value: Any, name: str = "lines") -> FeatureLines:
         """A Python caller's lines: ``FeatureLines``, the JSON object (a mapping), or a file name /
         JSON text by the command-line rule."""
         if isinstance(value, FeatureLines):
@@ -318,11 +352,13 @@ class FeatureLines:
             return cls.from_mapping(value)
         if isinstance(value, (str, os.PathLike)):
             return cls.parse(value, name)
-        raise GeometryError(f"parameter '{name}' = {_short(repr(value))} must be feature lines "
-                            f"{{image_lines, frontal_lines, frontal_size}}")
+        raise GeometryError(
+            f"parameter '{name}' = {_short(repr(value))} must be feature lines "
+            f"{{image_lines, frontal_lines, frontal_size}}"
+        )
 
     @classmethod
-    def from_json(cls, data: Any, name: str = "lines", base: str | os.PathLike | None = None) -> "FeatureLines":
+    def from_json(cls, data: Any, name: str = "lines", base: str | os.PathLike | None = None) -> FeatureLines:
         return _from_json_or_path(cls, data, name, base, "feature-lines")
 
 
@@ -353,11 +389,14 @@ class LineDraft:
         return FeatureLines(list(self.image_lines[:n]), list(self.frontal_lines[:n]), self.frontal_size)
 
     def to_json(self) -> dict[str, Any]:
-        return {"image_lines": [list(x) for x in self.image_lines],
-                "frontal_lines": [list(x) for x in self.frontal_lines], "frontal_size": list(self.frontal_size)}
+        return {
+            "image_lines": [list(x) for x in self.image_lines],
+            "frontal_lines": [list(x) for x in self.frontal_lines],
+            "frontal_size": list(self.frontal_size),
+        }
 
     @classmethod
-    def from_json(cls, data: Any, name: str = "lines") -> "LineDraft":
+    def from_json(cls, data: Any, name: str = "lines") -> LineDraft:
         """From a session's ``{image_lines, frontal_lines, frontal_size}`` (pairs may be unfinished;
         ``frontal_size`` defaults to 512x512); the line and size checks are :class:`FeatureLines`'."""
         if not isinstance(data, Mapping):
@@ -369,9 +408,12 @@ class LineDraft:
         return cls(drafts[0], drafts[1], as_size(data.get("frontal_size", [512, 512]), "frontal_size"))
 
     @classmethod
-    def of(cls, lines: FeatureLines) -> "LineDraft":
-        return cls(tuple(map(tuple, lines.image_lines.tolist())), tuple(map(tuple, lines.frontal_lines.tolist())),
-                   lines.frontal_size)
+    def of(cls, lines: FeatureLines) -> LineDraft:
+        return cls(
+            tuple(map(tuple, lines.image_lines.tolist())),
+            tuple(map(tuple, lines.frontal_lines.tolist())),
+            lines.frontal_size,
+        )
 
 
 # --- masks ----------------------------------------------------------------------------------------
@@ -400,7 +442,7 @@ class Mask:
         object.__setattr__(self, "bits", arr)
 
     @classmethod
-    def _own(cls, bits: np.ndarray) -> "Mask":
+    def _own(cls, bits: np.ndarray) -> Mask:
         """A mask over ``bits``, a fresh bool array of this module's own making (no second copy: a
         brush dab on an 8192² mask copied it twice)."""
         mask = cls.__new__(cls)
@@ -412,11 +454,11 @@ class Mask:
         raise AttributeError("Mask is immutable")
 
     @classmethod
-    def empty(cls, width: int, height: int) -> "Mask":
+    def empty(cls, width: int, height: int) -> Mask:
         return cls(np.zeros((height, width), dtype=bool))
 
     @classmethod
-    def from_image(cls, image, what: str = "mask") -> "Mask":
+    def from_image(cls, image, what: str = "mask") -> Mask:
         """White (> 0.5) pixels of a float image in [0, 1]: grey (H, W), colour (H, W, 3) by its mean,
         or with alpha (H, W, 2|4), where a transparent pixel is black."""
         arr = np.asarray(image, dtype=np.float32)
@@ -430,7 +472,7 @@ class Mask:
         return cls(value > 0.5)
 
     @classmethod
-    def from_alpha(cls, alpha, threshold: float = 0.5) -> "Mask":
+    def from_alpha(cls, alpha, threshold: float = 0.5) -> Mask:
         """The transparent pixels (alpha below ``threshold``) of an alpha channel in [0, 1]: the hole
         a fill closes when it is given no mask."""
         return cls(np.asarray(alpha, dtype=np.float32) < threshold)
@@ -464,12 +506,14 @@ class Mask:
         cols = np.flatnonzero(self.bits.any(axis=0))
         return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
 
-    def check_size(self, shape, what: str = "image", name: str = "mask") -> "Mask":
+    def check_size(self, shape, what: str = "image", name: str = "mask") -> Mask:
         """Raise ``GeometryError`` naming both sizes unless the mask is the size of ``shape``'s image."""
         h, w = int(shape[0]), int(shape[1])
         if self.bits.shape != (h, w):
-            raise GeometryError(f"the {name} is {self.size[0]}x{self.size[1]} but the {what} is {w}x{h}; "
-                                f"a {name} must be the size of its image")
+            raise GeometryError(
+                f"the {name} is {self.size[0]}x{self.size[1]} but the {what} is {w}x{h}; "
+                f"a {name} must be the size of its image"
+            )
         return self
 
     def to_image(self) -> np.ndarray:
@@ -494,13 +538,13 @@ class Mask:
         os.replace(tmp, target)
 
     @classmethod
-    def read(cls, path: str | os.PathLike, what: str = "mask") -> "Mask":
+    def read(cls, path: str | os.PathLike, what: str = "mask") -> Mask:
         """A mask image file (any format weft reads); errors are weft's one-line image errors."""
         from .image import load_image
 
         return cls.from_image(load_image(path).image, what)
 
-    def painted_line(self, p0, p1, radius: float, value: bool = True) -> "Mask":
+    def painted_line(self, p0, p1, radius: float, value: bool = True) -> Mask:
         """The mask with a round brush stroke from ``p0`` to ``p1`` (pixel coordinates ``(x, y)``,
         pixel centres at whole numbers) set to ``value`` (True paints, False erases): every pixel whose
         centre lies within ``radius`` of the segment. A zero-length stroke is a dot; radius 0 is a
@@ -508,7 +552,7 @@ class Mask:
         out = self.bits.copy()
         return self if paint_line(out, p0, p1, radius, value) is None else Mask._own(out)
 
-    def painted_polygon(self, points, value: bool = True) -> "Mask":
+    def painted_polygon(self, points, value: bool = True) -> Mask:
         """The mask with the polygon ``points`` [(x, y), ...] (a lasso, closed) set to ``value``."""
         import cv2
 
@@ -522,7 +566,11 @@ class Mask:
         return Mask._own(out)
 
     def __eq__(self, other) -> bool:
-        return isinstance(other, Mask) and self.bits.shape == other.bits.shape and bool(np.array_equal(self.bits, other.bits))
+        return (
+            isinstance(other, Mask)
+            and self.bits.shape == other.bits.shape
+            and bool(np.array_equal(self.bits, other.bits))
+        )
 
     def __hash__(self) -> int:
         return hash((self.bits.shape, np.packbits(self.bits).tobytes()))
@@ -567,7 +615,7 @@ class MaskStroke:
 
     __slots__ = ("_bits", "changed", "_ended")
 
-    def __init__(self, base: "Mask | None", width: int | None = None, height: int | None = None) -> None:
+    def __init__(self, base: Mask | None, width: int | None = None, height: int | None = None) -> None:
         if base is None:
             if not width or not height or width < 1 or height < 1:
                 raise GeometryError(f"a stroke needs a mask or a size, not {width}x{height}")
@@ -599,13 +647,13 @@ class MaskStroke:
     def cut(self, x0: int, y0: int, x1: int, y1: int) -> np.ndarray:
         """A copy of the bits in ``[y0:y1, x0:x1]`` (clipped to the mask)."""
         h, w = self._bits.shape
-        return self._bits[max(0, y0):min(h, y1), max(0, x0):min(w, x1)].copy()
+        return self._bits[max(0, y0) : min(h, y1), max(0, x0) : min(w, x1)].copy()
 
-    def snapshot(self) -> "Mask":
+    def snapshot(self) -> Mask:
         """The mask so far (a copy: the stroke goes on)."""
         return Mask(self._bits)
 
-    def mask(self) -> "Mask":
+    def mask(self) -> Mask:
         """The mask painted, ending the stroke: the bits are handed over, not copied."""
         self._ended = True
         return Mask._own(self._bits)
@@ -633,8 +681,14 @@ class Margins(NamedTuple):
     METAVAR = "L,T,R,B"
 
     @classmethod
-    def parse(cls, text: Any, name: str = "extend") -> "Margins":
-        shown = text if isinstance(text, str) else ",".join(map(str, text)) if isinstance(text, (list, tuple)) else repr(text)
+    def parse(cls, text: Any, name: str = "extend") -> Margins:
+        shown = (
+            text
+            if isinstance(text, str)
+            else ",".join(map(str, text))
+            if isinstance(text, (list, tuple))
+            else repr(text)
+        )
         values: tuple = ()
         try:
             if isinstance(text, str):
@@ -646,23 +700,31 @@ class Margins(NamedTuple):
         except (TypeError, ValueError, OverflowError):
             values = ()
         if len(values) != 4:
-            raise InvalidParameter(f"parameter '{name}' = {shown!r} must be L,T,R,B (pixels added on the left, "
-                                   f"top, right and bottom, e.g. 0,0,128,0)", name=name, value=text)
+            raise InvalidParameter(
+                f"parameter '{name}' = {shown!r} must be L,T,R,B (pixels added on the left, "
+                f"top, right and bottom, e.g. 0,0,128,0)",
+                name=name,
+                value=text,
+            )
         for side, v in zip(("left", "top", "right", "bottom"), values):
             if not 0 <= v <= MAX_SIDE:
-                raise InvalidParameter(f"parameter '{name}' = {shown}: the {side} margin {v} is outside 0..{MAX_SIDE}",
-                                       name=name, value=text)
+                raise InvalidParameter(
+                    f"parameter '{name}' = {shown}: the {side} margin {v} is outside 0..{MAX_SIDE}",
+                    name=name,
+                    value=text,
+                )
         return cls(*values)
 
     @classmethod
-    def coerce(cls, value: Any, name: str = "extend") -> "Margins":
+    def coerce(cls, value: Any, name: str = "extend") -> Margins:
         return value if isinstance(value, Margins) else cls.parse(value, name)
 
     @classmethod
-    def from_json(cls, data: Any, name: str = "extend", base: str | os.PathLike | None = None) -> "Margins":
+    def from_json(cls, data: Any, name: str = "extend", base: str | os.PathLike | None = None) -> Margins:
         if not isinstance(data, (list, str)):
-            raise InvalidParameter(f"parameter '{name}' = {data!r} must be [left, top, right, bottom] in pixels",
-                                   name=name, value=data)
+            raise InvalidParameter(
+                f"parameter '{name}' = {data!r} must be [left, top, right, bottom] in pixels", name=name, value=data
+            )
         return cls.parse(data, name)
 
     def to_json(self) -> list[int]:

@@ -28,12 +28,12 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any, Callable, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
-
 from weft.core.errors import Cancelled
 
 __all__ = ["Cancelled", "CancelToken", "Job", "JobResult", "JobRunner", "Progress", "ProgressReporter"]
@@ -58,7 +58,7 @@ class Progress(NamedTuple):
     preparing: bool = False
 
     @classmethod
-    def preparing_stage(cls, text: str) -> "Progress":
+    def preparing_stage(cls, text: str) -> Progress:
         """A report that the job is preparing (``text`` says what), before any work is done."""
         return cls(text, 0, 0, None, True)
 

@@ -20,6 +20,7 @@ def parse_json(text: str) -> Any:
     failure (bad syntax, nesting too deep for the parser, a number with thousands of digits) is a
     :class:`~weft.core.errors.WeftError` saying so in one line. Nothing is evaluated.
     """
+
     def no_constant(name: str):
         raise WeftError(f"not valid JSON: {name} is not a JSON number")
 
@@ -55,7 +56,9 @@ def read_json_file(path: str | os.PathLike, what: str) -> Any:
     try:
         text = raw.decode("utf-8-sig")  # a byte-order mark (Windows editors) is not an error
     except UnicodeDecodeError as e:
-        raise WeftError(f"{shown(name)}: not a {what} file (not UTF-8 JSON text: byte {e.start} is 0x{raw[e.start]:02x})") from None
+        raise WeftError(
+            f"{shown(name)}: not a {what} file (not UTF-8 JSON text: byte {e.start} is 0x{raw[e.start]:02x})"
+        ) from None
     try:
         return parse_json(text)
     except WeftError as e:

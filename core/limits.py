@@ -219,8 +219,10 @@ def check_output_size(width: int, height: int, source: str = "parameter 'size'")
 
     limit = get_max_pixels()
     if width * height > limit:
-        raise LimitError(f"{source}: an output of {width}x{height} = {width * height / 1e6:.1f} megapixels "
-                         f"exceeds the limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)")
+        raise LimitError(
+            f"{source}: an output of {width}x{height} = {width * height / 1e6:.1f} megapixels "
+            f"exceeds the limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)"
+        )
 
 
 def check_memory(nbytes: float, what: str, advice: str = "make the output smaller") -> None:
@@ -237,8 +239,10 @@ def check_duration(seconds: float, what: str, advice: str) -> None:
     """
     limit = get_max_seconds()
     if seconds > limit:
-        raise LimitError(f"{what} would take about {_duration(seconds)} (limit {_duration(limit)}): {advice}, "
-                         f"or set WEFT_MAX_SECONDS to allow it")
+        raise LimitError(
+            f"{what} would take about {_duration(seconds)} (limit {_duration(limit)}): {advice}, "
+            f"or set WEFT_MAX_SECONDS to allow it"
+        )
 
 
 def dft_seconds(h: int, w: int) -> float:

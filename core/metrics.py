@@ -33,7 +33,18 @@ from numpy.lib.stride_tricks import sliding_window_view
 from .errors import ImageError, InvalidParameter
 from .image import luminance, validate_image
 
-__all__ = ["coherence", "completeness", "fidelity", "fill_coherence", "fill_detail", "fill_seam", "psnr_db", "snr_db", "verbatim_fraction", "verbatim_region"]
+__all__ = [
+    "coherence",
+    "completeness",
+    "fidelity",
+    "fill_coherence",
+    "fill_detail",
+    "fill_seam",
+    "psnr_db",
+    "snr_db",
+    "verbatim_fraction",
+    "verbatim_region",
+]
 
 MIN_SIDE = 7
 # Upper bound on the float32 distance block held at once by the nearest-neighbour search
@@ -432,8 +443,9 @@ def fill_coherence(out, hole, reference=None, *, patch: int = 7, stride: int = 2
     img = _check_image(out, "output image", max(MIN_SIDE, patch))
     ref = img if reference is None else _check_image(reference, "reference image", max(MIN_SIDE, patch))
     if ref.shape[:2] != img.shape[:2]:
-        raise ImageError(f"reference image is {ref.shape[1]}x{ref.shape[0]} but the output is "
-                         f"{img.shape[1]}x{img.shape[0]}")
+        raise ImageError(
+            f"reference image is {ref.shape[1]}x{ref.shape[0]} but the output is {img.shape[1]}x{img.shape[0]}"
+        )
     mask = _check_hole(hole, img.shape)
     if not mask.any():
         raise ImageError("hole mask is empty: there is no filled region to judge")

@@ -32,9 +32,10 @@ import json
 import math
 import numbers
 import os
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -156,18 +157,24 @@ class Spec:
             try:
                 value: Any = whole_number(text.strip())
             except ValueError:
-                raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be an integer", name=self.name, value=text) from None
+                raise InvalidParameter(
+                    f"parameter '{self.name}' = {text!r} must be an integer", name=self.name, value=text
+                ) from None
         elif self.kind == "float":
             try:
                 if not text.isascii() or "_" in text:  # float() also takes 1_0.5 and other scripts' digits
                     raise ValueError
                 value = float(text)
             except ValueError:
-                raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be a number", name=self.name, value=text) from None
+                raise InvalidParameter(
+                    f"parameter '{self.name}' = {text!r} must be a number", name=self.name, value=text
+                ) from None
         elif self.kind == "bool":
             low = text.lower()
             if low not in ("1", "0", "true", "false", "yes", "no", "on", "off"):
-                raise InvalidParameter(f"parameter '{self.name}' = {text!r} must be true or false", name=self.name, value=text)
+                raise InvalidParameter(
+                    f"parameter '{self.name}' = {text!r} must be true or false", name=self.name, value=text
+                )
             value = low in ("1", "true", "yes", "on")
         elif self.kind == "size":
             value = parse_size(text, self.name)
@@ -182,8 +189,9 @@ def _fmt(x: float) -> str:
     return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
-def out_of_range(name: str, value: Any, lo: float | None, hi: float | None, why: str = "",
-                 input: str | None = None) -> InvalidParameter:
+def out_of_range(
+    name: str, value: Any, lo: float | None, hi: float | None, why: str = "", input: str | None = None
+) -> InvalidParameter:
     """Build the standard message: ``parameter 'overlap' = 40 is outside 1..31 (why)``.
 
     ``input`` names the method input whose size set the bound (see ``WeftError.input``).
@@ -254,8 +262,15 @@ def param(
     if (kind == "geometry") != (type is not None):
         raise TypeError("a geometry parameter needs its type (and only a geometry parameter has one)")
     meta = dict(
-        kind=kind, lo=lo, hi=hi, choices=tuple(choices or ()), optional=optional,
-        symbol=symbol, help=help, step=step, type=type,
+        kind=kind,
+        lo=lo,
+        hi=hi,
+        choices=tuple(choices or ()),
+        optional=optional,
+        symbol=symbol,
+        help=help,
+        step=step,
+        type=type,
     )
     return field(default=default, metadata={"weft": meta})
 
@@ -277,7 +292,7 @@ class Params:
     def check(self) -> None:
         """Cross-parameter rules; raise ``InvalidParameter`` (see :func:`out_of_range`)."""
 
-    def replace(self, **changes: Any) -> "Params":
+    def replace(self, **changes: Any) -> Params:
         unknown = set(changes) - {s.name for s in specs(type(self))}
         if unknown:
             raise InvalidParameter(_unknown_message(type(self), unknown))
@@ -294,7 +309,7 @@ class Params:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], *, base: str | os.PathLike | None = None) -> "Params":
+    def from_dict(cls, data: Mapping[str, Any], *, base: str | os.PathLike | None = None) -> Params:
         """Parameters from their JSON form; a geometry value is read by its type's ``from_json``
         (a file it names is found relative to ``base``, the recipe's folder)."""
         if not isinstance(data, Mapping):
@@ -374,8 +389,13 @@ class Recipe:
         inputs = dict(self.inputs)
         if relative_to is not None:
             inputs = {k: relative_path(v, relative_to) if os.path.isabs(v) else v for k, v in inputs.items()}
-        data = {"weft": RECIPE_VERSION, "method": self.method, "params": dict(self.params),
-                "inputs": inputs, "seed": self.seed}
+        data = {
+            "weft": RECIPE_VERSION,
+            "method": self.method,
+            "params": dict(self.params),
+            "inputs": inputs,
+            "seed": self.seed,
+        }
         if self.region is not None:
             data["region"] = Square(*self.region).to_json()
         if self.bit_depth is not None:
@@ -383,7 +403,7 @@ class Recipe:
         return json.dumps(data, sort_keys=False)
 
     @classmethod
-    def from_json(cls, text: str, *, base: str | os.PathLike | None = None) -> "Recipe":
+    def from_json(cls, text: str, *, base: str | os.PathLike | None = None) -> Recipe:
         try:
             data = parse_json(text)
         except WeftError as e:
@@ -391,43 +411,45 @@ class Recipe:
         return cls.from_data(data, base=base)
 
     @classmethod
-    def from_data(cls, data: Any, *, base: str | os.PathLike | None = None) -> "Recipe":
+    def from_data(cls, data: Any, *, base: str | os.PathLike | None = None) -> Recipe:
         """Validate a parsed recipe; relative input paths are joined to ``base`` when given."""
         if not isinstance(data, dict):
             raise WeftError("recipe must be a JSON object")
         version = data.get("weft")
         if version != RECIPE_VERSION:
-            raise WeftError(f"recipe has \"weft\": {version!r}; this version of weft reads recipes of version {RECIPE_VERSION}")
+            raise WeftError(
+                f'recipe has "weft": {version!r}; this version of weft reads recipes of version {RECIPE_VERSION}'
+            )
         method = data.get("method")
         if not isinstance(method, str):
-            raise WeftError("recipe has no \"method\" (a string such as \"quilt\")")
+            raise WeftError('recipe has no "method" (a string such as "quilt")')
         params = data.get("params", {})
         inputs = data.get("inputs", {})
         seed = data.get("seed")
         if not isinstance(params, dict):
-            raise WeftError("recipe \"params\" must be a JSON object")
+            raise WeftError('recipe "params" must be a JSON object')
         if not isinstance(inputs, dict) or not all(isinstance(v, str) for v in inputs.values()):
-            raise WeftError("recipe \"inputs\" must map input names to file paths")
+            raise WeftError('recipe "inputs" must map input names to file paths')
         for name, value in inputs.items():
             if not value or "\0" in value:
                 raise WeftError(f"recipe input {name!r} = {value!r} is not a file path")
         if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63):
-            raise WeftError(f"recipe \"seed\" = {seed!r} must be a non-negative integer below 2**63, or null")
+            raise WeftError(f'recipe "seed" = {seed!r} must be a non-negative integer below 2**63, or null')
         region = data.get("region")
         if region is not None:
             try:
                 region = Square.from_json(region, "region")
             except InvalidParameter:
-                raise WeftError(f"recipe \"region\" = {region!r} must be [x, y, side] in pixels") from None
+                raise WeftError(f'recipe "region" = {region!r} must be [x, y, side] in pixels') from None
         bit_depth = data.get("bit_depth")
         if bit_depth is not None and (isinstance(bit_depth, bool) or bit_depth not in (8, 16)):
-            raise WeftError(f"recipe \"bit_depth\" = {bit_depth!r} must be 8 or 16")
+            raise WeftError(f'recipe "bit_depth" = {bit_depth!r} must be 8 or 16')
         if base is not None:
             inputs = {k: str(Path(base) / v) if not os.path.isabs(v) else v for k, v in inputs.items()}
         return cls(method=method, params=params, inputs=inputs, seed=seed, region=region, bit_depth=bit_depth)
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> "Recipe":
+    def load(cls, path: str | os.PathLike) -> Recipe:
         """Read a recipe JSON file (at most :data:`MAX_FILE_BYTES`); messages start with its name."""
         path = Path(path)
         data = read_json_file(path, "recipe")

@@ -17,8 +17,13 @@ from typing import IO
 
 from .errors import WeftError
 
-_KINDS = ((stat.S_ISFIFO, "a named pipe (FIFO)"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"), (stat.S_ISDIR, "a directory"))
+_KINDS = (
+    (stat.S_ISFIFO, "a named pipe (FIFO)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISDIR, "a directory"),
+)
 
 
 def shown(path: str | os.PathLike | bytes) -> str:
@@ -84,8 +89,9 @@ def open_regular(path: str | os.PathLike, what: str = "file", *, error: type[Wef
         raise
 
 
-def read_regular(path: str | os.PathLike, limit: int, what: str = "file", *,
-                 error: type[WeftError] = NotRegularFile) -> bytes:
+def read_regular(
+    path: str | os.PathLike, limit: int, what: str = "file", *, error: type[WeftError] = NotRegularFile
+) -> bytes:
     """The bytes of the regular file ``path`` (see :func:`open_regular`); a file larger than ``limit``
     bytes is refused unread (``{path}: 12.0 MB is too large for a {what} (the limit is 10 MB); not read``),
     and one that grows past it while being read is refused after ``limit + 1`` bytes."""
@@ -93,7 +99,9 @@ def read_regular(path: str | os.PathLike, limit: int, what: str = "file", *,
     with open_regular(name, what, error=error) as f:
         size = os.fstat(f.fileno()).st_size
         if size > limit:
-            raise error(f"{shown(name)}: {_size(size)} is too large for {_a(what)} (the limit is {_size(limit)}); not read")
+            raise error(
+                f"{shown(name)}: {_size(size)} is too large for {_a(what)} (the limit is {_size(limit)}); not read"
+            )
         data = f.read(limit + 1)
     if len(data) > limit:
         raise error(f"{shown(name)}: too large for {_a(what)} (the limit is {_size(limit)}); not read")

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import importlib
 import threading
+from collections.abc import Callable, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -165,7 +166,7 @@ LOADING = "loading the {name} method"
 _warm: set[str] = set()
 _warm_locks: dict[str, threading.Lock] = {}
 _warm_lock = threading.Lock()
-_watchers: list["CompileWatch"] = []
+_watchers: list[CompileWatch] = []
 _watch_lock = threading.Lock()
 _compiles_running = 0
 _cache_notes: list[str] = []
@@ -226,8 +227,13 @@ def warm_up_report(name: str) -> dict[str, Any]:
     t0 = time.perf_counter()
     with watch_compiles() as watch:
         warm_up(name)
-    return {"method": name, "seconds": time.perf_counter() - t0, "compiled": watch.count,
-            "notice": kernel_cache_notice(), "repairs": kernel_cache_repairs()}
+    return {
+        "method": name,
+        "seconds": time.perf_counter() - t0,
+        "compiled": watch.count,
+        "notice": kernel_cache_notice(),
+        "repairs": kernel_cache_repairs(),
+    }
 
 
 class CompileWatch:

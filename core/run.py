@@ -17,8 +17,8 @@ from __future__ import annotations
 import contextlib
 import os
 import time
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
 
 from .errors import ImageError, WeftError
 from .geometry import Square
@@ -50,8 +50,9 @@ def load_recipe(path: str) -> Recipe:
             raise WeftError(f"{name}: {e}") from None
     fmt = next((fmt for magic, fmt in _SIGNATURES.items() if head.startswith(magic)), None)
     if fmt is not None:
-        raise WeftError(f"{name}: a {fmt} image carries no recipe; only PNGs exported by weft (and .json "
-                        f"recipe files) do")
+        raise WeftError(
+            f"{name}: a {fmt} image carries no recipe; only PNGs exported by weft (and .json recipe files) do"
+        )
     return Recipe.load(p)
 
 
@@ -69,8 +70,10 @@ def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) 
     takes = [i.name for i in method.inputs]
     unknown = sorted(set(recipe.inputs) - set(takes))
     if unknown:
-        raise WeftError(f"recipe names input {', '.join(map(repr, unknown))}, which {method.name} does not "
-                        f"take (it takes {', '.join(takes)})")
+        raise WeftError(
+            f"recipe names input {', '.join(map(repr, unknown))}, which {method.name} does not "
+            f"take (it takes {', '.join(takes)})"
+        )
     missing = [i.name for i in method.inputs if i.required and i.name not in recipe.inputs and i.name not in supplied]
     if missing:
         raise WeftError(f"recipe names no {', '.join(missing)} image for {method.name}")
@@ -83,20 +86,41 @@ def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) 
     return params.to_dict()
 
 
-def output_recipe(method, params: Params, input_paths: Mapping[str, str], seed: int,
-                  region: tuple[int, int, int] | None, out: str | os.PathLike) -> Recipe:
+def output_recipe(
+    method,
+    params: Params,
+    input_paths: Mapping[str, str],
+    seed: int,
+    region: tuple[int, int, int] | None,
+    out: str | os.PathLike,
+) -> Recipe:
     """The recipe a run's output at ``out`` carries: input paths relative to the output's folder
     (``weft run OUT.png`` then finds them wherever the folder moves); geometry (feature lines, a view)
     inline, so it needs no other file."""
     out_dir = Path(out).resolve().parent
     rel_inputs = {name: relative_path(path, out_dir) for name, path in input_paths.items()}
-    return Recipe(method=method.name, params=params.to_dict(), inputs=rel_inputs, seed=seed,
-                  region=None if region is None else Square(*region))
+    return Recipe(
+        method=method.name,
+        params=params.to_dict(),
+        inputs=rel_inputs,
+        seed=seed,
+        region=None if region is None else Square(*region),
+    )
 
 
-def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
-           region: tuple[int, int, int] | None = None, *, progress=None, cancel=None, warm_up: bool = True,
-           shown_paths: Mapping[str, str] | None = None, infos: dict | None = None):
+def render(
+    method,
+    params: Params,
+    input_paths: Mapping[str, str],
+    seed: int,
+    region: tuple[int, int, int] | None = None,
+    *,
+    progress=None,
+    cancel=None,
+    warm_up: bool = True,
+    shown_paths: Mapping[str, str] | None = None,
+    infos: dict | None = None,
+):
     """Load the inputs, run ``method`` and return ``(Result, seconds)`` (compute time only).
 
     The first input is cropped to ``region`` when given; an input smaller than its ``min_side`` is
@@ -111,8 +135,10 @@ def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
 
     shown = dict(shown_paths or input_paths)
     if region is not None and not method.takes_region:
-        raise WeftError(f"weft {method.name} takes no --region (it works on the whole {method.inputs[0].name}; "
-                        f"crop the image first)")
+        raise WeftError(
+            f"weft {method.name} takes no --region (it works on the whole {method.inputs[0].name}; "
+            f"crop the image first)"
+        )
     keep_alpha = {spec.name for spec in method.inputs if spec.alpha}
     loaded = {name: load_image(path, alpha=name in keep_alpha) for name, path in input_paths.items()}
     images = {name: item.image for name, item in loaded.items()}
@@ -125,8 +151,11 @@ def render(method, params: Params, input_paths: Mapping[str, str], seed: int,
         if spec.name in images and min(images[spec.name].shape[:2]) < spec.min_side:
             h, w = images[spec.name].shape[:2]
             cropped = " (the --region crop)" if region is not None and spec is method.inputs[0] else ""
-            raise ImageError(f"{shown[spec.name]}: the {spec.name} is {w}x{h}{cropped}; weft {method.name} "
-                             f"needs at least {spec.min_side}x{spec.min_side} pixels", path=shown[spec.name])
+            raise ImageError(
+                f"{shown[spec.name]}: the {spec.name} is {w}x{h}{cropped}; weft {method.name} "
+                f"needs at least {spec.min_side}x{spec.min_side} pixels",
+                path=shown[spec.name],
+            )
     from . import registry
 
     with registry.watch_compiles(this_thread=True) as compiles:

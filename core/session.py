@@ -79,8 +79,9 @@ def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) 
             proto = Square.from_json(proto, LEGACY_SQUARE)
         except WeftError:
             raise WeftError(f"{LEGACY_SQUARE} = {proto!r} must be [x, y, side] in pixels, or null") from None
-    lines = LineDraft.from_json(_get(data, LEGACY_LINES, dict, "an object {image_lines, frontal_lines, frontal_size}",
-                                     {}), LEGACY_LINES)
+    lines = LineDraft.from_json(
+        _get(data, LEGACY_LINES, dict, "an object {image_lines, frontal_lines, frontal_size}", {}), LEGACY_LINES
+    )
     seed = data.get("seed", 1)
     if not _ints([seed], 0, MAX_SEED):
         raise WeftError(f"seed = {seed!r} must be an integer in 0..{MAX_SEED}")
@@ -118,8 +119,14 @@ def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) 
     opened_for = _get(data, "opened_for", dict, "an object of input name -> method name", None)
     if opened_for is not None:
         opened_for = {k: v for k, v in opened_for.items() if k in inputs and isinstance(v, str)}
-    return {"method": data["method"], "params": params, "inputs": inputs, "geometry": geometry, "seed": seed,
-            "opened_for": opened_for}
+    return {
+        "method": data["method"],
+        "params": params,
+        "inputs": inputs,
+        "geometry": geometry,
+        "seed": seed,
+        "opened_for": opened_for,
+    }
 
 
 class _UnreadableMask(WeftError):
@@ -165,5 +172,4 @@ def _get(data: dict, key: str, kind: type, what: str, default):
 
 
 def _ints(values, lo: int, hi: int | None = None) -> bool:
-    return all(isinstance(v, int) and not isinstance(v, bool) and lo <= v and (hi is None or v <= hi)
-               for v in values)
+    return all(isinstance(v, int) and not isinstance(v, bool) and lo <= v and (hi is None or v <= hi) for v in values)

@@ -14,16 +14,29 @@ Example: a method whose one input carries a square that fills its ``square`` par
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
 from .errors import WeftError
 from .geometry import KINDS, LINES, MARGINS, MASK, SQUARE  # noqa: F401 (the kinds are re-exported)
 
-__all__ = ["Studio", "Geometry", "Figure", "describe_figures", "reduce_for_preview", "crop_around", "Around",
-           "SQUARE", "LINES", "MASK", "MARGINS", "REGION"]
+__all__ = [
+    "Studio",
+    "Geometry",
+    "Figure",
+    "describe_figures",
+    "reduce_for_preview",
+    "crop_around",
+    "Around",
+    "SQUARE",
+    "LINES",
+    "MASK",
+    "MARGINS",
+    "REGION",
+]
 
 #: The key of a square that fills no parameter: the recipe's source ``region`` (the input is cropped to it).
 REGION = "region"
@@ -140,7 +153,7 @@ class Figure:
             text += f" {self.unit}"
         return " ".join(part for part in (self.label, text, self.after) if part)
 
-    def prefixed(self, words: str) -> "Figure":
+    def prefixed(self, words: str) -> Figure:
         """The same figure with ``words`` before its label (a figure of a step, e.g. the rectification)."""
         return Figure(f"{words} {self.label}".strip(), self.unit, self.after, self.digits, self.whole)
 
@@ -282,8 +295,9 @@ class Studio:
         return self.canvas
 
 
-def reduce_for_preview(studio: Studio, inputs: Mapping[str, np.ndarray], params, side: int
-                       ) -> tuple[dict[str, np.ndarray], Any]:
+def reduce_for_preview(
+    studio: Studio, inputs: Mapping[str, np.ndarray], params, side: int
+) -> tuple[dict[str, np.ndarray], Any]:
     """Inputs and parameters of a reduced render: the studio's ``preview_inputs`` that are open
     scaled so the longer side of the largest is ``side``; else its ``preview_params`` sizes scaled
     so; unchanged when already that small (or when the method refuses the smaller size)."""
@@ -355,16 +369,24 @@ class Around:
         x0, y0, x1, y1 = self.box
         dx, dy = self.offset
         part = self.fitted(part)
-        if (part is None or part.ndim != base.ndim or (part.ndim == 3 and part.shape[2] != base.shape[2])
-                or y0 + dy < 0 or x0 + dx < 0 or y1 + dy > base.shape[0] or x1 + dx > base.shape[1]):
+        if (
+            part is None
+            or part.ndim != base.ndim
+            or (part.ndim == 3 and part.shape[2] != base.shape[2])
+            or y0 + dy < 0
+            or x0 + dx < 0
+            or y1 + dy > base.shape[0]
+            or x1 + dx > base.shape[1]
+        ):
             return None
         out = base.copy() if copy else base
-        out[y0 + dy:y1 + dy, x0 + dx:x1 + dx] = part
+        out[y0 + dy : y1 + dy, x0 + dx : x1 + dx] = part
         return out
 
 
-def around_region(stroke: tuple[float, float, float, float], width: int, height: int, *,
-                  context: int = 16) -> tuple[int, int, int, int]:
+def around_region(
+    stroke: tuple[float, float, float, float], width: int, height: int, *, context: int = 16
+) -> tuple[int, int, int, int]:
     """The part ``(x0, y0, x1, y1)`` of a ``width`` x ``height`` painted mask that :func:`crop_around`
     reads for ``stroke`` (same ``context``): the stroke's box grown by ``context``, grown again by
     ``context`` and a quarter of that box's longer side (the crop never reaches farther), clipped to
@@ -379,13 +401,24 @@ def _stroke_window(stroke: tuple[float, float, float, float], context: int) -> t
     """The stroke's box in whole pixels grown by ``context`` (exclusive ends, not clipped): where
     :func:`crop_around` looks for painted pixels."""
     sx0, sy0, sx1, sy1 = stroke
-    return (int(np.floor(sx0)) - context, int(np.floor(sy0)) - context,
-            int(np.ceil(sx1)) + 1 + context, int(np.ceil(sy1)) + 1 + context)
+    return (
+        int(np.floor(sx0)) - context,
+        int(np.floor(sy0)) - context,
+        int(np.ceil(sx1)) + 1 + context,
+        int(np.ceil(sy1)) + 1 + context,
+    )
 
 
-def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke: tuple[float, float, float, float],
-                *, side: int = AROUND_SIDE, context: int = 16,
-                mask_part: tuple[np.ndarray, tuple[int, int]] | None = None) -> Around | None:
+def crop_around(
+    studio: Studio,
+    inputs: Mapping[str, np.ndarray],
+    params,
+    stroke: tuple[float, float, float, float],
+    *,
+    side: int = AROUND_SIDE,
+    context: int = 16,
+    mask_part: tuple[np.ndarray, tuple[int, int]] | None = None,
+) -> Around | None:
     """What to render while a stroke paints the mask input ``studio.preview_around``: the inputs
     cropped around the painted region near the stroke, so the preview costs a fraction of a full
     render.
@@ -425,14 +458,16 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
         mask, (px, py) = np.asarray(mask_part[0]), mask_part[1]
         rx0, ry0, rx1, ry1 = around_region(stroke, w, h, context=context)
         if px > rx0 or py > ry0 or px + mask.shape[1] < rx1 or py + mask.shape[0] < ry1:
-            raise ValueError(f"the mask's part {mask.shape[1]}x{mask.shape[0]} at ({px}, {py}) does not cover "
-                             f"the stroke's region {(rx0, ry0, rx1, ry1)}")
+            raise ValueError(
+                f"the mask's part {mask.shape[1]}x{mask.shape[0]} at ({px}, {py}) does not cover "
+                f"the stroke's region {(rx0, ry0, rx1, ry1)}"
+            )
     plane = mask if mask.ndim == 2 else mask[..., 0]
     wx0, wy0, wx1, wy1 = _stroke_window(stroke, context)
     wx0, wy0, wx1, wy1 = max(0, wx0), max(0, wy0), min(w, wx1), min(h, wy1)
     if wx0 >= wx1 or wy0 >= wy1:
         return None
-    near = plane[wy0 - py:wy1 - py, wx0 - px:wx1 - px] > 0.5
+    near = plane[wy0 - py : wy1 - py, wx0 - px : wx1 - px] > 0.5
     rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
     if not len(rows):
         return None
@@ -447,7 +482,7 @@ def crop_around(studio: Studio, inputs: Mapping[str, np.ndarray], params, stroke
     crop |= {n for n, of in studio.masks_of.items() if next((i for i in of if i in inputs), None) == on}
     for n in dict.fromkeys([*inputs, name] if mask_part is not None else inputs):  # (each input once)
         if n == name and mask_part is not None:  # (the painted mask's part, as a 0/1 image)
-            part = (plane[y0 - py:y1 - py, x0 - px:x1 - px] > 0.5).astype(np.float32)
+            part = (plane[y0 - py : y1 - py, x0 - px : x1 - px] > 0.5).astype(np.float32)
         elif n not in crop or inputs[n].shape[:2] != (h, w):  # a mask of another size: the method says so
             continue
         else:

@@ -26,10 +26,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "docs" / "gallery"))
 
-from benchmarks import fill as bench  # noqa: E402
 from panels import grid, label, rgb  # noqa: E402
-
 from weft.core.image import save_image  # noqa: E402
+
+from benchmarks import fill as bench  # noqa: E402
 
 OUT = ROOT / "docs" / "images"
 SHOWN = ["weft", bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyPI)", "OpenCV Telea"]
@@ -37,10 +37,15 @@ SHOWN = ["weft", bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyP
 # the table)
 NO_GUIDE = "weft --engine patchmatch --structure no"
 SHOWN_OBJECT = ["weft", NO_GUIDE, bench.GMIC, bench.SHIFTMAP, "pypatchmatch", "Resynthesizer (PyPI)"]
-SHORT = {"weft": "weft fill (default engine)", NO_GUIDE: "weft fill --structure no",
-         bench.GMIC: "G'MIC inpaint_matchpatch",
-         bench.SHIFTMAP: "OpenCV shift-map", "pypatchmatch": "pypatchmatch",
-         "Resynthesizer (PyPI)": "Resynthesizer", "OpenCV Telea": "OpenCV Telea"}
+SHORT = {
+    "weft": "weft fill (default engine)",
+    NO_GUIDE: "weft fill --structure no",
+    bench.GMIC: "G'MIC inpaint_matchpatch",
+    bench.SHIFTMAP: "OpenCV shift-map",
+    "pypatchmatch": "pypatchmatch",
+    "Resynthesizer (PyPI)": "Resynthesizer",
+    "OpenCV Telea": "OpenCV Telea",
+}
 
 
 def outlined(img: np.ndarray, hole: np.ndarray) -> np.ndarray:
@@ -70,9 +75,13 @@ def blank(shape: tuple[int, ...], text: str) -> np.ndarray:
 def render(case: bench.FillCase, tools: dict[str, bench.Tool]) -> np.ndarray:
     inputs = case.build()
     truth = bench.truth_figures(inputs)
-    panels = [label(outlined(inputs.image, inputs.hole), f"input, hole outlined|{int(inputs.hole.sum())} px to fill"),
-              label(rgb(inputs.truth.astype(np.float32) / 255.0),
-                    f"ground truth|coh {truth['coherence']:.1f}  detail {truth['detail']:.2f}  seam {truth['seam']:.2f}")]
+    panels = [
+        label(outlined(inputs.image, inputs.hole), f"input, hole outlined|{int(inputs.hole.sum())} px to fill"),
+        label(
+            rgb(inputs.truth.astype(np.float32) / 255.0),
+            f"ground truth|coh {truth['coherence']:.1f}  detail {truth['detail']:.2f}  seam {truth['seam']:.2f}",
+        ),
+    ]
     with tempfile.TemporaryDirectory(prefix="weft-fill-gallery-") as tmp:
         files = bench.write_inputs(inputs, Path(tmp))
         for name in SHOWN_OBJECT if case.name == "fill-object" else SHOWN:
@@ -88,7 +97,9 @@ def render(case: bench.FillCase, tools: dict[str, bench.Tool]) -> np.ndarray:
                 panels.append(blank(inputs.truth.shape, f"{SHORT[name]}|failed: {err[:40]}"))
                 continue
             result = bench.read_output(out, inputs.truth)
-            panels.append(label(rgb(result.astype(np.float32) / 255.0), caption(SHORT[name], bench.figures(result, inputs))))
+            panels.append(
+                label(rgb(result.astype(np.float32) / 255.0), caption(SHORT[name], bench.figures(result, inputs)))
+            )
     return grid(panels, cols=4)
 
 

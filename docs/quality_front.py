@@ -28,8 +28,11 @@ OUT = ROOT / "docs" / "images" / "quality-front.png"
 #: (label, method, parameters): the documented settings, from faithful to coherent; the last two
 #: are the issue's reference points (not on the front).
 SETTINGS = [
-    ("quilt block 4/2, α 0.1, 3 passes, luminance", "quilt",
-     dict(block=4, overlap=2, alpha=0.1, iterations=3, correspondence="luminance")),
+    (
+        "quilt block 4/2, α 0.1, 3 passes, luminance",
+        "quilt",
+        dict(block=4, overlap=2, alpha=0.1, iterations=3, correspondence="luminance"),
+    ),
     ("quilt block 5/2, α 0.1, 3 passes", "quilt", dict(block=5, overlap=2, alpha=0.1, iterations=3)),
     ("quilt block 4/2, α 0.1, 3 passes", "quilt", dict(block=4, overlap=2, alpha=0.1, iterations=3)),
     ("quilt block 9/3, α 0.1, 3 passes", "quilt", dict(block=9, overlap=3, alpha=0.1, iterations=3)),
@@ -78,14 +81,18 @@ def pareto(rows: list[tuple[str, float, float]]) -> list[tuple[str, float, float
 
 
 def table(rows: list[tuple[str, float, float]]) -> str:
-    lines = ["| | T2 setting or peer | fidelity (higher is better) | coherence (lower is better) | beats on both |",
-             "| --- | --- | --- | --- | --- |"]
+    lines = [
+        "| | T2 setting or peer | fidelity (higher is better) | coherence (lower is better) | beats on both |",
+        "| --- | --- | --- | --- | --- |",
+    ]
     front = pareto(rows)
     for k, row in enumerate(rows):
         label, fid, coh = row
         beaten = [p for p, (pf, pc) in PEERS.items() if fid > pf and coh < pc]
-        lines.append(f"| {k + 1}{' (front)' if row in front else ''} | weft {label} | {fid:.4f} | {coh:.3f} | "
-                     f"{', '.join(beaten) or '—'} |")
+        lines.append(
+            f"| {k + 1}{' (front)' if row in front else ''} | weft {label} | {fid:.4f} | {coh:.3f} | "
+            f"{', '.join(beaten) or '—'} |"
+        )
     for p, (pf, pc) in PEERS.items():
         lines.append(f"| | {p} (peer) | {pf:.3f} | {pc:.2f} | |")
     return "\n".join(lines)
@@ -102,8 +109,10 @@ def draw(rows: list[tuple[str, float, float]], path: Path = OUT) -> None:
     f_lo, f_hi = min(0.5, min(f for _, f in pts) - 0.02), 1.0
 
     def xy(c, f):
-        return (int(left + (c - c_lo) / (c_hi - c_lo) * (w - left - right)),
-                int(h - bottom - (f - f_lo) / (f_hi - f_lo) * (h - top - bottom)))
+        return (
+            int(left + (c - c_lo) / (c_hi - c_lo) * (w - left - right)),
+            int(h - bottom - (f - f_lo) / (f_hi - f_lo) * (h - top - bottom)),
+        )
 
     grey, black, font = (200, 200, 200), (0, 0, 0), cv2.FONT_HERSHEY_SIMPLEX
     for c in np.arange(c_lo, c_hi + 1e-9, 0.04):

@@ -17,7 +17,6 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 from PySide6.QtCore import QSettings  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
-
 from weft.app.gui.document import DocumentState, InputImage  # noqa: E402
 from weft.app.gui.main_window import MainWindow  # noqa: E402
 from weft.core import registry  # noqa: E402
@@ -45,16 +44,23 @@ def _input(name: str) -> InputImage:
 def shoot(app, name: str, setup) -> Path:
     with tempfile.TemporaryDirectory() as tmp:
         os.environ["WEFT_RECOVERY_DIR"] = tmp  # never touch the user's recovery file
-        window = MainWindow(settings=QSettings(os.path.join(tmp, "s.ini"), QSettings.Format.IniFormat),
-                            load_defaults=False)
+        window = MainWindow(
+            settings=QSettings(os.path.join(tmp, "s.ini"), QSettings.Format.IniFormat), load_defaults=False
+        )
         window.resize(1440, 860)
         window.show()
         app.processEvents()
         setup(window)
         window.doc.undo_stack.clear()
         window.renderer.final(now=True)
-        _wait(app, lambda: window.renderer.last is not None and window.renderer.last.final
-              and not window.renderer.runner.busy("final"))
+        _wait(
+            app,
+            lambda: (
+                window.renderer.last is not None
+                and window.renderer.last.final
+                and not window.renderer.runner.busy("final")
+            ),
+        )
         for _ in range(5):
             app.processEvents()
         path = OUT / f"studio-{name}.png"
@@ -95,13 +101,13 @@ def nfpt(window) -> None:
 def fill(window) -> None:
     """Fill and extend on issue 15's photo (``benchmarks/fill.py``: the spoon pasted over the saucer's
     rim), its silhouette painted as the mask (*structure* auto: the rim continued)."""
-    from benchmarks.fill import by_name
+    import atexit
+    import shutil
 
     from weft.core.geometry import Mask
     from weft.core.image import save_image
 
-    import atexit
-    import shutil
+    from benchmarks.fill import by_name
 
     case = by_name()["fill-object"].build()
     folder = tempfile.mkdtemp(prefix="weft-shot-")  # the image's file, while the window reads it

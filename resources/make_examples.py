@@ -81,9 +81,19 @@ def _resize_area(img: np.ndarray, size: tuple[int, int]) -> np.ndarray:
 # y = slope * x + intercept in the rotated 512x512 image, found by tracking the bright mortar
 # rows. ``_refine_joint`` re-measures each to sub-pixel accuracy.
 _ROUGH_JOINTS = [
-    (-0.169, 88.3), (-0.143, 116.4), (-0.118, 145.2), (-0.094, 172.6), (-0.070, 201.9),
-    (-0.044, 230.3), (-0.024, 262.5), (-0.001, 291.8), (0.026, 320.9), (0.049, 351.1),
-    (0.074, 381.2), (0.100, 411.1), (0.126, 440.5),
+    (-0.169, 88.3),
+    (-0.143, 116.4),
+    (-0.118, 145.2),
+    (-0.094, 172.6),
+    (-0.070, 201.9),
+    (-0.044, 230.3),
+    (-0.024, 262.5),
+    (-0.001, 291.8),
+    (0.026, 320.9),
+    (0.049, 351.1),
+    (0.074, 381.2),
+    (0.100, 411.1),
+    (0.126, 440.5),
 ]
 
 
@@ -124,8 +134,9 @@ def frontal_brick_wall() -> tuple[np.ndarray, list[tuple[float, float]]]:
     fw, fh = FRONTAL_SIZE
     rect = np.float32([[0, 0], [fw - 1, 0], [fw - 1, fh - 1], [0, fh - 1]])
     rectify = cv2.getPerspectiveTransform(quad, rect)
-    wall = cv2.warpPerspective(rot / 255.0, rectify, FRONTAL_SIZE, flags=cv2.INTER_CUBIC,
-                               borderMode=cv2.BORDER_REPLICATE)
+    wall = cv2.warpPerspective(
+        rot / 255.0, rectify, FRONTAL_SIZE, flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
+    )
     rows = []
     for s, c in joints:
         pts = np.float64([[[0, c], [w_in, s * w_in + c]]])

@@ -9,7 +9,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from weft.core.image import load_image, save_image
 
 resource = pytest.importorskip("resource")
@@ -21,8 +20,9 @@ def _weft_under(limit: int, argv: list, cwd: Path) -> subprocess.CompletedProces
     def cap():
         resource.setrlimit(resource.RLIMIT_AS, (limit, resource.RLIM_INFINITY))
 
-    return subprocess.run([*WEFT, *map(str, argv)], cwd=cwd, preexec_fn=cap, capture_output=True, text=True,
-                          timeout=240)
+    return subprocess.run(
+        [*WEFT, *map(str, argv)], cwd=cwd, preexec_fn=cap, capture_output=True, text=True, timeout=240
+    )
 
 
 @pytest.fixture

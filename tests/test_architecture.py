@@ -60,7 +60,7 @@ def _imports(path: Path, package: str) -> set[str]:
             if node.level:
                 base = package.split(".")
                 if node.level > 1:
-                    base = base[:len(base) - node.level + 1]
+                    base = base[: len(base) - node.level + 1]
                 mod = ".".join(base + ([node.module] if node.module else []))
                 if node.module is None:
                     out.update(f"{mod}.{a.name}" for a in node.names)
@@ -109,7 +109,7 @@ def test_no_import_cycle_in_app_and_core():
         stack.append(node)
         for dep in sorted(graph.get(node, ())):
             if state.get(dep) == 1:
-                cycles.append(stack[stack.index(dep):] + [dep])
+                cycles.append(stack[stack.index(dep) :] + [dep])
             elif dep not in state:
                 visit(dep)
         stack.pop()

@@ -15,16 +15,20 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from weft.app import cli
 from weft.core.image import load_image
+
 from tests.data.make_corpus import BROKEN, ODD, make_corpus
 
 ROOT = Path(__file__).resolve().parents[1]
 # A convex quadrilateral's four sides, drawn inside a 40x40 photo, and their frontal square.
-LINES = json.dumps({"image_lines": [[4, 4, 34, 6], [34, 6, 36, 35], [36, 35, 5, 33], [5, 33, 4, 4]],
-                    "frontal_lines": [[0, 0, 31, 0], [31, 0, 31, 31], [31, 31, 0, 31], [0, 31, 0, 0]],
-                    "frontal_size": [32, 32]})
+LINES = json.dumps(
+    {
+        "image_lines": [[4, 4, 34, 6], [34, 6, 36, 35], [36, 35, 5, 33], [5, 33, 4, 4]],
+        "frontal_lines": [[0, 0, 31, 0], [31, 0, 31, 31], [31, 31, 0, 31], [0, 31, 0, 0]],
+        "frontal_size": [32, 32],
+    }
+)
 SUBCOMMANDS = ("quilt", "fast", "affine", "nfpt", "rectify", "blend", "fill")
 
 
@@ -121,20 +125,38 @@ def test_bomb_is_refused_without_decoding(corpus, tmp_path, capsys, monkeypatch)
     assert "megapixels exceeds the limit" in err
 
 
-@pytest.mark.parametrize("method,item", [("quilt", "empty"), ("fast", "truncated_jpeg"), ("blend", "bomb"),
-                                         ("rectify", "directory"), ("nfpt", "text_as_png")])
+@pytest.mark.parametrize(
+    "method,item",
+    [
+        ("quilt", "empty"),
+        ("fast", "truncated_jpeg"),
+        ("blend", "bomb"),
+        ("rectify", "directory"),
+        ("nfpt", "text_as_png"),
+    ],
+)
 def test_real_process_refuses_broken_file(corpus, tmp_path, method, item):
     path = corpus[item]
     out = tmp_path / "out.png"
-    proc = subprocess.run([sys.executable, "-m", "weft.app.cli", *argv(method, str(path), str(out))],
-                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "weft.app.cli", *argv(method, str(path), str(out))],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     check_refusal(proc.stderr, path, proc.returncode, out)
 
 
 def test_real_process_reads_non_ascii_path(corpus, tmp_path):
     out = tmp_path / "sortie ü.png"
-    proc = subprocess.run([sys.executable, "-m", "weft.app.cli", *argv("quilt", str(corpus["non_ascii"]), str(out))],
-                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "weft.app.cli", *argv("quilt", str(corpus["non_ascii"]), str(out))],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr
     assert out.is_file()
 

@@ -23,8 +23,9 @@ from .test_batch import make_frames, scene, slow_scene  # noqa: E402,F401  (fixt
 
 @pytest.fixture(scope="module")
 def cluster():
-    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1, host="127.0.0.1",
-                                  dashboard_address=None, silence_logs=50) as c:
+    with distributed.LocalCluster(
+        processes=True, n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, silence_logs=50
+    ) as c:
         yield c
 
 
@@ -43,8 +44,20 @@ def test_dask_gives_the_local_pools_bytes(scene, cluster, capsys, monkeypatch):
         pids = set(client.run(os.getpid).values())
     assert {int(w.rsplit(":", 1)[1]) for w in workers} <= pids  # run by the cluster's processes
     # Shipped inputs and outputs too (workers that share no folder with the client).
-    assert main([*base, "-o", str(tmp / "shipped" / "{stem}.png"), "--scheduler", cluster.scheduler_address,
-                 "--ship-inputs", "--ship-outputs"]) == 0
+    assert (
+        main(
+            [
+                *base,
+                "-o",
+                str(tmp / "shipped" / "{stem}.png"),
+                "--scheduler",
+                cluster.scheduler_address,
+                "--ship-inputs",
+                "--ship-outputs",
+            ]
+        )
+        == 0
+    )
     for f in frames:
         local = (tmp / "local" / f.name).read_bytes()
         assert (tmp / "dask" / f.name).read_bytes() == local
@@ -54,8 +67,19 @@ def test_dask_gives_the_local_pools_bytes(scene, cluster, capsys, monkeypatch):
 def test_a_bad_frame_fails_alone_on_dask(scene, cluster, capsys):
     tmp, frames = scene
     frames[0].write_bytes(frames[0].read_bytes()[:100])
-    code = main(["batch", str(tmp / "look.json"), "--over", "target", str(tmp / "frames"), "-o",
-                 str(tmp / "o" / "{stem}.png"), "--scheduler", cluster.scheduler_address])
+    code = main(
+        [
+            "batch",
+            str(tmp / "look.json"),
+            "--over",
+            "target",
+            str(tmp / "frames"),
+            "-o",
+            str(tmp / "o" / "{stem}.png"),
+            "--scheduler",
+            cluster.scheduler_address,
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 1
     assert err.strip().splitlines()[-1].startswith("4 written, 1 failed: frame_1.png: truncated or corrupt PNG data")
@@ -63,16 +87,40 @@ def test_a_bad_frame_fails_alone_on_dask(scene, cluster, capsys):
 
 def test_workers_without_scheduler_is_a_usage_error(scene, capsys):
     tmp, _ = scene
-    code = main(["batch", str(tmp / "look.json"), "--over", "target", str(tmp / "frames"), "-o",
-                 str(tmp / "o" / "{stem}.png"), "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"])
+    code = main(
+        [
+            "batch",
+            str(tmp / "look.json"),
+            "--over",
+            "target",
+            str(tmp / "frames"),
+            "-o",
+            str(tmp / "o" / "{stem}.png"),
+            "--scheduler",
+            "tcp://127.0.0.1:1",
+            "--workers",
+            "2",
+        ]
+    )
     assert code == 2 and "--workers sets local processes" in capsys.readouterr().err
 
 
 def test_an_unreachable_scheduler_is_one_line(scene, capsys, monkeypatch):
     tmp, _ = scene
     monkeypatch.setattr("weft.core.batch.execute.CONNECT_TIMEOUT", "1s")
-    code = main(["batch", str(tmp / "look.json"), "--over", "target", str(tmp / "frames"), "-o",
-                 str(tmp / "o" / "{stem}.png"), "--scheduler", "tcp://127.0.0.1:9"])
+    code = main(
+        [
+            "batch",
+            str(tmp / "look.json"),
+            "--over",
+            "target",
+            str(tmp / "frames"),
+            "-o",
+            str(tmp / "o" / "{stem}.png"),
+            "--scheduler",
+            "tcp://127.0.0.1:9",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 2 and err.startswith("weft: cannot reach the Dask scheduler at tcp://127.0.0.1:9")
     assert len(err.strip().splitlines()) == 1
@@ -96,8 +144,9 @@ def test_a_worker_killed_mid_batch_loses_no_item(slow_scene, cluster, client):
         resume.wait(60)
 
     box = {}
-    thread = threading.Thread(target=lambda: box.update(summary=batch.run(
-        p, scheduler=cluster.scheduler_address, on_outcome=on_outcome)))
+    thread = threading.Thread(
+        target=lambda: box.update(summary=batch.run(p, scheduler=cluster.scheduler_address, on_outcome=on_outcome))
+    )
     thread.start()
     try:
         assert first_done.wait(120)
@@ -125,7 +174,12 @@ def test_a_worker_killed_mid_batch_loses_no_item(slow_scene, cluster, client):
         assert load_image(out).image.shape[:2] == (96, 96)
         assert json.loads(read_recipe(out))["inputs"]["target"] == f"../frames/{f.name}"
     # Identical to the local pool's outputs.
-    assert batch.run(batch.plan(str(tmp / "look.json"), [("target", str(tmp / "frames"))],
-                                str(tmp / "ref" / "{stem}.png")), workers=1).written == 8
+    assert (
+        batch.run(
+            batch.plan(str(tmp / "look.json"), [("target", str(tmp / "frames"))], str(tmp / "ref" / "{stem}.png")),
+            workers=1,
+        ).written
+        == 8
+    )
     for f in frames:
         assert (tmp / "o" / f.name).read_bytes() == (tmp / "ref" / f.name).read_bytes()

@@ -35,8 +35,20 @@ def _run(argv, capfd):
 @pytest.mark.parametrize("address", ["tls://127.0.0.1:1", "ucx://127.0.0.1:1"])
 def test_an_address_weft_cannot_use_is_one_line(scene, capfd, address):
     tmp, _ = scene
-    code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
-                           tmp / "o" / "{stem}.png", "--scheduler", address], capfd)
+    code, out, err = _run(
+        [
+            "batch",
+            tmp / "look.json",
+            "--over",
+            "target",
+            tmp / "frames",
+            "-o",
+            tmp / "o" / "{stem}.png",
+            "--scheduler",
+            address,
+        ],
+        capfd,
+    )
     assert code == 2 and err.count("\n") == 1 and err.startswith(f"weft: cannot reach the Dask scheduler at {address} ")
     assert "internal error" not in err
 
@@ -48,8 +60,9 @@ def _free_port() -> int:
 
 
 def _start(args: list[str], tmp: Path) -> subprocess.Popen:
-    return subprocess.Popen([str(DASK), *args], cwd=tmp, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                            start_new_session=True)
+    return subprocess.Popen(
+        [str(DASK), *args], cwd=tmp, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
 
 
 def _wait_for_scheduler(address: str) -> None:
@@ -69,8 +82,9 @@ def _cluster(tmp: Path, workers: int):
     """A local Dask scheduler (and ``workers`` worker processes of one thread each), killed on the
     way out: ``(address, scheduler process, worker process or None)``."""
     address = f"tcp://127.0.0.1:{_free_port()}"
-    scheduler = _start(["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                        "--dashboard-address", ":0"], tmp)
+    scheduler = _start(
+        ["scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1], "--dashboard-address", ":0"], tmp
+    )
     worker = None
     try:
         _wait_for_scheduler(address)
@@ -87,6 +101,7 @@ def _cluster(tmp: Path, workers: int):
 
 def _kill_when_one_is_written(out_dir: Path, process: subprocess.Popen) -> threading.Thread:
     """A thread that kills ``process`` once the batch has written its first output."""
+
     def kill():
         deadline = time.monotonic() + 240
         while time.monotonic() < deadline and not (out_dir.is_dir() and any(out_dir.glob("*.png"))):
@@ -104,10 +119,24 @@ def test_a_scheduler_without_workers_is_a_time_limit_not_a_silent_wait(scene, ca
     tmp, _ = scene
     with _cluster(tmp_path, workers=0) as (address, _scheduler, _worker):
         monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)
-        code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
-                               tmp / "o" / "{stem}.png", "--scheduler", address], capfd)
-        assert code == 2 and err == (f"weft: the Dask scheduler at {address} has no workers (waited 2 s; set "
-                                     "WEFT_DASK_WORKER_TIMEOUT to wait longer)\n")
+        code, out, err = _run(
+            [
+                "batch",
+                tmp / "look.json",
+                "--over",
+                "target",
+                tmp / "frames",
+                "-o",
+                tmp / "o" / "{stem}.png",
+                "--scheduler",
+                address,
+            ],
+            capfd,
+        )
+        assert code == 2 and err == (
+            f"weft: the Dask scheduler at {address} has no workers (waited 2 s; set "
+            "WEFT_DASK_WORKER_TIMEOUT to wait longer)\n"
+        )
 
 
 @pytest.mark.slow
@@ -117,8 +146,21 @@ def test_a_scheduler_killed_mid_batch_ends_with_the_summary(slow_scene, capfd, t
     with _cluster(tmp_path, workers=1) as (address, scheduler, _worker):
         out_dir = tmp / "killed"
         killer = _kill_when_one_is_written(out_dir, scheduler)
-        code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
-                               out_dir / "{stem}.png", "--scheduler", address, "-q"], capfd)
+        code, out, err = _run(
+            [
+                "batch",
+                tmp / "look.json",
+                "--over",
+                "target",
+                tmp / "frames",
+                "-o",
+                out_dir / "{stem}.png",
+                "--scheduler",
+                address,
+                "-q",
+            ],
+            capfd,
+        )
         killer.join()
         lines = err.strip().splitlines()
         assert code == 1 and "Traceback" not in err and "internal error" not in err, err
@@ -133,8 +175,21 @@ def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_sce
         monkeypatch.setattr(execute, "WORKER_TIMEOUT", 3.0)
         out_dir = tmp / "orphaned"
         killer = _kill_when_one_is_written(out_dir, worker)
-        code, out, err = _run(["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o",
-                               out_dir / "{stem}.png", "--scheduler", address, "-q"], capfd)
+        code, out, err = _run(
+            [
+                "batch",
+                tmp / "look.json",
+                "--over",
+                "target",
+                tmp / "frames",
+                "-o",
+                out_dir / "{stem}.png",
+                "--scheduler",
+                address,
+                "-q",
+            ],
+            capfd,
+        )
         killer.join()
         lines = err.strip().splitlines()
         assert code == 1 and "Traceback" not in err, err

@@ -13,7 +13,6 @@ import time
 from pathlib import Path
 
 import pytest
-
 from weft.core.image import load_image, save_image
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,13 +47,26 @@ def test_ctrl_c_as_workers_start_is_one_line(tmp_path, workers_seen):
     photo = load_image(ROOT / "resources" / "astronaut.png").image
     (tmp_path / "frames").mkdir()
     for i in range(6):
-        save_image(tmp_path / "frames" / f"f{i}.png", photo[:64, 2 * i:2 * i + 64])
+        save_image(tmp_path / "frames" / f"f{i}.png", photo[:64, 2 * i : 2 * i + 64])
     save_image(tmp_path / "gravel.png", load_image(ROOT / "resources" / "gravel.png").image[:64, :64])
-    (tmp_path / "look.json").write_text(json.dumps({"weft": 1, "method": "fast", "params": {"n": 5}, "inputs": {
-        "texture": "gravel.png", "target": "frames/f0.png"}, "seed": 1}))
-    batch = subprocess.Popen([*WEFT, "batch", "look.json", "--over", "target", "frames", "-o", "out/{stem}.png",
-                              "--workers", "2", "-q"], cwd=tmp_path, stderr=subprocess.PIPE, text=True,
-                             start_new_session=True)
+    (tmp_path / "look.json").write_text(
+        json.dumps(
+            {
+                "weft": 1,
+                "method": "fast",
+                "params": {"n": 5},
+                "inputs": {"texture": "gravel.png", "target": "frames/f0.png"},
+                "seed": 1,
+            }
+        )
+    )
+    batch = subprocess.Popen(
+        [*WEFT, "batch", "look.json", "--over", "target", "frames", "-o", "out/{stem}.png", "--workers", "2", "-q"],
+        cwd=tmp_path,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 120
     while len(_group_workers(batch.pid)) < workers_seen and batch.poll() is None and time.monotonic() < deadline:
         time.sleep(0.005)

@@ -28,8 +28,13 @@ def test_prepare_inputs_crops_resizes_and_greys():
 
 def test_run_case_row_and_table(monkeypatch):
     monkeypatch.setattr("shutil.which", lambda name: None)  # no G'MIC here: those columns stay out
-    case = Case("tiny", "quilt", {"texture": Input("brick", crop=(0, 0, 64, 64))},
-                {"block": 16, "size": (64, 64)}, metrics=("coherence", "completeness"))
+    case = Case(
+        "tiny",
+        "quilt",
+        {"texture": Input("brick", crop=(0, 0, 64, 64))},
+        {"block": 16, "size": (64, 64)},
+        metrics=("coherence", "completeness"),
+    )
     row = run_case(case, repeats=2)
     assert row["case"] == "tiny" and row["size"] == [64, 64] and row["runs"] == 2
     assert 0 < row["min_s"] <= row["median_s"]
@@ -64,15 +69,31 @@ def test_cold_runs_a_command_with_stderr_on_a_terminal_and_tables_the_rows(tmp_p
     assert 0 < r["first_words"] <= r["seconds"] and r["silent"] <= r["seconds"]
     with pytest.raises(RuntimeError, match="exited 3"):
         cold.timed_run([sys.executable, "-c", "raise SystemExit(3)"], str(tmp_path / "cache"))
-    row = {"command": "fast --target", "runs": 3, "cold_s": 2.5, "warm_s": 0.8, "ratio": 3.12, "cold_silent_s": 1.3,
-           "cold_first_words_s": 0.6, "cold_range": [2.4, 2.7], "warm_range": [0.8, 0.9]}
+    row = {
+        "command": "fast --target",
+        "runs": 3,
+        "cold_s": 2.5,
+        "warm_s": 0.8,
+        "ratio": 3.12,
+        "cold_silent_s": 1.3,
+        "cold_first_words_s": 0.6,
+        "cold_range": [2.4, 2.7],
+        "warm_range": [0.8, 0.9],
+    }
     table = cold.markdown_table([row])
     assert table.splitlines()[2] == "| fast --target | 2.5 (2.4–2.7) | 0.8 (0.8–0.9) | 3.1x | 0.6 s | 1.3 s |"
-    assert set(cold.commands(tmp_path)) >= {"studio", "quilt --target, 3 passes", "nfpt 1024x768", "affine",
-                                              "fast --target", "warm-up (all methods)"}
+    assert set(cold.commands(tmp_path)) >= {
+        "studio",
+        "quilt --target, 3 passes",
+        "nfpt 1024x768",
+        "affine",
+        "fast --target",
+        "warm-up (all methods)",
+    }
 
 
 # --- fill and extend (issue 15): benchmarks/fill.py and its peer runner --------------------------------------
+
 
 def _tiny_fill_case():
     import numpy as np
@@ -186,8 +207,10 @@ def test_fill_goals_compare_weft_with_the_peers_and_the_truth():
     from benchmarks import fill
 
     case = fill.by_name()["fill-gravel"]
-    peers = [{"tool": fill.GMIC, "coherence": 10.0, "process_s": 1.0},
-             {"tool": fill.SHIFTMAP, "coherence": 8.0, "process_s": 1.2}]
+    peers = [
+        {"tool": fill.GMIC, "coherence": 10.0, "process_s": 1.0},
+        {"tool": fill.SHIFTMAP, "coherence": 8.0, "process_s": 1.2},
+    ]
     truth = {"detail": 1.0, "seam": 1.0}
     good = {"tool": "weft", "coherence": 9.0, "detail": 1.1, "seam": 0.9, "known_max": 0, "process_s": 0.8}
     assert fill.goals(good, peers + [good], truth, case) == "coherence yes, detail yes, seam yes, known yes, time yes"
@@ -223,8 +246,10 @@ def test_command_line_selects_fill_cases_by_pattern(capsys):
     assert "no tool matches nobody" in capsys.readouterr().err
 
 
-@pytest.mark.skipif("fill" not in __import__("weft.core.registry", fromlist=["names"]).names(),
-                    reason="the fill method is not registered in this checkout")
+@pytest.mark.skipif(
+    "fill" not in __import__("weft.core.registry", fromlist=["names"]).names(),
+    reason="the fill method is not registered in this checkout",
+)
 def test_fill_weft_rows_run_the_command_line_on_a_hole_and_an_uncrop():
     import numpy as np
 
@@ -233,8 +258,11 @@ def test_fill_weft_rows_run_the_command_line_on_a_hole_and_an_uncrop():
     hole_case = _tiny_fill_case()
     rows = fill.run_fill_case(hole_case, repeats=1, quick=True, tools=fill.tools_named(["weft"]))
     weft_rows = [r for r in rows if r["tool"].startswith("weft")]
-    assert [r["tool"] for r in weft_rows] == ["weft", *(f"weft --engine {e}" for e in fill.WEFT_ENGINES),
-                                              "weft --engine patchmatch --structure no"]
+    assert [r["tool"] for r in weft_rows] == [
+        "weft",
+        *(f"weft --engine {e}" for e in fill.WEFT_ENGINES),
+        "weft --engine patchmatch --structure no",
+    ]
     for row in weft_rows:
         assert "error" not in row, row
         assert row["known_max"] == 0 and row["reach_px"] <= fill.BAND and row["unfilled"] < 0.05
@@ -257,9 +285,10 @@ def test_fill_weft_rows_run_the_command_line_on_a_hole_and_an_uncrop():
 def test_quilt_samples_tables_old_and_new_defaults(capsys):
     """``python -m benchmarks.quilt_samples``: one row per sample with the resolved default block and
     each figure old -> new; the new figures are the defaults' own."""
-    from benchmarks import quilt_samples
     from weft.core.metrics import coherence
     from weft.core.quilting import METHOD, QuiltParams
+
+    from benchmarks import quilt_samples
 
     assert quilt_samples.main(["--seeds", "1", "--samples", "cat-fur"]) == 0
     row = capsys.readouterr().out.strip().splitlines()[-1]

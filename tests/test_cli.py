@@ -6,7 +6,6 @@ import sys
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.image import load_image, read_recipe, save_image
 
@@ -28,8 +27,24 @@ def run(argv, capsys):
 
 def test_quilt_writes_image_and_report(texture_path, tmp_path, capsys):
     out_path = tmp_path / "out.png"
-    code, out, err = run(["quilt", texture_path, "-o", out_path, "--size", "64x50", "--block", "16",
-                          "--mode", "random", "--seed", "3", "--report"], capsys)
+    code, out, err = run(
+        [
+            "quilt",
+            texture_path,
+            "-o",
+            out_path,
+            "--size",
+            "64x50",
+            "--block",
+            "16",
+            "--mode",
+            "random",
+            "--seed",
+            "3",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert err == ""  # not a terminal: no progress bar
     lines = out.strip().splitlines()
@@ -162,8 +177,9 @@ def test_real_process_prints_one_line_and_no_traceback(tmp_path, texture_path, k
     if kind == "truncated":
         bad.write_bytes(texture_path.read_bytes()[:600])
     out_path = tmp_path / "out.png"
-    proc = subprocess.run([sys.executable, "-m", "weft.app.cli", "quilt", str(bad), "-o", str(out_path)],
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "weft.app.cli", "quilt", str(bad), "-o", str(out_path)], capture_output=True, text=True
+    )
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr and "input.png" in proc.stderr
     assert not out_path.exists()
@@ -171,8 +187,10 @@ def test_real_process_prints_one_line_and_no_traceback(tmp_path, texture_path, k
 
 def test_region_restricts_the_source_and_is_recorded(texture_path, tmp_path, capsys):
     out = tmp_path / "r.png"
-    code, _, err = run(["quilt", texture_path, "-o", out, "--region", "4,8,24", "--block", "8", "--mode", "random",
-                        "--seed", "1"], capsys)
+    code, _, err = run(
+        ["quilt", texture_path, "-o", out, "--region", "4,8,24", "--block", "8", "--mode", "random", "--seed", "1"],
+        capsys,
+    )
     assert code == 0, err
     recipe = json.loads(read_recipe(out))
     assert recipe["region"] == [4, 8, 24]

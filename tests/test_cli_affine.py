@@ -4,11 +4,11 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
-from benchmarks.fixtures.procedural import cells
 from weft.core.examples import example
 from weft.core.image import load_image, read_recipe, save_image
+
+from benchmarks.fixtures.procedural import cells
 
 
 def run(argv, capsys):
@@ -42,8 +42,10 @@ def test_synthesis_reports_snr_and_reproduces_from_its_recipe(tmp_path, capsys, 
 
 def test_shaker_box_reports_iterations_and_errors(tmp_path, capsys):
     out = tmp_path / "shaker.png"
-    code, stdout, err = run(["affine", example("brick"), "-o", out, "--boundary", "shaker", "--block", "16",
-                             "--seed", "2", "--report"], capsys)
+    code, stdout, err = run(
+        ["affine", example("brick"), "-o", out, "--boundary", "shaker", "--block", "16", "--seed", "2", "--report"],
+        capsys,
+    )
     assert code == 0, err
     report = json.loads(stdout)
     errs = report["boundary_error"]
@@ -54,17 +56,50 @@ def test_shaker_box_reports_iterations_and_errors(tmp_path, capsys):
 
 def test_transfer_with_a_prototype_from_another_picture(tmp_path, capsys, scales_png):
     out = tmp_path / "transfer.png"
-    code, stdout, err = run(["affine", example("chelsea"), "--prototype-image", scales_png, "--prototype", "20,30,64",
-                             "--boundary", "partial", "-o", out, "--seed", "1", "--report"], capsys)
+    code, stdout, err = run(
+        [
+            "affine",
+            example("chelsea"),
+            "--prototype-image",
+            scales_png,
+            "--prototype",
+            "20,30,64",
+            "--boundary",
+            "partial",
+            "-o",
+            out,
+            "--seed",
+            "1",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     report = json.loads(stdout)
     assert report["prototype"] == [20, 30, 64] and report["boundary"] == "partial"
     assert load_image(out).image.shape == (200, 300, 3)
     # re-render the texture's own transforms with the swapped prototype (absorb: its colour)
     out2 = tmp_path / "swap.png"
-    code, stdout, err = run(["affine", scales_png, "--prototype-image", example("cat-fur"), "--prototype", "0,0,64",
-                             "--reuse-transforms", "true", "--lowpass", "absorb", "-o", out2, "--seed", "1",
-                             "--report"], capsys)
+    code, stdout, err = run(
+        [
+            "affine",
+            scales_png,
+            "--prototype-image",
+            example("cat-fur"),
+            "--prototype",
+            "0,0,64",
+            "--reuse-transforms",
+            "true",
+            "--lowpass",
+            "absorb",
+            "-o",
+            out2,
+            "--seed",
+            "1",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     report = json.loads(stdout)
     assert report["analysis_prototype"] == [48, 48, 64]
@@ -73,8 +108,9 @@ def test_transfer_with_a_prototype_from_another_picture(tmp_path, capsys, scales
 
 def test_parametric_field(tmp_path, capsys, scales_png):
     out = tmp_path / "field.png"
-    code, stdout, err = run(["affine", scales_png, "--field", "swirl", "--size", "96x64", "-o", out, "--seed", "3",
-                             "--report"], capsys)
+    code, stdout, err = run(
+        ["affine", scales_png, "--field", "swirl", "--size", "96x64", "-o", out, "--seed", "3", "--report"], capsys
+    )
     assert code == 0, err
     report = json.loads(stdout)
     assert report["boundary"] == "shaker" and "snr_db" not in report  # another size: nothing to compare

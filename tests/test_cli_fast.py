@@ -4,7 +4,6 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.examples import example
 from weft.core.image import load_image, read_recipe
@@ -18,8 +17,24 @@ def run(argv, capsys):
 
 def test_transfer_with_report_and_recipe(tmp_path, capsys):
     out = tmp_path / "out.png"
-    code, stdout, err = run(["fast", example("gravel"), "--target", example("camera"), "-o", out,
-                             "--metric", "target", "--p", "0.1", "--seed", "4", "--report"], capsys)
+    code, stdout, err = run(
+        [
+            "fast",
+            example("gravel"),
+            "--target",
+            example("camera"),
+            "-o",
+            out,
+            "--metric",
+            "target",
+            "--p",
+            "0.1",
+            "--seed",
+            "4",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     report = json.loads(stdout)
     assert report["method"] == "fast" and report["size"] == [256, 256]
@@ -40,8 +55,24 @@ def test_super_resolution_and_novel_style(tmp_path, capsys):
     assert report["mode"] == "superres" and report["p"] == 0.0 and report["p_l"] == 0.03
     assert load_image(sr).image.shape == (512, 512)
     nv = tmp_path / "novel.png"
-    code, stdout, err = run(["fast", example("chelsea"), "--mode", "novel", "--magnify", "2", "--p", "0.2",
-                             "-o", nv, "--seed", "1", "--report"], capsys)
+    code, stdout, err = run(
+        [
+            "fast",
+            example("chelsea"),
+            "--mode",
+            "novel",
+            "--magnify",
+            "2",
+            "--p",
+            "0.2",
+            "-o",
+            nv,
+            "--seed",
+            "1",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert load_image(nv).image.shape == (400, 600, 3)
 
@@ -54,7 +85,9 @@ def test_synthesis_with_size_and_mask(tmp_path, capsys):
     mpath = tmp_path / "mask.png"
     save_image(mpath, mask)
     out = tmp_path / "syn.png"
-    code, _, err = run(["fast", example("cat-fur"), "--mask", mpath, "--size", "96x64", "-o", out, "--seed", "2"], capsys)
+    code, _, err = run(
+        ["fast", example("cat-fur"), "--mask", mpath, "--size", "96x64", "-o", out, "--seed", "2"], capsys
+    )
     assert code == 0, err
     assert load_image(out).image.shape == (64, 96, 3)
 

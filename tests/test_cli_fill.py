@@ -6,7 +6,6 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.examples import example
 from weft.core.fill.band import band_region
@@ -60,8 +59,9 @@ def _untouched(out, image, hole, band=2):
 def test_fill_a_mask(files, tmp_path, capsys, which):
     paths, hole = files
     out_path = tmp_path / "out.png"
-    code, out, err = run(["fill", paths[which], "--mask", paths["mask"], "-o", out_path, "--seed", "3", "--report",
-                          "-q"], capsys)
+    code, out, err = run(
+        ["fill", paths[which], "--mask", paths["mask"], "-o", out_path, "--seed", "3", "--report", "-q"], capsys
+    )
     assert code == 0, err
     line = json.loads(out)
     assert line["hole_pixels"] == int(hole.sum()) and line["size"] == [72, 72]
@@ -94,8 +94,25 @@ def test_rgba_transparent_region_is_the_hole(files, tmp_path, capsys):
 def test_extend_uncrops(files, tmp_path, capsys, engine):
     paths, _ = files
     out_path = tmp_path / "out.png"
-    code, out, err = run(["fill", paths["colour"], "--extend", "8,0,24,4", "--engine", engine, "--patch", "9",
-                          "-o", out_path, "--seed", "2", "--report", "-q"], capsys)
+    code, out, err = run(
+        [
+            "fill",
+            paths["colour"],
+            "--extend",
+            "8,0,24,4",
+            "--engine",
+            engine,
+            "--patch",
+            "9",
+            "-o",
+            out_path,
+            "--seed",
+            "2",
+            "--report",
+            "-q",
+        ],
+        capsys,
+    )
     assert code == 0, err
     line = json.loads(out)
     assert line["size"] == [104, 76] and line["hole_pixels"] == 104 * 76 - 72 * 72 and line["extend"] == [8, 0, 24, 4]
@@ -107,8 +124,24 @@ def test_extend_uncrops(files, tmp_path, capsys, engine):
 def test_size_and_anchor(files, tmp_path, capsys):
     paths, _ = files
     out_path = tmp_path / "out.png"
-    code, _, err = run(["fill", paths["grey"], "--size", "100x80", "--anchor", "top-left", "--band", "0",
-                        "-o", out_path, "--seed", "2", "-q"], capsys)
+    code, _, err = run(
+        [
+            "fill",
+            paths["grey"],
+            "--size",
+            "100x80",
+            "--anchor",
+            "top-left",
+            "--band",
+            "0",
+            "-o",
+            out_path,
+            "--seed",
+            "2",
+            "-q",
+        ],
+        capsys,
+    )
     assert code == 0, err
     result, image = load_image(out_path).image, load_image(paths["grey"]).image
     assert result.shape == (80, 100) and np.array_equal(result[:72, :72], image)
@@ -117,18 +150,53 @@ def test_size_and_anchor(files, tmp_path, capsys):
 def test_source_mask_and_texture(files, tmp_path, capsys):
     paths, hole = files
     out_path = tmp_path / "out.png"
-    code, _, err = run(["fill", paths["grey"], "--mask", paths["mask"], "--source-mask", paths["source"],
-                        "-o", out_path, "--seed", "2", "-q", "--patch", "12"], capsys)
+    code, _, err = run(
+        [
+            "fill",
+            paths["grey"],
+            "--mask",
+            paths["mask"],
+            "--source-mask",
+            paths["source"],
+            "-o",
+            out_path,
+            "--seed",
+            "2",
+            "-q",
+            "--patch",
+            "12",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert _untouched(load_image(out_path).image, load_image(paths["grey"]).image, hole)
     out2 = tmp_path / "out2.png"
-    code, _, err = run(["fill", paths["grey"], "--mask", paths["mask"], "--texture", paths["texture"],
-                        "-o", out2, "--seed", "2", "-q", "--band", "0"], capsys)
+    code, _, err = run(
+        [
+            "fill",
+            paths["grey"],
+            "--mask",
+            paths["mask"],
+            "--texture",
+            paths["texture"],
+            "-o",
+            out2,
+            "--seed",
+            "2",
+            "-q",
+            "--band",
+            "0",
+        ],
+        capsys,
+    )
     assert code == 0, err
     result = load_image(out2).image
     brick = load_image(paths["texture"]).image
     # the hole now holds brick: its values are the brick's (dark bricks, light mortar), not gravel's
-    assert abs(result[hole].mean() - brick.mean()) < abs(result[hole].mean() - load_image(paths["grey"]).image.mean()) + 0.02
+    assert (
+        abs(result[hole].mean() - brick.mean())
+        < abs(result[hole].mean() - load_image(paths["grey"]).image.mean()) + 0.02
+    )
     assert np.array_equal(result[~hole], load_image(paths["grey"]).image[~hole])
 
 
@@ -148,40 +216,100 @@ def test_bad_inputs(files, tmp_path, capsys):
     o = tmp_path / "out.png"
     base = ["-o", o, "-q", "--seed", "1"]
     # mask size differs from the image
-    _refused(capsys, ["fill", paths["grey"], "--mask", paths["small"], *base], o,
-             "small.png", "the mask is 50x40 but the image is 72x72")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--mask", paths["small"], *base],
+        o,
+        "small.png",
+        "the mask is 50x40 but the image is 72x72",
+    )
     # empty mask: nothing to fill, nothing written, exit 2
-    _refused(capsys, ["fill", paths["grey"], "--mask", paths["black"], *base], o,
-             "black.png", "nothing to fill: the mask has no white pixel")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--mask", paths["black"], *base],
+        o,
+        "black.png",
+        "nothing to fill: the mask has no white pixel",
+    )
     # mask covering everything
-    _refused(capsys, ["fill", paths["grey"], "--mask", paths["white"], *base], o,
-             "white.png", "covers the whole image: nothing is left to copy from", "whole 24x24 patch")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--mask", paths["white"], *base],
+        o,
+        "white.png",
+        "covers the whole image: nothing is left to copy from",
+        "whole 24x24 patch",
+    )
     # too little to copy from for the patch size given (the hole leaves a 72x8 strip; with no --patch
     # the default block shrinks to the 8x8 the strip holds)
     strip = np.ones((72, 72), np.float32)
     strip[:8] = 0
     save_image(tmp_path / "strip.png", strip)
-    _refused(capsys, ["fill", paths["grey"], "--mask", tmp_path / "strip.png", "--patch", "24", *base], o,
-             "grey.png", "needs at least one whole 24x24 patch of known pixels", "largest is 8x8")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--mask", tmp_path / "strip.png", "--patch", "24", *base],
+        o,
+        "grey.png",
+        "needs at least one whole 24x24 patch of known pixels",
+        "largest is 8x8",
+    )
     # a patch larger than the image allows
-    _refused(capsys, ["fill", paths["grey"], "--mask", paths["mask"], "--patch", "100", *base], o,
-             "grey.png", "parameter 'patch' = 100 is outside 3..72 (the image is 72x72)")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--mask", paths["mask"], "--patch", "100", *base],
+        o,
+        "grey.png",
+        "parameter 'patch' = 100 is outside 3..72 (the image is 72x72)",
+    )
     # extend negative, malformed or beyond the pixel limit
-    _refused(capsys, ["fill", paths["grey"], "--extend", "0,-4,0,0", *base], o,
-             "parameter 'extend'", "the top margin -4 is outside")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--extend", "0,-4,0,0", *base],
+        o,
+        "parameter 'extend'",
+        "the top margin -4 is outside",
+    )
     _refused(capsys, ["fill", paths["grey"], "--extend", "1,2,3", *base], o, "parameter 'extend'", "L,T,R,B")
-    _refused(capsys, ["fill", paths["grey"], "--extend", "0,0,16000,16000", *base], o,
-             "parameter 'extend'", "exceeds the limit of", "megapixels")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--extend", "0,0,16000,16000", *base],
+        o,
+        "parameter 'extend'",
+        "exceeds the limit of",
+        "megapixels",
+    )
     # --size smaller than the image
-    _refused(capsys, ["fill", paths["grey"], "--size", "64x64", *base], o,
-             "parameter 'size' = 64x64 is smaller than the 72x72 image")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], "--size", "64x64", *base],
+        o,
+        "parameter 'size' = 64x64 is smaller than the 72x72 image",
+    )
     # --texture with a --source-mask of the wrong size (it must be the texture's)
-    _refused(capsys, ["fill", paths["grey"], "--mask", paths["mask"], "--texture", paths["texture"],
-                      "--source-mask", paths["source"], *base], o,
-             "source.png", "the source mask is 72x72 but the texture is 60x60")
+    _refused(
+        capsys,
+        [
+            "fill",
+            paths["grey"],
+            "--mask",
+            paths["mask"],
+            "--texture",
+            paths["texture"],
+            "--source-mask",
+            paths["source"],
+            *base,
+        ],
+        o,
+        "source.png",
+        "the source mask is 72x72 but the texture is 60x60",
+    )
     # no mask, no alpha, no extend
-    _refused(capsys, ["fill", paths["grey"], *base], o,
-             "nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size")
+    _refused(
+        capsys,
+        ["fill", paths["grey"], *base],
+        o,
+        "nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size",
+    )
 
 
 def test_a_mask_painted_on_a_transparent_layer_is_read_with_its_alpha(tmp_path):
@@ -196,8 +324,10 @@ def test_a_mask_painted_on_a_transparent_layer_is_read_with_its_alpha(tmp_path):
     layer[20:30, 20:40, 3] = 255
     Image.fromarray(layer, "RGBA").save(tmp_path / "mask.png")
     out = tmp_path / "out.png"
-    assert main(["fill", str(tmp_path / "img.png"), "--mask", str(tmp_path / "mask.png"), "--band", "0",
-                 "-o", str(out)]) == 0
+    assert (
+        main(["fill", str(tmp_path / "img.png"), "--mask", str(tmp_path / "mask.png"), "--band", "0", "-o", str(out)])
+        == 0
+    )
     res = np.asarray(Image.open(out))
     keep = np.ones((64, 64), bool)
     keep[20:30, 20:40] = False
@@ -217,8 +347,13 @@ def test_fill_takes_no_region(files, tmp_path, capsys):
     from weft.core.run import render
 
     with pytest.raises(WeftError, match="weft fill takes no --region"):
-        render(registry.get("fill"), FillParams(), {"image": str(paths["grey"]), "mask": str(paths["mask"])}, 1,
-               region=(0, 0, 40))
+        render(
+            registry.get("fill"),
+            FillParams(),
+            {"image": str(paths["grey"]), "mask": str(paths["mask"])},
+            1,
+            region=(0, 0, 40),
+        )
 
 
 def test_a_photo_given_as_the_mask_is_refused(files, tmp_path, capsys):
@@ -228,10 +363,21 @@ def test_a_photo_given_as_the_mask_is_refused(files, tmp_path, capsys):
 
     paths, hole = files
     o = tmp_path / "out.png"
-    _refused(capsys, ["fill", paths["colour"], "--mask", paths["colour"], "-o", o, "-q"], o,
-             "colour.png", "the mask is not black and white", "% of its pixels are grey or coloured")
-    _refused(capsys, ["fill", paths["colour"], "--mask", paths["mask"], "--source-mask", paths["grey"], "-o", o, "-q"],
-             o, "grey.png", "the source mask is not black and white")
+    _refused(
+        capsys,
+        ["fill", paths["colour"], "--mask", paths["colour"], "-o", o, "-q"],
+        o,
+        "colour.png",
+        "the mask is not black and white",
+        "% of its pixels are grey or coloured",
+    )
+    _refused(
+        capsys,
+        ["fill", paths["colour"], "--mask", paths["mask"], "--source-mask", paths["grey"], "-o", o, "-q"],
+        o,
+        "grey.png",
+        "the source mask is not black and white",
+    )
     soft = cv2.GaussianBlur(hole.astype(np.float32), (9, 9), 2.0)
     assert ((soft > 0.1) & (soft < 0.9)).any()
     save_image(tmp_path / "soft.png", soft)

@@ -12,7 +12,6 @@ import threading
 
 import numpy as np
 import pytest
-
 import weft.core._kernels  # noqa: F401  (the compile-event listener)
 from weft.app import cli
 from weft.app.cli import main
@@ -170,7 +169,11 @@ def test_warm_up_command_for_real_in_processes(tmp_path):
     import sys
 
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    cmd = [sys.executable, "-c", "import sys; from weft.app.cli import main; sys.exit(main(['warm-up', 'blend', 'rectify', '--jobs', '2']))"]
+    cmd = [
+        sys.executable,
+        "-c",
+        "import sys; from weft.app.cli import main; sys.exit(main(['warm-up', 'blend', 'rectify', '--jobs', '2']))",
+    ]
     first = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
     assert first.returncode == 0, first.stderr
     lines = first.stdout.splitlines()

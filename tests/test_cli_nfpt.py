@@ -1,12 +1,10 @@
 """`weft rectify` and `weft nfpt` as a user runs them: outputs, reports, recipes, bad input."""
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.examples import example
 from weft.core.image import load_image, read_recipe
@@ -38,8 +36,26 @@ def test_rectify_writes_the_frontal_image_and_reports_the_homography(tmp_path, c
 
 def test_nfpt_synthesizes_reprojects_and_reproduces_its_recipe(tmp_path, capsys):
     out = tmp_path / "wall.png"
-    code, stdout, err = run(["nfpt", PHOTO, "--lines", LINES, "--size", "160x128", "--block", "32", "--overlap", "8",
-                             "-o", out, "--seed", "3", "--report"], capsys)
+    code, stdout, err = run(
+        [
+            "nfpt",
+            PHOTO,
+            "--lines",
+            LINES,
+            "--size",
+            "160x128",
+            "--block",
+            "32",
+            "--overlap",
+            "8",
+            "-o",
+            out,
+            "--seed",
+            "3",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     report = json.loads(stdout)
     assert report["size"] == [160, 128] and report["patches"] == 35 and report["repaired_pixels"] >= 0
@@ -52,45 +68,131 @@ def test_nfpt_synthesizes_reprojects_and_reproduces_its_recipe(tmp_path, capsys)
     assert np.array_equal(load_image(out).image, load_image(again).image)
 
     into = tmp_path / "into.png"
-    code, stdout, err = run(["nfpt", PHOTO, "--lines", LINES, "--size", "640x480", "--block", "32", "--overlap", "8",
-                             "--into-photo", "true", "-o", into, "--seed", "3", "--report"], capsys)
+    code, stdout, err = run(
+        [
+            "nfpt",
+            PHOTO,
+            "--lines",
+            LINES,
+            "--size",
+            "640x480",
+            "--block",
+            "32",
+            "--overlap",
+            "8",
+            "--into-photo",
+            "true",
+            "-o",
+            into,
+            "--seed",
+            "3",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert load_image(into).image.shape == (360, 480, 3) and json.loads(stdout)["photo_replaced_fraction"] > 0.5
 
     view = tmp_path / "view.json"
     view.write_text(json.dumps({"quad": [[10, 20], [200, 5], [210, 150], [5, 140]], "size": [220, 160]}))
     viewed = tmp_path / "viewed.png"
-    code, _, err = run(["nfpt", PHOTO, "--lines", LINES, "--size", "160x128", "--block", "32", "--overlap", "8",
-                        "--view", view, "-o", viewed, "--seed", "3"], capsys)
+    code, _, err = run(
+        [
+            "nfpt",
+            PHOTO,
+            "--lines",
+            LINES,
+            "--size",
+            "160x128",
+            "--block",
+            "32",
+            "--overlap",
+            "8",
+            "--view",
+            view,
+            "-o",
+            viewed,
+            "--seed",
+            "3",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert load_image(viewed).image.shape == (160, 220, 3)
 
 
 def test_nfpt_without_lines_synthesizes_the_photo_as_it_is(tmp_path, capsys):
     out = tmp_path / "gravel.png"
-    code, _, err = run(["nfpt", example("gravel"), "--size", "96x64", "--block", "24", "--overlap", "6",
-                        "--smooth", "true", "-o", out, "--seed", "1"], capsys)
+    code, _, err = run(
+        [
+            "nfpt",
+            example("gravel"),
+            "--size",
+            "96x64",
+            "--block",
+            "24",
+            "--overlap",
+            "6",
+            "--smooth",
+            "true",
+            "-o",
+            out,
+            "--seed",
+            "1",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert load_image(out).image.shape == (64, 96)
 
 
-@pytest.mark.parametrize("argv, fragment", [
-    (["rectify", PHOTO, "-o", "{out}"], "needs --lines L.json"),
-    (["rectify", PHOTO, "--lines", "{tmp}/nowhere.json", "-o", "{out}"], "nowhere.json: no such feature-lines file"),
-    (["rectify", PHOTO, "--lines", LINES, "--warp", "morph", "-o", "{out}"], "lie on one plane"),
-    (["rectify", PHOTO, "--lines", LINES, "--warp", "affine", "-o", "{out}"], "parameter 'warp' = 'affine'"),
-    (["rectify", PHOTO, "--lines", '{"image_lines": [[1, 1, 1, 1]], "frontal_lines": [[0, 0, 9, 9]], '
-                                     '"frontal_size": [10, 10]}', "-o", "{out}"], "image line 0 has zero length"),
-    (["rectify", PHOTO, "--lines", '{"image_lines": [[1, 1, 90, 1], [1, 5, 90, 5], [1, 9, 90, 9], [1, 13, 90, 13]], '
-                                     '"frontal_lines": [[0, 0, 9, 0], [0, 3, 9, 3], [0, 6, 9, 6], [0, 9, 9, 9]], '
-                                     '"frontal_size": [10, 10]}', "-o", "{out}"], "feature lines are parallel"),
-    (["rectify", PHOTO, "--lines", "{tmp}/bad.json", "-o", "{out}"], "bad.json: not valid JSON"),
-    (["nfpt", PHOTO, "--lines", LINES, "--view", "{tmp}/v.json", "--into-photo", "true", "-o", "{out}"],
-     "exclude each other"),
-    (["nfpt", PHOTO, "--lines", LINES, "--view", "{tmp}/nowhere.json", "-o", "{out}"], "no such view file"),
-    (["nfpt", PHOTO, "--into-photo", "true", "-o", "{out}"], "--into-photo needs the feature lines"),
-    (["nfpt", PHOTO, "--block", "32", "--overlap", "20", "-o", "{out}"], "parameter 'overlap' = 20 is outside 2..16"),
-])
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["rectify", PHOTO, "-o", "{out}"], "needs --lines L.json"),
+        (
+            ["rectify", PHOTO, "--lines", "{tmp}/nowhere.json", "-o", "{out}"],
+            "nowhere.json: no such feature-lines file",
+        ),
+        (["rectify", PHOTO, "--lines", LINES, "--warp", "morph", "-o", "{out}"], "lie on one plane"),
+        (["rectify", PHOTO, "--lines", LINES, "--warp", "affine", "-o", "{out}"], "parameter 'warp' = 'affine'"),
+        (
+            [
+                "rectify",
+                PHOTO,
+                "--lines",
+                '{"image_lines": [[1, 1, 1, 1]], "frontal_lines": [[0, 0, 9, 9]], "frontal_size": [10, 10]}',
+                "-o",
+                "{out}",
+            ],
+            "image line 0 has zero length",
+        ),
+        (
+            [
+                "rectify",
+                PHOTO,
+                "--lines",
+                '{"image_lines": [[1, 1, 90, 1], [1, 5, 90, 5], [1, 9, 90, 9], [1, 13, 90, 13]], '
+                '"frontal_lines": [[0, 0, 9, 0], [0, 3, 9, 3], [0, 6, 9, 6], [0, 9, 9, 9]], '
+                '"frontal_size": [10, 10]}',
+                "-o",
+                "{out}",
+            ],
+            "feature lines are parallel",
+        ),
+        (["rectify", PHOTO, "--lines", "{tmp}/bad.json", "-o", "{out}"], "bad.json: not valid JSON"),
+        (
+            ["nfpt", PHOTO, "--lines", LINES, "--view", "{tmp}/v.json", "--into-photo", "true", "-o", "{out}"],
+            "exclude each other",
+        ),
+        (["nfpt", PHOTO, "--lines", LINES, "--view", "{tmp}/nowhere.json", "-o", "{out}"], "no such view file"),
+        (["nfpt", PHOTO, "--into-photo", "true", "-o", "{out}"], "--into-photo needs the feature lines"),
+        (
+            ["nfpt", PHOTO, "--block", "32", "--overlap", "20", "-o", "{out}"],
+            "parameter 'overlap' = 20 is outside 2..16",
+        ),
+    ],
+)
 def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, fragment):
     (tmp_path / "bad.json").write_text("{nope")
     (tmp_path / "v.json").write_text('{"quad": [[0, 0], [99, 0], [99, 79], [0, 79]]}')  # a good view
@@ -107,7 +209,6 @@ def test_recipe_finds_the_lines_file_from_any_folder(tmp_path, monkeypatch):
     import shutil
 
     import numpy as np
-
     from weft.app.cli import main
     from weft.core.examples import RESOURCES
     from weft.core.image import load_image, read_recipe
@@ -115,8 +216,23 @@ def test_recipe_finds_the_lines_file_from_any_folder(tmp_path, monkeypatch):
     for name in ("perspective.png", "perspective-lines.json"):
         shutil.copy(RESOURCES / name, tmp_path / name)
     monkeypatch.chdir(tmp_path)
-    assert main(["nfpt", "perspective.png", "--lines", "perspective-lines.json", "--size", "96x96",
-                 "-o", "out.png", "--seed", "2"]) == 0
+    assert (
+        main(
+            [
+                "nfpt",
+                "perspective.png",
+                "--lines",
+                "perspective-lines.json",
+                "--size",
+                "96x96",
+                "-o",
+                "out.png",
+                "--seed",
+                "2",
+            ]
+        )
+        == 0
+    )
     lines = json.loads((tmp_path / "perspective-lines.json").read_text())
     assert json.loads(read_recipe(tmp_path / "out.png"))["params"]["lines"]["image_lines"] == lines["image_lines"]
     elsewhere = tmp_path / "elsewhere"

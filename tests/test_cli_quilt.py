@@ -4,7 +4,6 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.examples import example
 from weft.core.image import load_image, read_recipe, save_image
@@ -38,9 +37,32 @@ def run(argv, capsys):
 
 def test_mincut_synthesis_tileable_poisson(files, tmp_path, capsys):
     out_path = tmp_path / "out.png"
-    code, out, err = run(["quilt", files["brick"], "-o", out_path, "--mode", "mincut", "--size", "100x90",
-                          "--block", "20", "--overlap", "5", "--tol", "3", "--tile", "true", "--poisson", "true",
-                          "--seed", "2", "--report"], capsys)
+    code, out, err = run(
+        [
+            "quilt",
+            files["brick"],
+            "-o",
+            out_path,
+            "--mode",
+            "mincut",
+            "--size",
+            "100x90",
+            "--block",
+            "20",
+            "--overlap",
+            "5",
+            "--tol",
+            "3",
+            "--tile",
+            "true",
+            "--poisson",
+            "true",
+            "--seed",
+            "2",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     report = json.loads(out)
     assert report["size"] == [100, 90] and report["blocks"] == 7 * 6
@@ -52,8 +74,24 @@ def test_mincut_synthesis_tileable_poisson(files, tmp_path, capsys):
 
 def test_transfer_with_iterations_and_recipe_reproduces(files, tmp_path, capsys):
     a, b = tmp_path / "a.png", tmp_path / "b.png"
-    code, out, err = run(["quilt", files["gravel"], "--target", files["camera"], "-o", a, "--block", "12",
-                          "--iterations", "2", "--seed", "5", "--report"], capsys)
+    code, out, err = run(
+        [
+            "quilt",
+            files["gravel"],
+            "--target",
+            files["camera"],
+            "-o",
+            a,
+            "--block",
+            "12",
+            "--iterations",
+            "2",
+            "--seed",
+            "5",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert json.loads(out)["iterations"] == 2 and json.loads(out)["size"] == [64, 64]
     recipe = json.loads(read_recipe(a))
@@ -64,16 +102,44 @@ def test_transfer_with_iterations_and_recipe_reproduces(files, tmp_path, capsys)
 
 def test_transfer_with_maps(files, tmp_path, capsys):
     out_path = tmp_path / "maps.png"
-    code, _, err = run(["quilt", files["gravel"], "--target", files["camera"], "--source-map", files["gravel"],
-                        "--target-map", files["camera"], "-o", out_path, "--seed", "1"], capsys)
+    code, _, err = run(
+        [
+            "quilt",
+            files["gravel"],
+            "--target",
+            files["camera"],
+            "--source-map",
+            files["gravel"],
+            "--target-map",
+            files["camera"],
+            "-o",
+            out_path,
+            "--seed",
+            "1",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert load_image(out_path).image.shape == (64, 64)
 
 
 def test_blend_pyramid_and_poisson(files, tmp_path, capsys):
     out_path = tmp_path / "blend.png"
-    code, out, err = run(["blend", files["camera"], files["gravel"], "--mask", files["mask"], "-o", out_path,
-                          "--levels", "4", "--report"], capsys)
+    code, out, err = run(
+        [
+            "blend",
+            files["camera"],
+            files["gravel"],
+            "--mask",
+            files["mask"],
+            "-o",
+            out_path,
+            "--levels",
+            "4",
+            "--report",
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert json.loads(out)["levels"] == 4
     blended = load_image(out_path).image
@@ -83,24 +149,40 @@ def test_blend_pyramid_and_poisson(files, tmp_path, capsys):
     code, _, err = run(["blend", files["camera"], files["gravel"], "--mask", files["white"], "-o", out_path], capsys)
     assert code == 0, err
     assert np.abs(load_image(out_path).image - camera).max() <= 1 / 255 + 1e-6
-    code, _, err = run(["blend", files["camera"], files["gravel"], "--mask", files["mask"], "-o", out_path,
-                        "--mode", "poisson"], capsys)
+    code, _, err = run(
+        ["blend", files["camera"], files["gravel"], "--mask", files["mask"], "-o", out_path, "--mode", "poisson"],
+        capsys,
+    )
     assert code == 0, err
 
 
 @pytest.mark.parametrize(
     "argv, fragment",
     [
-        (["quilt", "{brick}", "--block", "32", "--overlap", "40"],
-         "parameter 'overlap' = 40 is outside 1..31 (must be smaller than block = 32)"),
-        (["quilt", "{brick}", "--block", "65", "--mode", "mincut"], "'block' = 65 is outside 2..64 (must fit in the texture, 64x64)"),
-        (["quilt", "{brick}", "--mode", "random", "--poisson", "true"], "'poisson' = true needs mode overlap or mincut"),
+        (
+            ["quilt", "{brick}", "--block", "32", "--overlap", "40"],
+            "parameter 'overlap' = 40 is outside 1..31 (must be smaller than block = 32)",
+        ),
+        (
+            ["quilt", "{brick}", "--block", "65", "--mode", "mincut"],
+            "'block' = 65 is outside 2..64 (must fit in the texture, 64x64)",
+        ),
+        (
+            ["quilt", "{brick}", "--mode", "random", "--poisson", "true"],
+            "'poisson' = true needs mode overlap or mincut",
+        ),
         (["quilt", "{brick}", "--iterations", "3"], "more passes need a target"),
         (["quilt", "{brick}", "--source-map", "{gravel}"], "input 'source-map' needs a target"),
         (["quilt", "{gravel}", "--target", "{camera}", "--source-map", "{gravel}"], "'target_map' is required"),
         (["quilt", "{gravel}", "--target", "{camera}", "--size", "10x10"], "'size' cannot be given with a target"),
-        (["quilt", "{gravel}", "--target", "{camera}", "--mode", "random"], "'mode' = 'random' is not one of overlap, mincut"),
-        (["quilt", "{brick}", "--mode", "mincut", "--tile", "true", "--size", "20x20"], "too small for a tileable output"),
+        (
+            ["quilt", "{gravel}", "--target", "{camera}", "--mode", "random"],
+            "'mode' = 'random' is not one of overlap, mincut",
+        ),
+        (
+            ["quilt", "{brick}", "--mode", "mincut", "--tile", "true", "--size", "20x20"],
+            "too small for a tileable output",
+        ),
         (["quilt", "{brick}", "--alpha", "1.5"], "'alpha' = 1.5 is outside 0..1"),
         (["quilt", "{brick}", "--rule", "best"], "'rule' = 'best' is not one of tol, epsilon, sampled"),
         (["blend", "{camera}", "{gravel}", "--mask", "{small}"], "mask is 32x32 but the images are 64x64"),

@@ -3,7 +3,6 @@
 import json
 
 import numpy as np
-
 from weft.app.cli import main
 from weft.core.examples import RESOURCES
 from weft.core.image import load_image, read_recipe

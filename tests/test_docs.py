@@ -20,8 +20,11 @@ import weft_results  # noqa: E402
 
 PAGES = [ROOT / "README.md", *sorted(DOCS.rglob("*.rst")), *sorted((DOCS / "gallery").glob("*.py"))]
 PAGES = [p for p in PAGES if "_build" not in p.parts and "auto_gallery" not in p.parts]
-HISTORY = re.compile(r"last round|this round|previous code|previous round|\bissue \d+|\bissues? #\d+|"
-                     r"\bbefore the .* work\b", re.I)
+HISTORY = re.compile(
+    r"last round|this round|previous code|previous round|\bissue \d+|\bissues? #\d+|"
+    r"\bbefore the .* work\b",
+    re.I,
+)
 
 
 def test_the_pages_carry_no_history():
@@ -42,8 +45,11 @@ def test_every_promise_names_tests_that_exist():
 
 
 def test_every_page_is_in_a_table_of_contents():
-    rst = [p for p in DOCS.rglob("*.rst") if "_build" not in p.parts and "auto_gallery" not in p.parts
-           and p.parent.name != "gallery"]
+    rst = [
+        p
+        for p in DOCS.rglob("*.rst")
+        if "_build" not in p.parts and "auto_gallery" not in p.parts and p.parent.name != "gallery"
+    ]
     listed = set()
     for page in rst:
         for block in re.findall(r"\.\. toctree::\n((?:   .*\n|\n)+)", page.read_text(encoding="utf-8")):
@@ -78,10 +84,18 @@ def test_every_parameter_says_what_it_changes():
 
 def test_a_results_file_renders_as_a_table_with_its_machine_and_command(tmp_path, monkeypatch):
     monkeypatch.setattr(weft_results, "RESULTS", tmp_path)
-    (tmp_path / "batch.json").write_text(json.dumps({
-        "suite": "batch", "command": "python -m benchmarks.batch --repeats 1", "date": "2030-01-02 03:04 UTC",
-        "machine": {"cpu": "Test CPU", "cores": 2}, "note": "a shared machine",
-        "rows": [{"recipe": "fast", "pool": "local, 1 worker", "items_per_s": 12.345, "busy": 0.97}]}))
+    (tmp_path / "batch.json").write_text(
+        json.dumps(
+            {
+                "suite": "batch",
+                "command": "python -m benchmarks.batch --repeats 1",
+                "date": "2030-01-02 03:04 UTC",
+                "machine": {"cpu": "Test CPU", "cores": 2},
+                "note": "a shared machine",
+                "rows": [{"recipe": "fast", "pool": "local, 1 worker", "items_per_s": 12.345, "busy": 0.97}],
+            }
+        )
+    )
     lines = "\n".join(weft_results.render("batch"))
     assert "Test CPU, 2 cores" in lines and "2030-01-02" in lines and "A shared machine" in lines
     assert "``python -m benchmarks.batch --repeats 1``" in lines

@@ -12,10 +12,10 @@ import os
 
 import numpy as np
 import pytest
-
 from weft.app import cli
 from weft.core.errors import ImageError
 from weft.core.image import save_image
+
 from tests.data.make_corpus import make_corpus
 
 
@@ -44,6 +44,7 @@ def _read_only(folder, monkeypatch):
 
     def denied(*_a, **_k):
         raise PermissionError(errno.EACCES, "Permission denied")
+
     monkeypatch.setattr("weft.core.image.files.tempfile.mkstemp", denied)
 
 

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.image import load_image, read_recipe, save_image
 
@@ -37,8 +36,12 @@ def _mount_namespaces() -> str | None:
 def _in_namespace_with_bind(src: Path, dst: Path, argv: list) -> subprocess.CompletedProcess:
     """``weft argv`` with ``dst`` a bind mount of ``src``, in a mount namespace of its own."""
     script = 'mount --bind "$1" "$2" && shift 2 && exec "$@"'
-    return subprocess.run(["unshare", "-m", "sh", "-c", script, "sh", str(src), str(dst), *WEFT, *map(str, argv)],
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        ["unshare", "-m", "sh", "-c", script, "sh", str(src), str(dst), *WEFT, *map(str, argv)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 def _texture(path: Path) -> Path:
@@ -66,7 +69,9 @@ def test_an_input_reached_through_a_bind_mount_is_not_overwritten(tmp_path, bind
     before = texture.read_bytes()
     done = _in_namespace_with_bind(src, dst, ["quilt", texture, *QUILT, "-o", dst / "in.png"])
     assert done.returncode == 2, done.stderr
-    assert done.stderr.strip().splitlines() == [f"weft: {dst / 'in.png'}: refusing to overwrite the input file {texture}"]
+    assert done.stderr.strip().splitlines() == [
+        f"weft: {dst / 'in.png'}: refusing to overwrite the input file {texture}"
+    ]
     assert texture.read_bytes() == before
 
 
@@ -77,10 +82,20 @@ def test_a_batch_never_overwrites_its_frames_through_a_bind_mount(tmp_path, bind
     frames = [_texture(src / "frames" / f"f{i}.png") for i in range(3)]
     before = [f.read_bytes() for f in frames]
     recipe = tmp_path / "look.json"
-    recipe.write_text(json.dumps({"weft": 1, "method": "fast", "params": {"n": 5},
-                                  "inputs": {"texture": str(texture), "target": str(frames[0])}, "seed": 1}))
-    done = _in_namespace_with_bind(src, dst, ["batch", recipe, "--over", "target", src / "frames",
-                                              "-o", str(dst / "frames" / "{stem}.png"), "-q"])
+    recipe.write_text(
+        json.dumps(
+            {
+                "weft": 1,
+                "method": "fast",
+                "params": {"n": 5},
+                "inputs": {"texture": str(texture), "target": str(frames[0])},
+                "seed": 1,
+            }
+        )
+    )
+    done = _in_namespace_with_bind(
+        src, dst, ["batch", recipe, "--over", "target", src / "frames", "-o", str(dst / "frames" / "{stem}.png"), "-q"]
+    )
     assert done.returncode == 2, done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "refusing to overwrite the input file" in lines[0] and "f0.png" in lines[0], lines
@@ -123,8 +138,9 @@ def test_a_batch_never_overwrites_its_recipe_png(tmp_path, capsys):
     frames.mkdir()
     for i in range(2):
         _texture(frames / f"look{'' if i == 0 else i}.png")  # item 0's output would be look.png
-    code, out, err = _run(["batch", look, "--over", "texture", frames, "-o", str(tmp_path / "{stem}.png"), "-q"],
-                          capsys)
+    code, out, err = _run(
+        ["batch", look, "--over", "texture", frames, "-o", str(tmp_path / "{stem}.png"), "-q"], capsys
+    )
     assert code == 2 and "refusing to overwrite the recipe file" in err and err.count("\n") == 1, err
     assert look.read_bytes() == before
 
@@ -133,12 +149,33 @@ def _fast_batch(tmp_path, n=3):
     frames = tmp_path / "frames"
     frames.mkdir()
     for i in range(n):
-        save_image(frames / f"f{i}.png", load_image(ROOT / "resources" / "astronaut.png").image[4 * i:4 * i + 40, :48])
+        save_image(
+            frames / f"f{i}.png", load_image(ROOT / "resources" / "astronaut.png").image[4 * i : 4 * i + 40, :48]
+        )
     _texture(tmp_path / "gravel.png")
-    (tmp_path / "look.json").write_text(json.dumps({"weft": 1, "method": "fast", "params": {"n": 5}, "inputs": {
-        "texture": "gravel.png", "target": "frames/f0.png"}, "seed": 2}))
-    return ["batch", tmp_path / "look.json", "--over", "target", frames, "-o", str(tmp_path / "out" / "{stem}.png"),
-            "--workers", "1", "-q"]
+    (tmp_path / "look.json").write_text(
+        json.dumps(
+            {
+                "weft": 1,
+                "method": "fast",
+                "params": {"n": 5},
+                "inputs": {"texture": "gravel.png", "target": "frames/f0.png"},
+                "seed": 2,
+            }
+        )
+    )
+    return [
+        "batch",
+        tmp_path / "look.json",
+        "--over",
+        "target",
+        frames,
+        "-o",
+        str(tmp_path / "out" / "{stem}.png"),
+        "--workers",
+        "1",
+        "-q",
+    ]
 
 
 def test_a_rerun_redoes_an_output_cut_short_or_damaged(tmp_path, capsys):
@@ -146,7 +183,7 @@ def test_a_rerun_redoes_an_output_cut_short_or_damaged(tmp_path, capsys):
     assert _run(argv, capsys)[0] == 0
     outs = sorted((tmp_path / "out").iterdir())
     whole = [p.read_bytes() for p in outs]
-    outs[0].write_bytes(whole[0][:len(whole[0]) // 2])  # an interrupted copy: the recipe chunk is still there
+    outs[0].write_bytes(whole[0][: len(whole[0]) // 2])  # an interrupted copy: the recipe chunk is still there
     damaged = bytearray(whole[1])
     damaged[-20] ^= 0x40  # one flipped bit in the pixels
     outs[1].write_bytes(bytes(damaged))
@@ -165,8 +202,9 @@ def _bomb_png(path: Path, width: int, height: int) -> None:
         return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
 
     ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
-    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64))
-                     + chunk(b"IEND", b""))
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b"")
+    )
 
 
 def test_one_bomb_frame_fails_alone_and_the_rest_are_written(tmp_path, capsys):
@@ -175,8 +213,10 @@ def test_one_bomb_frame_fails_alone_and_the_rest_are_written(tmp_path, capsys):
     code, out, err = _run(argv, capsys)
     lines = err.strip().splitlines()
     assert code == 1, err
-    assert lines[-1] == ("3 written, 1 failed: f9.png: 60000x60000 = 3600.0 megapixels exceeds the limit of "
-                         "50 megapixels (set WEFT_MAX_PIXELS to raise it)")
+    assert lines[-1] == (
+        "3 written, 1 failed: f9.png: 60000x60000 = 3600.0 megapixels exceeds the limit of "
+        "50 megapixels (set WEFT_MAX_PIXELS to raise it)"
+    )
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f0.png", "f1.png", "f2.png"]
 
 

@@ -8,14 +8,11 @@ cannot be written is refused before the work, and numbers are written in ASCII d
 from __future__ import annotations
 
 import os
-import struct
-import zlib
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.errors import ImageError
 from weft.core.image import load_image, save_image
@@ -39,7 +36,7 @@ def _jpeg() -> tuple[bytes, int]:
 def test_a_jpeg_whose_scan_stops_halfway_is_refused(tmp_path, capfd):
     data, sos = _jpeg()
     bad = tmp_path / "half.jpg"
-    bad.write_bytes(data[:sos + (len(data) - sos) // 2] + b"\xff\xd9")  # cut, but with an end marker
+    bad.write_bytes(data[: sos + (len(data) - sos) // 2] + b"\xff\xd9")  # cut, but with an end marker
     with pytest.raises(ImageError, match=r"half\.jpg: truncated or corrupt JPEG data \(premature end of data"):
         load_image(bad)
     code, out, err = _run(["quilt", bad, *QUILT, "-o", tmp_path / "o.png"], capfd)
@@ -133,8 +130,10 @@ def test_weft_run_on_a_jpeg_says_only_png_exports_carry_a_recipe(tmp_path, capfd
     data, _ = _jpeg()
     cat = _write(tmp_path / "cat.jpg", data)
     code, out, err = _run(["run", cat, "-o", tmp_path / "o.png"], capfd)
-    assert (code, err) == (2, f"weft: {cat}: a JPEG image carries no recipe; only PNGs exported by weft "
-                              "(and .json recipe files) do\n")
+    assert (code, err) == (
+        2,
+        f"weft: {cat}: a JPEG image carries no recipe; only PNGs exported by weft (and .json recipe files) do\n",
+    )
     plain = tmp_path / "plain.png"
     save_image(plain, np.zeros((8, 8, 3), np.float32))
     code, out, err = _run(["run", plain, "-o", tmp_path / "o.png"], capfd)

@@ -4,12 +4,11 @@ shown runs as written on the bundled examples, every picture and page it links t
 from __future__ import annotations
 
 import os
+import pathlib
 import re
 import shlex
-import pathlib
 
 import pytest
-
 from weft.app.cli import main
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -59,8 +58,16 @@ def test_pictures_and_pages_named_in_the_readme_exist():
 
 def test_every_job_of_the_quick_start_has_a_command():
     commands = shell_commands(ROOT / "README.md")
-    for job in ("weft quilt", "weft fast", "weft fill resources/coffee.png --mask", "weft fill resources/brick.png --extend",
-                "weft rectify", "weft nfpt", "weft batch", "weft run"):
+    for job in (
+        "weft quilt",
+        "weft fast",
+        "weft fill resources/coffee.png --mask",
+        "weft fill resources/brick.png --extend",
+        "weft rectify",
+        "weft nfpt",
+        "weft batch",
+        "weft run",
+    ):
         assert any(c.startswith(job) for c in commands), job
 
 

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.app.gui.document import read_session
 from weft.core.errors import WeftError
@@ -19,8 +18,18 @@ from weft.core.image import load_image, read_recipe, save_image
 from weft.core.params import MAX_FILE_BYTES
 
 ROOT = Path(__file__).resolve().parents[1]
-UNSAFE_MODULES = {"pickle", "cPickle", "_pickle", "shelve", "marshal", "dill", "cloudpickle", "jsonpickle", "joblib",
-                  "yaml"}
+UNSAFE_MODULES = {
+    "pickle",
+    "cPickle",
+    "_pickle",
+    "shelve",
+    "marshal",
+    "dill",
+    "cloudpickle",
+    "jsonpickle",
+    "joblib",
+    "yaml",
+}
 UNSAFE_CALLS = {"eval", "exec", "compile", "__import__"}
 SQUARE = [[2, 2, 29, 2], [2, 29, 29, 29], [2, 2, 2, 29], [29, 2, 29, 29]]  # feature lines: the identity
 QUILT = {"mode": "random", "block": 8, "size": [24, 24]}  # fast, and every output pixel is copied
@@ -43,8 +52,12 @@ def _offences(source: str, filename: str = "<test>") -> list[str]:
             func = node.func
             if isinstance(func, ast.Name) and func.id in UNSAFE_CALLS:
                 found.append(f"{where}: {func.id}(...)")
-            elif (isinstance(func, ast.Attribute) and func.attr in UNSAFE_CALLS
-                  and isinstance(func.value, ast.Name) and func.value.id in ("builtins", "__builtins__")):
+            elif (
+                isinstance(func, ast.Attribute)
+                and func.attr in UNSAFE_CALLS
+                and isinstance(func.value, ast.Name)
+                and func.value.id in ("builtins", "__builtins__")
+            ):
                 found.append(f"{where}: {func.value.id}.{func.attr}(...)")
             for kw in node.keywords:  # numpy.load(..., allow_pickle=True) and the like
                 if kw.arg == "allow_pickle" and not (isinstance(kw.value, ast.Constant) and kw.value.value is False):
@@ -53,12 +66,20 @@ def _offences(source: str, filename: str = "<test>") -> list[str]:
 
 
 def test_the_checker_finds_what_it_looks_for():
-    source = ("import pickle\nfrom shelve import open\nimport yaml.loader\nx = eval('1')\nexec('x = 2')\n"
-              "builtins.__import__('os')\nnp.load(f, allow_pickle=True)\n"
-              "app.exec()\nast.literal_eval('1')\nimport json\nnp.load(f)\n")
+    source = (
+        "import pickle\nfrom shelve import open\nimport yaml.loader\nx = eval('1')\nexec('x = 2')\n"
+        "builtins.__import__('os')\nnp.load(f, allow_pickle=True)\n"
+        "app.exec()\nast.literal_eval('1')\nimport json\nnp.load(f)\n"
+    )
     assert [o.split(": ", 1)[1] for o in _offences(source)] == [
-        "import pickle", "from shelve import ...", "import yaml.loader", "eval(...)", "exec(...)",
-        "builtins.__import__(...)", "allow_pickle=..."]
+        "import pickle",
+        "from shelve import ...",
+        "import yaml.loader",
+        "eval(...)",
+        "exec(...)",
+        "builtins.__import__(...)",
+        "allow_pickle=...",
+    ]
 
 
 def test_no_module_of_weft_unpickles_or_evaluates_text():
@@ -159,27 +180,33 @@ def test_bad_recipe_files_are_refused_in_one_line_and_nothing_runs(tmp_path, cap
         assert stdout == "" and not out.exists(), name
 
 
-@pytest.mark.parametrize("fields, fragment", [
-    ({"params": [1, 2]}, '"params" must be a JSON object'),
-    ({"params": {"block": "8"}}, "parameter 'block' = '8' must be an integer"),
-    ({"params": {"block": 8.0}}, "parameter 'block' = 8.0 must be an integer"),
-    ({"params": {"mode": "__import__('os')"}}, "parameter 'mode' = \"__import__('os')\" is not one of"),
-    ({"params": {"blok": 8}}, "unknown parameter blok for QuiltParams"),
-    ({"params": {"block": True}}, "parameter 'block' = True must be an integer"),
-    ({"inputs": ["tex.png"]}, '"inputs" must map input names to file paths'),
-    ({"inputs": {"texture": 7}}, '"inputs" must map input names to file paths'),
-    ({"inputs": {"texture": ""}}, "recipe input 'texture' = '' is not a file path"),
-    ({"inputs": {"texture": "tex.png", "bogus": "tex.png"}}, "recipe names input 'bogus', which quilt does not take"),
-    ({"inputs": {}}, "recipe names no texture image for quilt"),
-    ({"seed": "7"}, "recipe \"seed\" = '7' must be a non-negative integer"),
-    ({"seed": True}, "recipe \"seed\" = True must be a non-negative integer"),
-    ({"seed": 2**64}, f"recipe \"seed\" = {2**64} must be a non-negative integer below 2**63"),
-    ({"region": [1, 2]}, "recipe \"region\" = [1, 2] must be [x, y, side]"),
-    ({"method": 3}, "recipe has no \"method\""),
-    ({"method": "teleport"}, "unknown method 'teleport'"),
-    ({"method": "__import__('os').system('true')"}, "unknown method \"__import__('os').system('true')\""),
-    ({"weft": 2}, "this version of weft reads recipes of version 1"),
-])
+@pytest.mark.parametrize(
+    "fields, fragment",
+    [
+        ({"params": [1, 2]}, '"params" must be a JSON object'),
+        ({"params": {"block": "8"}}, "parameter 'block' = '8' must be an integer"),
+        ({"params": {"block": 8.0}}, "parameter 'block' = 8.0 must be an integer"),
+        ({"params": {"mode": "__import__('os')"}}, "parameter 'mode' = \"__import__('os')\" is not one of"),
+        ({"params": {"blok": 8}}, "unknown parameter blok for QuiltParams"),
+        ({"params": {"block": True}}, "parameter 'block' = True must be an integer"),
+        ({"inputs": ["tex.png"]}, '"inputs" must map input names to file paths'),
+        ({"inputs": {"texture": 7}}, '"inputs" must map input names to file paths'),
+        ({"inputs": {"texture": ""}}, "recipe input 'texture' = '' is not a file path"),
+        (
+            {"inputs": {"texture": "tex.png", "bogus": "tex.png"}},
+            "recipe names input 'bogus', which quilt does not take",
+        ),
+        ({"inputs": {}}, "recipe names no texture image for quilt"),
+        ({"seed": "7"}, "recipe \"seed\" = '7' must be a non-negative integer"),
+        ({"seed": True}, 'recipe "seed" = True must be a non-negative integer'),
+        ({"seed": 2**64}, f'recipe "seed" = {2**64} must be a non-negative integer below 2**63'),
+        ({"region": [1, 2]}, 'recipe "region" = [1, 2] must be [x, y, side]'),
+        ({"method": 3}, 'recipe has no "method"'),
+        ({"method": "teleport"}, "unknown method 'teleport'"),
+        ({"method": "__import__('os').system('true')"}, "unknown method \"__import__('os').system('true')\""),
+        ({"weft": 2}, "this version of weft reads recipes of version 1"),
+    ],
+)
 def test_recipe_fields_of_the_wrong_kind_are_refused_naming_the_file(tmp_path, capsys, fields, fragment):
     _image(tmp_path / "tex.png", 0)
     path = _recipe(tmp_path / "bad.json", **fields)
@@ -217,9 +244,11 @@ def test_a_png_carrying_a_huge_recipe_is_refused(tmp_path, capsys):
 def test_a_png_carrying_a_bad_recipe_is_refused(tmp_path, capsys, sentinel):
     png = tmp_path / "carrier.png"
     out = tmp_path / "out.png"
-    for text, fragment in [(f"__import__('os').system('touch {sentinel}')", "recipe is not valid JSON"),
-                           ('{"weft": 1, "method": "quilt", "seed": NaN}', "NaN is not a JSON number"),
-                           ("[" * 100_000 + "]" * 100_000, "nested too deeply")]:
+    for text, fragment in [
+        (f"__import__('os').system('touch {sentinel}')", "recipe is not valid JSON"),
+        ('{"weft": 1, "method": "quilt", "seed": NaN}', "NaN is not a JSON number"),
+        ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+    ]:
         save_image(png, np.zeros((8, 8, 3), np.float32), recipe=text)
         code, _, err = run(["run", png, "-o", out], capsys)
         assert code == 2 and one_line(err).startswith(f"weft: {png}: ") and fragment in err, err
@@ -247,8 +276,9 @@ def test_a_recipe_folder_or_unreadable_recipe_is_refused(tmp_path, capsys):
 
 
 def _direct(tex: Path, out: Path, capsys) -> np.ndarray:
-    code, _, err = run(["quilt", tex, "-o", out, "--mode", "random", "--block", "8", "--size", "24x24",
-                        "--seed", "5"], capsys)
+    code, _, err = run(
+        ["quilt", tex, "-o", out, "--mode", "random", "--block", "8", "--size", "24x24", "--seed", "5"], capsys
+    )
     assert code == 0, err
     return load_image(out).image
 
@@ -259,8 +289,9 @@ def elsewhere(tmp_path, monkeypatch):
     cwd = tmp_path / "elsewhere"
     _image(cwd / "tex.png", 99)
     _image(cwd / "sub" / "tex.png", 98)
-    (cwd / "lines.json").write_text(json.dumps({"image_lines": SQUARE, "frontal_lines": SQUARE,
-                                                "frontal_size": [32, 32]}))
+    (cwd / "lines.json").write_text(
+        json.dumps({"image_lines": SQUARE, "frontal_lines": SQUARE, "frontal_size": [32, 32]})
+    )
     monkeypatch.chdir(cwd)
     return cwd
 
@@ -315,15 +346,33 @@ def test_nfpt_lines_file_resolves_against_the_recipe_folder(tmp_path, capsys, el
     project = tmp_path / "project"
     _image(project / "photo.png", 0, side=32)
     lines = [[3, 3, 28, 4], [3, 28, 28, 27], [3, 3, 4, 28], [28, 4, 27, 27]]  # not the decoy's lines
-    (project / "lines.json").write_text(json.dumps({"image_lines": lines, "frontal_lines": SQUARE,
-                                                    "frontal_size": [32, 32]}))
+    (project / "lines.json").write_text(
+        json.dumps({"image_lines": lines, "frontal_lines": SQUARE, "frontal_size": [32, 32]})
+    )
     nfpt = {"lines": "lines.json", "size": [24, 24], "block": 12, "overlap": 3}
     recipe = _recipe(project / "r.json", method="nfpt", params=nfpt, inputs={"photo": "photo.png"})
     out, direct = tmp_path / "out.png", tmp_path / "direct.png"
     code, _, err = run(["run", recipe, "-o", out], capsys)
     assert code == 0, err
-    code, _, err = run(["nfpt", project / "photo.png", "--lines", project / "lines.json", "--size", "24x24",
-                        "--block", "12", "--overlap", "3", "--seed", "5", "-o", direct], capsys)
+    code, _, err = run(
+        [
+            "nfpt",
+            project / "photo.png",
+            "--lines",
+            project / "lines.json",
+            "--size",
+            "24x24",
+            "--block",
+            "12",
+            "--overlap",
+            "3",
+            "--seed",
+            "5",
+            "-o",
+            direct,
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert np.array_equal(load_image(out).image, load_image(direct).image)
 
@@ -331,11 +380,14 @@ def test_nfpt_lines_file_resolves_against_the_recipe_folder(tmp_path, capsys, el
 # --- recipes naming files that are not there -------------------------------------------------------
 
 
-@pytest.mark.parametrize("method, inputs, missing", [
-    ("quilt", {"texture": "tex.png", "target": "gone.png"}, "target"),
-    ("quilt", {"texture": "sub/gone.png"}, "texture"),
-    ("fast", {"texture": "tex.png", "target": "../elsewhere/tex.png/gone.png"}, "target"),
-])
+@pytest.mark.parametrize(
+    "method, inputs, missing",
+    [
+        ("quilt", {"texture": "tex.png", "target": "gone.png"}, "target"),
+        ("quilt", {"texture": "sub/gone.png"}, "texture"),
+        ("fast", {"texture": "tex.png", "target": "../elsewhere/tex.png/gone.png"}, "target"),
+    ],
+)
 def test_a_recipe_naming_a_missing_image_says_which(tmp_path, capsys, elsewhere, method, inputs, missing):
     _image(tmp_path / "project" / "tex.png", 0)
     _image(elsewhere / "gone.png", 1)  # a file of that name in the current directory must not be taken
@@ -371,12 +423,17 @@ def test_a_recipe_naming_a_missing_lines_file_says_which(tmp_path, capsys, elsew
     out = tmp_path / "out.png"
     code, stdout, err = run(["run", recipe, "-o", out], capsys)
     assert code == 2
-    assert one_line(err) == (f"weft: {recipe}: parameter 'lines' names lines.json, "
-                             f"but {project / 'lines.json'} does not exist\n")
+    assert one_line(err) == (
+        f"weft: {recipe}: parameter 'lines' names lines.json, but {project / 'lines.json'} does not exist\n"
+    )
     assert stdout == "" and not out.exists()
     # an absolute path that is not there either
-    recipe = _recipe(project / "r.json", method="nfpt", params=dict(nfpt, lines=str(tmp_path / "no" / "l.json")),
-                     inputs={"photo": "photo.png"})
+    recipe = _recipe(
+        project / "r.json",
+        method="nfpt",
+        params=dict(nfpt, lines=str(tmp_path / "no" / "l.json")),
+        inputs={"photo": "photo.png"},
+    )
     code, _, err = run(["run", recipe, "-o", out], capsys)
     assert code == 2 and "parameter 'lines' names" in one_line(err) and str(tmp_path / "no" / "l.json") in err
     assert not out.exists()
@@ -386,9 +443,15 @@ def test_a_recipe_naming_a_missing_lines_file_says_which(tmp_path, capsys, elsew
 
 
 def _session(**fields) -> dict:
-    data = {"weft_session": 1, "method": "fast", "params": {"fast": {"p": 0.4}}, "inputs": {"texture": "tex.png"},
-            "prototype": None, "lines": {"image_lines": [], "frontal_lines": [], "frontal_size": [512, 512]},
-            "seed": 3}
+    data = {
+        "weft_session": 1,
+        "method": "fast",
+        "params": {"fast": {"p": 0.4}},
+        "inputs": {"texture": "tex.png"},
+        "prototype": None,
+        "lines": {"image_lines": [], "frontal_lines": [], "frontal_size": [512, 512]},
+        "seed": 3,
+    }
     data.update(fields)
     return data
 
@@ -396,12 +459,15 @@ def _session(**fields) -> dict:
 def test_a_good_session_reads_with_paths_relative_to_it(tmp_path, elsewhere):
     path = tmp_path / "project" / "s.weft.json"
     path.parent.mkdir()
-    path.write_text(json.dumps(_session(inputs={"texture": "tex.png", "target": "sub/t.png",
-                                                 "photo": str(tmp_path / "abs.png")})))
+    path.write_text(
+        json.dumps(_session(inputs={"texture": "tex.png", "target": "sub/t.png", "photo": str(tmp_path / "abs.png")}))
+    )
     data = read_session(path)
-    assert data["inputs"] == {"texture": str(tmp_path / "project" / "tex.png"),
-                              "target": str(tmp_path / "project" / "sub" / "t.png"),
-                              "photo": str(tmp_path / "abs.png")}
+    assert data["inputs"] == {
+        "texture": str(tmp_path / "project" / "tex.png"),
+        "target": str(tmp_path / "project" / "sub" / "t.png"),
+        "photo": str(tmp_path / "abs.png"),
+    }
     assert data["params"]["fast"].p == 0.4 and data["seed"] == 3 and data["method"] == "fast"
 
 
@@ -418,27 +484,30 @@ def test_bad_session_files_are_refused_in_one_line(tmp_path, sentinel):
         assert fragment in message, (name, message)
 
 
-@pytest.mark.parametrize("fields, fragment", [
-    ({"method": "teleport"}, "unknown method 'teleport'"),
-    ({"params": [1]}, "params must be an object"),
-    ({"params": {"fast": [1]}}, "fast: FastParams: parameters must be a JSON object"),
-    ({"params": {"fast": {"p": "0.3"}}}, "fast: parameter 'p' = '0.3' must be a number"),
-    ({"params": {"fast": {"zzz": 1}}}, "fast: unknown parameter zzz for FastParams"),
-    ({"inputs": ["tex.png"]}, "inputs must be an object"),
-    ({"inputs": {"bogus": "tex.png"}}, "unknown input 'bogus'"),
-    ({"inputs": {"texture": 3}}, "input 'texture' = 3 is not a file path"),
-    ({"prototype": ["a", 1, 2]}, "prototype = ['a', 1, 2] must be [x, y, side]"),
-    ({"prototype": [1, 2, 0]}, "prototype = [1, 2, 0] must be [x, y, side]"),
-    ({"prototype": {"x": 1}}, "prototype = {'x': 1} must be [x, y, side]"),
-    ({"lines": [1]}, "lines must be an object"),
-    ({"lines": {"image_lines": "abc"}}, "image_lines must be a list of [x1, y1, x2, y2]"),
-    ({"lines": {"frontal_lines": [[1, 2, 3]]}}, "frontal_lines[0] = [1, 2, 3] must be [x1, y1, x2, y2]"),
-    ({"lines": {"frontal_size": [0]}}, "frontal_size = [0] must be [width, height]"),
-    ({"seed": -1}, "seed = -1 must be an integer in 0..2147483647"),
-    ({"seed": 2**40}, f"seed = {2**40} must be an integer in 0..2147483647"),
-    ({"seed": "3"}, "seed = '3' must be an integer"),
-    ({"weft_session": 2}, "not a weft session file (version 1)"),
-])
+@pytest.mark.parametrize(
+    "fields, fragment",
+    [
+        ({"method": "teleport"}, "unknown method 'teleport'"),
+        ({"params": [1]}, "params must be an object"),
+        ({"params": {"fast": [1]}}, "fast: FastParams: parameters must be a JSON object"),
+        ({"params": {"fast": {"p": "0.3"}}}, "fast: parameter 'p' = '0.3' must be a number"),
+        ({"params": {"fast": {"zzz": 1}}}, "fast: unknown parameter zzz for FastParams"),
+        ({"inputs": ["tex.png"]}, "inputs must be an object"),
+        ({"inputs": {"bogus": "tex.png"}}, "unknown input 'bogus'"),
+        ({"inputs": {"texture": 3}}, "input 'texture' = 3 is not a file path"),
+        ({"prototype": ["a", 1, 2]}, "prototype = ['a', 1, 2] must be [x, y, side]"),
+        ({"prototype": [1, 2, 0]}, "prototype = [1, 2, 0] must be [x, y, side]"),
+        ({"prototype": {"x": 1}}, "prototype = {'x': 1} must be [x, y, side]"),
+        ({"lines": [1]}, "lines must be an object"),
+        ({"lines": {"image_lines": "abc"}}, "image_lines must be a list of [x1, y1, x2, y2]"),
+        ({"lines": {"frontal_lines": [[1, 2, 3]]}}, "frontal_lines[0] = [1, 2, 3] must be [x1, y1, x2, y2]"),
+        ({"lines": {"frontal_size": [0]}}, "frontal_size = [0] must be [width, height]"),
+        ({"seed": -1}, "seed = -1 must be an integer in 0..2147483647"),
+        ({"seed": 2**40}, f"seed = {2**40} must be an integer in 0..2147483647"),
+        ({"seed": "3"}, "seed = '3' must be an integer"),
+        ({"weft_session": 2}, "not a weft session file (version 1)"),
+    ],
+)
 def test_session_fields_of_the_wrong_kind_are_refused_naming_the_file(tmp_path, fields, fragment):
     path = tmp_path / "s.weft.json"
     path.write_text(json.dumps(_session(**fields)))

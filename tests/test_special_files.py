@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.errors import WeftError
 from weft.core.image import load_image, read_recipe, save_image
@@ -86,8 +85,11 @@ def test_lines_and_views_from_a_fifo_or_a_device(fifo, tmp_path, capsys, option)
 def test_a_recipe_naming_a_device_as_its_lines(tmp_path, capsys):
     photo = _texture(tmp_path / "p.png")
     recipe = tmp_path / "r.json"
-    recipe.write_text(json.dumps({"weft": 1, "method": "nfpt", "params": {"lines": "/dev/zero"},
-                                  "inputs": {"photo": "p.png"}, "seed": 1}))
+    recipe.write_text(
+        json.dumps(
+            {"weft": 1, "method": "nfpt", "params": {"lines": "/dev/zero"}, "inputs": {"photo": "p.png"}, "seed": 1}
+        )
+    )
     code, out, err = _run(["run", recipe, "-o", tmp_path / "o.png"], capsys)
     assert code == 2 and err.count("\n") == 1 and "/dev/zero: is a character device" in err, err
 
@@ -99,18 +101,54 @@ def test_a_batch_whose_fixed_input_or_resumed_output_is_a_fifo(fifo, tmp_path, c
     frames.mkdir()
     _texture(frames / "a.png")
     recipe = tmp_path / "look.json"
-    recipe.write_text(json.dumps({"weft": 1, "method": "fast", "params": {"n": 5},
-                                  "inputs": {"texture": "gravel.png", "target": "f0.png"}, "seed": 1}))
-    code, out, err = _run(["batch", recipe, "--over", "target", frames, "-o", str(tmp_path / "out" / "{stem}.png"),
-                           "--workers", "1", "-q"], capsys)
-    assert code == 2 and err == (f"weft: {recipe}: the texture image {tmp_path / 'gravel.png'} is a named pipe "
-                                 "(FIFO), not an image file\n")
+    recipe.write_text(
+        json.dumps(
+            {
+                "weft": 1,
+                "method": "fast",
+                "params": {"n": 5},
+                "inputs": {"texture": "gravel.png", "target": "f0.png"},
+                "seed": 1,
+            }
+        )
+    )
+    code, out, err = _run(
+        [
+            "batch",
+            recipe,
+            "--over",
+            "target",
+            frames,
+            "-o",
+            str(tmp_path / "out" / "{stem}.png"),
+            "--workers",
+            "1",
+            "-q",
+        ],
+        capsys,
+    )
+    assert code == 2 and err == (
+        f"weft: {recipe}: the texture image {tmp_path / 'gravel.png'} is a named pipe (FIFO), not an image file\n"
+    )
     os.rename(tmp_path / "gravel.png", fifo)
     _texture(tmp_path / "gravel.png")
     (tmp_path / "out").mkdir()
     os.rename(fifo, tmp_path / "out" / "a.png")  # an output left as a pipe: not done, and not replaced
-    code, out, err = _run(["batch", recipe, "--over", "target", frames, "-o", str(tmp_path / "out" / "{stem}.png"),
-                           "--workers", "1", "-q"], capsys)
+    code, out, err = _run(
+        [
+            "batch",
+            recipe,
+            "--over",
+            "target",
+            frames,
+            "-o",
+            str(tmp_path / "out" / "{stem}.png"),
+            "--workers",
+            "1",
+            "-q",
+        ],
+        capsys,
+    )
     assert code == 2 and err.count("\n") == 1 and "which is a named pipe (FIFO)" in err, err
 
 
@@ -129,8 +167,11 @@ def test_a_recipe_chunk_that_inflates_to_a_gigabyte_is_refused(tmp_path, capsys)
     data = plain.read_bytes()
     inflater = zlib.compressobj(9)
     # 1 GiB of spaces after a valid recipe's first bytes: about 1 MB compressed
-    bomb = inflater.compress(b'{"weft": 1, "method": "quilt"') + b"".join(
-        inflater.compress(b" " * 2**24) for _ in range(64)) + inflater.flush()
+    bomb = (
+        inflater.compress(b'{"weft": 1, "method": "quilt"')
+        + b"".join(inflater.compress(b" " * 2**24) for _ in range(64))
+        + inflater.flush()
+    )
     png = tmp_path / "bomb.png"
     png.write_bytes(data[:33] + _chunk(b"zTXt", b"weft-recipe\0\0" + bomb) + data[33:])
     import tracemalloc

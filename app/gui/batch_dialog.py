@@ -13,8 +13,8 @@ nothing here names a method, input or parameter.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
@@ -34,7 +34,6 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
-
 from weft.core import batch, registry
 from weft.core.errors import WeftError
 from weft.core.jobs import CancelToken
@@ -88,12 +87,16 @@ class BatchDialog(QDialog):
         self.browse = browse = QPushButton("Browse…")
         browse.clicked.connect(self._browse_folder)
         self.output = QLineEdit()
-        self.output.setPlaceholderText(f"output folder (default: a '{OUTPUT_SUBFOLDER}' folder inside the input folder)")
+        self.output.setPlaceholderText(
+            f"output folder (default: a '{OUTPUT_SUBFOLDER}' folder inside the input folder)"
+        )
         self.browse_out = browse_out = QPushButton("Browse…")
         browse_out.clicked.connect(self._browse_output)
         self.names = QLineEdit(DEFAULT_NAMES)
-        self.names.setToolTip("{stem}: the input file's name without extension, {name}: with it, {index}: "
-                              "its position from 0 (e.g. frame_{index:04d}.png)")
+        self.names.setToolTip(
+            "{stem}: the input file's name without extension, {name}: with it, {index}: "
+            "its position from 0 (e.g. frame_{index:04d}.png)"
+        )
         self.workers = QSpinBox()
         self.workers.setRange(1, max(1, batch.default_workers()))
         self.workers.setValue(batch.default_workers())
@@ -148,8 +151,10 @@ class BatchDialog(QDialog):
         self.resize(640, self.sizeHint().height())
 
     def _describe(self) -> None:
-        self.about.setText(f"The current result's recipe ({self.recipe.method}, seed {self.recipe.seed}) is applied "
-                           "to every image of the folder, each in place of the chosen input.")
+        self.about.setText(
+            f"The current result's recipe ({self.recipe.method}, seed {self.recipe.seed}) is applied "
+            "to every image of the folder, each in place of the chosen input."
+        )
         self.seed_per_item.setText(f"seed + item number (otherwise seed {self.recipe.seed} on every item)")
 
     # --- inputs --------------------------------------------------------------------------------
@@ -164,8 +169,11 @@ class BatchDialog(QDialog):
             self.output.setText(path)
 
     def _folder_changed(self, text: str) -> None:
-        self.output.setPlaceholderText(str(Path(text) / OUTPUT_SUBFOLDER) if text.strip() else
-                                       f"output folder (default: a '{OUTPUT_SUBFOLDER}' folder inside the input folder)")
+        self.output.setPlaceholderText(
+            str(Path(text) / OUTPUT_SUBFOLDER)
+            if text.strip()
+            else f"output folder (default: a '{OUTPUT_SUBFOLDER}' folder inside the input folder)"
+        )
 
     def output_folder(self) -> str:
         given = self.output.text().strip()
@@ -204,8 +212,9 @@ class BatchDialog(QDialog):
         self._set_running(True)
         self.status.setText("starting the worker processes…")
         self.progress.setRange(0, 0)  # busy until the first item is counted
-        self._thread = threading.Thread(target=self._work, args=(over, pattern, options, workers, self._cancel),
-                                        name="weft-batch", daemon=True)
+        self._thread = threading.Thread(
+            target=self._work, args=(over, pattern, options, workers, self._cancel), name="weft-batch", daemon=True
+        )
         self._thread.start()
 
     def _emit(self, signal, *args) -> None:
@@ -221,10 +230,18 @@ class BatchDialog(QDialog):
         try:
             plan = batch.plan("the studio's recipe", over, pattern, recipe=self.recipe, **options)
             self._emit(self.progressed, len(plan.skipped), len(plan.items), 0, -1.0)
-            summary = batch.run(plan, workers=workers, cancel=cancel,
-                                progress=lambda s: self._emit(
-                                    self.progressed, s.done, s.total, s.failed,
-                                    -1.0 if s.seconds_left is None else float(s.seconds_left)))
+            summary = batch.run(
+                plan,
+                workers=workers,
+                cancel=cancel,
+                progress=lambda s: self._emit(
+                    self.progressed,
+                    s.done,
+                    s.total,
+                    s.failed,
+                    -1.0 if s.seconds_left is None else float(s.seconds_left),
+                ),
+            )
         except WeftError as e:
             self._emit(self.batch_finished, " ".join(str(e).split()), -1, False)
             return
@@ -243,8 +260,17 @@ class BatchDialog(QDialog):
     def _set_running(self, running: bool) -> None:
         self.run_button.setEnabled(not running)
         self.cancel_button.setEnabled(running)
-        for w in (self.over, self.folder, self.browse, self.output, self.browse_out, self.names, self.workers,
-                  self.seed_per_item, self.force):
+        for w in (
+            self.over,
+            self.folder,
+            self.browse,
+            self.output,
+            self.browse_out,
+            self.names,
+            self.workers,
+            self.seed_per_item,
+            self.force,
+        ):
             w.setEnabled(not running)
 
     def _on_progress(self, done: int, total: int, failed: int, seconds_left: float) -> None:

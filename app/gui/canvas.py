@@ -32,7 +32,6 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
-
 from weft.core.studio import LINES, MARGINS, MASK, SQUARE
 
 from .lines_panel import FeatureLinesPanel
@@ -120,14 +119,18 @@ class InputsPane(QSplitter):
         if tool is None:
             view = self.view(input_name)
             if geometry.kind == SQUARE:
-                tool = PatchTool(view, self.doc, geometry.key,
-                                 on_drag=lambda square, k=geometry.key: self.dragging.emit(k, square))
+                tool = PatchTool(
+                    view, self.doc, geometry.key, on_drag=lambda square, k=geometry.key: self.dragging.emit(k, square)
+                )
             elif geometry.kind == MASK:
-                tool = MaskTool(view, self.doc, geometry,
-                                on_stroke=lambda mask, box, k=geometry.key: self.painting.emit(k, mask, box))
+                tool = MaskTool(
+                    view,
+                    self.doc,
+                    geometry,
+                    on_stroke=lambda mask, box, k=geometry.key: self.painting.emit(k, mask, box),
+                )
             elif geometry.kind == MARGINS:
-                tool = MarginsTool(view, self.doc, geometry,
-                                   on_drag=lambda m, k=geometry.key: self.dragging.emit(k, m))
+                tool = MarginsTool(view, self.doc, geometry, on_drag=lambda m, k=geometry.key: self.dragging.emit(k, m))
             elif geometry.kind == LINES:
                 # one lines panel (with the frontal frame), on the view of the first lines geometry met
                 if self.lines_panel is None:
@@ -168,8 +171,9 @@ class InputsPane(QSplitter):
         if lines is not None:
             self.tool(lines, lines.input_for(self.doc.inputs))
             self.tabs.insertTab(0, self.lines_panel, "frontal frame")
-            self.tabs.setTabToolTip(0, "the frontal frame: the photo rectified live from the feature lines; "
-                                       "draw each line's partner here")
+            self.tabs.setTabToolTip(
+                0, "the frontal frame: the photo rectified live from the feature lines; draw each line's partner here"
+            )
             self.lines_panel.set_active(True)
         self.tabs.setCurrentIndex(0)
         self.tabs.setVisible(self.tabs.count() > 0)
@@ -181,8 +185,9 @@ class InputsPane(QSplitter):
     def paints_on_canvas(self) -> bool:
         """The current method's canvas carries a painted mask: painting is the main work, on the
         large view."""
-        return any(g.kind == MASK and g.input_for(self.doc.inputs) == self.doc.studio.canvas
-                   for g in self.doc.studio.geometry)
+        return any(
+            g.kind == MASK and g.input_for(self.doc.inputs) == self.doc.studio.canvas for g in self.doc.studio.geometry
+        )
 
     def sync_tools(self) -> None:
         """Attach each geometry's tool to the view of the input it is drawn on now (others none), and
@@ -209,8 +214,10 @@ class InputsPane(QSplitter):
                 wanted[name] = tools[0]
             else:
                 wanted[name] = self._toolsets.setdefault(tuple(tools), ToolSet(tools))
-            self._bar(name).attach([t for t in tools if isinstance(t, MaskTool)] or None,
-                                   next((t for t in tools if isinstance(t, MarginsTool)), None))
+            self._bar(name).attach(
+                [t for t in tools if isinstance(t, MaskTool)] or None,
+                next((t for t in tools if isinstance(t, MarginsTool)), None),
+            )
         for name, bar in self._bars.items():
             if name not in per_view:
                 bar.attach(None, None)
@@ -277,8 +284,11 @@ class InputsPane(QSplitter):
         is_open = self.doc.image(name) is not None
         button.setEnabled(is_open)
         pretty = name.replace("_", " ")
-        button.setToolTip(f"remove the {pretty} (the method runs without it; Ctrl+Z brings it back)" if is_open
-                          else f"no {pretty} is open (optional)")
+        button.setToolTip(
+            f"remove the {pretty} (the method runs without it; Ctrl+Z brings it back)"
+            if is_open
+            else f"no {pretty} is open (optional)"
+        )
 
     def geometry_changed(self) -> None:
         self.sync_tools()

@@ -17,17 +17,17 @@ image file as that input makes it the mask. A session keeps it as a 1-bit PNG be
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoCommand, QUndoStack
-
 from weft.core import registry
 from weft.core.errors import WeftError
-from weft.core.geometry import LINES, MARGINS, MASK, SQUARE, LineDraft, Margins, Mask, MaskStroke, Square
+from weft.core.geometry import LINES, MASK, SQUARE, LineDraft, Margins, Mask, MaskStroke, Square
 from weft.core.params import Params, Recipe, relative_path
 from weft.core.session import SESSION_VERSION, mask_file, read_session  # noqa: F401 (read_session: the studio reads sessions)
 from weft.core.studio import Geometry, Studio
@@ -293,12 +293,11 @@ class Document(QObject):
         painted = {g.input for g in self.studio.geometry if g.kind == MASK}
         inputs = {}
         for spec in self.current.inputs:  # what method_inputs gives the method: its painted masks are
-            item = self.item(spec.name)   # not files (export writes them beside the result)
+            item = self.item(spec.name)  # not files (export writes them beside the result)
             if item is not None and item.path and spec.name not in painted:
                 inputs[spec.name] = item.path
         params = self.run_params(live=False) if params is None else params
-        return Recipe(method=self.method, params=params.to_dict(), inputs=inputs,
-                      seed=self.seed, region=self.region())
+        return Recipe(method=self.method, params=params.to_dict(), inputs=inputs, seed=self.seed, region=self.region())
 
     # --- edits (undoable) ----------------------------------------------------------------------
     def push(self, command: QUndoCommand) -> None:
@@ -317,8 +316,9 @@ class Document(QObject):
         if params != self.current_params:
             self.push(SetParams(self, self.method, params, text))
 
-    def set_input(self, name: str, path: str | None, image: np.ndarray, with_alpha: np.ndarray | None = None,
-                  bit_depth: int = 8) -> None:
+    def set_input(
+        self, name: str, path: str | None, image: np.ndarray, with_alpha: np.ndarray | None = None, bit_depth: int = 8
+    ) -> None:
         """Undoable opening of an input image. An input the current method paints (a mask geometry)
         becomes that mask (refused in one line if it is not the size of its image). Masks painted on
         this input that do not fit the new image are dropped (said in ``message``; undo brings them back)."""
@@ -432,6 +432,7 @@ class Document(QObject):
         """The session JSON object. A mask is the name of its PNG beside ``session`` (the file the
         JSON goes to; :meth:`session_masks` says what to write there); without ``session`` masks are
         left out."""
+
         def path(p):
             return p if relative_to is None else relative_path(p, relative_to)
 
@@ -446,17 +447,25 @@ class Document(QObject):
             "params": {name: p.to_dict() for name, p in self.params.items()},
             "inputs": {name: path(item.path) for name, item in self.inputs.items() if item.path},
             # which method an input was opened for, where a method takes it only then (Studio.own_inputs)
-            "opened_for": {name: item.opened_for for name, item in self.inputs.items()
-                           if item.path and item.opened_for is not None},
-            "geometry": {name: {key: geometry(name, key, value) for key, value in values.items()}
-                         for name, values in self.geometry.items() if values},
+            "opened_for": {
+                name: item.opened_for for name, item in self.inputs.items() if item.path and item.opened_for is not None
+            },
+            "geometry": {
+                name: {key: geometry(name, key, value) for key, value in values.items()}
+                for name, values in self.geometry.items()
+                if values
+            },
             "seed": self.seed,
         }
 
     def session_masks(self, session: str | Path) -> dict[Path, Mask]:
         """The mask PNGs a session at ``session`` keeps beside it: file -> mask."""
-        return {mask_file(session, name, key): value for name, values in self.geometry.items()
-                for key, value in values.items() if isinstance(value, Mask)}
+        return {
+            mask_file(session, name, key): value
+            for name, values in self.geometry.items()
+            for key, value in values.items()
+            if isinstance(value, Mask)
+        }
 
     def session_writer(self, path: str | Path) -> Callable[[], None]:
         """Writing the session at ``path``, captured now: a function that encodes its masks as 1-bit
@@ -541,8 +550,10 @@ class SetInput(QUndoCommand):
         self.doc._put_input(self.name, self.new)
         for method, key, mask in self.dropped:
             h, w = self.new.image.shape[:2]
-            self.doc.message.emit(f"the {key.replace('_', ' ')} of {method} ({mask.size[0]}x{mask.size[1]}) does not "
-                                  f"fit the new {self.name.replace('_', ' ')} ({w}x{h}): dropped (Ctrl+Z brings it back)")
+            self.doc.message.emit(
+                f"the {key.replace('_', ' ')} of {method} ({mask.size[0]}x{mask.size[1]}) does not "
+                f"fit the new {self.name.replace('_', ' ')} ({w}x{h}): dropped (Ctrl+Z brings it back)"
+            )
         if self.dropped:
             self.doc.changed.emit("geometry")
 

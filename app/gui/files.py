@@ -24,18 +24,18 @@ import dataclasses
 import json
 import os
 import threading
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable, TypeVar
+from typing import TypeVar
 
-from PySide6.QtCore import QEventLoop, QMetaObject, QObject, QStandardPaths, Qt, QTimer, Signal
+from PySide6.QtCore import QEventLoop, QMetaObject, QObject, Qt, QTimer, Signal
 from PySide6.QtWidgets import QFileDialog
-
 from weft.core import registry
 from weft.core.errors import WeftError
+from weft.core.image import atomic_write_bytes, save_image
 from weft.core.jobs import JobResult, JobRunner
 from weft.core.readfile import file_key
 from weft.core.studio import MASK, SQUARE
-from weft.core.image import atomic_write_bytes, save_image
 
 from . import recovery
 from .document import DocumentState, InputImage, read_input, read_session
@@ -250,8 +250,9 @@ class FileActions(QObject):
     def save_session_dialog(self) -> bool:
         """Ask where, then save; True if the session was saved."""
         if self.session_path:
-            path, _ = QFileDialog.getSaveFileName(self.window, "Save session as", self.session_path,
-                                                  "weft session (*.weft.json *.json)")
+            path, _ = QFileDialog.getSaveFileName(
+                self.window, "Save session as", self.session_path, "weft session (*.weft.json *.json)"
+            )
             if path:
                 self.settings.setValue("last_dir", str(Path(path).parent))
         else:
@@ -270,8 +271,9 @@ class FileActions(QObject):
         return True
 
     def open_session_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self.window, "Open session", str(self.settings.value("last_dir", "") or ""),
-                                              "weft session (*.json)")
+        path, _ = QFileDialog.getOpenFileName(
+            self.window, "Open session", str(self.settings.value("last_dir", "") or ""), "weft session (*.json)"
+        )
         if path:
             self.open_session(path)
 
@@ -303,8 +305,10 @@ class FileActions(QObject):
         def decode() -> tuple[dict, dict[str, InputImage]]:
             data = read_session(path, dropped=dropped)  # (its mask PNGs decoded); missing or unreadable: the rest opens
             if data["method"] not in offered:
-                raise WeftError(f"{path}: the studio does not offer method {data['method']!r} "
-                                f"(it offers {', '.join(offered)}; use 'weft {data['method']}')")
+                raise WeftError(
+                    f"{path}: the studio does not offer method {data['method']!r} "
+                    f"(it offers {', '.join(offered)}; use 'weft {data['method']}')"
+                )
             images = {}
             for name, p in data["inputs"].items():
                 try:
@@ -341,8 +345,15 @@ class FileActions(QObject):
         does not get shows as an empty input, which can be opened again; one it gets silently changes the result)."""
         opened_for = data.get("opened_for") or {}  # (not recorded: no own input counts as opened for its method)
         images = {name: dataclasses.replace(item, opened_for=opened_for.get(name)) for name, item in images.items()}
-        self.doc.restore(DocumentState(inputs=images, method=data["method"], params=data["params"],
-                                       geometry=data["geometry"], seed=data["seed"]))
+        self.doc.restore(
+            DocumentState(
+                inputs=images,
+                method=data["method"],
+                params=data["params"],
+                geometry=data["geometry"],
+                seed=data["seed"],
+            )
+        )
         self.renderer.final(now=True)
 
     # --- asking, autosave, recovery --------------------------------------------------------------
@@ -438,8 +449,9 @@ class FileActions(QObject):
             if not recovery.claim(path, self._me):
                 continue
             when = recovery.modified(path)
-            if not self.window._ask_restore(f"A weft window did not close normally{f' ({when})' if when else ''}. "
-                                            f"Restore its unsaved session?"):
+            if not self.window._ask_restore(
+                f"A weft window did not close normally{f' ({when})' if when else ''}. Restore its unsaved session?"
+            ):
                 self._discard_file(path)
                 continue
             try:

@@ -16,18 +16,19 @@ Clear and Invert act on the mask being painted; Fill transparent makes the first
 
 from __future__ import annotations
 
-from PySide6.QtCore import QSize, Qt, Signal
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import QFrame, QSizePolicy, QSpinBox, QToolButton, QWidget
-
 from weft.core.geometry import Mask
 
 from .flow_layout import FlowLayout
 from .margins_tool import ExtendDialog, MarginsTool
 from .mask_tool import BRUSH, BRUSH_MAX, BRUSH_MIN, ERASER, LASSO_ADD, LASSO_SUBTRACT, MODES, MaskTool
 
-_EDGES = ("; outside the image a press paints while the brush's circle covers the image, and drags the canvas "
-          "edges farther out or with Shift")
+_EDGES = (
+    "; outside the image a press paints while the brush's circle covers the image, and drags the canvas "
+    "edges farther out or with Shift"
+)
 _LABELS = {BRUSH: "Brush", ERASER: "Eraser", LASSO_ADD: "Lasso +", LASSO_SUBTRACT: "Lasso −"}
 _LABELS_ALL = {BRUSH: "Include", ERASER: "Exclude", LASSO_ADD: "Lasso +", LASSO_SUBTRACT: "Lasso −"}
 
@@ -35,18 +36,22 @@ _LABELS_ALL = {BRUSH: "Include", ERASER: "Exclude", LASSO_ADD: "Lasso +", LASSO_
 def _tips(name: str, everywhere: bool) -> dict[str, str]:
     """The mode buttons' tooltips for a mask called ``name``."""
     if everywhere:
-        return {BRUSH: f"Include: paint the {name}, where the method may copy from (on nothing painted: only "
-                       f"there; [ and ] size the brush)" + _EDGES,
-                ERASER: f"Exclude: paint where the method must not copy from (on nothing painted: everywhere "
-                        f"else stays in the {name})" + _EDGES,
-                LASSO_ADD: f"draw a closed outline to add to the {name}",
-                LASSO_SUBTRACT: f"draw a closed outline to take from the {name}"}
-    return {BRUSH: f"paint the {name} ([ and ] size the brush; Esc cancels a stroke)" + _EDGES,
-            ERASER: f"erase the {name} ([ and ] size the brush)" + _EDGES,
-            LASSO_ADD: f"draw a closed outline to add to the {name} (start it inside the image: a press "
-                       "outside drags the canvas edges)",
-            LASSO_SUBTRACT: f"draw a closed outline to take from the {name} (start it inside the image: a "
-                            "press outside drags the canvas edges)"}
+        return {
+            BRUSH: f"Include: paint the {name}, where the method may copy from (on nothing painted: only "
+            f"there; [ and ] size the brush)" + _EDGES,
+            ERASER: f"Exclude: paint where the method must not copy from (on nothing painted: everywhere "
+            f"else stays in the {name})" + _EDGES,
+            LASSO_ADD: f"draw a closed outline to add to the {name}",
+            LASSO_SUBTRACT: f"draw a closed outline to take from the {name}",
+        }
+    return {
+        BRUSH: f"paint the {name} ([ and ] size the brush; Esc cancels a stroke)" + _EDGES,
+        ERASER: f"erase the {name} ([ and ] size the brush)" + _EDGES,
+        LASSO_ADD: f"draw a closed outline to add to the {name} (start it inside the image: a press "
+        "outside drags the canvas edges)",
+        LASSO_SUBTRACT: f"draw a closed outline to take from the {name} (start it inside the image: a "
+        "press outside drags the canvas edges)",
+    }
 
 
 def _separator() -> QFrame:
@@ -106,12 +111,16 @@ class GeometryBar(QWidget):
         self.clear_action = self._action("Clear", "", self.clear_mask)
         self.invert_action = self._action("Invert", "", self.invert_mask)
         self.transparent_action = self._action("Fill transparent", "", self.fill_transparent)
-        self.extend_action = self._action("Extend canvas…", "type the pixels to add on each side (or drag outward "
-                                          "from outside the image: beyond the brush's circle, or with Shift)",
-                                          self.extend_dialog)
+        self.extend_action = self._action(
+            "Extend canvas…",
+            "type the pixels to add on each side (or drag outward "
+            "from outside the image: beyond the brush's circle, or with Shift)",
+            self.extend_dialog,
+        )
         self.clear_button, self.invert_button, self.transparent_button, self.extend_button = (
-            self.buttons[a] for a in (self.clear_action, self.invert_action, self.transparent_action,
-                                      self.extend_action))
+            self.buttons[a]
+            for a in (self.clear_action, self.invert_action, self.transparent_action, self.extend_action)
+        )
 
     def _button(self, action: QAction, index: int | None = None) -> QToolButton:
         """A button for ``action`` in the flow (at ``index``, else last), shown while it is visible."""
@@ -146,9 +155,20 @@ class GeometryBar(QWidget):
 
     def menu_actions(self) -> list[QAction]:
         """Its actions that apply now (for the window's Edit menu)."""
-        return [a for a in (*self.target_actions, *self.mode_actions.values(), self.smaller_action,
-                            self.larger_action, self.clear_action, self.invert_action, self.transparent_action,
-                            self.extend_action) if a.isVisible()]
+        return [
+            a
+            for a in (
+                *self.target_actions,
+                *self.mode_actions.values(),
+                self.smaller_action,
+                self.larger_action,
+                self.clear_action,
+                self.invert_action,
+                self.transparent_action,
+                self.extend_action,
+            )
+            if a.isVisible()
+        ]
 
     # --- which tools -----------------------------------------------------------------------------
     def attach(self, mask_tool, margins_tool: MarginsTool | None) -> None:
@@ -160,8 +180,16 @@ class GeometryBar(QWidget):
         self.mask_tools, self.margins_tool = tools, margins_tool
         armed = next((t for t in tools if t.armed), tools[0] if tools else None)
         has_mask = armed is not None
-        for a in [*self.mode_actions.values(), self.size_action, self.smaller_action, self.larger_action,
-                  self.clear_action, self.invert_action, self.transparent_action, self.edit_separator]:
+        for a in [
+            *self.mode_actions.values(),
+            self.size_action,
+            self.smaller_action,
+            self.larger_action,
+            self.clear_action,
+            self.invert_action,
+            self.transparent_action,
+            self.edit_separator,
+        ]:
             a.setVisible(has_mask)
         self.transparent_action.setVisible(any(not t.everywhere for t in tools))
         self.extend_action.setVisible(margins_tool is not None)
@@ -223,8 +251,10 @@ class GeometryBar(QWidget):
         if tool.mask() is None:
             others = [t.name for t in self.mask_tools if t is not tool]
             outside = f"outside the {others[0]}" if others else ""
-            return (f"the brush paints the {tool.name}: nothing painted yet, so everywhere {outside} — Include "
-                    f"to copy only from where you paint, Exclude to keep copies away from there").replace("  ", " ")
+            return (
+                f"the brush paints the {tool.name}: nothing painted yet, so everywhere {outside} — Include "
+                f"to copy only from where you paint, Exclude to keep copies away from there"
+            ).replace("  ", " ")
         return f"the brush paints the {tool.name} (shown in its own colour): Include adds to it, Exclude takes away"
 
     def _label_modes(self, tool: MaskTool | None) -> None:
@@ -259,12 +289,16 @@ class GeometryBar(QWidget):
         pretty = on.replace("_", " ")
         mask = tool.mask()
         self.clear_action.setEnabled(mask is not None and bool(mask))
-        self.clear_action.setToolTip(f"remove the whole {tool.name}" + (
-            " (then the method copies from everywhere again)" if tool.everywhere else ""))
+        self.clear_action.setToolTip(
+            f"remove the whole {tool.name}"
+            + (" (then the method copies from everywhere again)" if tool.everywhere else "")
+        )
         self.invert_action.setEnabled(item is not None and not (tool.everywhere and mask is None))
         self.invert_action.setToolTip(
-            f"nothing painted: the {tool.name} is everywhere already" if tool.everywhere and mask is None
-            else f"swap what the {tool.name} covers and what it does not")
+            f"nothing painted: the {tool.name} is everywhere already"
+            if tool.everywhere and mask is None
+            else f"swap what the {tool.name} covers and what it does not"
+        )
         hole = self._hole_tool()
         alpha = None if item is None else item.alpha
         if item is None:
@@ -276,8 +310,9 @@ class GeometryBar(QWidget):
         else:
             why = ""
         self.transparent_action.setEnabled(not why and hole is not None)
-        self.transparent_action.setToolTip(why or f"make the {hole.name if hole else ''} the transparent pixels "
-                                                  f"of the {pretty}")
+        self.transparent_action.setToolTip(
+            why or f"make the {hole.name if hole else ''} the transparent pixels of the {pretty}"
+        )
 
     # --- the actions -----------------------------------------------------------------------------
     def clear_mask(self) -> None:

@@ -16,7 +16,6 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QFileDialog, QHBoxLayout, QLabel, QPushButton, QSizePolicy, QSpinBox, QVBoxLayout, QWidget
-
 from weft.core.errors import WeftError
 from weft.core.jobs import JobResult, JobRunner
 from weft.core.studio import LINES
@@ -101,8 +100,12 @@ class FeatureLinesPanel(QWidget):
             self.message.emit(text)
             return
         lines, words = result.value
-        self.doc.set_lines(lines.image_lines.tolist(), lines.frontal_lines.tolist(), text="Suggest lines",
-                           frontal_size=lines.frontal_size)
+        self.doc.set_lines(
+            lines.image_lines.tolist(),
+            lines.frontal_lines.tolist(),
+            text="Suggest lines",
+            frontal_size=lines.frontal_size,
+        )
         self.message.emit(words)
 
     def _build(self) -> None:
@@ -111,13 +114,17 @@ class FeatureLinesPanel(QWidget):
         row = QHBoxLayout()
         self.quad_button = QPushButton("Quad…")
         self.quad_button.setCheckable(True)
-        self.quad_button.setToolTip("click the plane's four corners on the photo, clockwise from top-left: "
-                                    "four line pairs (the frontal rectangle's edges)")
+        self.quad_button.setToolTip(
+            "click the plane's four corners on the photo, clockwise from top-left: "
+            "four line pairs (the frontal rectangle's edges)"
+        )
         self.quad_button.toggled.connect(self._quad_mode)
         row.addWidget(self.quad_button)
         self.suggest_button = QPushButton("Suggest lines")
-        self.suggest_button.setToolTip("find two families of straight lines in the photo and propose line pairs "
-                                       "from them (edit them like drawn ones; Undo takes them back)")
+        self.suggest_button.setToolTip(
+            "find two families of straight lines in the photo and propose line pairs "
+            "from them (edit them like drawn ones; Undo takes them back)"
+        )
         self.suggest_button.clicked.connect(self.suggest)
         self.suggest_button.setVisible(False)
         row.addWidget(self.suggest_button)
@@ -154,8 +161,12 @@ class FeatureLinesPanel(QWidget):
 
     def _quad_mode(self, on: bool) -> None:
         if on:
-            self.photo_view.tool = QuadTool(self.photo_view, self.doc, on_done=lambda: self.quad_button.setChecked(False),
-                                            on_prompt=self.rectify_status.setText)
+            self.photo_view.tool = QuadTool(
+                self.photo_view,
+                self.doc,
+                on_done=lambda: self.quad_button.setChecked(False),
+                on_prompt=self.rectify_status.setText,
+            )
         else:
             self.photo_view.tool = self.photo_lines
             self._update_rectified()  # the status says the rectification again
@@ -215,8 +226,9 @@ class FeatureLinesPanel(QWidget):
         except WeftError as e:
             self.message.emit(str(e))
             return False
-        self.doc.set_lines(fl.image_lines.tolist(), fl.frontal_lines.tolist(), text="Load lines",
-                           frontal_size=fl.frontal_size)
+        self.doc.set_lines(
+            fl.image_lines.tolist(), fl.frontal_lines.tolist(), text="Load lines", frontal_size=fl.frontal_size
+        )
         return True
 
     def save_lines_dialog(self) -> None:

@@ -36,7 +36,6 @@ from PySide6.QtWidgets import (
     QSizePolicy,
     QSplitter,
 )
-
 from weft.core.errors import WeftError
 from weft.core.examples import example, examples
 from weft.core.jobs import JobRunner
@@ -249,9 +248,13 @@ class MainWindow(QMainWindow):
     def _confirm(self, question: str) -> bool:
         """Ask a yes/no question in a modal box; True for yes. The one place the studio asks
         (tests replace it)."""
-        answer = QMessageBox.question(self, "weft", question,
-                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
-                                      QMessageBox.StandardButton.No)
+        answer = QMessageBox.question(
+            self,
+            "weft",
+            question,
+            QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+            QMessageBox.StandardButton.No,
+        )
         return answer == QMessageBox.StandardButton.Yes
 
     def _ask_restore(self, question: str) -> bool:
@@ -268,15 +271,19 @@ class MainWindow(QMainWindow):
     def _ask_unsaved(self, doing: str) -> str:
         """The document has unsaved edits and the user is about to ``doing`` (e.g. "quit"): ask
         Save / Discard / Cancel in a modal box; returns "save", "discard" or "cancel"."""
-        box = QMessageBox(QMessageBox.Icon.Question, "weft",
-                          f"Save your unsaved edits as a session before you {doing}?",
-                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
-                          | QMessageBox.StandardButton.Cancel, self)
+        box = QMessageBox(
+            QMessageBox.Icon.Question,
+            "weft",
+            f"Save your unsaved edits as a session before you {doing}?",
+            QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel,
+            self,
+        )
         box.setDefaultButton(QMessageBox.StandardButton.Save)
         box.setEscapeButton(QMessageBox.StandardButton.Cancel)
         answer = box.exec()
-        return {QMessageBox.StandardButton.Save: "save",
-                QMessageBox.StandardButton.Discard: "discard"}.get(QMessageBox.StandardButton(answer), "cancel")
+        return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
+            QMessageBox.StandardButton(answer), "cancel"
+        )
 
     def may_drop_edits(self, doing: str) -> bool:
         """True when there is nothing unsaved, or the user saved (a session) or discarded it."""
@@ -299,11 +306,13 @@ class MainWindow(QMainWindow):
         for path in examples():
             item = QListWidgetItem(QIcon(str(path)), path.stem)
             item.setData(Qt.ItemDataRole.UserRole, str(path))
-            item.setToolTip(f"{path.name}: double-click to open it as the method's first input, "
-                            f"drag onto a view to open it there")
+            item.setToolTip(
+                f"{path.name}: double-click to open it as the method's first input, drag onto a view to open it there"
+            )
             self.example_list.addItem(item)
         self.example_list.itemDoubleClicked.connect(
-            lambda item: self.open_input(self.doc.studio.canvas, item.data(Qt.ItemDataRole.UserRole)))
+            lambda item: self.open_input(self.doc.studio.canvas, item.data(Qt.ItemDataRole.UserRole))
+        )
         dock = QDockWidget("Examples", self)
         dock.setObjectName("examples")
         dock.setWidget(self.example_list)
@@ -337,13 +346,16 @@ class MainWindow(QMainWindow):
         self.pixel_label = QLabel("")
         # the read-out keeps its own room (a typical read-out's width), so moving the mouse does not
         # shift the message, and a longer read-out is elided rather than pushed into it
-        self.pixel_label.setFixedWidth(self.pixel_label.fontMetrics().horizontalAdvance(
-            "texture  x 0000  y 0000  65535 65535 65535  (16-bit)") + 8)
+        self.pixel_label.setFixedWidth(
+            self.pixel_label.fontMetrics().horizontalAdvance("texture  x 0000  y 0000  65535 65535 65535  (16-bit)") + 8
+        )
         self.zoom_label = QLabel("")
         self.progress_bar = QProgressBar()
         self.progress_bar.setMaximumWidth(320)
         # room for a stage, its percentage and the time left (longer text is shortened to fit)
-        self.progress_bar.setMinimumWidth(self.progress_bar.fontMetrics().horizontalAdvance("synthesis 100% · 10 min 5 s") + 24)
+        self.progress_bar.setMinimumWidth(
+            self.progress_bar.fontMetrics().horizontalAdvance("synthesis 100% · 10 min 5 s") + 24
+        )
         self._work_started: float | None = None  # when the running render's counted work began
         self._last_fraction = 0.0
         self.progress_bar.setRange(0, 1000)
@@ -378,8 +390,13 @@ class MainWindow(QMainWindow):
         self.clear_input_menu = m.addMenu("&Clear Input")  # the current method's optional inputs
         m.addSeparator()
         self._action(m, "Open &Session…", self.files.open_session_dialog, "Ctrl+Shift+L")
-        self._action(m, "&Save Session", self.files.save_session_quick, QKeySequence.StandardKey.Save,
-                     tip="save to the session file last saved or opened (asks where the first time)")
+        self._action(
+            m,
+            "&Save Session",
+            self.files.save_session_quick,
+            QKeySequence.StandardKey.Save,
+            tip="save to the session file last saved or opened (asks where the first time)",
+        )
         self._action(m, "Save Session &As…", self.files.save_session_dialog, QKeySequence.StandardKey.SaveAs)
         m.addSeparator()
         self.save_result_action = self._action(m, "&Export Result…", self.files.save_result_dialog, "Ctrl+E")
@@ -400,8 +417,9 @@ class MainWindow(QMainWindow):
         e.addAction(redo)
         self.undo_action, self.redo_action = undo, redo
         e.addSeparator()
-        self.copy_result_action = self._action(e, "&Copy Result", self.copy_result, "Ctrl+Shift+C",
-                                               tip="copy the full-size result shown to the clipboard")
+        self.copy_result_action = self._action(
+            e, "&Copy Result", self.copy_result, "Ctrl+Shift+C", tip="copy the full-size result shown to the clipboard"
+        )
         self._action(e, "New &Seed", self.method_panel.new_seed, "Ctrl+R")
         self.clear_square_action = self._action(e, "Clear S&quare", lambda: self.doc.set_square(None))
         self.geometry_menu = e.addMenu("&Mask and Canvas")  # the mask and margins tools' actions, if any
@@ -420,13 +438,22 @@ class MainWindow(QMainWindow):
             toggle.setText(f"{dock.windowTitle()} Panel")
             toggle.setStatusTip(f"show or hide the {dock.windowTitle()} panel")
             v.addAction(toggle)
-        self.paint_large_action = self._action(v, "Large &Picture to Paint", self._toggle_paint_large, "Ctrl+L",
-                                               tip="the picture you paint on gets the larger share of the window, "
-                                                   "the result the smaller (a method that paints on its picture)")
+        self.paint_large_action = self._action(
+            v,
+            "Large &Picture to Paint",
+            self._toggle_paint_large,
+            "Ctrl+L",
+            tip="the picture you paint on gets the larger share of the window, "
+            "the result the smaller (a method that paints on its picture)",
+        )
         self.paint_large_action.setCheckable(True)
         self.paint_large_action.setChecked(self.settings.value("paint_large", False, type=bool))
-        self.reset_layout_action = self._action(v, "Reset &Layout", self.reset_layout,
-                                                tip="put every panel back where it was when the studio was first opened")
+        self.reset_layout_action = self._action(
+            v,
+            "Reset &Layout",
+            self.reset_layout,
+            tip="put every panel back where it was when the studio was first opened",
+        )
         self.view_menu = v
         self._refresh_recent()
 
@@ -446,17 +473,23 @@ class MainWindow(QMainWindow):
         width = self.width()
         method_width = max(self.method_panel.minimumSizeHint().width(), min(390, int(width * 0.3)))
         if width < NARROW:
-            if (self.dockWidgetArea(self.examples_dock) != self.dockWidgetArea(self.method_dock)
-                    and not self.examples_dock.isFloating() and not self.method_dock.isFloating()):
+            if (
+                self.dockWidgetArea(self.examples_dock) != self.dockWidgetArea(self.method_dock)
+                and not self.examples_dock.isFloating()
+                and not self.method_dock.isFloating()
+            ):
                 self.tabifyDockWidget(self.method_dock, self.examples_dock)
             self.method_dock.raise_()
             self.resizeDocks([self.method_dock], [method_width], Qt.Orientation.Horizontal)
         else:
-            if (self.dockWidgetArea(self.examples_dock) != Qt.DockWidgetArea.LeftDockWidgetArea
-                    and not self.examples_dock.isFloating()):
+            if (
+                self.dockWidgetArea(self.examples_dock) != Qt.DockWidgetArea.LeftDockWidgetArea
+                and not self.examples_dock.isFloating()
+            ):
                 self.addDockWidget(Qt.DockWidgetArea.LeftDockWidgetArea, self.examples_dock)
-            self.resizeDocks([self.examples_dock, self.method_dock], [EXAMPLES_WIDTH, method_width],
-                             Qt.Orientation.Horizontal)
+            self.resizeDocks(
+                [self.examples_dock, self.method_dock], [EXAMPLES_WIDTH, method_width], Qt.Orientation.Horizontal
+            )
         total = max(self.width() - method_width - (0 if width < NARROW else EXAMPLES_WIDTH) - 24, 400)
         self._split(total)
 
@@ -515,7 +548,7 @@ class MainWindow(QMainWindow):
 
     def _add_recent(self, path: str) -> None:
         recent = [p for p in (self.settings.value("recent", []) or []) if p != path]
-        self.settings.setValue("recent", [path] + recent[:MAX_RECENT - 1])
+        self.settings.setValue("recent", [path] + recent[: MAX_RECENT - 1])
         self._refresh_recent()
 
     def _refresh_recent(self) -> None:
@@ -554,7 +587,10 @@ class MainWindow(QMainWindow):
 
     def _resplit_for_method(self) -> None:
         """After a method change: the split follows whether the new method paints on its canvas."""
-        if getattr(self, "_sized", False) and getattr(self, "_split_share", None) != self.inputs_pane.paints_on_canvas():
+        if (
+            getattr(self, "_sized", False)
+            and getattr(self, "_split_share", None) != self.inputs_pane.paints_on_canvas()
+        ):
             self._split(max(sum(self.splitter.sizes()), 400))
 
     def _on_doc_changed(self, what: str) -> None:
@@ -602,8 +638,9 @@ class MainWindow(QMainWindow):
         # (always there, disabled when the method has one input: the File menu keeps its length, so
         # a habitual click never lands on another entry)
         self.open_second_action.setEnabled(len(inputs) > 1)
-        self.open_second_action.setText(f"Open {inputs[1].name.replace('_', ' ')}…" if len(inputs) > 1
-                                         else "Open Second Input…")
+        self.open_second_action.setText(
+            f"Open {inputs[1].name.replace('_', ' ')}…" if len(inputs) > 1 else "Open Second Input…"
+        )
         self.open_other_menu.clear()
         for inp in inputs:
             act = self.open_other_menu.addAction(f"{inp.name.replace('_', ' ')}…")
@@ -684,7 +721,13 @@ class MainWindow(QMainWindow):
         room = bar.contentsRect().width() - 8
         percent = f"{round(100 * bar.value() / max(bar.maximum(), 1))}%"
         metrics = bar.fontMetrics()
-        for text in (full, f"{stage} %p%" + (f" · {left}" if left else ""), f"{stage} %p%", "%p%" + (f" · {left}" if left else ""), "%p%"):
+        for text in (
+            full,
+            f"{stage} %p%" + (f" · {left}" if left else ""),
+            f"{stage} %p%",
+            "%p%" + (f" · {left}" if left else ""),
+            "%p%",
+        ):
             if metrics.horizontalAdvance(text.replace("%p%", percent)) <= room:
                 break
         bar.setFormat(text)
@@ -719,8 +762,9 @@ class MainWindow(QMainWindow):
         is drawn yet: its geometry's help, e.g. "paint what to fill"."""
         # (a mask that means "every pixel" unpainted, a sampling area, is not what there is to do)
         geometry = [g for g in self.doc.studio.geometry if not g.empty_is_all]
-        if not any(g.kind in (MASK, MARGINS) for g in geometry) or any(self.doc.value(g.key) is not None
-                                                                         for g in geometry):
+        if not any(g.kind in (MASK, MARGINS) for g in geometry) or any(
+            self.doc.value(g.key) is not None for g in geometry
+        ):
             return None
         words = "; ".join(g.help for g in geometry if g.help) or "draw on the input"
         return words[0].upper() + words[1:]
@@ -736,8 +780,9 @@ class MainWindow(QMainWindow):
             self._show_before()
             return
         if message.startswith("render failed"):  # not a warm-up's: the result no longer matches the panel
-            self.result_view.set_stale(f"Out of date — {message}. The result shown is from earlier settings"
-                                       f" (F5 renders again).")
+            self.result_view.set_stale(
+                f"Out of date — {message}. The result shown is from earlier settings (F5 renders again)."
+            )
         if self.renderer.last is not None:
             self.result_view.set_image(self.renderer.last.image)
 

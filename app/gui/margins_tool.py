@@ -7,12 +7,11 @@ frame drawn as a dashed outline); one undo command on release; Esc cancels. ``Ex
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 from PySide6.QtCore import QRectF, Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QDialog, QDialogButtonBox, QFormLayout, QGraphicsRectItem, QLabel, QSpinBox
-
 from weft.core.geometry import MAX_SIDE, Margins
 
 from .tools import Tool, _cosmetic
@@ -92,8 +91,7 @@ class MarginsTool(Tool):
         at = event.position()
         dx, dy = (at.x() - x0) * k, (at.y() - y0) * k
         moves = (-dx, -dy, dx, dy)
-        return Margins(*(max(0, min(MAX_SIDE, int(round(v + d)))) if s else v
-                         for v, d, s in zip(m, moves, sides)))
+        return Margins(*(max(0, min(MAX_SIDE, int(round(v + d)))) if s else v for v, d, s in zip(m, moves, sides)))
 
     def move(self, view, pos, event):
         if self.drag is None and self.hover_cursor:
@@ -125,7 +123,7 @@ class MarginsTool(Tool):
 
 
 class ExtendDialog(QDialog):
-    """"Extend canvas…": the four margins typed, in pixels."""
+    """ "Extend canvas…": the four margins typed, in pixels."""
 
     def __init__(self, margins: Margins, size: tuple[int, int], parent=None):
         super().__init__(parent)

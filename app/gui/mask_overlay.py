@@ -11,7 +11,6 @@ import numpy as np
 from PySide6.QtCore import QPointF, QRectF
 from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QGraphicsItem
-
 from weft.core.geometry import Mask, MaskStroke
 
 #: The colours (RGBA) of the masks of one image, in the order the method lists them.

@@ -24,13 +24,12 @@ only the armed tool paints, shows its circle and takes ``[`` / ``]``.
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, QSettings, QSize, Qt
 from PySide6.QtGui import QBrush, QColor, QPainterPath
 from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsPathItem
-
 from weft.core.geometry import MASK, Mask, MaskStroke
 
 from .mask_overlay import MASK_COLOURS, MaskOverlay
@@ -53,8 +52,14 @@ def default_size(width: int, height: int, fraction: float = BRUSH_FRACTION) -> i
 class MaskTool(Tool):
     """Paints the mask geometry ``geometry`` of the current method on ``view`` (module docstring)."""
 
-    def __init__(self, view, doc, geometry, on_stroke: Callable[[Mask | None, tuple | None], None] | None = None,
-                 on_size: Callable[[int], None] | None = None):
+    def __init__(
+        self,
+        view,
+        doc,
+        geometry,
+        on_stroke: Callable[[Mask | None, tuple | None], None] | None = None,
+        on_size: Callable[[int], None] | None = None,
+    ):
         self.view, self.doc, self.geometry, self.on_stroke, self.on_size = view, doc, geometry, on_stroke, on_size
         self.geometry_key = geometry.key
         self.mode = BRUSH
@@ -260,8 +265,11 @@ class MaskTool(Tool):
         if changed is not None:
             self.overlay.update_box(self.live, changed)
             t = self.touched
-            self.touched = changed if t is None else (min(t[0], changed[0]), min(t[1], changed[1]),
-                                                      max(t[2], changed[2]), max(t[3], changed[3]))
+            self.touched = (
+                changed
+                if t is None
+                else (min(t[0], changed[0]), min(t[1], changed[1]), max(t[2], changed[2]), max(t[3], changed[3]))
+            )
         if self.on_stroke is not None:  # the eraser's strokes too: erased pixels are previewed unfilled
             self.on_stroke(self.live, box)
 

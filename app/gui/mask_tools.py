@@ -17,10 +17,36 @@ This module gathers them for the inputs pane.
 from .geometry_bar import GeometryBar
 from .margins_tool import ExtendDialog, MarginsTool
 from .mask_overlay import MASK_COLOURS, MASK_RGBA, MaskOverlay
-from .mask_tool import (BRUSH, BRUSH_DEFAULT, BRUSH_MAX, BRUSH_MIN, ERASER, LASSO_ADD, LASSO_SUBTRACT, MODES,
-                        MaskTool, default_size)
+from .mask_tool import (
+    BRUSH,
+    BRUSH_DEFAULT,
+    BRUSH_MAX,
+    BRUSH_MIN,
+    ERASER,
+    LASSO_ADD,
+    LASSO_SUBTRACT,
+    MODES,
+    MaskTool,
+    default_size,
+)
 from .tool_set import ToolSet
 
-__all__ = ["GeometryBar", "ExtendDialog", "MarginsTool", "MASK_COLOURS", "MASK_RGBA", "MaskOverlay", "BRUSH",
-           "BRUSH_DEFAULT", "BRUSH_MAX", "BRUSH_MIN", "ERASER", "LASSO_ADD", "LASSO_SUBTRACT", "MODES", "MaskTool",
-           "default_size", "ToolSet"]
+__all__ = [
+    "GeometryBar",
+    "ExtendDialog",
+    "MarginsTool",
+    "MASK_COLOURS",
+    "MASK_RGBA",
+    "MaskOverlay",
+    "BRUSH",
+    "BRUSH_DEFAULT",
+    "BRUSH_MAX",
+    "BRUSH_MIN",
+    "ERASER",
+    "LASSO_ADD",
+    "LASSO_SUBTRACT",
+    "MODES",
+    "MaskTool",
+    "default_size",
+    "ToolSet",
+]

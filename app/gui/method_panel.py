@@ -29,7 +29,6 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
-
 from weft.core.errors import WeftError
 from weft.core.geometry import Square
 from weft.core.params import FLOAT, INT
@@ -60,8 +59,9 @@ class MethodPanel(QWidget):
         self.method_box = QComboBox()
         for name, method in doc.methods.items():
             self.method_box.addItem(method.studio.title, name)
-            self.method_box.setItemData(self.method_box.count() - 1, f"weft {name}: {method.summary}",
-                                        Qt.ItemDataRole.ToolTipRole)
+            self.method_box.setItemData(
+                self.method_box.count() - 1, f"weft {name}: {method.summary}", Qt.ItemDataRole.ToolTipRole
+            )
         self.method_box.currentIndexChanged.connect(self._method_chosen)
         top.addWidget(self.method_box, 1)
         lay.addLayout(top)
@@ -103,9 +103,11 @@ class MethodPanel(QWidget):
         sq = QHBoxLayout(self.square_row)
         sq.setContentsMargins(0, 0, 0, 0)
         self.square_boxes: list[QSpinBox] = []
-        for text, tip in (("X", "left edge of the square, pixels from the image's left"),
-                          ("Y", "top edge of the square, pixels from the image's top"),
-                          ("side", "side of the square, pixels")):
+        for text, tip in (
+            ("X", "left edge of the square, pixels from the image's left"),
+            ("Y", "top edge of the square, pixels from the image's top"),
+            ("side", "side of the square, pixels"),
+        ):
             label = QLabel(text)
             box = QSpinBox()
             box.setKeyboardTracking(False)  # a typed number counts on Enter (or leaving the box)
@@ -167,7 +169,9 @@ class MethodPanel(QWidget):
             return
         values = [b.value() for b in self.square_boxes]
         if doc.value(g.key) is None:  # none drawn: the boxes left blank take the corner and a default side
-            values = [d if v == b.minimum() else v for v, b, d in zip(values, self.square_boxes, _default_square(image))]
+            values = [
+                d if v == b.minimum() else v for v, b, d in zip(values, self.square_boxes, _default_square(image))
+            ]
         try:
             square = Square.parse(values, g.key)
             square.crop(image, where.replace("_", " "), g.key)
@@ -221,7 +225,7 @@ class MethodPanel(QWidget):
             self.square_label.clear()
             return
         x, y, s = square
-        patch = image[y:y + s, x:x + s]
+        patch = image[y : y + s, x : x + s]
         if patch.size:
             pix = QPixmap.fromImage(to_qimage(patch)).scaled(THUMB, THUMB, Qt.AspectRatioMode.KeepAspectRatio)
             self.square_label.setPixmap(pix)

@@ -24,7 +24,6 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 from superqt import QLabeledDoubleSlider, QLabeledSlider
-
 from weft.core.params import BOOL, CHOICE, FLOAT, INT, SIZE, Params, Spec, specs
 
 
@@ -139,8 +138,10 @@ class _Row(QWidget):
         """While "auto" is ticked the editor is disabled: its tooltip says why and how to edit it."""
         if self.auto is not None and self.auto.isChecked():
             now = "" if resolved is None else f" (now {resolved})"
-            self.editor.setToolTip(f"{self.spec.name} is derived from the inputs: \"auto\" is ticked{now}.\n"
-                                   f"Untick \"auto\" to set it by hand, starting from this value.")
+            self.editor.setToolTip(
+                f'{self.spec.name} is derived from the inputs: "auto" is ticked{now}.\n'
+                f'Untick "auto" to set it by hand, starting from this value.'
+            )
         else:
             self.editor.setToolTip(self.toolTip())
 
@@ -170,8 +171,11 @@ class _Row(QWidget):
 
     def set_value(self, value: Any, shown_when_auto: Any = None) -> None:
         """Show ``value`` without emitting ``changed``."""
-        widgets = [self, self.editor] + ([self.auto] if self.auto else []) + (
-            [self.w_box, self.h_box] if self.spec.kind == SIZE else [])
+        widgets = (
+            [self, self.editor]
+            + ([self.auto] if self.auto else [])
+            + ([self.w_box, self.h_box] if self.spec.kind == SIZE else [])
+        )
         for w in widgets:
             w.blockSignals(True)
         try:
@@ -232,15 +236,17 @@ class ParamsPanel(QWidget):
             self.form.addRow(label, row)
             self.rows[spec.name] = row
 
-    def show_params(self, params: Params, auto_values: dict[str, Any] | None = None,
-                    ranges: dict[str, tuple] | None = None) -> None:
+    def show_params(
+        self, params: Params, auto_values: dict[str, Any] | None = None, ranges: dict[str, tuple] | None = None
+    ) -> None:
         """Show ``params`` (``auto_values`` are what "auto" resolves to, shown greyed; ``ranges`` the
         narrower range a parameter accepts with the open inputs, for its slider and tooltip)."""
         auto_values, ranges = auto_values or {}, ranges or {}
         for name, row in self.rows.items():
             value = getattr(params, name)
-            row.set_range(ranges.get(name), value if isinstance(value, (int, float)) and not isinstance(value, bool)
-                          else None)
+            row.set_range(
+                ranges.get(name), value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+            )
             row.set_value(value, auto_values.get(name))
 
     def row(self, name: str) -> _Row:

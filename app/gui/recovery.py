@@ -25,7 +25,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from PySide6.QtCore import QStandardPaths
-
 from weft.core.image import atomic_write_bytes
 
 PREFIX = "recovery-"
@@ -36,8 +35,11 @@ SETTINGS_KEY = "recovery/settings_id"
 
 def recovery_folder() -> Path:
     """Where recovery files live: ``WEFT_RECOVERY_DIR`` if set, else the app data folder."""
-    folder = os.environ.get("WEFT_RECOVERY_DIR") or QStandardPaths.writableLocation(
-        QStandardPaths.StandardLocation.AppDataLocation) or str(Path.home() / ".weft")
+    folder = (
+        os.environ.get("WEFT_RECOVERY_DIR")
+        or QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
+        or str(Path.home() / ".weft")
+    )
     return Path(folder)
 
 
@@ -63,7 +65,7 @@ def process_started(pid: int) -> str | None:
         text = Path(f"/proc/{pid}/stat").read_text()
     except OSError:
         return None
-    return text[text.rfind(")") + 2:].split()[19]  # fields after the command name; 22nd of the line
+    return text[text.rfind(")") + 2 :].split()[19]  # fields after the command name; 22nd of the line
 
 
 def _pid_running(pid: int) -> bool:
@@ -79,7 +81,7 @@ def _pid_running(pid: int) -> bool:
 
 
 def lock_path(recovery: Path) -> Path:
-    return recovery.with_name(recovery.name[:-len(SUFFIX)] + LOCK_SUFFIX)
+    return recovery.with_name(recovery.name[: -len(SUFFIX)] + LOCK_SUFFIX)
 
 
 @dataclass(frozen=True)
@@ -96,8 +98,9 @@ class Owner:
         return cls(os.getpid(), _host(), process_started(os.getpid()), settings)
 
     def to_bytes(self) -> bytes:
-        return json.dumps({"pid": self.pid, "host": self.host, "started": self.started,
-                           "settings": self.settings}).encode("utf-8")
+        return json.dumps(
+            {"pid": self.pid, "host": self.host, "started": self.started, "settings": self.settings}
+        ).encode("utf-8")
 
     @classmethod
     def read(cls, lock: Path) -> Owner | None:
@@ -178,6 +181,9 @@ def modified(recovery: Path) -> str:
         t = recovery.stat().st_mtime
     except OSError:
         return ""
-    day = "today" if time.strftime("%Y%m%d", time.localtime(t)) == time.strftime("%Y%m%d") else \
-        time.strftime("%d %b", time.localtime(t))
+    day = (
+        "today"
+        if time.strftime("%Y%m%d", time.localtime(t)) == time.strftime("%Y%m%d")
+        else time.strftime("%d %b", time.localtime(t))
+    )
     return f"{day} {time.strftime('%H:%M', time.localtime(t))}"

@@ -38,17 +38,16 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
-
 from weft.core import registry
-from weft.core.jobs import JobResult, JobRunner, Progress
-from weft.core.params import Params, Recipe
 from weft.core.errors import WeftError
 from weft.core.geometry import MaskStroke
+from weft.core.jobs import JobResult, JobRunner, Progress
+from weft.core.params import Params, Recipe
 from weft.core.studio import around_region, crop_around, describe_figures, reduce_for_preview
 
 PREVIEW_SIDE = 400
@@ -153,8 +152,7 @@ def stroke_part(doc, box) -> tuple[np.ndarray, tuple[int, int]] | None:
     return live[1].cut(x0, y0, x1, y1), (x0, y0)
 
 
-def preparation(doc, *, side: int | None = None, around_box=None
-                ) -> tuple[Callable[[], tuple | None], Params] | None:
+def preparation(doc, *, side: int | None = None, around_box=None) -> tuple[Callable[[], tuple | None], Params] | None:
     """What a job of the document's current method runs on, captured now on the GUI thread (the
     document's inputs and parameters: references to immutable values) and built by the returned
     call, on the job's worker: its painted masks as float images, a crop to the source region, a
@@ -217,8 +215,11 @@ class Renderer(QObject):
         if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
             sys.setswitchinterval(GIL_SWITCH_INTERVAL)
         self.doc = doc
-        self.runner = JobRunner(max_workers=workers, on_result=self._delivered.emit,
-                                on_progress=lambda jid, slot, p: self._progressed.emit(jid, slot, p))
+        self.runner = JobRunner(
+            max_workers=workers,
+            on_result=self._delivered.emit,
+            on_progress=lambda jid, slot, p: self._progressed.emit(jid, slot, p),
+        )
         self._delivered.connect(self._on_result)
         self._progressed.connect(self._on_progress)
         self._preview_finished.connect(self._on_preview_finished)
@@ -317,8 +318,12 @@ class Renderer(QObject):
 
     def running(self) -> bool:
         """A preview or final render is running or about to start."""
-        return (self._final_running or self._preview_running is not None
-                or self._final_timer.isActive() or self._preview_timer.isActive())
+        return (
+            self._final_running
+            or self._preview_running is not None
+            or self._final_timer.isActive()
+            or self._preview_timer.isActive()
+        )
 
     def shutdown(self) -> None:
         self._warm_up_timer.stop()
@@ -455,8 +460,19 @@ class Renderer(QObject):
         if final:
             self._around_image = None
         self.input_shown = False
-        self.last = Shown(res.image, result.job_id, seconds, dict(res.figures), final, prepared, compiled,
-                          recipe, before, masks, method=name)
+        self.last = Shown(
+            res.image,
+            result.job_id,
+            seconds,
+            dict(res.figures),
+            final,
+            prepared,
+            compiled,
+            recipe,
+            before,
+            masks,
+            method=name,
+        )
         self.shown.emit(self.last)
 
     def _around_base(self) -> np.ndarray | None:
@@ -489,10 +505,21 @@ class Renderer(QObject):
         x0, y0, x1, y1 = crop.box
         dx, dy = crop.offset
         rh, rw = res.image.shape[:2]
-        self.around_shown.emit(Shown(self._around_image, job_id, seconds, dict(res.figures), False, recipe=None,
-                                     before=None if self.last is None else self.last.before, method=method,
-                                     crop=(x1 - x0, y1 - y0, rw, rh),
-                                     changed=(x0 + dx, y0 + dy, x1 + dx, y1 + dy), over=over))
+        self.around_shown.emit(
+            Shown(
+                self._around_image,
+                job_id,
+                seconds,
+                dict(res.figures),
+                False,
+                recipe=None,
+                before=None if self.last is None else self.last.before,
+                method=method,
+                crop=(x1 - x0, y1 - y0, rw, rh),
+                changed=(x0 + dx, y0 + dy, x1 + dx, y1 + dy),
+                over=over,
+            )
+        )
 
     def _on_progress(self, job_id: int, slot: str, p: Progress) -> None:
         if slot != "final" or job_id != self.latest_final:
@@ -555,8 +582,11 @@ def describe(shown: Shown) -> str:
         cw, ch, rw, rh = shown.crop
         at = "" if (rw, rh) == (cw, ch) else f" (rendered at {rw}x{rh})"
         later = len(_figure_words(shown, crop=False)) > len(_figure_words(shown))
-        return (f"preview around the stroke in {shown.seconds * 1000:.0f} ms — its {cw}x{ch} crop{at}"
-                + (f": {figs}" if figs else "") + ("; the image's figures on release" if later else ""))
+        return (
+            f"preview around the stroke in {shown.seconds * 1000:.0f} ms — its {cw}x{ch} crop{at}"
+            + (f": {figs}" if figs else "")
+            + ("; the image's figures on release" if later else "")
+        )
     prepared = ""
     if shown.compiled:
         prepared = f" (after preparing its kernels for {shown.prepared:.1f} s, first run only)"

@@ -17,12 +17,11 @@ overlay in the view's scene, and pushes one undo command on release. Esc cancels
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QFont, QPen
 from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsLineItem, QGraphicsRectItem, QGraphicsSimpleTextItem
-
 from weft.core.geometry import Square
 
 HANDLE_PX = 8  # grab distance of handles and end points, in screen pixels
@@ -291,9 +290,13 @@ class LineTool(Tool):
             i, k = end
             ends = [(i, k)]
             if not event.modifiers() & Qt.KeyboardModifier.AltModifier:
-                x, y = self.lines()[i][2 * k:2 * k + 2]
-                ends += [(j, e) for j, line in enumerate(self.lines()) for e in (0, 1)
-                         if (j, e) != (i, k) and abs(line[2 * e] - x) < LINKED and abs(line[2 * e + 1] - y) < LINKED]
+                x, y = self.lines()[i][2 * k : 2 * k + 2]
+                ends += [
+                    (j, e)
+                    for j, line in enumerate(self.lines())
+                    for e in (0, 1)
+                    if (j, e) != (i, k) and abs(line[2 * e] - x) < LINKED and abs(line[2 * e + 1] - y) < LINKED
+                ]
             self.drag = ("end", i, k, ends)
             self.selected = i
         else:
@@ -313,7 +316,7 @@ class LineTool(Tool):
             lines.append([sx, sy, x, y])
         else:
             for i, end in self.drag[3]:
-                lines[i][2 * end:2 * end + 2] = [x, y]
+                lines[i][2 * end : 2 * end + 2] = [x, y]
         return lines
 
     def move(self, view, pos, event):
@@ -368,8 +371,9 @@ class QuadTool(Tool):
 
     CORNERS = ("top-left", "top-right", "bottom-right", "bottom-left")
 
-    def __init__(self, view, doc, on_done: Callable[[], None] | None = None,
-                 on_prompt: Callable[[str], None] | None = None):
+    def __init__(
+        self, view, doc, on_done: Callable[[], None] | None = None, on_prompt: Callable[[str], None] | None = None
+    ):
         self.view, self.doc, self.on_done, self.on_prompt = view, doc, on_done, on_prompt
         self.points: list[tuple[float, float]] = []
         self.items: list = []
@@ -379,8 +383,10 @@ class QuadTool(Tool):
         """Say which corner to click next (on screen, through ``on_prompt``)."""
         if self.on_prompt is not None and len(self.points) < 4:
             k = len(self.points)
-            self.on_prompt(f"Quad: click the plane's {self.CORNERS[k]} corner on the photo ({k + 1} of 4"
-                           f"{'' if k == 0 else '; Esc starts again'})")
+            self.on_prompt(
+                f"Quad: click the plane's {self.CORNERS[k]} corner on the photo ({k + 1} of 4"
+                f"{'' if k == 0 else '; Esc starts again'})"
+            )
 
     def _draw(self) -> None:
         scene = self.view.scene()

@@ -29,7 +29,6 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
-
 from weft.core.errors import WeftError
 from weft.core.image import save_image
 from weft.core.jobs import JobResult, JobRunner
@@ -133,8 +132,11 @@ class VariationsDialog(QDialog):
             return
         spec = self._spec(row)
         # the range the method accepts with the open inputs (a block fits in the sample), else the Spec's
-        lo_limit, hi_limit = self.doc.param_ranges().get(spec.name, (spec.lo, spec.hi)) \
-            if self.method == self.doc.method else (spec.lo, spec.hi)
+        lo_limit, hi_limit = (
+            self.doc.param_ranges().get(spec.name, (spec.lo, spec.hi))
+            if self.method == self.doc.method
+            else (spec.lo, spec.hi)
+        )
         for box in (self.lo[row], self.hi[row]):
             box.setRange(lo_limit, hi_limit)
             box.setDecimals(0 if spec.kind == INT else 3)
@@ -314,13 +316,16 @@ class VariationsDialog(QDialog):
         for j, v in enumerate(cols):
             painter.drawText(QRect(left + j * (w + gap), line, w, line), Qt.AlignmentFlag.AlignCenter, f"{nb} = {v}")
         for i, v in enumerate(rows):
-            painter.drawText(QRect(4, top + i * (h + gap), left - 8, h),
-                             Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter, f"{na} = {v}")
+            painter.drawText(
+                QRect(4, top + i * (h + gap), left - 8, h),
+                Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter,
+                f"{na} = {v}",
+            )
         for (i, j), im in self.images.items():
             painter.drawImage(QPoint(left + j * (w + gap), top + i * (h + gap)), to_qimage(im))
         painter.end()
         bits = np.frombuffer(sheet.constBits(), np.uint8).reshape(height, sheet.bytesPerLine())
-        return bits[:, :width * 3].reshape(height, width, 3).astype(np.float32) / 255.0
+        return bits[:, : width * 3].reshape(height, width, 3).astype(np.float32) / 255.0
 
     def export_grid(self, path: str | None = None) -> bool:
         """Write the grid as one PNG (asks where when no path is given)."""
@@ -361,7 +366,6 @@ class VariationsDialog(QDialog):
     def closeEvent(self, event):  # noqa: N802
         self.shutdown()
         super().closeEvent(event)
-
 
 
 def _one_line(text: str) -> str:

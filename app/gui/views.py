@@ -17,9 +17,10 @@ only a part of the array on screen changed in place (a stroke's preview pasted i
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QObject, QPoint, QPointF, QRectF, Qt, Signal
@@ -411,7 +412,7 @@ class ImageView(QGraphicsView):
     def wheelEvent(self, event):  # noqa: N802 (Qt naming)
         steps = event.angleDelta().y() / 120.0
         if steps:
-            self.zoom_by(1.25 ** steps, at=event.position().toPoint())
+            self.zoom_by(1.25**steps, at=event.position().toPoint())
         event.accept()
 
     # --- coordinates ---------------------------------------------------------------------------
@@ -429,7 +430,8 @@ class ImageView(QGraphicsView):
     # --- mouse: tools and panning --------------------------------------------------------------
     def _panning(self, event) -> bool:
         return event.button() == Qt.MouseButton.MiddleButton or (
-            event.button() == Qt.MouseButton.LeftButton and (self._space or self.tool is None))
+            event.button() == Qt.MouseButton.LeftButton and (self._space or self.tool is None)
+        )
 
     def mousePressEvent(self, event):  # noqa: N802
         if self._panning(event):
@@ -437,8 +439,12 @@ class ImageView(QGraphicsView):
             self.viewport().setCursor(Qt.CursorShape.ClosedHandCursor)
             event.accept()
             return
-        if (self.tool is not None and event.button() == Qt.MouseButton.LeftButton and self.image is not None
-                and not self.converting):  # (not on the image being replaced: its geometry is the new one's)
+        if (
+            self.tool is not None
+            and event.button() == Qt.MouseButton.LeftButton
+            and self.image is not None
+            and not self.converting
+        ):  # (not on the image being replaced: its geometry is the new one's)
             self.setFocus()
             self._tool_drag = True
             self.tool.press(self, self.mapToScene(event.position().toPoint()), event)
@@ -547,16 +553,19 @@ class ResultView(ImageView):
         self.notice.setObjectName("result-notice")
         self.notice.setAlignment(Qt.AlignmentFlag.AlignCenter)
         self.notice.setWordWrap(True)
-        self.notice.setStyleSheet("QLabel { background: rgba(20, 20, 20, 200); color: white; padding: 12px 18px;"
-                                  " border-radius: 6px; font-size: 15px; }")
+        self.notice.setStyleSheet(
+            "QLabel { background: rgba(20, 20, 20, 200); color: white; padding: 12px 18px;"
+            " border-radius: 6px; font-size: 15px; }"
+        )
         self.notice.hide()
         # "stale": the result on screen does not match the panel (its render failed); shown along
         # the top so the pixels stay visible, until a render succeeds
         self.stale = QLabel(self.viewport())
         self.stale.setObjectName("result-stale")
         self.stale.setWordWrap(True)
-        self.stale.setStyleSheet("QLabel { background: rgba(150, 30, 30, 220); color: white; padding: 6px 10px;"
-                                 " font-size: 13px; }")
+        self.stale.setStyleSheet(
+            "QLabel { background: rgba(150, 30, 30, 220); color: white; padding: 6px 10px; font-size: 13px; }"
+        )
         self.stale.hide()
 
     def set_stale(self, text: str | None) -> None:

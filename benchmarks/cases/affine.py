@@ -16,7 +16,6 @@ import time
 from functools import lru_cache
 
 import numpy as np
-
 from weft.core.metrics import snr_db
 
 from .base import Case, Input
@@ -49,8 +48,13 @@ def _procedural_figures(name: str):
         tex = _procedural(name)
         s, img = _median_time(lambda: synthesize(tex))
         sp, paper = _median_time(lambda: synthesize(tex, **PAPER))
-        figs = {"snr_db": snr_db(tex, img), f"{name}_s": s, "snr_paper_db": snr_db(tex, paper),
-                f"{name}_paper_s": sp, "snr_lowpass_db": snr_db(tex, np.clip(decompose(tex, 32).low, 0, 1))}
+        figs = {
+            "snr_db": snr_db(tex, img),
+            f"{name}_s": s,
+            "snr_paper_db": snr_db(tex, paper),
+            f"{name}_paper_s": sp,
+            "snr_lowpass_db": snr_db(tex, np.clip(decompose(tex, 32).low, 0, 1)),
+        }
         if name == "cells":  # the same scales, less regular: how the SNR falls with irregularity
             for jitter, tone in ((0.0, 0.0), (0.03, 0.04), (0.06, 0.08), (0.1, 0.08)):
                 t = _procedural("cells", jitter=jitter, tone=tone)
@@ -80,9 +84,14 @@ def _shaker_figures(inputs, out):
     model = analyse(inputs["texture"])
     s, (matched, rep) = _median_time(lambda: match_boundaries(model, "shaker", iterations=20, rng=1))
     sp, _ = _median_time(lambda: match_boundaries(model, "partial"))
-    return {"shaker_s": s, "shaker_iterations": rep.iterations, "partial_s": sp,
-            "boundary_error_start": rep.errors[0], "boundary_error_end": rep.errors[-1],
-            "shaker_s_per_iteration": s / max(rep.iterations, 1)}
+    return {
+        "shaker_s": s,
+        "shaker_iterations": rep.iterations,
+        "partial_s": sp,
+        "boundary_error_start": rep.errors[0],
+        "boundary_error_end": rep.errors[-1],
+        "shaker_s_per_iteration": s / max(rep.iterations, 1),
+    }
 
 
 def _rerender_figures(inputs, out):

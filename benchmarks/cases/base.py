@@ -14,8 +14,9 @@ two copies on two threads at once and reports the speed-up over running them one
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 
 @dataclass(frozen=True)

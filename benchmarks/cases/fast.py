@@ -20,8 +20,7 @@ CASES: list[Case] = [
     Case(
         name="fast-transfer-640x500",
         method="fast",
-        inputs={"texture": Input("gravel", crop=(0, 0, 192, 192)),
-                "target": Input("astronaut", resize=(640, 500))},
+        inputs={"texture": Input("gravel", crop=(0, 0, 192, 192)), "target": Input("astronaut", resize=(640, 500))},
         params={"n": 5},
         process=True,
         parallel=True,

@@ -15,7 +15,6 @@ import time
 from functools import lru_cache
 
 import numpy as np
-
 from weft.core.examples import RESOURCES, example
 from weft.core.image import load_image, resize
 from weft.core.metrics import coherence, completeness, psnr_db
@@ -30,20 +29,26 @@ def _scaled_lines(factor: float) -> str:
     """The bundled feature lines for perspective.png scaled by ``factor`` (inline JSON)."""
     data = json.loads(LINES.read_text())
     image = (np.array(data["image_lines"]) + 0.5) * factor - 0.5
-    return json.dumps({"image_lines": image.round(4).tolist(), "frontal_lines": data["frontal_lines"],
-                       "frontal_size": data["frontal_size"]})
+    return json.dumps(
+        {
+            "image_lines": image.round(4).tolist(),
+            "frontal_lines": data["frontal_lines"],
+            "frontal_size": data["frontal_size"],
+        }
+    )
 
 
 def _interior(img: np.ndarray, frac: float = 0.05) -> np.ndarray:
     h, w = img.shape[:2]
     m = int(frac * min(h, w))
-    return img[m:h - m, m:w - m]
+    return img[m : h - m, m : w - m]
 
 
 @lru_cache(maxsize=1)
 def synthetic_accuracy() -> dict[str, float]:
     """Accuracy (and the time of the fit + warp alone) on the synthetic known-geometry case."""
     from weft.core.rectify import Rectifier, apply_homography
+
     from benchmarks.fixtures.synthetic import perspective_case
 
     frontal = resize(load_image(example("gravel")).image, (400, 300), interpolation="cubic")
@@ -62,10 +67,13 @@ def synthetic_accuracy() -> dict[str, float]:
     pts = np.column_stack([xs.ravel(), ys.ravel()])
     err = apply_homography(np.linalg.inv(case.homography) @ out.homography, pts) - pts
     truth = _interior(case.frontal)
-    return {"psnr_db": psnr_db(truth, _interior(out.image)), "psnr_exact_db": psnr_db(truth, _interior(exact)),
-            "psnr_half_px_db": psnr_db(truth, _interior(shifted)),
-            "max_err_px": float(np.sqrt((err ** 2).sum(axis=1)).max()),
-            "synthetic_rectify_ms": 1000 * statistics.median(times)}
+    return {
+        "psnr_db": psnr_db(truth, _interior(out.image)),
+        "psnr_exact_db": psnr_db(truth, _interior(exact)),
+        "psnr_half_px_db": psnr_db(truth, _interior(shifted)),
+        "max_err_px": float(np.sqrt((err**2).sum(axis=1)).max()),
+        "synthetic_rectify_ms": 1000 * statistics.median(times),
+    }
 
 
 def _rectify_figures(inputs, out):
@@ -86,15 +94,21 @@ def _truth() -> np.ndarray:
 def _with_rectification(inputs, out):
     """Coherence against the rectified wall (the source) and against the true frontal wall."""
     src = _rectified_wall()
-    return {"coherence": coherence(out, src), "completeness": completeness(out, src),
-            "coherence_vs_truth": coherence(out, _truth())}
+    return {
+        "coherence": coherence(out, src),
+        "completeness": completeness(out, src),
+        "coherence_vs_truth": coherence(out, _truth()),
+    }
 
 
 def _without_rectification(inputs, out):
     """Coherence against the photo crop (the source) and against the true frontal wall."""
     src = inputs["photo"]
-    return {"coherence": coherence(out, src), "completeness": completeness(out, src),
-            "coherence_vs_truth": coherence(out, _truth())}
+    return {
+        "coherence": coherence(out, src),
+        "completeness": completeness(out, src),
+        "coherence_vs_truth": coherence(out, _truth()),
+    }
 
 
 CASES: list[Case] = [
@@ -106,7 +120,7 @@ CASES: list[Case] = [
         figures=_rectify_figures,
         process=True,
         note="the live case: a 640x480 photo rectified to 640x480 (fit + cubic warp); figures: synthetic "
-             "known-geometry case (PSNR fitted / exact / 0.5 px off, max geometric error)",
+        "known-geometry case (PSNR fitted / exact / 0.5 px off, max geometric error)",
     ),
     Case(
         name="nfpt-512",
@@ -123,7 +137,7 @@ CASES: list[Case] = [
         params={"size": (512, 512)},
         figures=_without_rectification,
         note="the paper's Fig. 3b: the same wall synthesized straight from the photo (its largest upright "
-             "rectangle, 248x194), no rectification",
+        "rectangle, 248x194), no rectification",
     ),
     Case(
         name="nfpt-into-photo",

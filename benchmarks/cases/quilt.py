@@ -33,9 +33,14 @@ def t1_over_seeds(inputs, out, seeds=T1_SEEDS, size=(512, 512), **params) -> dic
         coh.append(coherence(res.image, tex))
         comp.append(completeness(res.image, tex))
         verb.append(res.figures["verbatim_fraction"])
-    return {"coherence_median": statistics.median(coh), "coherence_max": max(coh),
-            "completeness_median": statistics.median(comp), "completeness_max": max(comp),
-            "verbatim_max": max(verb)}
+    return {
+        "coherence_median": statistics.median(coh),
+        "coherence_max": max(coh),
+        "completeness_median": statistics.median(comp),
+        "completeness_max": max(comp),
+        "verbatim_max": max(verb),
+    }
+
 
 CASES: list[Case] = [
     Case(
@@ -93,8 +98,8 @@ CASES: list[Case] = [
         figures=t1_over_seeds,
         quick={"size": (256, 256)},
         note="T1: 512x512 from brick_128 with the defaults (block 56 = 7/16 of the sample, tol 6); figures of "
-             "seed 1, and median/max over seeds 0-9 (peers: Texturize 0.027/0.015, G'MIC 0.037/0.021, numpy "
-             "quilting 0.027/0.046)",
+        "seed 1, and median/max over seeds 0-9 (peers: Texturize 0.027/0.015, G'MIC 0.037/0.021, numpy "
+        "quilting 0.027/0.046)",
     ),
     Case(
         name="quilt-t2-block9",
@@ -113,7 +118,7 @@ CASES: list[Case] = [
         metrics=("fidelity", "coherence"),
         quick={"iterations": 1},
         note="T2: camera_256 in gravel_128, block 4 / overlap 2, alpha 0.1, 3 iterations "
-             "(the coherent end of the front: beats G'MIC stylize 0.54/0.35 and numpy quilting 0.984/0.41)",
+        "(the coherent end of the front: beats G'MIC stylize 0.54/0.35 and numpy quilting 0.984/0.41)",
     ),
     Case(
         name="quilt-t2-block4-luminance",
@@ -123,6 +128,6 @@ CASES: list[Case] = [
         metrics=("fidelity", "coherence"),
         quick={"iterations": 1},
         note="T2: the same with unblurred luminance correspondence (the faithful end: beats Resynthesizer "
-             "0.996/0.54, numpy quilting 0.984/0.41, Ashikhmin 0.94/0.50)",
+        "0.996/0.54, numpy quilting 0.984/0.41, Ashikhmin 0.94/0.50)",
     ),
 ]

@@ -128,8 +128,10 @@ def _install_fallback_locator() -> None:
         classes.append(TempCacheLocator)  # after numba's own: used only when they all fail
 
 
-_NO_CACHE_NOTICE = ("numba can write its cache nowhere (NUMBA_CACHE_DIR, the package folder, the home "
-                    "folder and {tmp} are not writable): kernels are compiled on every run")
+_NO_CACHE_NOTICE = (
+    "numba can write its cache nowhere (NUMBA_CACHE_DIR, the package folder, the home "
+    "folder and {tmp} are not writable): kernels are compiled on every run"
+)
 _original_enable_caching = _dispatcher.Dispatcher.enable_caching
 
 
@@ -180,10 +182,13 @@ _DAMAGED_NOTICE = "numba's cache of {what} could not be read (damaged: {why}); i
 def _drop_damaged(cache_file, error: BaseException) -> None:
     """Remove a function's cache files (its index and every data file) that could not be read (cut
     short by a power cut, overwritten) and say so once; numba then compiles and saves it afresh."""
-    base = cache_file._index_name[:-len(".nbi")]
+    base = cache_file._index_name[: -len(".nbi")]
     try:
-        names = [n for n in os.listdir(cache_file._cache_path)
-                 if n == cache_file._index_name or (n.startswith(base + ".") and n.endswith(".nbc"))]
+        names = [
+            n
+            for n in os.listdir(cache_file._cache_path)
+            if n == cache_file._index_name or (n.startswith(base + ".") and n.endswith(".nbc"))
+        ]
     except OSError:
         names = []
     for name in names:

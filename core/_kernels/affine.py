@@ -201,8 +201,12 @@ def render(proto, cy, cx, mats, shifts, alpha, origins, window, index, out):
                 w10 = wgt * ay * (1.0 - ax)
                 w11 = wgt * ay * ax
                 for c in range(C):
-                    out[oy + a, ox + b, c] += (w00 * proto[y0, x0, c] + w01 * proto[y0, x0 + 1, c]
-                                               + w10 * proto[y0 + 1, x0, c] + w11 * proto[y0 + 1, x0 + 1, c])
+                    out[oy + a, ox + b, c] += (
+                        w00 * proto[y0, x0, c]
+                        + w01 * proto[y0, x0 + 1, c]
+                        + w10 * proto[y0 + 1, x0, c]
+                        + w11 * proto[y0 + 1, x0 + 1, c]
+                    )
 
 
 @njit(cache=True, nogil=True)
@@ -229,8 +233,9 @@ def accumulate(frames, window, origins, shifts, R, acc, acc2, wacc):
 
 
 @njit(cache=True, nogil=True)
-def boundary_pass(frames, window, origins, mask, acc, acc2, wacc, placed, shifts, order, radius, R,
-                  cols, clock, moved_at, seen_at):
+def boundary_pass(
+    frames, window, origins, mask, acc, acc2, wacc, placed, shifts, order, radius, R, cols, clock, moved_at, seen_at
+):
     """One pass of boundary matching (§4): visit the patches in ``order``; for each, choose the
     translation within ``radius`` of its current one (and within ``|t| <= R``) that minimises its
     boundary error against the patches already on the canvas, then put it (back) on the canvas.
@@ -524,5 +529,18 @@ def lk_systems(proto, gy, gx, cy, cx, params, targets, weights, JtJ, Jtr, err):
     ``w (g P(c + M y + o) - s_t)`` over the patch (an addition to the paper, see
     ``weft.core.affine.analysis``); the Levenberg-Marquardt steps are taken by the caller."""
     for i in range(params.shape[0]):
-        err[i] = _lk_system(proto, gy, gx, cy, cx, params[i], params[i, 4], params[i, 5], params[i, 6],
-                            targets[i], weights[i], JtJ[i], Jtr[i])
+        err[i] = _lk_system(
+            proto,
+            gy,
+            gx,
+            cy,
+            cx,
+            params[i],
+            params[i, 4],
+            params[i, 5],
+            params[i, 6],
+            targets[i],
+            weights[i],
+            JtJ[i],
+            Jtr[i],
+        )

@@ -56,8 +56,29 @@ def _add(cand, nc, c):
 
 
 @njit(cache=True, nogil=True)
-def coherent_rows(src, src_mean, tgt, tgt_mean, res, pos, allowed, mask, res_offs, tgt_offs,
-                  y0, y1, h, metric, has_target, target_weight, w, p, p_l, m, state):
+def coherent_rows(
+    src,
+    src_mean,
+    tgt,
+    tgt_mean,
+    res,
+    pos,
+    allowed,
+    mask,
+    res_offs,
+    tgt_offs,
+    y0,
+    y1,
+    h,
+    metric,
+    has_target,
+    target_weight,
+    w,
+    p,
+    p_l,
+    m,
+    state,
+):
     """Synthesize rows ``y0..y1-1`` (see the module docstring for the arrays)."""
     H, W = res.shape
     Hs, Ws = src.shape

@@ -29,11 +29,28 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .poisson import poisson_cg
 from ..quilting.codes import (  # noqa: F401 (re-exported: the codes of place_block's array)
-    MODE_MINCUT, MODE_OVERLAP, MODE_RANDOM, N_IPARAMS, P_B, P_BAND, P_BOTTOM, P_LEFT, P_MODE, P_POISSON, P_RIGHT,
-    P_SX, P_SY, P_TOP, P_WRAP, P_X0, P_Y0, SAMPLE_FRACTION, TOP_FRACTION,
+    MODE_MINCUT,
+    MODE_OVERLAP,
+    MODE_RANDOM,
+    N_IPARAMS,
+    P_B,
+    P_BAND,
+    P_BOTTOM,
+    P_LEFT,
+    P_MODE,
+    P_POISSON,
+    P_RIGHT,
+    P_SX,
+    P_SY,
+    P_TOP,
+    P_WRAP,
+    P_X0,
+    P_Y0,
+    SAMPLE_FRACTION,
+    TOP_FRACTION,
 )
+from .poisson import poisson_cg
 
 _DY = (1, -1, 0, 0)
 _DX = (0, 0, 1, -1)
@@ -159,7 +176,7 @@ def _cost_map(cross, sq, const, cost):
     """``cost[py * pw + px] = max(sq - 2 cross + const, 0)`` for the (ph, pw) positions of ``sq``;
     returns the filled prefix of the work buffer ``cost``."""
     ph, pw = sq.shape
-    cost = cost[:ph * pw]
+    cost = cost[: ph * pw]
     for py in range(ph):
         for px in range(pw):
             v = sq[py, px] - 2.0 * cross[py, px] + const
@@ -222,8 +239,12 @@ def seam_error(err, mask):
     total = 0.0
     for y in range(h):
         for x in range(w):
-            if mask[y, x] and ((y > 0 and not mask[y - 1, x]) or (y < h - 1 and not mask[y + 1, x])
-                               or (x > 0 and not mask[y, x - 1]) or (x < w - 1 and not mask[y, x + 1])):
+            if mask[y, x] and (
+                (y > 0 and not mask[y - 1, x])
+                or (y < h - 1 and not mask[y + 1, x])
+                or (x > 0 and not mask[y, x - 1])
+                or (x < w - 1 and not mask[y, x + 1])
+            ):
                 total += err[y, x]
     return total
 
@@ -278,8 +299,26 @@ def choose_sampled(cross, sq, const, cost, u, seed):
 
 
 @njit(cache=True, nogil=True)
-def make_template(canvas, prev, corr_t, y0, x0, bsz, top, left, right, bottom, wrap,
-                  w_overlap, w_prev, w_corr, mean, mean_c, tbuf, tcorr):
+def make_template(
+    canvas,
+    prev,
+    corr_t,
+    y0,
+    x0,
+    bsz,
+    top,
+    left,
+    right,
+    bottom,
+    wrap,
+    w_overlap,
+    w_prev,
+    w_corr,
+    mean,
+    mean_c,
+    tbuf,
+    tcorr,
+):
     """Write the correlation templates of the block at (y0, x0) and return the constant term.
 
     ``tbuf`` (C, N, N) gets ``w_overlap * M * (O - mean) + w_prev * (P - mean)`` in its top-left
@@ -470,8 +509,12 @@ def poisson_band(canvas, old, label, win, band):
                     for dx in (-1, 0, 1):
                         qy = wy + dy
                         qx = wx + dx
-                        if 0 <= qy < ws and 0 <= qx < ws and dist[qy, qx] == step - 1 \
-                                and label[qy, qx] == label[wy, wx]:
+                        if (
+                            0 <= qy < ws
+                            and 0 <= qx < ws
+                            and dist[qy, qx] == step - 1
+                            and label[qy, qx] == label[wy, wx]
+                        ):
                             found = True
                 if found:
                     dist[wy, wx] = step

@@ -37,21 +37,47 @@ Example
 ((128, 128), (128, 128))
 """
 
+from .analysis import analyse, levenberg_marquardt
 from .boundary import BoundaryReport, match_boundaries, total_boundary_error
-from .spectral import Centroids, centroid_pairs, centroids, cos2_window, segment_sums
 from .fields import field_model, field_transforms
 from .method import METHOD, synthesize, warm_up
+from .model import AffineModel, Decomposition, Grid, Prototype, decompose, lowpass, make_prototype, prototype_from_patch
 from .params import AffineParams, check_rect, default_rect
-from .analysis import analyse, levenberg_marquardt
-from .model import (AffineModel, Decomposition, Grid, Prototype, decompose, lowpass, make_prototype,
-                    prototype_from_patch)
+from .spectral import Centroids, centroid_pairs, centroids, cos2_window, segment_sums
 from .synthesis import compose, render
 from .transforms import candidate_transforms, correlate_shifts, regularise_pairs, sampling_matrices
 
 __all__ = [
-    "METHOD", "AffineModel", "AffineParams", "BoundaryReport", "Centroids", "Decomposition", "Grid", "Prototype",
-    "analyse", "candidate_transforms", "centroid_pairs", "centroids", "check_rect", "compose", "correlate_shifts",
-    "cos2_window", "decompose", "default_rect", "field_model", "field_transforms", "levenberg_marquardt", "lowpass",
-    "make_prototype", "match_boundaries", "prototype_from_patch", "regularise_pairs", "render", "sampling_matrices",
-    "segment_sums", "synthesize", "total_boundary_error", "warm_up",
+    "METHOD",
+    "AffineModel",
+    "AffineParams",
+    "BoundaryReport",
+    "Centroids",
+    "Decomposition",
+    "Grid",
+    "Prototype",
+    "analyse",
+    "candidate_transforms",
+    "centroid_pairs",
+    "centroids",
+    "check_rect",
+    "compose",
+    "correlate_shifts",
+    "cos2_window",
+    "decompose",
+    "default_rect",
+    "field_model",
+    "field_transforms",
+    "levenberg_marquardt",
+    "lowpass",
+    "make_prototype",
+    "match_boundaries",
+    "prototype_from_patch",
+    "regularise_pairs",
+    "render",
+    "sampling_matrices",
+    "segment_sums",
+    "synthesize",
+    "total_boundary_error",
+    "warm_up",
 ]

@@ -11,8 +11,8 @@ translation (:func:`levenberg_marquardt`). ``propagate=False, refine=0`` is the 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -20,15 +20,16 @@ from numpy.lib.stride_tricks import sliding_window_view
 from ..errors import ImageError, InvalidParameter
 from ..image import validate_image
 from ..jobs import CancelToken, Progress, ProgressReporter
-from .spectral import centroids, cos2_window
 from .model import AffineModel, Decomposition, Grid, Prototype, decompose, make_prototype, padded
 from .params import LOWPASS, Rect
+from .spectral import centroids, cos2_window
 from .synthesis import render
 from .transforms import _clamp_scale, candidate_transforms, correlate_indexed, sampling_matrices
 
+
 def _patches(canvas: np.ndarray, grid: Grid) -> np.ndarray:
     B, h = grid.block, grid.step
-    view = sliding_window_view(canvas, (B, B))[::h, ::h][:grid.rows, :grid.cols]
+    view = sliding_window_view(canvas, (B, B))[::h, ::h][: grid.rows, : grid.cols]
     return np.ascontiguousarray(view).reshape(-1, B, B)
 
 
@@ -96,8 +97,9 @@ def analyse(
     """
     texture = validate_image(texture, "texture")
     if lowpass not in LOWPASS:
-        raise InvalidParameter(f"parameter 'lowpass' = {lowpass!r} is not one of {', '.join(LOWPASS)}",
-                               name="lowpass", value=lowpass)
+        raise InvalidParameter(
+            f"parameter 'lowpass' = {lowpass!r} is not one of {', '.join(LOWPASS)}", name="lowpass", value=lowpass
+        )
     _check_geometry(texture.shape, block, segments)
     dec = decompose(texture, block, colour, need_chroma=lowpass == "add")
     if isinstance(prototype, Prototype):
@@ -170,9 +172,10 @@ class _State:
     choice: np.ndarray  # (K,) int8
 
     @classmethod
-    def empty(cls, K: int) -> "_State":
-        return cls(np.tile(np.eye(2), (K, 1, 1)), np.zeros((K, 2)), np.zeros(K), np.full(K, np.inf),
-                   np.full(K, -1, np.int8))
+    def empty(cls, K: int) -> _State:
+        return cls(
+            np.tile(np.eye(2), (K, 1, 1)), np.zeros((K, 2)), np.zeros(K), np.full(K, np.inf), np.full(K, -1, np.int8)
+        )
 
     def set(self, rows, mats, shifts, alpha, err, choice) -> None:
         self.mats[rows] = mats
@@ -181,7 +184,7 @@ class _State:
         self.err[rows] = err
         self.choice[rows] = choice
 
-    def model(self, ctx: "_Context", lowpass, proto, dec) -> AffineModel:
+    def model(self, ctx: _Context, lowpass, proto, dec) -> AffineModel:
         return AffineModel(
             grid=ctx.grid,
             transforms=np.linalg.inv(self.mats),
@@ -212,7 +215,7 @@ class _Context:
     grad: tuple | None = None  # the prototype's derivatives, for refinement
 
     @classmethod
-    def build(cls, dec: Decomposition, proto: Prototype, block: int, lowpass: str) -> "_Context":
+    def build(cls, dec: Decomposition, proto: Prototype, block: int, lowpass: str) -> _Context:
         H, W = dec.grey.shape
         grid = Grid(H, W, block)
         win = cos2_window(block)
@@ -223,8 +226,7 @@ class _Context:
         else:
             targets_cmp, cmp = _patches(grid.pad(dec.luminance), grid), proto.grey
         hp, c = padded(proto.highpass)
-        return cls(grid, hp, padded(cmp)[0], c, lowpass == "add", targets_hp, targets_hp * win, targets_cmp,
-                   weights)
+        return cls(grid, hp, padded(cmp)[0], c, lowpass == "add", targets_hp, targets_hp * win, targets_cmp, weights)
 
     def evaluate(self, mats: np.ndarray, *, symmetric: bool, rows) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Translations (§2.3), factors and RMS errors (§2.4) of candidate sampling matrices
@@ -237,11 +239,13 @@ class _Context:
         if symmetric:
             index = np.concatenate([index, index], axis=1)
             flip = np.concatenate([flip, ~flip], axis=1)
-        return self.evaluate_shared(np.ascontiguousarray(mats[:, :h]).reshape(-1, 2, 2), index, flip, rows,
-                                    np.ascontiguousarray(mats))
+        return self.evaluate_shared(
+            np.ascontiguousarray(mats[:, :h]).reshape(-1, 2, 2), index, flip, rows, np.ascontiguousarray(mats)
+        )
 
-    def evaluate_shared(self, frame_mats: np.ndarray, index: np.ndarray, flip: np.ndarray, rows,
-                        mats: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate_shared(
+        self, frame_mats: np.ndarray, index: np.ndarray, flip: np.ndarray, rows, mats: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`evaluate` for candidates sharing frames: candidate j of patch i is the
         prototype warped by ``frame_mats[index[i, j]]``, turned by 180° where ``flip[i, j]``."""
         from .._kernels import affine as _k
@@ -260,8 +264,17 @@ class _Context:
         else:
             if mats is None:
                 mats = np.where(flip[..., None, None], -1.0, 1.0) * frame_mats[index]
-            _k.score_candidates(self.cmp, c, c, np.ascontiguousarray(mats), sh.astype(np.float64),
-                                self.targets_cmp[rows], self.weights[rows], alpha, err)
+            _k.score_candidates(
+                self.cmp,
+                c,
+                c,
+                np.ascontiguousarray(mats),
+                sh.astype(np.float64),
+                self.targets_cmp[rows],
+                self.weights[rows],
+                alpha,
+                err,
+            )
         return sh.astype(np.float64), alpha, err
 
     def try_row(self, state: _State, row: int, other: int, base: int) -> np.ndarray:
@@ -270,7 +283,7 @@ class _Context:
         current choice (choice code ``base`` + 0, 1, 2). Returns the mask of patches changed."""
         cols = self.grid.cols
         sl = slice(row * cols, (row + 1) * cols)
-        frame_mats = state.mats[other * cols:(other + 1) * cols]
+        frame_mats = state.mats[other * cols : (other + 1) * cols]
         c = np.arange(cols)
         index = np.stack([np.maximum(c - 1, 0), c, np.minimum(c + 1, cols - 1)], axis=1)
         sh, al, er = self.evaluate_shared(frame_mats, index, np.zeros(index.shape, bool), sl)
@@ -293,8 +306,7 @@ class _Context:
         mats = np.ascontiguousarray(state.mats[sel])
         offsets = -np.einsum("kij,kj->ki", mats, state.shifts[sel])  # o = -M t
         params = np.concatenate([mats.reshape(-1, 4), offsets, np.ones((len(sel), 1))], axis=1)
-        params = levenberg_marquardt(self.hp, self.grad, c, params, self.targets_hp[sel], self.weights[sel],
-                                     iterations)
+        params = levenberg_marquardt(self.hp, self.grad, c, params, self.targets_hp[sel], self.weights[sel], iterations)
         mats = np.ascontiguousarray(params[:, :4].reshape(-1, 2, 2))
         offsets = params[:, 4:6]
         # scales within [1/4, 4] (for M as for T = M^-1): also never singular
@@ -303,15 +315,31 @@ class _Context:
         sh = np.ascontiguousarray(np.clip(-np.einsum("kij,kj->ki", np.linalg.inv(mats), offsets), -R, R))
         alpha = np.zeros((len(mats), 1))
         err = np.zeros((len(mats), 1))
-        _k.score_candidates(self.cmp, c, c, mats[:, None].copy(), sh[:, None].copy(), self.targets_cmp[sel],
-                            self.weights[sel], alpha, err)
+        _k.score_candidates(
+            self.cmp,
+            c,
+            c,
+            mats[:, None].copy(),
+            sh[:, None].copy(),
+            self.targets_cmp[sel],
+            self.weights[sel],
+            alpha,
+            err,
+        )
         better = err[:, 0] <= state.err[sel]
         idx = sel[better]
         state.set(idx, mats[better], sh[better], alpha[better, 0], err[better, 0], state.choice[idx])
 
 
-def levenberg_marquardt(proto: np.ndarray, grad: tuple, centre: float, params: np.ndarray, targets: np.ndarray,
-                        weights: np.ndarray, iterations: int) -> np.ndarray:
+def levenberg_marquardt(
+    proto: np.ndarray,
+    grad: tuple,
+    centre: float,
+    params: np.ndarray,
+    targets: np.ndarray,
+    weights: np.ndarray,
+    iterations: int,
+) -> np.ndarray:
     """Refine affine maps by damped Gauss-Newton steps (an addition to the paper).
 
     Minimises, per patch, ``Σ_y (w(y) (g P(c + M y + o) - s_t(y)))²`` over ``params`` =
@@ -369,23 +397,28 @@ def _central(patch: np.ndarray, B: int) -> np.ndarray:
     s = patch.shape[0]
     if s >= B:
         o = (s - B) // 2
-        return patch[o:o + B, o:o + B]
+        return patch[o : o + B, o : o + B]
     out = np.zeros((B, B), np.float32)
     o = (B - s) // 2
-    out[o:o + s, o:o + s] = patch
+    out[o : o + s, o : o + s] = patch
     return out
 
 
 def _check_geometry(shape, block: int, segments: int) -> None:
     if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or block < 8 or block > 256 or block % 2:
-        raise InvalidParameter(f"parameter 'block' = {block!r} must be an even integer in 8..256", name="block",
-                               value=block)
+        raise InvalidParameter(
+            f"parameter 'block' = {block!r} must be an even integer in 8..256", name="block", value=block
+        )
     if isinstance(segments, bool) or not isinstance(segments, (int, np.integer)) or segments < 4 or segments % 2:
-        raise InvalidParameter(f"parameter 'segments' = {segments!r} must be an even integer >= 4",
-                               name="segments", value=segments)
+        raise InvalidParameter(
+            f"parameter 'segments' = {segments!r} must be an even integer >= 4", name="segments", value=segments
+        )
     h, w = shape[:2]
     if min(h, w) < 8:
         raise ImageError(f"the texture is {w}x{h}; the affine model needs at least 8x8 pixels")
     if block > min(h, w):
-        raise InvalidParameter(f"parameter 'block' = {block} is outside 8..{max(8, min(h, w))} (the patch must "
-                               f"fit in the {w}x{h} image)", name="block", value=block)
+        raise InvalidParameter(
+            f"parameter 'block' = {block} is outside 8..{max(8, min(h, w))} (the patch must fit in the {w}x{h} image)",
+            name="block",
+            value=block,
+        )

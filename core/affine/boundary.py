@@ -24,16 +24,16 @@ increase: that is what makes the forced schedule converge. The total is reported
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
 from ..errors import InvalidParameter
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
-from .spectral import cos2_window
 from .model import AffineModel, Prototype, padded
+from .spectral import cos2_window
 from .synthesis import _as_prototype, compose
 
 MODES = ("none", "partial", "shaker")
@@ -117,9 +117,26 @@ class _Canvas:
 
         if not skip:
             self.seen_at[:] = -1
-        return int(_k.boundary_pass(self.frames, self.window, self.origins, self.mask, self.acc, self.acc2,
-                                    self.wacc, self.placed, self.shifts, np.ascontiguousarray(order, dtype=np.int64),
-                                    int(radius), self.R, self.grid.cols, self.clock, self.moved_at, self.seen_at))
+        return int(
+            _k.boundary_pass(
+                self.frames,
+                self.window,
+                self.origins,
+                self.mask,
+                self.acc,
+                self.acc2,
+                self.wacc,
+                self.placed,
+                self.shifts,
+                np.ascontiguousarray(order, dtype=np.int64),
+                int(radius),
+                self.R,
+                self.grid.cols,
+                self.clock,
+                self.moved_at,
+                self.seen_at,
+            )
+        )
 
     def total_error(self) -> float:
         """``Σ_image Σ_pairs W_a W_b (p_a - p_b)² = Σ mask (wacc acc2 - acc²)``."""
@@ -127,8 +144,11 @@ class _Canvas:
 
     def preview(self, model: AffineModel) -> np.ndarray:
         g = self.grid
-        return compose(model, g.crop(self.acc.astype(np.float32))[..., None]) if model.lowpass == "add" else \
-            np.clip(g.crop(self.acc.astype(np.float32)), 0.0, 1.0)
+        return (
+            compose(model, g.crop(self.acc.astype(np.float32))[..., None])
+            if model.lowpass == "add"
+            else np.clip(g.crop(self.acc.astype(np.float32)), 0.0, 1.0)
+        )
 
 
 def total_boundary_error(model: AffineModel, prototype: Prototype | np.ndarray | None = None) -> float:
@@ -205,11 +225,13 @@ def match_boundaries(
     all shifts tie).
     """
     if mode not in MODES:
-        raise InvalidParameter(f"parameter 'boundary' = {mode!r} is not one of {', '.join(MODES)}",
-                               name="boundary", value=mode)
+        raise InvalidParameter(
+            f"parameter 'boundary' = {mode!r} is not one of {', '.join(MODES)}", name="boundary", value=mode
+        )
     if start not in STARTS:
-        raise InvalidParameter(f"parameter 'shaker_start' = {start!r} is not one of {', '.join(STARTS)}",
-                               name="shaker_start", value=start)
+        raise InvalidParameter(
+            f"parameter 'shaker_start' = {start!r} is not one of {', '.join(STARTS)}", name="shaker_start", value=start
+        )
     for name, value, lo in (("iterations", iterations, 1), ("per_radius", per_radius, 1)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < lo:
             raise InvalidParameter(f"parameter '{name}' = {value!r} must be an integer >= {lo}", name=name, value=value)

@@ -21,8 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InvalidParameter
-from .params import FIELDS
 from .model import AffineModel, Grid, Prototype
+from .params import FIELDS
 
 
 def field_transforms(grid: Grid, field: str, strength: float = 1.0) -> np.ndarray:
@@ -42,8 +42,9 @@ def field_transforms(grid: Grid, field: str, strength: float = 1.0) -> np.ndarra
         ``T = s R(θ)``: rotation by θ (counter-clockwise on screen) and uniform scale s.
     """
     if field not in FIELDS:
-        raise InvalidParameter(f"parameter 'field' = {field!r} is not one of {', '.join(FIELDS)}",
-                               name="field", value=field)
+        raise InvalidParameter(
+            f"parameter 'field' = {field!r} is not one of {', '.join(FIELDS)}", name="field", value=field
+        )
     o = grid.origins().astype(np.float64)
     half = (grid.block - 1) / 2.0
     cy = o[:, 0] - grid.step + half
@@ -69,8 +70,9 @@ def field_transforms(grid: Grid, field: str, strength: float = 1.0) -> np.ndarra
     return T * scale[:, None, None]
 
 
-def field_model(shape: tuple[int, int], prototype: Prototype, field: str = "swirl", *, strength: float = 1.0,
-                block: int = 32) -> AffineModel:
+def field_model(
+    shape: tuple[int, int], prototype: Prototype, field: str = "swirl", *, strength: float = 1.0, block: int = 32
+) -> AffineModel:
     """A model whose transforms come from a parametric field (Fig. 6), translations zero.
 
     Parameters
@@ -94,6 +96,15 @@ def field_model(shape: tuple[int, int], prototype: Prototype, field: str = "swir
     grid = Grid(int(h), int(w), int(block))
     T = field_transforms(grid, field, strength)
     K = grid.count
-    return AffineModel(grid=grid, transforms=T, sampling=np.linalg.inv(T), shifts=np.zeros((K, 2)),
-                       alpha=np.ones(K), choice=np.full(K, -1, np.int8), rms=np.full(K, np.nan, np.float32),
-                       lowpass="absorb", prototype=prototype, decomposition=None)
+    return AffineModel(
+        grid=grid,
+        transforms=T,
+        sampling=np.linalg.inv(T),
+        shifts=np.zeros((K, 2)),
+        alpha=np.ones(K),
+        choice=np.full(K, -1, np.int8),
+        rms=np.full(K, np.nan, np.float32),
+        lowpass="absorb",
+        prototype=prototype,
+        decomposition=None,
+    )

@@ -5,7 +5,7 @@ from __future__ import annotations
 import hashlib
 import threading
 from collections import OrderedDict
-from typing import Callable, Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
@@ -16,11 +16,11 @@ from ..limits import check_output_size
 from ..metrics import snr_db
 from ..registry import InputSpec, Method, Result
 from ..studio import SQUARE, Figure, Geometry, Studio
+from .analysis import analyse
 from .boundary import BoundaryReport, match_boundaries
 from .fields import field_model
-from .params import MIN_SIDE, AffineParams, check_rect, default_rect
-from .analysis import analyse
 from .model import AffineModel, _recombine, make_prototype
+from .params import MIN_SIDE, AffineParams, check_rect, default_rect
 from .synthesis import render
 
 
@@ -94,18 +94,32 @@ def synthesize(
     float32 (H, W) or (H, W, 3) in [0, 1]
     """
     params = AffineParams(
-        prototype=prototype, block=block, segments=segments, lowpass=lowpass, colour=colour,
-        propagate=propagate, refine=refine, reuse_transforms=reuse_transforms,
-        analysis_prototype=analysis_prototype, boundary=boundary, iterations=iterations,
-        per_radius=per_radius, shaker_start=shaker_start, field=field, field_strength=field_strength, size=size)
+        prototype=prototype,
+        block=block,
+        segments=segments,
+        lowpass=lowpass,
+        colour=colour,
+        propagate=propagate,
+        refine=refine,
+        reuse_transforms=reuse_transforms,
+        analysis_prototype=analysis_prototype,
+        boundary=boundary,
+        iterations=iterations,
+        per_radius=per_radius,
+        shaker_start=shaker_start,
+        field=field,
+        field_strength=field_strength,
+        size=size,
+    )
     inputs = {"texture": texture}
     if prototype_image is not None:
         inputs["prototype_image"] = prototype_image
     return _run(inputs, params, rng=rng, progress=progress, cancel=cancel).image
 
 
-def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=None, progress=None, cancel=None
-              ) -> tuple[np.ndarray, AffineModel, BoundaryReport, dict]:
+def _pipeline(
+    inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=None, progress=None, cancel=None
+) -> tuple[np.ndarray, AffineModel, BoundaryReport, dict]:
     texture = validate_image(inputs["texture"], "texture")
     other = inputs.get("prototype_image")
     if other is not None:
@@ -122,8 +136,9 @@ def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=Non
         if B > min(h, w):
             raise ImageError(f"the output is {w}x{h}; it must be at least the block, {B} pixels, on each side")
         rect = params.prototype or default_rect(source.shape, B, source_name)
-        proto = make_prototype(source, check_rect(rect, source.shape, source_name), block=B, colour=params.colour,
-                               what=source_name)
+        proto = make_prototype(
+            source, check_rect(rect, source.shape, source_name), block=B, colour=params.colour, what=source_name
+        )
         model = field_model((h, w), proto, params.field, strength=params.field_strength, block=B)
         render_proto = proto
     elif params.reuse_transforms:
@@ -132,21 +147,45 @@ def _pipeline(inputs: Mapping[str, np.ndarray], params: AffineParams, *, rng=Non
         model = _cached_analysis(texture, arect, params, progress, cancel)
         rect = params.prototype or default_rect(source.shape, B, source_name)
         dec = model.decomposition if other is None else None
-        render_proto = make_prototype(source, check_rect(rect, source.shape, source_name), block=B,
-                                      colour=params.colour, decomposition=dec, what=source_name)
+        render_proto = make_prototype(
+            source,
+            check_rect(rect, source.shape, source_name),
+            block=B,
+            colour=params.colour,
+            decomposition=dec,
+            what=source_name,
+        )
         info["analysis_prototype"] = list(arect)
     else:
         rect = params.prototype
         if rect is not None:
             check_rect(rect, source.shape, source_name)
-        model = analyse(texture, prototype=rect, prototype_image=other, block=B, segments=params.segments,
-                        lowpass=params.lowpass, colour=params.colour, propagate=params.propagate,
-                        refine=params.refine, progress=progress, cancel=cancel)
+        model = analyse(
+            texture,
+            prototype=rect,
+            prototype_image=other,
+            block=B,
+            segments=params.segments,
+            lowpass=params.lowpass,
+            colour=params.colour,
+            propagate=params.propagate,
+            refine=params.refine,
+            progress=progress,
+            cancel=cancel,
+        )
         render_proto = model.prototype
     info["prototype"] = list(render_proto.rect) if render_proto.rect is not None else None
-    model, report = match_boundaries(model, params.resolved_boundary(), prototype=render_proto,
-                                     iterations=params.iterations, per_radius=params.per_radius,
-                                     start=params.shaker_start, rng=rng, progress=progress, cancel=cancel)
+    model, report = match_boundaries(
+        model,
+        params.resolved_boundary(),
+        prototype=render_proto,
+        iterations=params.iterations,
+        per_radius=params.per_radius,
+        start=params.shaker_start,
+        rng=rng,
+        progress=progress,
+        cancel=cancel,
+    )
     out = render(model, render_proto)
     return out, model, report, info
 
@@ -161,16 +200,34 @@ _cache_lock = threading.Lock()
 def _cached_analysis(texture: np.ndarray, arect, params: AffineParams, progress, cancel) -> AffineModel:
     """:func:`analyse` of the texture for ``arect``, remembered by content and parameters (models
     are never modified, so threads may share them)."""
-    key = (hashlib.blake2b(texture.tobytes(), digest_size=16).digest(), texture.shape, tuple(arect), params.block,
-           params.segments, params.lowpass, params.colour, params.propagate, params.refine)
+    key = (
+        hashlib.blake2b(texture.tobytes(), digest_size=16).digest(),
+        texture.shape,
+        tuple(arect),
+        params.block,
+        params.segments,
+        params.lowpass,
+        params.colour,
+        params.propagate,
+        params.refine,
+    )
     with _cache_lock:
         model = _cache.get(key)
         if model is not None:
             _cache.move_to_end(key)
             return model
-    model = analyse(texture, prototype=arect, block=params.block, segments=params.segments, lowpass=params.lowpass,
-                    colour=params.colour, propagate=params.propagate, refine=params.refine,
-                    progress=progress, cancel=cancel)
+    model = analyse(
+        texture,
+        prototype=arect,
+        block=params.block,
+        segments=params.segments,
+        lowpass=params.lowpass,
+        colour=params.colour,
+        propagate=params.propagate,
+        refine=params.refine,
+        progress=progress,
+        cancel=cancel,
+    )
     with _cache_lock:
         _cache[key] = model
         while len(_cache) > _CACHE_SIZE:
@@ -216,21 +273,39 @@ METHOD = Method(
     params=AffineParams,
     inputs=(
         InputSpec("texture", "the texture to model (or the picture to transfer a texture onto)", min_side=MIN_SIDE),
-        InputSpec("prototype_image", "take the prototype from this picture instead (texture transfer, §4)",
-                  required=False, min_side=MIN_SIDE),
+        InputSpec(
+            "prototype_image",
+            "take the prototype from this picture instead (texture transfer, §4)",
+            required=False,
+            min_side=MIN_SIDE,
+        ),
     ),
     run=_run,
     warm_up=warm_up,
     studio=Studio(
         title="Affine prototype model (Smith & Bhalerao)",
         canvas="texture",
-        geometry=(Geometry(SQUARE, on=("prototype_image", "texture"), param="prototype",
-                           help="drag a square: the prototype patch (on the prototype image when one is open); "
-                                "with reuse transforms the result follows it live",
-                           live=lambda params: params.reuse_transforms),),
-        preview_params=("size",), compare=("texture",), examples={"texture": "wood-grain"}, rank=2,
-        figures={"patches": Figure("patches"), "snr_db": Figure("SNR against the texture", "dB"),
-                 "snr_lowpass_db": Figure("SNR of its lowpass alone", "dB"),
-                 "rms_median": Figure("median transform fit error"), "boundary": Figure("boundary matching"),
-                 "shaker_iterations": Figure("shaker iterations")}),
+        geometry=(
+            Geometry(
+                SQUARE,
+                on=("prototype_image", "texture"),
+                param="prototype",
+                help="drag a square: the prototype patch (on the prototype image when one is open); "
+                "with reuse transforms the result follows it live",
+                live=lambda params: params.reuse_transforms,
+            ),
+        ),
+        preview_params=("size",),
+        compare=("texture",),
+        examples={"texture": "wood-grain"},
+        rank=2,
+        figures={
+            "patches": Figure("patches"),
+            "snr_db": Figure("SNR against the texture", "dB"),
+            "snr_lowpass_db": Figure("SNR of its lowpass alone", "dB"),
+            "rms_median": Figure("median transform fit error"),
+            "boundary": Figure("boundary matching"),
+            "shaker_iterations": Figure("shaker iterations"),
+        },
+    ),
 )

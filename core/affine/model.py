@@ -16,8 +16,8 @@ import cv2
 import numpy as np
 
 from ..errors import ImageError, InvalidParameter
-from ..image import PcaBasis, from_pca, luminance, rgb_to_yiq, to_pca, validate_image, yiq_to_rgb
 from ..geometry import Square
+from ..image import PcaBasis, from_pca, luminance, rgb_to_yiq, to_pca, validate_image, yiq_to_rgb
 from .params import COLOURS, MIN_SIDE, Rect, check_rect, default_rect
 
 # ----------------------------------------------------------------------------------------------
@@ -81,8 +81,9 @@ def decompose(image: np.ndarray, block: int, colour: str = "pca", *, need_chroma
         way (the same lowpass as the grey's).
     """
     if colour not in COLOURS:
-        raise InvalidParameter(f"parameter 'colour' = {colour!r} is not one of {', '.join(COLOURS)}",
-                               name="colour", value=colour)
+        raise InvalidParameter(
+            f"parameter 'colour' = {colour!r} is not one of {', '.join(COLOURS)}", name="colour", value=colour
+        )
     basis, offset, chroma = None, 0.0, None
     if image.ndim == 2:
         grey = image
@@ -97,9 +98,16 @@ def decompose(image: np.ndarray, block: int, colour: str = "pca", *, need_chroma
         chroma = comps[..., 1:]
     low = lowpass(grey, block)
     chroma_low = lowpass(chroma, block) if chroma is not None and need_chroma else None
-    return Decomposition(grey=grey.astype(np.float32, copy=False), luminance=luminance(image), low=low,
-                         high=(grey - low).astype(np.float32),
-                         chroma_low=chroma_low, colour=colour, basis=basis, offset=offset)
+    return Decomposition(
+        grey=grey.astype(np.float32, copy=False),
+        luminance=luminance(image),
+        low=low,
+        high=(grey - low).astype(np.float32),
+        chroma_low=chroma_low,
+        colour=colour,
+        basis=basis,
+        offset=offset,
+    )
 
 
 def _recombine(dec: Decomposition, grey: np.ndarray) -> np.ndarray:
@@ -145,8 +153,15 @@ class Prototype:
         return self.highpass.shape[0]
 
 
-def make_prototype(image: np.ndarray, rect: Rect | str | None = None, *, block: int = 32, colour: str = "pca",
-                   decomposition: Decomposition | None = None, what: str = "prototype image") -> Prototype:
+def make_prototype(
+    image: np.ndarray,
+    rect: Rect | str | None = None,
+    *,
+    block: int = 32,
+    colour: str = "pca",
+    decomposition: Decomposition | None = None,
+    what: str = "prototype image",
+) -> Prototype:
     """Cut a prototype square out of an image (§3.3, §3.4).
 
     Parameters
@@ -172,14 +187,22 @@ def make_prototype(image: np.ndarray, rect: Rect | str | None = None, *, block: 
         The square does not fit in the image.
     """
     image = validate_image(image, what)
-    rect = default_rect(image.shape, block, what) if rect is None else Square.coerce(rect, "prototype").check_side("prototype", minimum=MIN_SIDE, even=True)
+    rect = (
+        default_rect(image.shape, block, what)
+        if rect is None
+        else Square.coerce(rect, "prototype").check_side("prototype", minimum=MIN_SIDE, even=True)
+    )
     check_rect(rect, image.shape, what)
     dec = decomposition or decompose(image, block, colour, need_chroma=False)
     x, y, s = rect
     sl = (slice(y, y + s), slice(x, x + s))
     col = np.ascontiguousarray(image[sl]) if image.ndim == 3 else None
-    return Prototype(highpass=np.ascontiguousarray(dec.high[sl]), grey=np.ascontiguousarray(luminance(image[sl])),
-                     colour=col, rect=rect)
+    return Prototype(
+        highpass=np.ascontiguousarray(dec.high[sl]),
+        grey=np.ascontiguousarray(luminance(image[sl])),
+        colour=col,
+        rect=rect,
+    )
 
 
 def prototype_from_patch(patch: np.ndarray, *, block: int = 32, colour: str = "pca") -> Prototype:
@@ -247,18 +270,18 @@ class Grid:
         return self.block // 4
 
     def origins(self) -> np.ndarray:
-        r, c = np.mgrid[:self.rows, :self.cols]
+        r, c = np.mgrid[: self.rows, : self.cols]
         return (np.stack([r.ravel(), c.ravel()], axis=1) * self.step).astype(np.int64)
 
     def pad(self, img: np.ndarray) -> np.ndarray:
         """Zero-pad an (H, W[, C]) image onto the canvas (§3)."""
         hc, wc = self.canvas
         out = np.zeros((hc, wc) + img.shape[2:], np.float32)
-        out[self.step:self.step + self.height, self.step:self.step + self.width] = img
+        out[self.step : self.step + self.height, self.step : self.step + self.width] = img
         return out
 
     def crop(self, canvas: np.ndarray) -> np.ndarray:
-        return canvas[self.step:self.step + self.height, self.step:self.step + self.width]
+        return canvas[self.step : self.step + self.height, self.step : self.step + self.width]
 
     def inside(self) -> np.ndarray:
         """1 on the image, 0 on the padding (canvas shape, float32)."""
@@ -312,7 +335,7 @@ class AffineModel:
     def shape(self) -> tuple[int, int]:
         return self.grid.height, self.grid.width
 
-    def with_shifts(self, shifts: np.ndarray) -> "AffineModel":
+    def with_shifts(self, shifts: np.ndarray) -> AffineModel:
         return replace(self, shifts=np.ascontiguousarray(shifts, dtype=np.int64))
 
 

@@ -82,7 +82,7 @@ def _bins(n: int, segments: int, lowcut: float) -> _Bins:
     wts = np.zeros((nb, 4 * half))
     rows = np.arange(nb)
     wts[rows, seg] = 1.0  # M (eq. 9)
-    wts[rows, half + seg] = (omega ** 2).sum(axis=1)  # f1 (eq. 7)
+    wts[rows, half + seg] = (omega**2).sum(axis=1)  # f1 (eq. 7)
     wts[rows, 2 * half + seg] = omega[:, 0]  # f2 (eq. 8), y
     wts[rows, 3 * half + seg] = omega[:, 1]  # f2, x
     for arr in (flat, omega, wts):
@@ -90,8 +90,9 @@ def _bins(n: int, segments: int, lowcut: float) -> _Bins:
     return _Bins(flat, omega, wts)
 
 
-def segment_sums(patches: np.ndarray, *, segments: int = 32, lowcut: float | None = None,
-                 windowed: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def segment_sums(
+    patches: np.ndarray, *, segments: int = 32, lowcut: float | None = None, windowed: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per-segment spectral sums of a batch of square patches (§2.1, eqs. 2 and 7–9).
 
     Parameters
@@ -136,8 +137,8 @@ def segment_sums(patches: np.ndarray, *, segments: int = 32, lowcut: float | Non
     sums = mag.astype(np.float64) @ bins.weights
     half = segments // 2
     M = sums[:, :half]
-    f1 = sums[:, half:2 * half]
-    f2 = np.stack([sums[:, 2 * half:3 * half], sums[:, 3 * half:]], axis=-1)
+    f1 = sums[:, half : 2 * half]
+    f2 = np.stack([sums[:, 2 * half : 3 * half], sums[:, 3 * half :]], axis=-1)
     if single:
         return M[0], f1[0], f2[0]
     return M, f1, f2
@@ -145,8 +146,9 @@ def segment_sums(patches: np.ndarray, *, segments: int = 32, lowcut: float | Non
 
 def _check_segments(segments: int) -> None:
     if isinstance(segments, bool) or not isinstance(segments, (int, np.integer)) or segments < 4 or segments % 2:
-        raise InvalidParameter(f"parameter 'segments' = {segments!r} must be an even integer >= 4",
-                               name="segments", value=segments)
+        raise InvalidParameter(
+            f"parameter 'segments' = {segments!r} must be an even integer >= 4", name="segments", value=segments
+        )
 
 
 @dataclass(frozen=True)
@@ -215,9 +217,9 @@ def centroid_pairs(M: np.ndarray, f1: np.ndarray, f2: np.ndarray) -> Centroids:
     cM = np.zeros((K, 3 * half + 1))
     c1 = np.zeros((K, 3 * half + 1))
     c2 = np.zeros((K, 3 * half + 1, 2))
-    cM[:, 1:half + 1] = np.cumsum(M, axis=1)
-    c1[:, 1:half + 1] = np.cumsum(f1, axis=1)
-    c2[:, 1:half + 1] = np.cumsum(f2, axis=1)
+    cM[:, 1 : half + 1] = np.cumsum(M, axis=1)
+    c1[:, 1 : half + 1] = np.cumsum(f1, axis=1)
+    c2[:, 1 : half + 1] = np.cumsum(f2, axis=1)
     for l in range(half + 1, 3 * half + 1):
         base = l - half if l <= N else l - N
         if l <= N:  # eqs. 14-16
@@ -248,7 +250,7 @@ def centroid_pairs(M: np.ndarray, f1: np.ndarray, f2: np.ndarray) -> Centroids:
         ok = m > tiny
         safe = np.where(ok, m, 1.0)
         mu = s2 / safe[..., None]
-        var = s1 / safe - (mu ** 2).sum(axis=-1)  # eq. 10
+        var = s1 / safe - (mu**2).sum(axis=-1)  # eq. 10
         return np.where(ok, var, np.inf), mu, m
 
     v1, mu1, m1 = run(ks, ls)

@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .spectral import cos2_window
 from .model import AffineModel, Prototype, _recombine, padded, prototype_from_patch
+from .spectral import cos2_window
+
 
 def _as_prototype(model: AffineModel, prototype) -> Prototype:
     if prototype is None:
@@ -45,8 +46,18 @@ def render_canvas(model: AffineModel, proto: Prototype, index: np.ndarray | None
     hc, wc = model.grid.canvas
     out = np.zeros((hc, wc, sig.shape[2]), np.float32)
     idx = np.arange(model.grid.count, dtype=np.int64) if index is None else np.asarray(index, dtype=np.int64)
-    _k.render(sig, c, c, model.sampling, model.shifts.astype(np.float64), model.alpha, model.grid.origins(),
-              cos2_window(model.block), idx, out)
+    _k.render(
+        sig,
+        c,
+        c,
+        model.sampling,
+        model.shifts.astype(np.float64),
+        model.alpha,
+        model.grid.origins(),
+        cos2_window(model.block),
+        idx,
+        out,
+    )
     return out
 
 
@@ -71,8 +82,9 @@ def compose(model: AffineModel, synth: np.ndarray) -> np.ndarray:
     return np.clip(out, 0.0, 1.0).astype(np.float32, copy=False)
 
 
-def render(model: AffineModel, prototype: Prototype | np.ndarray | None = None, *,
-           index: np.ndarray | None = None) -> np.ndarray:
+def render(
+    model: AffineModel, prototype: Prototype | np.ndarray | None = None, *, index: np.ndarray | None = None
+) -> np.ndarray:
     """Draw a model with its own prototype or a swapped one (§3, §4 "re-synthesizing based on the
     existing transformations").
 

@@ -30,8 +30,14 @@ MIN_SINE = 0.05
 # The eight centroid pairings of eq. 21 and their negations: (which centroid first, sign of the
 # first, sign of the second).
 PAIRINGS = (
-    (0, 1, 1), (1, 1, 1), (0, 1, -1), (1, 1, -1),
-    (0, -1, -1), (1, -1, -1), (0, -1, 1), (1, -1, 1),
+    (0, 1, 1),
+    (1, 1, 1),
+    (0, 1, -1),
+    (1, 1, -1),
+    (0, -1, -1),
+    (1, -1, -1),
+    (0, -1, 1),
+    (1, -1, 1),
 )
 
 
@@ -155,7 +161,7 @@ def sampling_matrices(T: np.ndarray) -> np.ndarray:
 def _pruned_inverse(L: int, radius: int) -> tuple[np.ndarray, np.ndarray]:
     """Matrices of the inverse real 2-D DFT restricted to shifts ``-radius..radius`` (rows in
     the order 0..R, -R..-1): ``rho = Ey @ X @ Ex.T`` for an rfft2 spectrum X (L, L//2 + 1)."""
-    vals = np.r_[0:radius + 1, -radius:0]
+    vals = np.r_[0 : radius + 1, -radius:0]
     ky = np.fft.fftfreq(L) * L
     ey = np.exp(2j * np.pi * np.outer(vals, ky) / L) / L
     kx = np.arange(L // 2 + 1)
@@ -175,8 +181,9 @@ def _turn_phase(L: int) -> np.ndarray:
     return np.exp(2j * np.pi * (ky[:, None] + kx[None, :]) / L).astype(np.complex64)
 
 
-def correlate_shifts(frames: np.ndarray, targets: np.ndarray, radius: int, *,
-                     turned: bool = False) -> tuple[np.ndarray, np.ndarray]:
+def correlate_shifts(
+    frames: np.ndarray, targets: np.ndarray, radius: int, *, turned: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Translation of each warped prototype that best fits its target patch (§2.3, eq. 23).
 
     Parameters
@@ -215,8 +222,9 @@ def correlate_shifts(frames: np.ndarray, targets: np.ndarray, radius: int, *,
     return correlate_indexed(frames.reshape(n * J, L, L), index, flip, targets, radius)
 
 
-def correlate_indexed(frames: np.ndarray, index: np.ndarray, flip: np.ndarray, targets: np.ndarray,
-                      radius: int) -> tuple[np.ndarray, np.ndarray]:
+def correlate_indexed(
+    frames: np.ndarray, index: np.ndarray, flip: np.ndarray, targets: np.ndarray, radius: int
+) -> tuple[np.ndarray, np.ndarray]:
     """:func:`correlate_shifts` for candidates that share frames (§2.3, eq. 23).
 
     Parameters
@@ -243,7 +251,7 @@ def correlate_indexed(frames: np.ndarray, index: np.ndarray, flip: np.ndarray, t
     B = targets.shape[-1]
     R = radius
     g = np.zeros((n, L, L), np.float32)
-    g[:, R:R + B, R:R + B] = targets
+    g[:, R : R + B, R : R + B] = targets
     import scipy.fft as sfft  # here, not at import: 0.12 s that every weft process paid
 
     G = sfft.rfft2(g)[:, None]
@@ -251,8 +259,14 @@ def correlate_indexed(frames: np.ndarray, index: np.ndarray, flip: np.ndarray, t
     # rho[u] = sum g[v] f[v - u]: spectrum G conj(F); a turned frame has spectrum phase conj(F),
     # so its correlation has spectrum G F conj(phase)
     h = J // 2
-    if (J % 2 == 0 and F_count == n * h and np.array_equal(index[:, :h].ravel(), np.arange(n * h))
-            and np.array_equal(index[:, h:], index[:, :h]) and not flip[:, :h].any() and flip[:, h:].all()):
+    if (
+        J % 2 == 0
+        and F_count == n * h
+        and np.array_equal(index[:, :h].ravel(), np.arange(n * h))
+        and np.array_equal(index[:, h:], index[:, :h])
+        and not flip[:, :h].any()
+        and flip[:, h:].all()
+    ):
         Fr = F.reshape(n, h, L, -1)  # own frames, then the same turned: no gathering needed
         spec = np.concatenate([G * np.conj(Fr), G * (Fr * np.conj(_turn_phase(L)))], axis=1)
     else:
@@ -265,7 +279,7 @@ def correlate_indexed(frames: np.ndarray, index: np.ndarray, flip: np.ndarray, t
     win = rho.reshape(n, J, -1)
     best = np.argmax(win, axis=-1)
     side = 2 * R + 1
-    vals = np.r_[0:R + 1, -R:0]
+    vals = np.r_[0 : R + 1, -R:0]
     shifts = np.stack([vals[best // side], vals[best % side]], axis=-1).astype(np.int64)
     peak = np.take_along_axis(win, best[..., None], axis=-1)[..., 0].astype(np.float32)
     return shifts, peak

@@ -28,12 +28,58 @@ Importing this package imports neither Dask nor the method modules. :mod:`.prepa
 batch is and the checks before any work; :mod:`.execute` runs its items.
 """
 
-from .execute import (CONNECT_TIMEOUT, IN_FLIGHT_PER_WORKER, MAX_ATTEMPTS, SCHEDULER_ENV, DaskPool, LocalPool,
-                      WorkerDied, default_workers, run, run_item, scheduler_address, set_threads, warm_up)
-from .prepare import (IMAGE_EXTENSIONS, SAVE_EXTENSIONS, BatchProgress, Item, Outcome, Plan, Summary, check_memory,
-                   expand_over, item_memory, plan)
+from .execute import (
+    CONNECT_TIMEOUT,
+    IN_FLIGHT_PER_WORKER,
+    MAX_ATTEMPTS,
+    SCHEDULER_ENV,
+    DaskPool,
+    LocalPool,
+    WorkerDied,
+    default_workers,
+    run,
+    run_item,
+    scheduler_address,
+    set_threads,
+    warm_up,
+)
+from .prepare import (
+    IMAGE_EXTENSIONS,
+    SAVE_EXTENSIONS,
+    BatchProgress,
+    Item,
+    Outcome,
+    Plan,
+    Summary,
+    check_memory,
+    expand_over,
+    item_memory,
+    plan,
+)
 
-__all__ = ["BatchProgress", "CONNECT_TIMEOUT", "DaskPool", "IMAGE_EXTENSIONS", "IN_FLIGHT_PER_WORKER", "Item",
-           "LocalPool", "MAX_ATTEMPTS", "Outcome", "Plan", "SAVE_EXTENSIONS", "SCHEDULER_ENV", "Summary",
-           "WorkerDied", "check_memory", "default_workers", "expand_over", "item_memory", "plan", "run", "run_item",
-           "scheduler_address", "set_threads", "warm_up"]
+__all__ = [
+    "BatchProgress",
+    "CONNECT_TIMEOUT",
+    "DaskPool",
+    "IMAGE_EXTENSIONS",
+    "IN_FLIGHT_PER_WORKER",
+    "Item",
+    "LocalPool",
+    "MAX_ATTEMPTS",
+    "Outcome",
+    "Plan",
+    "SAVE_EXTENSIONS",
+    "SCHEDULER_ENV",
+    "Summary",
+    "WorkerDied",
+    "check_memory",
+    "default_workers",
+    "expand_over",
+    "item_memory",
+    "plan",
+    "run",
+    "run_item",
+    "scheduler_address",
+    "set_threads",
+    "warm_up",
+]

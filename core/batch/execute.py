@@ -13,15 +13,25 @@ import secrets
 import tempfile
 import threading
 import time
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any
 
 from ..errors import Cancelled, WeftError
 from ..jobs import CancelToken
 from ..limits import LimitError, _bytes
-from .prepare import (BatchProgress, Item, Outcome, Plan, Summary, check_memory, item_memory, too_large_alone,
-                      workers_that_fit)
+from .prepare import (
+    BatchProgress,
+    Item,
+    Outcome,
+    Plan,
+    Summary,
+    check_memory,
+    item_memory,
+    too_large_alone,
+    workers_that_fit,
+)
 
 #: Times an item is started before a worker dying under it fails the item (Dask's default too).
 MAX_ATTEMPTS = 3
@@ -106,8 +116,9 @@ def run_item(item: Item) -> Outcome:
                 paths[name] = str(copy)
         cancel = CancelToken(_cancel_event) if _cancel_event is not None else None
         try:
-            result, seconds = render(method, params, paths, item.seed, item.region, cancel=cancel,
-                                     warm_up=False, shown_paths=item.inputs)
+            result, seconds = render(
+                method, params, paths, item.seed, item.region, cancel=cancel, warm_up=False, shown_paths=item.inputs
+            )
         except WeftError as e:
             message = _one_line(e)
             for name, path in paths.items():  # a shipped copy is named by the file it came from
@@ -118,9 +129,18 @@ def run_item(item: Item) -> Outcome:
             os.makedirs(os.path.dirname(item.output), exist_ok=True)
             atomic_write_bytes(Path(item.output), data)
             data = None
-        return Outcome(item.index, item.label, item.output, "written", seconds=seconds,
-                       figures=dict(result.figures), worker=worker, data=data, elapsed=time.perf_counter() - t0,
-                       cpu=time.process_time() - c0)
+        return Outcome(
+            item.index,
+            item.label,
+            item.output,
+            "written",
+            seconds=seconds,
+            figures=dict(result.figures),
+            worker=worker,
+            data=data,
+            elapsed=time.perf_counter() - t0,
+            cpu=time.process_time() - c0,
+        )
     except Cancelled:
         return Outcome(item.index, item.label, item.output, "failed", error="cancelled", worker=worker)
     except WeftError as e:
@@ -128,8 +148,9 @@ def run_item(item: Item) -> Outcome:
     except MemoryError:
         return Outcome(item.index, item.label, item.output, "failed", error="out of memory", worker=worker)
     except OSError as e:
-        return Outcome(item.index, item.label, item.output, "failed",
-                       error=f"{e.strerror or _one_line(e)}", worker=worker)
+        return Outcome(
+            item.index, item.label, item.output, "failed", error=f"{e.strerror or _one_line(e)}", worker=worker
+        )
     finally:
         if tmpdir is not None:
             tmpdir.cleanup()
@@ -190,6 +211,7 @@ def _init_local_worker(method_name: str, cancel_event, parent: int | None = None
 # --------------------------------------------------------------------------------------------------
 # Pools: the same items, the same function, local processes or a Dask cluster
 
+
 class WorkerDied(Exception):
     """The process running an item died (killed, or out of memory)."""
 
@@ -210,8 +232,12 @@ class LocalPool:
         self._start()
 
     def _start(self) -> None:
-        self.executor = cf.ProcessPoolExecutor(self.workers, mp_context=self.ctx, initializer=_init_local_worker,
-                                               initargs=(self.method, self.cancel_event, os.getpid()))
+        self.executor = cf.ProcessPoolExecutor(
+            self.workers,
+            mp_context=self.ctx,
+            initializer=_init_local_worker,
+            initargs=(self.method, self.cancel_event, os.getpid()),
+        )
         if self.workers > 1:  # (the executor starts a process per submit: each under _interrupts_held)
             try:
                 self._first_worker()
@@ -302,14 +328,17 @@ class DaskPool:
             self.client = Client(address, timeout=CONNECT_TIMEOUT)
         except Exception as e:  # noqa: BLE001 - OSError, TimeoutError; TypeError/ValueError for tls:// without
             # certificates; ImportError for ucx:// without ucx-py
-            raise WeftError(f"cannot reach the Dask scheduler at {address} ({type(e).__name__}: {_one_line(e)})"
-                            ) from None
+            raise WeftError(
+                f"cannot reach the Dask scheduler at {address} ({type(e).__name__}: {_one_line(e)})"
+            ) from None
         try:
             self.client.wait_for_workers(1, timeout=WORKER_TIMEOUT)
         except Exception:  # noqa: BLE001 - (TimeoutError, or the scheduler went away meanwhile)
             self.close()
-            raise WeftError(f"the Dask scheduler at {address} has no workers (waited {WORKER_TIMEOUT:g} s; "
-                            f"set {WORKER_TIMEOUT_ENV} to wait longer)") from None
+            raise WeftError(
+                f"the Dask scheduler at {address} has no workers (waited {WORKER_TIMEOUT:g} s; "
+                f"set {WORKER_TIMEOUT_ENV} to wait longer)"
+            ) from None
         self.method = method
         totals: dict[str, int] = collections.Counter()
         for addr, info in self.workers().items():
@@ -317,8 +346,11 @@ class DaskPool:
         self.client.run(_dask_threads, dict(totals))
 
     def workers(self) -> dict:
-        return self.client.scheduler_info(n_workers=-1)["workers"] if self._takes_n() else \
-            self.client.scheduler_info()["workers"]
+        return (
+            self.client.scheduler_info(n_workers=-1)["workers"]
+            if self._takes_n()
+            else self.client.scheduler_info()["workers"]
+        )
 
     def _takes_n(self) -> bool:
         import inspect
@@ -413,9 +445,16 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None,
-        progress: Callable[[BatchProgress], None] | None = None,
-        on_outcome: Callable[[Outcome], None] | None = None, cancel=None, pool=None) -> Summary:
+def run(
+    plan_: Plan,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: Callable[[BatchProgress], None] | None = None,
+    on_outcome: Callable[[Outcome], None] | None = None,
+    cancel=None,
+    pool=None,
+) -> Summary:
     """Run a planned batch; returns its :class:`Summary` once every item is done (or cancelled).
 
     Parameters
@@ -452,8 +491,14 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
     if todo and pool is None and not scheduler:  # an item too large even alone fails alone; the rest run
         alone = too_large_alone(todo)
         for item, reason in alone:
-            _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
-                    item, summary, state, on_outcome, progress)
+            _finish(
+                Outcome(item.index, item.label, item.output, "failed", error=reason),
+                item,
+                summary,
+                state,
+                on_outcome,
+                progress,
+            )
         refused = {item.index for item, _ in alone}
         todo = collections.deque(item for item in todo if item.index not in refused)
     if not todo:
@@ -474,9 +519,11 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
             for addr, info in pool.workers().items():
                 limit, threads = info.get("memory_limit") or 0, info.get("nthreads", 1)
                 if need and limit and need * threads > limit:
-                    raise LimitError(f"batch: one item ({label}) needs about {_bytes(need)} of memory; the Dask worker "
-                                     f"{addr} runs {threads} at once with a limit of {_bytes(limit)}: start workers "
-                                     f"with fewer threads (--nthreads) or more memory (--memory-limit)")
+                    raise LimitError(
+                        f"batch: one item ({label}) needs about {_bytes(need)} of memory; the Dask worker "
+                        f"{addr} runs {threads} at once with a limit of {_bytes(limit)}: start workers "
+                        f"with fewer threads (--nthreads) or more memory (--memory-limit)"
+                    )
         attempts: dict[int, int] = collections.Counter()
         inflight: dict[Any, Item] = {}
         limit = IN_FLIGHT_PER_WORKER * pool.slots
@@ -499,16 +546,28 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                     try:
                         item = _ship(item)
                     except WeftError as e:
-                        _finish(Outcome(item.index, item.label, item.output, "failed", error=str(e)),
-                                item, summary, state, on_outcome, progress)
+                        _finish(
+                            Outcome(item.index, item.label, item.output, "failed", error=str(e)),
+                            item,
+                            summary,
+                            state,
+                            on_outcome,
+                            progress,
+                        )
                         continue
                 inflight[pool.submit(item)] = item
             reason = pool.gone() if isinstance(pool, DaskPool) else None
             if reason:  # every item not done fails
                 pool.cancel(inflight)
                 for item in [*inflight.values(), *todo]:
-                    _finish(Outcome(item.index, item.label, item.output, "failed", error=reason),
-                            item, summary, state, on_outcome, progress)
+                    _finish(
+                        Outcome(item.index, item.label, item.output, "failed", error=reason),
+                        item,
+                        summary,
+                        state,
+                        on_outcome,
+                        progress,
+                    )
                 inflight.clear()
                 todo.clear()
                 break
@@ -523,8 +582,13 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                 except (cf.CancelledError, asyncio.CancelledError):
                     if not (isinstance(pool, DaskPool) and pool.lost()):
                         continue
-                    outcome = Outcome(item.index, item.label, item.output, "failed",
-                                      error=f"the Dask scheduler at {pool.address} was lost before it was done")
+                    outcome = Outcome(
+                        item.index,
+                        item.label,
+                        item.output,
+                        "failed",
+                        error=f"the Dask scheduler at {pool.address} was lost before it was done",
+                    )
                 except Exception as e:  # noqa: BLE001 - e.g. a Dask communication error: this item's
                     outcome = Outcome(item.index, item.label, item.output, "failed", error=_one_line(e))
                 _finish(outcome, item, summary, state, on_outcome, progress)
@@ -536,9 +600,13 @@ def run(plan_: Plan, *, workers: int | None = None, scheduler: str | None = None
                     attempts[item.index] += 1
                     # Dask has already tried it on MAX_ATTEMPTS workers (its allowed-failures).
                     if attempts[item.index] >= MAX_ATTEMPTS or not isinstance(pool, LocalPool):
-                        outcome = Outcome(item.index, item.label, item.output, "failed",
-                                          error="the worker running it died each time it was tried "
-                                                "(killed, or out of memory)")
+                        outcome = Outcome(
+                            item.index,
+                            item.label,
+                            item.output,
+                            "failed",
+                            error="the worker running it died each time it was tried (killed, or out of memory)",
+                        )
                         _finish(outcome, item, summary, state, on_outcome, progress)
                     else:
                         todo.appendleft(item)
@@ -579,8 +647,7 @@ def _ship(item: Item) -> Item:
     return replace(item, shipped=shipped)
 
 
-def _finish(outcome: Outcome, item: Item, summary: Summary, state: BatchProgress,
-            on_outcome, progress) -> None:
+def _finish(outcome: Outcome, item: Item, summary: Summary, state: BatchProgress, on_outcome, progress) -> None:
     """Count one finished item (writing its output here when the worker sent it back)."""
     if outcome.status == "written" and outcome.data is not None:
         from ..image import atomic_write_bytes
@@ -597,7 +664,7 @@ def _finish(outcome: Outcome, item: Item, summary: Summary, state: BatchProgress
         reason = outcome.error or "failed"
         for path in item.inputs.values():  # "frame_0312.png: truncated PNG ..." rather than its whole path
             if reason.startswith(path + ": "):
-                summary.failed.append((item.index, os.path.basename(path), reason[len(path) + 2:]))
+                summary.failed.append((item.index, os.path.basename(path), reason[len(path) + 2 :]))
                 break
         else:
             summary.failed.append((item.index, item.label, reason))

@@ -10,9 +10,10 @@ import re
 import secrets
 import string
 import time
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any
 
 from ..errors import WeftError
 from ..limits import LimitError, _bytes, available_memory
@@ -26,6 +27,7 @@ SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
 # --------------------------------------------------------------------------------------------------
 # Items and outcomes (what crosses to a worker and back: plain, picklable values)
+
 
 @dataclass(frozen=True)
 class Item:
@@ -136,9 +138,16 @@ class Summary:
 
     def report(self) -> dict:
         """The summary ``--report`` line."""
-        return {"summary": True, "total": self.total, "written": self.written, "skipped": self.skipped,
-                "failed": len(self.failed), "cancelled": self.cancelled, "seconds": round(self.seconds, 3),
-                "items_per_second": round(self.written / self.seconds, 4) if self.seconds > 0 else None}
+        return {
+            "summary": True,
+            "total": self.total,
+            "written": self.written,
+            "skipped": self.skipped,
+            "failed": len(self.failed),
+            "cancelled": self.cancelled,
+            "seconds": round(self.seconds, 3),
+            "items_per_second": round(self.written / self.seconds, 4) if self.seconds > 0 else None,
+        }
 
 
 class BatchProgress:
@@ -172,6 +181,7 @@ class BatchProgress:
 # --------------------------------------------------------------------------------------------------
 # Planning: everything that can be wrong about the batch as a whole, before any work
 
+
 def _natural_key(path: str):
     return [int(t) if t.isdigit() else t.lower() for t in re.split(r"(\d+)", os.path.basename(path))] + [path]
 
@@ -180,8 +190,11 @@ def expand_over(name: str, where: str) -> list[str]:
     """The files of one ``--over``: a folder's image files, a glob's matches or one file, in natural
     order (``frame_2`` before ``frame_10``); ``WeftError`` if there are none."""
     if os.path.isdir(where):
-        files = [str(Path(where) / f) for f in os.listdir(where)
-                 if not f.startswith(".") and f.lower().endswith(IMAGE_EXTENSIONS) and (Path(where) / f).is_file()]
+        files = [
+            str(Path(where) / f)
+            for f in os.listdir(where)
+            if not f.startswith(".") and f.lower().endswith(IMAGE_EXTENSIONS) and (Path(where) / f).is_file()
+        ]
         if not files:
             raise WeftError(f"--over {name} {where}: the folder holds no image files ({', '.join(IMAGE_EXTENSIONS)})")
     elif glob.has_magic(where):
@@ -237,8 +250,11 @@ def _done_already(item: Item) -> bool:
     if not item.output.lower().endswith(".png") or not os.path.isfile(item.output):
         return False
     try:
-        return (read_recipe(item.output) == item.recipe and _png_bit_depth(item.output) == item.bit_depth
-                and png_is_whole(item.output))
+        return (
+            read_recipe(item.output) == item.recipe
+            and _png_bit_depth(item.output) == item.bit_depth
+            and png_is_whole(item.output)
+        )
     except (WeftError, OSError):
         return False
 
@@ -259,9 +275,19 @@ def _existing_seed(outputs: Sequence[tuple[int, str]], method: str) -> tuple[int
     return None
 
 
-def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, seed: int | None = None,
-         seed_per_item: bool = False, force: bool = False, bit_depth: int | None = None, ship_inputs: bool = False,
-         ship_outputs: bool = False, recipe=None) -> Plan:
+def plan(
+    recipe_path: str,
+    over: Sequence[tuple[str, str]],
+    pattern: str,
+    *,
+    seed: int | None = None,
+    seed_per_item: bool = False,
+    force: bool = False,
+    bit_depth: int | None = None,
+    ship_inputs: bool = False,
+    ship_outputs: bool = False,
+    recipe=None,
+) -> Plan:
     """Check a batch and list its items.
 
     Parameters
@@ -324,8 +350,11 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     lists = {name: expand_over(name, where) for name, where in over}
     counts = {len(v) for v in lists.values()}
     if len(counts) > 1:
-        raise WeftError("the --over lists differ in length (" + ", ".join(
-            f"{name}: {len(v)} files" for name, v in lists.items()) + "); they are taken in step, file by file")
+        raise WeftError(
+            "the --over lists differ in length ("
+            + ", ".join(f"{name}: {len(v)} files" for name, v in lists.items())
+            + "); they are taken in step, file by file"
+        )
     n = counts.pop()
 
     ext = os.path.splitext(pattern)[1].lower()
@@ -337,7 +366,9 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     for f in _pattern_fields(pattern):
         key = re.split(r"[.\[]", f, maxsplit=1)[0]
         if key not in allowed:
-            raise WeftError(f"pattern {pattern!r} uses {{{f}}}; it may use " + ", ".join("{" + a + "}" for a in allowed))
+            raise WeftError(
+                f"pattern {pattern!r} uses {{{f}}}; it may use " + ", ".join("{" + a + "}" for a in allowed)
+            )
 
     first = names[0]
     fixed = {k: str(Path(v).resolve()) for k, v in recipe.inputs.items() if k not in lists}
@@ -353,19 +384,26 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     keys: dict[tuple, str] = {}
     for i in range(n):
         over_files = {name: lists[name][i] for name in lists}
-        values = {"stem": Path(over_files[first]).stem, "name": Path(over_files[first]).name, "index": i,
-                  **{name: Path(path).stem for name, path in over_files.items()}}
+        values = {
+            "stem": Path(over_files[first]).stem,
+            "name": Path(over_files[first]).name,
+            "index": i,
+            **{name: Path(path).stem for name, path in over_files.items()},
+        }
         out = os.path.abspath(_format(pattern, values))
         label = os.path.basename(over_files[first])
         key = file_key(out)
         if out in seen or key in keys:
-            raise WeftError(f"pattern {pattern!r} gives {shown(out)} for both {shown(seen.get(out) or keys[key])} "
-                            f"and {shown(label)}: add {{index}} or {{stem}} so every item has its own output")
+            raise WeftError(
+                f"pattern {pattern!r} gives {shown(out)} for both {shown(seen.get(out) or keys[key])} "
+                f"and {shown(label)}: add {{index}} or {{stem}} so every item has its own output"
+            )
         seen[out] = keys[key] = label
         if key in read:
             what = "recipe" if own_file and read[key] == recipe_path else "input"
-            raise WeftError(f"pattern {pattern!r}: refusing to overwrite the {what} file {shown(read[key])} "
-                            f"(as {shown(out)})")
+            raise WeftError(
+                f"pattern {pattern!r}: refusing to overwrite the {what} file {shown(read[key])} (as {shown(out)})"
+            )
         try:
             kind = kind_of(os.stat(out).st_mode)
         except FileNotFoundError:
@@ -391,10 +429,21 @@ def plan(recipe_path: str, over: Sequence[tuple[str, str]], pattern: str, *, see
     for i, label, inputs, out in rows:
         item_seed = (seed + i) % 2**63 if seed_per_item else seed
         text = output_recipe(method, params, inputs, item_seed, recipe.region, out).to_json()
-        items.append(Item(index=i, label=label, method=method.name, params=params_dict, inputs=inputs,
-                          seed=item_seed, region=recipe.region, output=out, recipe=text,
-                          bit_depth=_item_bit_depth(method, inputs, out, bit_depth),
-                          write=not ship_outputs))
+        items.append(
+            Item(
+                index=i,
+                label=label,
+                method=method.name,
+                params=params_dict,
+                inputs=inputs,
+                seed=item_seed,
+                region=recipe.region,
+                output=out,
+                recipe=text,
+                bit_depth=_item_bit_depth(method, inputs, out, bit_depth),
+                write=not ship_outputs,
+            )
+        )
     skipped = () if force else tuple(it for it in items if _done_already(it))
     return Plan(items=tuple(items), skipped=skipped, method=method.name, seed=seed, ship_inputs=ship_inputs)
 
@@ -463,8 +512,13 @@ def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> l
         big = next(((name, s) for name, s in shapes.items() if s is not None and s[0] * s[1] > limit), None)
         if big is not None:
             name, (h, w) = big[0], big[1][:2]
-            alone.append((item, f"{shown(item.inputs[name])}: {w}x{h} = {w * h / 1e6:.1f} megapixels exceeds the "
-                                f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)"))
+            alone.append(
+                (
+                    item,
+                    f"{shown(item.inputs[name])}: {w}x{h} = {w * h / 1e6:.1f} megapixels exceeds the "
+                    f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)",
+                )
+            )
             continue
         if params is None or available is None or any(s is None for s in shapes.values()):
             continue
@@ -476,8 +530,12 @@ def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> l
         except (WeftError, KeyError, TypeError, ValueError):
             continue
         if need > available:
-            alone.append((item, f"needs about {_bytes(need)} of memory, {_bytes(available)} is available: "
-                                "make its inputs smaller"))
+            alone.append(
+                (
+                    item,
+                    f"needs about {_bytes(need)} of memory, {_bytes(available)} is available: make its inputs smaller",
+                )
+            )
     return alone
 
 
@@ -490,8 +548,9 @@ def workers_that_fit(items: Iterable[Item], workers: int, *, available: int | No
     return max(1, min(workers, int(available // need)))
 
 
-def check_memory(items: Iterable[Item], workers: int, *, available: int | None = None,
-                 option: str = "--workers") -> None:
+def check_memory(
+    items: Iterable[Item], workers: int, *, available: int | None = None, option: str = "--workers"
+) -> None:
     """Refuse up front a batch whose largest item's estimate times ``workers`` exceeds ``available``
     memory (default: what the system has available now), saying how many workers would fit."""
     need, label = item_memory(items)
@@ -499,7 +558,8 @@ def check_memory(items: Iterable[Item], workers: int, *, available: int | None =
     if not need or available is None or need * workers <= available:
         return
     fits = int(available // need)
-    advice = (f"use {option} {fits}" if fits >= 1
-              else "make the inputs smaller (even one item does not fit)")
-    raise LimitError(f"batch: one item ({label}) needs about {_bytes(need)} of memory, {workers} workers at once "
-                     f"{_bytes(need * workers)}, {_bytes(available)} is available: {advice}")
+    advice = f"use {option} {fits}" if fits >= 1 else "make the inputs smaller (even one item does not fit)"
+    raise LimitError(
+        f"batch: one item ({label}) needs about {_bytes(need)} of memory, {workers} workers at once "
+        f"{_bytes(need * workers)}, {_bytes(available)} is available: {advice}"
+    )

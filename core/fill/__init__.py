@@ -37,12 +37,36 @@ from .method import METHOD, fill_image, warm_up
 from .params import ANCHORS, DEFAULT_ENGINE, DEFAULT_PATCH, ENGINES, FillParams, structure_value
 from .quilt import fill_quilt
 
-__all__ = ["ANCHORS", "DEFAULT_ENGINE", "DEFAULT_PATCH", "ENGINES", "FillParams", "METHOD", "fill",
-           "fill_quilt", "warm_up"]
+__all__ = [
+    "ANCHORS",
+    "DEFAULT_ENGINE",
+    "DEFAULT_PATCH",
+    "ENGINES",
+    "FillParams",
+    "METHOD",
+    "fill",
+    "fill_quilt",
+    "warm_up",
+]
 
 
-def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=None, patch=None, band=2,
-         structure="auto", source_mask=None, texture=None, seed=0, progress=None, cancel=None) -> np.ndarray:
+def fill(
+    image,
+    mask=None,
+    *,
+    extend=None,
+    size=None,
+    anchor="center",
+    engine=None,
+    patch=None,
+    band=2,
+    structure="auto",
+    source_mask=None,
+    texture=None,
+    seed=0,
+    progress=None,
+    cancel=None,
+) -> np.ndarray:
     """Fill the hole of ``image`` and/or extend its canvas; returns the filled float32 image.
 
     Parameters
@@ -72,9 +96,16 @@ def fill(image, mask=None, *, extend=None, size=None, anchor="center", engine=No
 
     Raises ``WeftError`` (one line) for nothing to fill, a mask of another size, too little to copy from.
     """
-    params = FillParams(engine=engine or DEFAULT_ENGINE, patch=patch, band=band, structure=structure_value(structure),
-                        extend=None if extend is None else Margins.coerce(extend),
-                        size=None if size is None else tuple(size), anchor=anchor)
-    out, _figures = fill_image(image, mask, params=params, source_mask=source_mask, texture=texture, rng=seed,
-                               progress=progress, cancel=cancel)
+    params = FillParams(
+        engine=engine or DEFAULT_ENGINE,
+        patch=patch,
+        band=band,
+        structure=structure_value(structure),
+        extend=None if extend is None else Margins.coerce(extend),
+        size=None if size is None else tuple(size),
+        anchor=anchor,
+    )
+    out, _figures = fill_image(
+        image, mask, params=params, source_mask=source_mask, texture=texture, rng=seed, progress=progress, cancel=cancel
+    )
     return out

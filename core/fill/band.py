@@ -40,8 +40,9 @@ def band_region(hole: np.ndarray, band: int, exclude: np.ndarray | None = None) 
     return ring
 
 
-def blend_band(image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarray | None = None,
-               written: np.ndarray | None = None) -> np.ndarray:
+def blend_band(
+    image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarray | None = None, written: np.ndarray | None = None
+) -> np.ndarray:
     """``image`` (H, W, C) float32 with its band around ``hole`` re-solved; every other pixel is
     returned bit for bit. ``exclude``: pixels never changed (transparent ones). ``written``: the
     pixels the engine wrote (default ``hole``): the hole and the band's known pixels its cut ran

@@ -50,8 +50,10 @@ def check_engine_args(image, hole, source, patch: int, name: str):
     if patch > min(h, w):
         raise InvalidParameter(f"parameter 'patch' = {patch} is larger than the {w}x{h} image", name="patch")
     if not whole_patches(src, patch).any():
-        raise WeftError(f"the {name} engine needs at least one whole {patch}x{patch} patch of known pixels to copy "
-                        f"from; the source has none")
+        raise WeftError(
+            f"the {name} engine needs at least one whole {patch}x{patch} patch of known pixels to copy "
+            f"from; the source has none"
+        )
     return img, hole, src
 
 

@@ -57,11 +57,11 @@ def min_cut(err: np.ndarray, *, left: int = 0, top: int = 0, right: int = 0, bot
     if left > 0:
         strips.append(("left", err[:, :left]))
     if right > 0:
-        strips.append(("right", err[:, w - right:]))
+        strips.append(("right", err[:, w - right :]))
     if top > 0:
         strips.append(("top", err[:top, :].T))
     if bottom > 0:
-        strips.append(("bottom", err[h - bottom:, :].T))
+        strips.append(("bottom", err[h - bottom :, :].T))
     paths = {}
     for shape in dict.fromkeys(s.shape for _, s in strips):
         group = [(side, s) for side, s in strips if s.shape == shape]
@@ -78,8 +78,9 @@ def min_cut(err: np.ndarray, *, left: int = 0, top: int = 0, right: int = 0, bot
     return new
 
 
-def poisson_cg(nbr: np.ndarray, ndeg: np.ndarray, rhs: np.ndarray, x: np.ndarray, tol: float,
-               max_iter: int) -> np.ndarray:
+def poisson_cg(
+    nbr: np.ndarray, ndeg: np.ndarray, rhs: np.ndarray, x: np.ndarray, tol: float, max_iter: int
+) -> np.ndarray:
     """Solve ``ndeg_p x_p - sum_{q in nbr_p} x_q = rhs_p`` (``nbr`` (n, 4), -1: none) for every
     channel of ``rhs`` (n, C), starting from ``x`` (overwritten); stops at ``||r|| <= tol ||rhs||``."""
     n, c = rhs.shape

@@ -9,9 +9,9 @@ checked at least once per block, pixel row or EM iteration.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import import_module
-from typing import Callable
 
 import numpy as np
 
@@ -49,12 +49,31 @@ def _always(_image: np.ndarray, _hole: np.ndarray) -> bool:
 
 #: The engines, by ``--engine`` name (``auto`` picks one of them: :func:`weft.core.fill.params.auto_engine`).
 TABLE: dict[str, Engine] = {
-    e.name: e for e in (
-        Engine("patchmatch", "multi-scale patch search with voting (Wexler et al., PatchMatch)", 7,
-               "patchmatch:fill_patchmatch", True, _always),
-        Engine("quilt", "blocks in fill-front order with min-cut seams (Efros & Freeman)", 24,
-               "quilt:fill_quilt", True, _quilt_refines),
-        Engine("hybrid", "quilt with 64-px blocks, then full-resolution patch search refines the seams", 64,
-               "hybrid:fill_hybrid", True, _always),
+    e.name: e
+    for e in (
+        Engine(
+            "patchmatch",
+            "multi-scale patch search with voting (Wexler et al., PatchMatch)",
+            7,
+            "patchmatch:fill_patchmatch",
+            True,
+            _always,
+        ),
+        Engine(
+            "quilt",
+            "blocks in fill-front order with min-cut seams (Efros & Freeman)",
+            24,
+            "quilt:fill_quilt",
+            True,
+            _quilt_refines,
+        ),
+        Engine(
+            "hybrid",
+            "quilt with 64-px blocks, then full-resolution patch search refines the seams",
+            64,
+            "hybrid:fill_hybrid",
+            True,
+            _always,
+        ),
     )
 }

@@ -35,8 +35,20 @@ REFINE_PATCH = 7
 REFINE_ITERATIONS = 5
 
 
-def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0,
-                cuttable=None, refine_patch=REFINE_PATCH, iterations=REFINE_ITERATIONS) -> np.ndarray:
+def fill_hybrid(
+    image,
+    hole,
+    source=None,
+    *,
+    patch=BLOCK,
+    rng=0,
+    progress=None,
+    cancel=None,
+    band=0,
+    cuttable=None,
+    refine_patch=REFINE_PATCH,
+    iterations=REFINE_ITERATIONS,
+) -> np.ndarray:
     """Fill ``hole`` of ``image`` with :func:`~weft.core.fill.quilt.fill_quilt` (block side ``patch``;
     ``band`` / ``cuttable``: the known pixels the cut, and then the refine, may change), then refine
     the hole and those pixels with :func:`~weft.core.fill.patchmatch.refine_patchmatch`
@@ -62,13 +74,32 @@ def fill_hybrid(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, 
     def refine_progress(p):
         report.update(total + int(round(p.fraction * iterations)))
 
-    quilted = fill_quilt(image, holes, source, patch=patch, rng=gen, progress=quilt_progress, cancel=cancel,
-                         band=band, cuttable=cuttable, refine=False)  # (its own refine follows)
+    quilted = fill_quilt(
+        image,
+        holes,
+        source,
+        patch=patch,
+        rng=gen,
+        progress=quilt_progress,
+        cancel=cancel,
+        band=band,
+        cuttable=cuttable,
+        refine=False,
+    )  # (its own refine follows)
     if cuttable is not None:
         region = holes | np.asarray(cuttable, dtype=bool)
     else:
         region = holes | band_region(holes, band) if band > 0 else holes
     allowed = ~holes if source is None else np.asarray(source, dtype=bool) & ~holes
     rp = max(3, min(int(refine_patch), int(patch), *holes.shape))
-    return refine_band(quilted, holes, region, allowed, patch=rp, iterations=iterations, rng=gen,
-                       progress=refine_progress, cancel=cancel)
+    return refine_band(
+        quilted,
+        holes,
+        region,
+        allowed,
+        patch=rp,
+        iterations=iterations,
+        rng=gen,
+        progress=refine_progress,
+        cancel=cancel,
+    )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import cv2
 import numpy as np
@@ -43,8 +43,12 @@ def _mask_bits(mask, shape: tuple[int, int], what: str, against: str) -> np.ndar
     if m.dtype != bool and not (m.ndim == 3 and m.shape[2] in (2, 4)):  # (with alpha: Mask.from_image reads it)
         m = np.asarray(validate_image(m, what))
     if m.shape[:2] != tuple(shape):
-        raise _error(ImageError, f"the {what.replace('_', ' ')} is {m.shape[1]}x{m.shape[0]} but the {against} is "
-                     f"{shape[1]}x{shape[0]}; they must be the same size", what)
+        raise _error(
+            ImageError,
+            f"the {what.replace('_', ' ')} is {m.shape[1]}x{m.shape[0]} but the {against} is "
+            f"{shape[1]}x{shape[0]}; they must be the same size",
+            what,
+        )
     if m.dtype == bool:
         return m
     _black_and_white(m, what)
@@ -67,8 +71,12 @@ def _black_and_white(m: np.ndarray, what: str) -> None:
         odd |= (arr.max(axis=2) - arr.min(axis=2)) > 0.1
     share = float(odd.mean())
     if share > MAX_GREY_SHARE:
-        raise _error(ImageError, f"the {what.replace('_', ' ')} is not black and white: {share:.0%} of its pixels are "
-                     "grey or coloured (white = fill, black = keep; was a photo given as the mask?)", what)
+        raise _error(
+            ImageError,
+            f"the {what.replace('_', ' ')} is not black and white: {share:.0%} of its pixels are "
+            "grey or coloured (white = fill, black = keep; was a photo given as the mask?)",
+            what,
+        )
 
 
 def _margins(params: FillParams, w: int, h: int) -> Margins | None:
@@ -80,8 +88,13 @@ def _margins(params: FillParams, w: int, h: int) -> Margins | None:
         return None
     sw, sh = params.size
     if sw < w or sh < h:
-        raise _error(InvalidParameter, f"parameter 'size' = {sw}x{sh} is smaller than the {w}x{h} image "
-                     "(an uncrop only grows the canvas)", None, name="size", value=params.size)
+        raise _error(
+            InvalidParameter,
+            f"parameter 'size' = {sw}x{sh} is smaller than the {w}x{h} image (an uncrop only grows the canvas)",
+            None,
+            name="size",
+            value=params.size,
+        )
     dx, dy = sw - w, sh - h
     col = {"left": 0, "right": 2}.get(params.anchor.split("-")[-1], 1)
     row = {"top": 0, "bottom": 2}.get(params.anchor.split("-")[0], 1)
@@ -90,8 +103,9 @@ def _margins(params: FillParams, w: int, h: int) -> Margins | None:
     return Margins(left, top, dx - left, dy - top) if dx or dy else None
 
 
-def _run_patch(params: FillParams, ch: int, cw: int, *, hole: np.ndarray | None = None,
-               margins: Margins | None = None) -> int:
+def _run_patch(
+    params: FillParams, ch: int, cw: int, *, hole: np.ndarray | None = None, margins: Margins | None = None
+) -> int:
     """The patch side a run of ``params.engine`` (not ``auto``) uses on a ``cw`` x ``ch`` canvas: the
     one given, or the engine's default fitted to a small canvas; the quilt's :data:`BORDER_BLOCK`
     (at most a third of the canvas) for a hole along the border deeper than its 24-px block
@@ -138,8 +152,9 @@ def _as_like(image: np.ndarray, colour: bool) -> np.ndarray:
     return image
 
 
-def fill_image(image, mask=None, *, params: FillParams, source_mask=None, texture=None, rng=0,
-               progress=None, cancel=None) -> tuple[np.ndarray, dict]:
+def fill_image(
+    image, mask=None, *, params: FillParams, source_mask=None, texture=None, rng=0, progress=None, cancel=None
+) -> tuple[np.ndarray, dict]:
     """The whole method: ``(filled image, figures)``. See :func:`weft.core.fill.fill`."""
     colour, alpha = _split_alpha(image, "image")
     h, w = colour.shape[:2]
@@ -157,13 +172,18 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     if margins is not None and inner is not None and inner.any():
         return _by_region(image, hole, inner, params, source_mask, texture, rng, progress, cancel)
     if margins is None and named is None:
-        raise WeftError("nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size "
-                        "(--size WxH), or an image with transparent pixels")
+        raise WeftError(
+            "nothing to fill: give a mask (--mask MASK), margins (--extend L,T,R,B) or a canvas size "
+            "(--size WxH), or an image with transparent pixels"
+        )
     if margins is None and not hole.any():
         if named == "mask":
             raise _error(WeftError, "nothing to fill: the mask has no white pixel", "mask")
-        raise _error(WeftError, "nothing to fill: the image has no transparent pixel and no mask, --extend or --size "
-                     "was given", "image")
+        raise _error(
+            WeftError,
+            "nothing to fill: the image has no transparent pixel and no mask, --extend or --size was given",
+            "image",
+        )
     # the canvas: the image, grown by the margins (their pixels are part of the hole)
     if margins:
         cw, ch = margins.grown(w, h)
@@ -184,8 +204,11 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
         on_border = touches_border(hole)
         edges = None
-        if (texture is None and params.structure == "auto"
-                and auto_engine(picture, on_border, params.patch, params.structure, True) == "patchmatch"):
+        if (
+            texture is None
+            and params.structure == "auto"
+            and auto_engine(picture, on_border, params.patch, params.structure, True) == "patchmatch"
+        ):
             # whether the edge guide finds edges to continue decides; on the part patchmatch would
             # fill, so that its run takes this guide
             found = _edge_guide(colour, hole, transparent, params.replace(engine="patchmatch"), ch, cw)
@@ -195,11 +218,22 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     patch = _run_patch(params, ch, cw, hole=hole)
     if patch > min(ch, cw):
         grown = f", {cw}x{ch} once extended" if margins else ""
-        raise _error(InvalidParameter, f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image "
-                     f"is {w}x{h}{grown})", "image", name="patch", value=patch)
+        raise _error(
+            InvalidParameter,
+            f"parameter 'patch' = {patch} is outside 3..{max(3, min(ch, cw))} (the image is {w}x{h}{grown})",
+            "image",
+            name="patch",
+            value=patch,
+        )
     if params.structure == "yes" and texture is not None:
-        raise _error(InvalidParameter, "parameter 'structure' = yes continues the picture's own edges across the "
-                     "hole: it cannot copy from a second texture", "texture", name="structure", value="yes")
+        raise _error(
+            InvalidParameter,
+            "parameter 'structure' = yes continues the picture's own edges across the "
+            "hole: it cannot copy from a second texture",
+            "texture",
+            name="structure",
+            value="yes",
+        )
     structure = params.continues_edges(texture is not None)
     # the source: where blocks are copied from
     if texture is not None:
@@ -212,26 +246,41 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     else:
         src_region = ~hole & ~transparent
         if source_mask is not None:
-            src_region &= _mask_bits(source_mask, (h, w), "source_mask", "image") if not margins else np.pad(
-                _mask_bits(source_mask, (h, w), "source_mask", "image"),
-                ((margins.top, margins.bottom), (margins.left, margins.right)))
+            src_region &= (
+                _mask_bits(source_mask, (h, w), "source_mask", "image")
+                if not margins
+                else np.pad(
+                    _mask_bits(source_mask, (h, w), "source_mask", "image"),
+                    ((margins.top, margins.bottom), (margins.left, margins.right)),
+                )
+            )
         src_name, src_input = f"{w}x{h} image", "image"
         if not src_region.any():
             if source_mask is not None:
-                raise _error(WeftError, "the source mask has no white pixel outside the hole: nothing to copy from",
-                             "source_mask")
-            raise _error(WeftError, f"the {'mask' if named == 'mask' else 'hole'} covers the whole image: nothing is "
-                         f"left to copy from (needs at least one whole {patch}x{patch} patch of known pixels)",
-                         "mask" if named == "mask" else "image")
+                raise _error(
+                    WeftError,
+                    "the source mask has no white pixel outside the hole: nothing to copy from",
+                    "source_mask",
+                )
+            raise _error(
+                WeftError,
+                f"the {'mask' if named == 'mask' else 'hole'} covers the whole image: nothing is "
+                f"left to copy from (needs at least one whole {patch}x{patch} patch of known pixels)",
+                "mask" if named == "mask" else "image",
+            )
     if params.patch is None and not whole_patches(src_region, patch).any():
         side = _largest_square(src_region)  # a default patch shrinks to the largest the source holds
         if side >= 3:
             patch = side
     if not whole_patches(src_region, patch).any():
         side = _largest_square(src_region)
-        raise _error(WeftError, f"too little to copy from: the {engine_text(params)} needs at least one whole "
-                     f"{patch}x{patch} patch of known pixels in the {src_name}, whose largest is {side}x{side} "
-                     f"(a smaller --patch, a smaller hole or a larger source)", src_input)
+        raise _error(
+            WeftError,
+            f"too little to copy from: the {engine_text(params)} needs at least one whole "
+            f"{patch}x{patch} patch of known pixels in the {src_name}, whose largest is {side}x{side} "
+            f"(a smaller --patch, a smaller hole or a larger source)",
+            src_input,
+        )
     # the engine's canvas: the image, or the image above the texture with a filled gap between them
     if texture is not None:
         gap = patch
@@ -239,13 +288,13 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         cw2 = max(cw, tw)
         big = np.zeros((ch + gap + th, cw2) + colour.shape[2:], dtype=np.float32)
         big[:ch, :cw] = colour
-        big[ch + gap:, :tw] = tex
+        big[ch + gap :, :tw] = tex
         big_hole = np.zeros(big.shape[:2], dtype=bool)
         big_hole[:ch, :cw] = hole
-        big_hole[ch:ch + gap] = True
-        big_hole[:ch, cw:cw + gap] = True  # beside a narrower image: filled, so its edge has texture beside it
+        big_hole[ch : ch + gap] = True
+        big_hole[:ch, cw : cw + gap] = True  # beside a narrower image: filled, so its edge has texture beside it
         big_src = np.zeros(big.shape[:2], dtype=bool)
-        big_src[ch + gap:, :tw] = src_region
+        big_src[ch + gap :, :tw] = src_region
         work, work_hole, work_src = big, big_hole, big_src
     else:
         work, work_hole, work_src = colour, hole, src_region
@@ -270,10 +319,12 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         else:
             from .structure import structure_guide
 
-            engine_kw["guide"], continued = structure_guide(work[part], work_hole[part],
-                                                            ~work_hole[part] & ~transparent[part])
-    filled = engine.function()(work[part], work_hole[part], work_src[part], patch=patch, rng=rng,
-                               progress=progress, cancel=cancel, **engine_kw)
+            engine_kw["guide"], continued = structure_guide(
+                work[part], work_hole[part], ~work_hole[part] & ~transparent[part]
+            )
+    filled = engine.function()(
+        work[part], work_hole[part], work_src[part], patch=patch, rng=rng, progress=progress, cancel=cancel, **engine_kw
+    )
     if near is not None:
         whole = np.array(work, dtype=np.float32)
         whole[near] = filled
@@ -295,9 +346,14 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
         alpha = alpha.copy()
         alpha[hole] = 1.0  # filled pixels are opaque
         out = np.concatenate([out if out.ndim == 3 else out[..., None], alpha[..., None]], axis=2)
-    figures = {"engine": params.engine, "patch": patch, "hole_pixels": int(hole.sum()),
-               "hole_fraction": round(float(hole.mean()), 4), "canvas": [int(cw), int(ch)],
-               "source_pixels": int(src_region.sum())}
+    figures = {
+        "engine": params.engine,
+        "patch": patch,
+        "hole_pixels": int(hole.sum()),
+        "hole_fraction": round(float(hole.mean()), 4),
+        "canvas": [int(cw), int(ch)],
+        "source_pixels": int(src_region.sum()),
+    }
     if structure:
         figures["edges_continued"] = continued
     if margins:
@@ -305,8 +361,9 @@ def fill_image(image, mask=None, *, params: FillParams, source_mask=None, textur
     return np.ascontiguousarray(out, dtype=np.float32), figures
 
 
-def _edge_guide(colour: np.ndarray, hole: np.ndarray, transparent: np.ndarray, params: FillParams,
-                ch: int, cw: int) -> tuple[tuple[slice, slice], np.ndarray | None, int]:
+def _edge_guide(
+    colour: np.ndarray, hole: np.ndarray, transparent: np.ndarray, params: FillParams, ch: int, cw: int
+) -> tuple[tuple[slice, slice], np.ndarray | None, int]:
     """``(part, guide, edges continued)``: the structure guide of ``hole`` on the part of the canvas a
     run of ``params.engine`` fills (:func:`neighbourhood` of its patch; the whole canvas when that is
     most of it), from the known pixels that are not transparent."""
@@ -332,13 +389,29 @@ def _by_region(image, hole, inner, params, source_mask, texture, rng, progress, 
     along the border and the margins: growing the canvas does not change the engine or the pixels
     inside an interior hole."""
     first_params = params.replace(extend=None, size=None)
-    inside, fig1 = fill_image(image, inner, params=first_params, source_mask=source_mask, texture=texture, rng=rng,
-                              progress=_scaled(progress, 0, 2), cancel=cancel)
+    inside, fig1 = fill_image(
+        image,
+        inner,
+        params=first_params,
+        source_mask=source_mask,
+        texture=texture,
+        rng=rng,
+        progress=_scaled(progress, 0, 2),
+        cancel=cancel,
+    )
     rest = hole & ~inner
     if not rest.any() and _margins(params, hole.shape[1], hole.shape[0]) is None:
         return inside, fig1
-    out, fig2 = fill_image(inside, rest, params=params, source_mask=source_mask, texture=texture, rng=rng,
-                           progress=_scaled(progress, 1, 2), cancel=cancel)
+    out, fig2 = fill_image(
+        inside,
+        rest,
+        params=params,
+        source_mask=source_mask,
+        texture=texture,
+        rng=rng,
+        progress=_scaled(progress, 1, 2),
+        cancel=cancel,
+    )
     figures = dict(fig2)
     if fig1["engine"] != fig2["engine"]:
         figures["engine"] = f"{fig1['engine']} inside, {fig2['engine']} along the border"
@@ -371,9 +444,16 @@ def engine_text(params: FillParams) -> str:
 
 def _run(inputs: Mapping[str, np.ndarray], params: FillParams, *, rng=None, progress=None, cancel=None) -> Result:
     check_limits(inputs, params)
-    image, figures = fill_image(inputs["image"], inputs.get("mask"), params=params,
-                                source_mask=inputs.get("source_mask"), texture=inputs.get("texture"), rng=rng,
-                                progress=progress, cancel=cancel)
+    image, figures = fill_image(
+        inputs["image"],
+        inputs.get("mask"),
+        params=params,
+        source_mask=inputs.get("source_mask"),
+        texture=inputs.get("texture"),
+        rng=rng,
+        progress=progress,
+        cancel=cancel,
+    )
     return Result(image, figures)
 
 
@@ -481,31 +561,60 @@ def _always(params) -> bool:
 STUDIO = Studio(
     title="Fill and extend",
     canvas="image",
-    geometry=(Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)",
-                       label="hole"),
-              Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas"),
-              Geometry(MASK, on=("image",), input="source_mask", label="sampling area", empty_is_all=True,
-                       live=_always, help="the sampling area (optional): where fill copies from")),
+    geometry=(
+        Geometry(MASK, on=("image",), input="mask", help="paint what to fill ([ and ] size the brush)", label="hole"),
+        Geometry(MARGINS, on=("image",), param="extend", help="drag an edge outward to extend the canvas"),
+        Geometry(
+            MASK,
+            on=("image",),
+            input="source_mask",
+            label="sampling area",
+            empty_is_all=True,
+            live=_always,
+            help="the sampling area (optional): where fill copies from",
+        ),
+    ),
     preview_inputs=("image", "mask", "source_mask", "texture"),
-    examples={"image": "brick"}, rank=7, preview_around="mask", own_inputs=("texture",),
+    examples={"image": "brick"},
+    rank=7,
+    preview_around="mask",
+    own_inputs=("texture",),
     auto=_auto,
-    figures={"engine": Figure("engine"), "patch": Figure("patch", "px"), "hole_pixels": Figure("filled", "px"),
-             "hole_fraction": Figure("filled", "%", "of the image", digits=2),
-             "source_pixels": Figure("copied from", "px"), "edges_continued": Figure("edges continued")})
+    figures={
+        "engine": Figure("engine"),
+        "patch": Figure("patch", "px"),
+        "hole_pixels": Figure("filled", "px"),
+        "hole_fraction": Figure("filled", "%", "of the image", digits=2),
+        "source_pixels": Figure("copied from", "px"),
+        "edges_continued": Figure("edges continued"),
+    },
+)
 
 
 METHOD = Method(
     name="fill",
     summary="fill a hole (the white of --mask, or transparent pixels) or extend the canvas (--extend, --size) "
-            "with texture from the rest of the image",
+    "with texture from the rest of the image",
     params=FillParams,
     inputs=(
-        InputSpec("image", "the image to fill (a transparent region is the hole when no mask is given)", alpha=True,
-                  min_side=3),
-        InputSpec("mask", "white = the pixels to fill; the image's size (a transparent pixel is black)",
-                  required=False, alpha=True),
-        InputSpec("source_mask", "white = the only pixels to copy from (the image's size, or the texture's; "
-                  "a transparent pixel is black)", required=False, alpha=True),
+        InputSpec(
+            "image",
+            "the image to fill (a transparent region is the hole when no mask is given)",
+            alpha=True,
+            min_side=3,
+        ),
+        InputSpec(
+            "mask",
+            "white = the pixels to fill; the image's size (a transparent pixel is black)",
+            required=False,
+            alpha=True,
+        ),
+        InputSpec(
+            "source_mask",
+            "white = the only pixels to copy from (the image's size, or the texture's; a transparent pixel is black)",
+            required=False,
+            alpha=True,
+        ),
         InputSpec("texture", "copy from this image instead of the rest of the image", required=False),
     ),
     takes_region=False,

@@ -41,46 +41,80 @@ STRUCTURE = ("auto", "yes", "no")
 class FillParams(Params):
     """Parameters of ``weft fill``."""
 
-    engine: str = param(DEFAULT_ENGINE, choices=ENGINES,
-                        help="auto: patchmatch with the edge guide where it finds edges crossing a hole inside a "
-                             "colour picture (always with --structure yes), else hybrid; "
-                             + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()))
-    patch: int = param(None, kind="int", lo=3, hi=256, optional=True,
-                       help="patch side in pixels (quilt, hybrid: the block; patchmatch: at most 63); "
-                            "default per engine, smaller on a small image: "
-                            + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items())
-                            + f" ({BORDER_BLOCK} for an uncrop more than 24 px deep)")
-    extend: Margins = param(None, kind="geometry", type=Margins, optional=True,
-                            help="uncrop: pixels added on the left, top, right and bottom, filled like the hole")
-    size: tuple = param(None, kind="size", lo=1, hi=MAX_SIDE, optional=True,
-                        help="uncrop to this canvas size (at least the image's), the image placed by --anchor")
+    engine: str = param(
+        DEFAULT_ENGINE,
+        choices=ENGINES,
+        help="auto: patchmatch with the edge guide where it finds edges crossing a hole inside a "
+        "colour picture (always with --structure yes), else hybrid; "
+        + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()),
+    )
+    patch: int = param(
+        None,
+        kind="int",
+        lo=3,
+        hi=256,
+        optional=True,
+        help="patch side in pixels (quilt, hybrid: the block; patchmatch: at most 63); "
+        "default per engine, smaller on a small image: "
+        + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items())
+        + f" ({BORDER_BLOCK} for an uncrop more than 24 px deep)",
+    )
+    extend: Margins = param(
+        None,
+        kind="geometry",
+        type=Margins,
+        optional=True,
+        help="uncrop: pixels added on the left, top, right and bottom, filled like the hole",
+    )
+    size: tuple = param(
+        None,
+        kind="size",
+        lo=1,
+        hi=MAX_SIDE,
+        optional=True,
+        help="uncrop to this canvas size (at least the image's), the image placed by --anchor",
+    )
     anchor: str = param("center", choices=ANCHORS, help="where the image sits on a --size canvas")
-    band: int = param(2, lo=0, hi=32,
-                      help="how far around the hole, in pixels, known pixels may change so the fill meets them "
-                           "without a visible step (a Poisson band); 0 = they never change")
-    structure: str = param("auto", choices=STRUCTURE,
-                           help="continue the strong edges that cross the hole (a rim, a horizon) along smooth "
-                                "curves, where patches alone run them on straight or drip; auto: whenever the "
-                                "patchmatch engine runs on the picture's own pixels (no --texture); yes: always "
-                                "(auto then runs patchmatch); no: never")
+    band: int = param(
+        2,
+        lo=0,
+        hi=32,
+        help="how far around the hole, in pixels, known pixels may change so the fill meets them "
+        "without a visible step (a Poisson band); 0 = they never change",
+    )
+    structure: str = param(
+        "auto",
+        choices=STRUCTURE,
+        help="continue the strong edges that cross the hole (a rim, a horizon) along smooth "
+        "curves, where patches alone run them on straight or drip; auto: whenever the "
+        "patchmatch engine runs on the picture's own pixels (no --texture); yes: always "
+        "(auto then runs patchmatch); no: never",
+    )
 
     def check(self) -> None:
         if self.extend is not None and self.size is not None:
-            raise InvalidParameter("parameters 'extend' and 'size' cannot be given together (both set the canvas)",
-                                   name="size", value=self.size)
+            raise InvalidParameter(
+                "parameters 'extend' and 'size' cannot be given together (both set the canvas)",
+                name="size",
+                value=self.size,
+            )
         if self.structure == "yes" and self.engine not in ("auto", "patchmatch"):
-            raise InvalidParameter(f"parameter 'structure' = yes needs the patchmatch engine (or auto), not "
-                                   f"'{self.engine}'", name="structure", value=self.structure)
+            raise InvalidParameter(
+                f"parameter 'structure' = yes needs the patchmatch engine (or auto), not '{self.engine}'",
+                name="structure",
+                value=self.structure,
+            )
         if (self.engine == "patchmatch" or self.structure == "yes") and self.patch is not None:
             from .patchmatch import MAX_PATCH
 
             if self.patch > MAX_PATCH:
                 what = "for the patchmatch engine" if self.engine == "patchmatch" else "with 'structure' (patchmatch)"
-                raise InvalidParameter(f"parameter 'patch' = {self.patch} is outside 3..{MAX_PATCH} {what}",
-                                       name="patch", value=self.patch)
+                raise InvalidParameter(
+                    f"parameter 'patch' = {self.patch} is outside 3..{MAX_PATCH} {what}", name="patch", value=self.patch
+                )
 
     @classmethod
-    def from_dict(cls, data, *, base=None) -> "FillParams":
+    def from_dict(cls, data, *, base=None) -> FillParams:
         """As :meth:`Params.from_dict`, ``structure`` read by :func:`structure_value` (recipes and
         sessions of the round in which it was an on/off switch wrote ``true`` / ``false``), and an
         engine since dropped (:data:`RETIRED`) read as the one that replaced it."""
@@ -111,8 +145,9 @@ def structure_value(value):
     return value
 
 
-def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto",
-                edges: bool | None = None) -> str:
+def auto_engine(
+    colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto", edges: bool | None = None
+) -> str:
     """The engine ``auto`` runs: ``patchmatch`` with the edge guide where that guide has edges to
     continue (``edges``: at least one pair of edges crossing the hole, as
     :func:`weft.core.fill.structure.structure_guide` pairs them) in a colour picture's hole that
@@ -126,7 +161,12 @@ def auto_engine(colour_picture: bool, hole_on_border: bool, patch: int | None, s
 
     if structure == "yes":
         return "patchmatch"
-    if (structure == "auto" and colour_picture and not hole_on_border and edges
-            and (patch is None or patch <= MAX_PATCH)):
+    if (
+        structure == "auto"
+        and colour_picture
+        and not hole_on_border
+        and edges
+        and (patch is None or patch <= MAX_PATCH)
+    ):
         return "patchmatch"
     return "hybrid"

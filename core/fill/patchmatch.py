@@ -27,7 +27,7 @@ Every pixel outside the hole (and ``cuttable``) is returned exactly as given.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -35,8 +35,7 @@ from ..errors import ImageError
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
 from .common import touches_border, whole_patches
-from .search import (MAX_PATCH, MIN_PATCH, STEPS_FIRST, Flat, check_inputs, em, refine_band,
-                     refine_patchmatch, vote_mode)
+from .search import MAX_PATCH, MIN_PATCH, STEPS_FIRST, Flat, check_inputs, em, refine_band, refine_patchmatch, vote_mode
 
 __all__ = ["fill_patchmatch", "refine_patchmatch", "refine_band", "MIN_PATCH", "MAX_PATCH"]
 
@@ -97,8 +96,7 @@ class _Level:
         self.n_valid = int(np.count_nonzero(whole_patches(source, p)))
         depth = _depth_of(hole)
         self.depth = float(depth.max()) if hole.any() else 0.0
-        self.conf = np.ascontiguousarray(np.where(hole, GAMMA ** -depth, 1.0).astype(np.float32))
-
+        self.conf = np.ascontiguousarray(np.where(hole, GAMMA**-depth, 1.0).astype(np.float32))
 
 
 def fill_patchmatch(
@@ -175,8 +173,10 @@ def fill_patchmatch(
         given = np.asarray(guide, dtype=np.float32)
         guide = given[..., None] if given.ndim == 2 else given
         if guide.ndim != 3 or guide.shape[:2] != hole.shape or not 1 <= guide.shape[2] <= 8:
-            raise ImageError(f"the guide has shape {given.shape}; it must be (H, W) or (H, W, 1..8) with the "
-                             f"image's {hole.shape[1]}x{hole.shape[0]}")
+            raise ImageError(
+                f"the guide has shape {given.shape}; it must be (H, W) or (H, W, 1..8) with the "
+                f"image's {hole.shape[1]}x{hole.shape[0]}"
+            )
         if not np.isfinite(guide).all():
             raise ImageError("the guide holds NaN or infinite values")
     out = np.array(arr, dtype=np.float32, copy=True)
@@ -192,8 +192,10 @@ def fill_patchmatch(
 
     pyramid = [_Level(img.copy(), hole, source, p)]
     if pyramid[0].n_valid == 0:
-        raise ImageError(f"the source region holds no whole {p}x{p} patch: leave at least a {p}x{p} square "
-                         f"of known pixels to copy from (or use a smaller patch)")
+        raise ImageError(
+            f"the source region holds no whole {p}x{p} patch: leave at least a {p}x{p} square "
+            f"of known pixels to copy from (or use a smaller patch)"
+        )
     max_levels = 64 if levels is None else int(levels)
     deep = p * (_COARSEST_DEPTH_BORDER if touches_border(hole) else _COARSEST_DEPTH)
     while len(pyramid) < max_levels:
@@ -221,8 +223,7 @@ def fill_patchmatch(
     if iterations is not None:
         schedule = [int(iterations)] * n
     else:  # by level, finest first (a single level is the coarsest)
-        middle, coarsest = ((_EM_MIDDLE, _EM_COARSEST) if guide is None
-                            else (_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED))
+        middle, coarsest = (_EM_MIDDLE, _EM_COARSEST) if guide is None else (_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED)
         schedule = ([_EM_FINEST] + [middle] * (n - 2) + [coarsest]) if n > 1 else [coarsest]
     final = _FINAL_REFINE if guide is None else _FINAL_REFINE_GUIDED
     report = ProgressReporter(progress, "fill", sum(schedule) + final)
@@ -236,7 +237,7 @@ def fill_patchmatch(
             sy, sx = _random_matches(fl, gen)
         else:
             fixed = None  # the guide steers the coarsest level's layout only
-            _upsample_into(im, lv.hole, pyramid[li + 1].img[..., :im.shape[2]])
+            _upsample_into(im, lv.hole, pyramid[li + 1].img[..., : im.shape[2]])
             coarse, fl = fl, Flat(im, lv.hole, lv.source, p, conf=lv.conf)
             sy, sx = _upsample_matches(fl, coarse, sy, sx, gen)
             # the first estimate of this level: the coarse matches, doubled, voted (an upsampled
@@ -250,8 +251,23 @@ def fill_patchmatch(
             def step(_it, done0=done):
                 report.update(done0 + _it + 1)
 
-            em(fl, im, lv.hole, sy, sx, dist, iterations=schedule[li], gen=gen, steps_first=STEPS_FIRST,
-                shrink=_PYRAMID_SHRINK, bias=bias, worst=0.0, cancel=cancel, on_iteration=step, fixed=fixed)
+            em(
+                fl,
+                im,
+                lv.hole,
+                sy,
+                sx,
+                dist,
+                iterations=schedule[li],
+                gen=gen,
+                steps_first=STEPS_FIRST,
+                shrink=_PYRAMID_SHRINK,
+                bias=bias,
+                worst=0.0,
+                cancel=cancel,
+                on_iteration=step,
+                fixed=fixed,
+            )
             done += schedule[li]
     res = pyramid[0].img[..., :nch]
     if out.ndim == 2:
@@ -264,10 +280,19 @@ def fill_patchmatch(
     def refine_progress(pr: Progress, done0=units) -> None:
         report.update(done0 + int(round(pr.fraction * final)))
 
-    return refine_band(out, hole, region, source, patch=p, iterations=final, rng=gen,
-                       progress=refine_progress if progress is not None else None, cancel=cancel, worst=_FINAL_WORST,
-                       last_vote_stride=_LAST_STRIDE)
-
+    return refine_band(
+        out,
+        hole,
+        region,
+        source,
+        patch=p,
+        iterations=final,
+        rng=gen,
+        progress=refine_progress if progress is not None else None,
+        cancel=cancel,
+        worst=_FINAL_WORST,
+        last_vote_stride=_LAST_STRIDE,
+    )
 
 
 def _halve_plain(a: np.ndarray) -> np.ndarray:
@@ -327,14 +352,19 @@ def _onion_fill(img: np.ndarray, hole: np.ndarray) -> None:
         ring = todo & (count > 0)
         if not ring.any():
             break
-        sums = np.stack([cv2.filter2D(np.ascontiguousarray(img[..., c] * known), -1, ones,
-                                      borderType=cv2.BORDER_CONSTANT) for c in range(img.shape[2])], axis=2)
+        sums = np.stack(
+            [
+                cv2.filter2D(np.ascontiguousarray(img[..., c] * known), -1, ones, borderType=cv2.BORDER_CONSTANT)
+                for c in range(img.shape[2])
+            ],
+            axis=2,
+        )
         img[ring] = sums[ring] / count[ring][:, None]
         done |= ring
         todo &= ~ring
 
 
-def _upsample_matches(fl: "Flat", coarse: "Flat", sy: np.ndarray, sx: np.ndarray, gen: np.random.Generator):
+def _upsample_matches(fl: Flat, coarse: Flat, sy: np.ndarray, sx: np.ndarray, gen: np.random.Generator):
     """The coarser level's matches (``sy``, ``sx`` of ``coarse``'s target patches), doubled, for the
     finer level's target patches (random where the coarse level had no match or the doubled one is
     not a whole source patch)."""
@@ -348,7 +378,7 @@ def _upsample_matches(fl: "Flat", coarse: "Flat", sy: np.ndarray, sx: np.ndarray
     return np.where(ok, ny, ry), np.where(ok, nx, rx)
 
 
-def _random_matches(fl: "Flat", gen: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def _random_matches(fl: Flat, gen: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     """A whole source patch drawn at random for each of ``fl``'s target patches (int64 corners)."""
     vy, vx = np.nonzero(fl.valid)
     pick = gen.integers(0, len(vy), len(fl.ty))
@@ -368,6 +398,7 @@ def _upsample_into(img: np.ndarray, hole: np.ndarray, coarse: np.ndarray) -> Non
     x1 = np.minimum(x0 + 1, wc - 1)
     ay = (fy - y0)[:, None]
     ax = (fx - x0)[:, None]
-    v = ((1 - ay) * ((1 - ax) * coarse[y0, x0] + ax * coarse[y0, x1])
-         + ay * ((1 - ax) * coarse[y1, x0] + ax * coarse[y1, x1]))
+    v = (1 - ay) * ((1 - ax) * coarse[y0, x0] + ax * coarse[y0, x1]) + ay * (
+        (1 - ax) * coarse[y1, x0] + ax * coarse[y1, x1]
+    )
     img[ys, xs] = v.astype(np.float32)

@@ -77,8 +77,8 @@ import cv2
 import numpy as np
 
 from ..params import as_rng
-from .cut import min_cut
 from .common import Progress, check_engine_args, whole_patches
+from .cut import min_cut
 
 #: E&F's tolerance: a block within (1 + EPSILON) of the best cost may be chosen.
 EPSILON = 0.1
@@ -182,8 +182,9 @@ def _telea(img: np.ndarray, unknown: np.ndarray) -> np.ndarray:
     return out
 
 
-def _gap_cost(template: np.ndarray, unknown: np.ndarray, search: np.ndarray, crop: tuple[slice, slice],
-              blurred: list[np.ndarray]) -> np.ndarray | None:
+def _gap_cost(
+    template: np.ndarray, unknown: np.ndarray, search: np.ndarray, crop: tuple[slice, slice], blurred: list[np.ndarray]
+) -> np.ndarray | None:
     """Step 5's thin-gap cost of every block position of ``search[crop]``, or None when the window's
     ``unknown`` pixels (float32 0/1) are no thin gap (one lies more than :data:`GAP_WIDTH` px from a
     valued pixel): the SSD, over those pixels, between the window's diffusion fill (``cv2.inpaint``,
@@ -209,15 +210,24 @@ def _edges(canvas: np.ndarray, known: np.ndarray) -> tuple[np.ndarray, np.ndarra
     grey = canvas.mean(axis=2).astype(np.float32)
     gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
-    inner = cv2.erode(known.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
-                      borderValue=1) > 0
+    inner = (
+        cv2.erode(known.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=1) > 0
+    )
     mag = np.where(inner, np.sqrt(gx * gx + gy * gy), 0.0).astype(np.float32)
     mean = float(mag[inner].mean()) if inner.any() else 0.0
     return (mag / mean if mean > 0 else mag), inner.astype(np.float32)
 
 
-def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: int, x1: int,
-           edges: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+def _score(
+    have: np.ndarray,
+    score: np.ndarray,
+    b: int,
+    y0: int,
+    y1: int,
+    x0: int,
+    x1: int,
+    edges: tuple[np.ndarray, np.ndarray] | None = None,
+) -> None:
     """Recompute ``score`` (see :func:`fill_quilt`) on rows ``[y0, y1)`` and columns ``[x0, x1)``."""
     h, w = have.shape
     m = b // 2 + 2  # context the box filter and the front's dilation read around the region
@@ -225,8 +235,9 @@ def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: in
     sub = have[ya:yb, xa:xb]
     # the window of a centre pixel: rows [y - b//2, y - b//2 + b) (cv2's anchor for even sizes too)
     count = cv2.boxFilter(sub.astype(np.float32), -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
-    near = cv2.dilate(sub.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
-                      borderValue=0) > 0
+    near = (
+        cv2.dilate(sub.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=0) > 0
+    )
     front = ~sub & near
     if edges is not None:  # step 1's structure term: count x (1 + DATA g / G)
         mag, inner = edges[0][ya:yb, xa:xb], edges[1][ya:yb, xa:xb]
@@ -234,7 +245,7 @@ def _score(have: np.ndarray, score: np.ndarray, b: int, y0: int, y1: int, x0: in
         n = cv2.boxFilter(inner, -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
         count = count * (1.0 + DATA * g / np.maximum(n, 1.0))
     part = np.where(front, count, -1.0)
-    score[y0:y1, x0:x1] = part[y0 - ya:y1 - ya, x0 - xa:x1 - xa]
+    score[y0:y1, x0:x1] = part[y0 - ya : y1 - ya, x0 - xa : x1 - xa]
 
 
 #: Rows per strip of :class:`_Front`.
@@ -253,16 +264,27 @@ class _Front:
 
     def update(self, y0: int, y1: int) -> None:
         for k in range(y0 // _STRIP, -(-y1 // _STRIP)):
-            self.maxima[k] = self.score[k * _STRIP:(k + 1) * _STRIP].max()
+            self.maxima[k] = self.score[k * _STRIP : (k + 1) * _STRIP].max()
 
     def first_max(self) -> tuple[int, int]:
         k = int(np.argmax(self.maxima))  # the first strip holding the maximum, then its first in scan order
-        y, x = divmod(int(np.argmax(self.score[k * _STRIP:(k + 1) * _STRIP])), self.score.shape[1])
+        y, x = divmod(int(np.argmax(self.score[k * _STRIP : (k + 1) * _STRIP])), self.score.shape[1])
         return k * _STRIP + y, x
 
 
-def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, cancel=None, band=0,
-               cuttable=None, refine: bool | None = None) -> np.ndarray:
+def fill_quilt(
+    image,
+    hole,
+    source=None,
+    *,
+    patch=BLOCK,
+    rng=0,
+    progress=None,
+    cancel=None,
+    band=0,
+    cuttable=None,
+    refine: bool | None = None,
+) -> np.ndarray:
     """Fill ``hole`` of ``image`` with blocks quilted from ``source`` (default: the known pixels).
 
     Parameters
@@ -348,7 +370,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         # overlap's width of it (a straight front: B/2 known -> B/3) and the block fills more
         y0 = int(min(max(py - b // 2, 0), h - b))
         x0 = int(min(max(px - b // 2, 0), w - b))
-        sub = have[y0:y0 + b, x0:x0 + b]
+        sub = have[y0 : y0 + b, x0 : x0 + b]
         if sub.any() and not sub.all():
             ky, kx = np.nonzero(sub)
             y0 = int(min(max(y0 - round(SHIFT * (ky.mean() - (b - 1) / 2)), 0), h - b))
@@ -360,7 +382,9 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
         hs, ws = valid.shape
         ry0, rx0, ry1, rx1 = 0, 0, hs, ws
         reach = REACH
-        while 0 < reach < max(hs, ws):  # the locality prior: blocks from near the window, the nearest reach that has any
+        while (
+            0 < reach < max(hs, ws)
+        ):  # the locality prior: blocks from near the window, the nearest reach that has any
             ry0, ry1 = max(0, y0 - sy0 - reach), min(hs, y0 - sy0 + reach + 1)
             rx0, rx1 = max(0, x0 - sx0 - reach), min(ws, x0 - sx0 + reach + 1)
             if ry0 < ry1 and rx0 < rx1 and valid[ry0:ry1, rx0:rx1].any():
@@ -399,7 +423,7 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
             if mine.any():
                 # the copies' offsets as one int64 each, ordered as (dy, dx) rows are (np.unique with
                 # axis=0 sorted them the same way, 5x slower)
-                sh = shift[:, y0:y0 + b, x0:x0 + b][:, mine].astype(np.int64)
+                sh = shift[:, y0 : y0 + b, x0 : x0 + b][:, mine].astype(np.int64)
                 codes, counts = np.unique((sh[0] + span) * (2 * span + 1) + (sh[1] + span), return_counts=True)
                 shifts = np.stack([codes // (2 * span + 1) - span, codes % (2 * span + 1) - span], axis=1)
                 conts = []
@@ -410,7 +434,9 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
                 if conts:
                     c_cost, ty, tx = min(conts)
                     bound = best
-                    if GAP > 0 and not colour and un.any():  # a continued copy must not draw into a thin gap what its sides lack
+                    if (
+                        GAP > 0 and not colour and un.any()
+                    ):  # a continued copy must not draw into a thin gap what its sides lack
                         gap = _gap_cost(template, un, search, crop, gap_search)
                         if gap is not None:
                             with_gap = cost + GAP * gap
@@ -419,14 +445,18 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
                     if c_cost <= bound * (1.0 + COHERE) + 1e-9:
                         cy, cx = ty, tx
         cy, cx = cy + ry0, cx + rx0
-        block = search[cy:cy + b, cx:cx + b]
+        block = search[cy : cy + b, cx : cx + b]
         new_region = ~have[win]
         soft = filled[win]
         if soft.any():
             err = ((canvas[win] - block) ** 2).sum(axis=2).astype(np.float64)
             err[~soft] = _BIG
-            sides = dict(left=soft[:, :ov].any(), top=soft[:ov, :].any(), right=soft[:, b - ov:].any(),
-                         bottom=soft[b - ov:, :].any())
+            sides = dict(
+                left=soft[:, :ov].any(),
+                top=soft[:ov, :].any(),
+                right=soft[:, b - ov :].any(),
+                bottom=soft[b - ov :, :].any(),
+            )
             cut = min_cut(err, **{k: (ov if v else 0) for k, v in sides.items()})
             new_region |= soft & cut
         left -= int(np.count_nonzero(new_region & ~have[win]))
@@ -448,10 +478,21 @@ def fill_quilt(image, hole, source=None, *, patch=BLOCK, rng=0, progress=None, c
     return out.reshape(shape)
 
 
-def _refine(out: np.ndarray, hole: np.ndarray, region: np.ndarray, src: np.ndarray, gen, cancel, progress) -> np.ndarray:
+def _refine(
+    out: np.ndarray, hole: np.ndarray, region: np.ndarray, src: np.ndarray, gen, cancel, progress
+) -> np.ndarray:
     """Step 7: :func:`weft.core.fill.patchmatch.refine_band` over the hole and the band (``region``)."""
     from .patchmatch import refine_band
 
-    return refine_band(out, hole, region, src, patch=max(3, min(REFINE_PATCH, *hole.shape)), iterations=REFINE,
-                       rng=gen, progress=progress, cancel=cancel, worst=REFINE_WORST)
-
+    return refine_band(
+        out,
+        hole,
+        region,
+        src,
+        patch=max(3, min(REFINE_PATCH, *hole.shape)),
+        iterations=REFINE,
+        rng=gen,
+        progress=progress,
+        cancel=cancel,
+        worst=REFINE_WORST,
+    )

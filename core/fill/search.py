@@ -12,7 +12,7 @@ only: a fill loads no numba.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -35,6 +35,7 @@ _SIGMA_PERCENTILE = 75  # the vote's weights exp(-d / 2 sigma^2), sigma^2 this p
 # them at a fifth of the cost, except in the last vote of a fill (see refine_patchmatch)
 VOTE_STRIDE = 3
 
+
 def box_sum(a: np.ndarray, p: int) -> np.ndarray:
     """Sums of ``a`` over every p x p window, indexed by the window's top-left corner (a bool ``a``:
     exact int32 counts from OpenCV's integral image, ~10x faster than two float64 cumsums)."""
@@ -48,7 +49,6 @@ def box_sum(a: np.ndarray, p: int) -> np.ndarray:
     return c[p:, p:] - c[:-p, p:] - c[p:, :-p] + c[:-p, :-p]
 
 
-
 def check_inputs(image, hole, source, patch, levels, iterations):
     arr = np.asarray(image)
     if arr.ndim not in (2, 3) or (arr.ndim == 3 and not 1 <= arr.shape[2] <= 4):
@@ -57,16 +57,19 @@ def check_inputs(image, hole, source, patch, levels, iterations):
         raise ImageError(f"image must be float in [0, 1], got {arr.dtype}")
     h, w = arr.shape[:2]
     if isinstance(patch, bool) or not isinstance(patch, (int, np.integer)) or not MIN_PATCH <= patch <= MAX_PATCH:
-        raise InvalidParameter(f"parameter 'patch' = {patch!r} must be an integer {MIN_PATCH}..{MAX_PATCH}",
-                               name="patch", value=patch)
+        raise InvalidParameter(
+            f"parameter 'patch' = {patch!r} must be an integer {MIN_PATCH}..{MAX_PATCH}", name="patch", value=patch
+        )
     patch = int(patch)
     if min(h, w) < patch:
         raise ImageError(f"image is {w}x{h}: smaller than the {patch}x{patch} patch")
     for name, value in (("levels", levels), ("iterations", iterations)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer))
-                                  or not 1 <= value <= 64):
-            raise InvalidParameter(f"parameter '{name}' = {value!r} must be an integer 1..64 or None",
-                                   name=name, value=value)
+        if value is not None and (
+            isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= 64
+        ):
+            raise InvalidParameter(
+                f"parameter '{name}' = {value!r} must be an integer 1..64 or None", name=name, value=value
+            )
 
     def mask(m, what):
         m = np.asarray(m)
@@ -80,7 +83,6 @@ def check_inputs(image, hole, source, patch, levels, iterations):
     return arr, hole, source, patch
 
 
-
 class Flat:
     """An image as the patch search sees it: target patches (those touching the hole), the allowed
     source corners, gathering of p x p patches by their top-left corner, and the distance of target
@@ -88,8 +90,15 @@ class Flat:
     difference weighted by its confidence (the pyramid's levels), except on the ``fixed`` channels
     (the guide, known in the hole), weighted 1."""
 
-    def __init__(self, img: np.ndarray, hole: np.ndarray, source: np.ndarray, p: int, conf: np.ndarray | None = None,
-                 fixed: slice | None = None):
+    def __init__(
+        self,
+        img: np.ndarray,
+        hole: np.ndarray,
+        source: np.ndarray,
+        p: int,
+        conf: np.ndarray | None = None,
+        fixed: slice | None = None,
+    ):
         from numpy.lib.stride_tricks import as_strided
 
         h, w, c = img.shape
@@ -100,8 +109,9 @@ class Flat:
         # had to be built for every gather: half of the refine's time)
         s0, s1, s2 = img.strides
         assert img.flags.c_contiguous and s1 == c * s2
-        self.windows = as_strided(img, shape=(h - p + 1, w - p + 1, p, p * c), strides=(s0, s1, s0, s2),
-                                  writeable=False)
+        self.windows = as_strided(
+            img, shape=(h - p + 1, w - p + 1, p, p * c), strides=(s0, s1, s0, s2), writeable=False
+        )
         self.valid = whole_patches(source, p)
         touches = box_sum(hole, p) > 0.5
         ty, tx = np.nonzero(touches)
@@ -177,8 +187,13 @@ def _principal_candidates(fl: Flat, img: np.ndarray, gen: np.random.Generator, k
     axis = v.reshape(fl.p, fl.p, fl.c).astype(np.float32)
     proj = np.zeros(img.shape[:2], np.float32)
     for ch in range(fl.c):  # the projection of every window, by its top-left corner
-        proj += cv2.filter2D(np.ascontiguousarray(img[..., ch]), cv2.CV_32F, np.ascontiguousarray(axis[..., ch]),
-                             anchor=(0, 0), borderType=cv2.BORDER_CONSTANT)
+        proj += cv2.filter2D(
+            np.ascontiguousarray(img[..., ch]),
+            cv2.CV_32F,
+            np.ascontiguousarray(axis[..., ch]),
+            anchor=(0, 0),
+            borderType=cv2.BORDER_CONSTANT,
+        )
     src = proj[vy, vx]
     order = _stable_argsort(src)
     pos = np.searchsorted(src[order], proj[fl.ty, fl.tx])
@@ -202,8 +217,9 @@ def _stable_argsort(values: np.ndarray) -> np.ndarray:
     return keys & np.int64(0xFFFFFFFF)
 
 
-def vote_mode(img: np.ndarray, hole: np.ndarray, fl: Flat, sy, sx, weight, stride: int = VOTE_STRIDE,
-               fixed: slice | None = None) -> np.ndarray:
+def vote_mode(
+    img: np.ndarray, hole: np.ndarray, fl: Flat, sy, sx, weight, stride: int = VOTE_STRIDE, fixed: slice | None = None
+) -> np.ndarray:
     """Every pixel of ``hole`` is copied through the offset (match minus target corner) that the
     target patches covering it agree on most (those at every ``stride``-th row and column of
     corners, and the last), each counted with its ``weight`` (0..1). numpy; writes ``img`` in place
@@ -233,8 +249,9 @@ def vote_mode(img: np.ndarray, hole: np.ndarray, fl: Flat, sy, sx, weight, strid
     yy = np.minimum(p + hy[:, None] - shifts[None, :], hv + p - 1)  # (a row beyond the corners: none)
     xx = np.minimum(p + hx[:, None] - shifts[None, :], wv + p - 1)
     idx = (yy[:, :, None] * (wv + p) + xx[:, None, :]).reshape(len(hy), -1)
-    inside = ((hy[:, None] - shifts[None, :] < hv)[:, :, None]
-              & (hx[:, None] - shifts[None, :] < wv)[:, None, :]).reshape(len(hy), -1)
+    inside = (
+        (hy[:, None] - shifts[None, :] < hv)[:, :, None] & (hx[:, None] - shifts[None, :] < wv)[:, None, :]
+    ).reshape(len(hy), -1)
     keys = np.where(inside, np.take(kmap.ravel(), idx), np.int64(none) << wbits)
     keys.sort(axis=1)
     cs = keys >> wbits
@@ -256,9 +273,20 @@ def vote_mode(img: np.ndarray, hole: np.ndarray, fl: Flat, sy, sx, weight, strid
     return changed
 
 
-def refine_band(filled: np.ndarray, hole: np.ndarray, region: np.ndarray, source: np.ndarray, *, patch: int,
-                iterations: int, rng=0, progress=None, cancel=None, worst: float = 0.0,
-                last_vote_stride: int | None = None) -> np.ndarray:
+def refine_band(
+    filled: np.ndarray,
+    hole: np.ndarray,
+    region: np.ndarray,
+    source: np.ndarray,
+    *,
+    patch: int,
+    iterations: int,
+    rng=0,
+    progress=None,
+    cancel=None,
+    worst: float = 0.0,
+    last_vote_stride: int | None = None,
+) -> np.ndarray:
     """:func:`refine_patchmatch` of a finished fill over ``region`` (the hole and the blend band's
     known pixels that may change), copying only from ``source`` pixels outside it, so the band
     becomes a continuation of the copies; over the hole alone, from the whole source, when the band
@@ -269,9 +297,19 @@ def refine_band(filled: np.ndarray, hole: np.ndarray, region: np.ndarray, source
         region, sources = hole, source
         if not whole_patches(sources, patch).any():
             return filled
-    return refine_patchmatch(filled, region, sources, filled, patch=patch, iterations=iterations, rng=rng,
-                             progress=progress, cancel=cancel, worst=worst,
-                             last_vote_stride=last_vote_stride)
+    return refine_patchmatch(
+        filled,
+        region,
+        sources,
+        filled,
+        patch=patch,
+        iterations=iterations,
+        rng=rng,
+        progress=progress,
+        cancel=cancel,
+        worst=worst,
+        last_vote_stride=last_vote_stride,
+    )
 
 
 def refine_patchmatch(
@@ -316,8 +354,9 @@ def refine_patchmatch(
     one). Returns float32, every pixel outside the hole equal to ``image``'s bit for bit.
     """
     if isinstance(worst, bool) or not isinstance(worst, (int, float, np.integer, np.floating)) or not 0 <= worst < 100:
-        raise InvalidParameter(f"parameter 'worst' = {worst!r} must be a percentage 0..100 (below 100)",
-                               name="worst", value=worst)
+        raise InvalidParameter(
+            f"parameter 'worst' = {worst!r} must be a percentage 0..100 (below 100)", name="worst", value=worst
+        )
     arr, hole, source, p = check_inputs(image, hole, source, patch, None, iterations)
     out = np.array(arr, dtype=np.float32, copy=True)
     if not hole.any():
@@ -330,8 +369,10 @@ def refine_patchmatch(
     img[hole] = (start if start.ndim == 3 else start[..., None])[hole]
     fl = Flat(img, hole, source, p)
     if not fl.valid.any():
-        raise ImageError(f"the source region holds no whole {p}x{p} patch: leave at least a {p}x{p} square "
-                         f"of known pixels to copy from (or use a smaller patch)")
+        raise ImageError(
+            f"the source region holds no whole {p}x{p} patch: leave at least a {p}x{p} square "
+            f"of known pixels to copy from (or use a smaller patch)"
+        )
     n = len(fl.ty)
     report = ProgressReporter(progress, "fill", iterations)
     cy, cx = _principal_candidates(fl, img, gen, _REFINE_CANDIDATES)
@@ -341,9 +382,23 @@ def refine_patchmatch(
     dist = fl.dist(targets, everyone, sy, sx)
     for c in range(1, len(cy)):
         _try(fl, targets, everyone, sy, sx, dist, cy[c], cx[c], np.ones(n, bool))
-    em(fl, img, hole, sy, sx, dist, iterations=iterations, gen=gen, steps_first=STEPS_FIRST,
-        shrink=_SEARCH_SHRINK, bias=0.0, worst=worst, cancel=cancel, on_iteration=lambda it: report.update(it + 1),
-        last_stride=last_vote_stride)
+    em(
+        fl,
+        img,
+        hole,
+        sy,
+        sx,
+        dist,
+        iterations=iterations,
+        gen=gen,
+        steps_first=STEPS_FIRST,
+        shrink=_SEARCH_SHRINK,
+        bias=0.0,
+        worst=worst,
+        cancel=cancel,
+        on_iteration=lambda it: report.update(it + 1),
+        last_stride=last_vote_stride,
+    )
     if out.ndim == 2:
         out[hole] = img[..., 0][hole]
     else:
@@ -351,10 +406,25 @@ def refine_patchmatch(
     return out
 
 
-def em(fl: Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.ndarray, dist: np.ndarray, *,
-        iterations: int, gen: np.random.Generator, steps_first: tuple[int, ...], shrink: int, bias: float,
-        worst: float, cancel: CancelToken | None, on_iteration: Callable[[int], None],
-        last_stride: int | None = None, fixed: slice | None = None) -> None:
+def em(
+    fl: Flat,
+    img: np.ndarray,
+    hole: np.ndarray,
+    sy: np.ndarray,
+    sx: np.ndarray,
+    dist: np.ndarray,
+    *,
+    iterations: int,
+    gen: np.random.Generator,
+    steps_first: tuple[int, ...],
+    shrink: int,
+    bias: float,
+    worst: float,
+    cancel: CancelToken | None,
+    on_iteration: Callable[[int], None],
+    last_stride: int | None = None,
+    fixed: slice | None = None,
+) -> None:
     """EM iterations on ``img`` (the array ``fl`` views), improving the matches (``sy``, ``sx``, their
     ``dist``) of ``fl``'s target patches and writing the hole's pixels, in place. Each iteration:
     (E) the inexact patches (a distance above 0; with ``worst``, at least that percentile of their
@@ -400,6 +470,7 @@ def em(fl: Flat, img: np.ndarray, hole: np.ndarray, sy: np.ndarray, sx: np.ndarr
         inexact = np.zeros((fl.h + p - 1, fl.w + p - 1), bool)  # pixels covered by a patch that is not an exact copy
         inexact[p - 1 + fl.ty[dist > 0.0], p - 1 + fl.tx[dist > 0.0]] = True
         stride = VOTE_STRIDE if last_stride is None or it < iterations - 1 else last_stride
-        changed = vote_mode(img, hole & (box_sum(inexact, p) > 0.5), fl, sy, sx, np.exp(-dn / (2.0 * sigma2)),
-                             stride, fixed)
+        changed = vote_mode(
+            img, hole & (box_sum(inexact, p) > 0.5), fl, sy, sx, np.exp(-dn / (2.0 * sigma2)), stride, fixed
+        )
         on_iteration(it)

@@ -74,8 +74,9 @@ _TENSOR = 2.0  # the structure tensor's smoothing (the edges' normals)
 _MAX_EDGES = 4  # at most this many edges are continued (the best pairs), a guide channel each
 
 
-def structure_guide(image: np.ndarray, hole: np.ndarray, known: np.ndarray | None = None, *,
-                    reach: int = REACH) -> tuple[np.ndarray | None, int]:
+def structure_guide(
+    image: np.ndarray, hole: np.ndarray, known: np.ndarray | None = None, *, reach: int = REACH
+) -> tuple[np.ndarray | None, int]:
     """The guide of the module text for filling ``hole`` in ``image``, and the number of edges it
     continues across the hole: ``(float32 (H, W, n) in [-1, 1], n)``, a channel per edge (at most
     ``_MAX_EDGES``, the best pairs), or ``(None, 0)`` when no two edges entering the hole pair up
@@ -132,8 +133,9 @@ def structure_guide(image: np.ndarray, hole: np.ndarray, known: np.ndarray | Non
         struct[ey, ex] = True
         nx_[ey, ex], ny_[ey, ex] = np.cos(angle[ey, ex]), np.sin(angle[ey, ex])
         reached = _orient(struct, nx_, ny_, list(zip(ys.tolist(), xs.tolist())))
-        d, labels = cv2.distanceTransformWithLabels((~reached).astype(np.uint8), cv2.DIST_L2, 5,
-                                                    labelType=cv2.DIST_LABEL_PIXEL)
+        d, labels = cv2.distanceTransformWithLabels(
+            (~reached).astype(np.uint8), cv2.DIST_L2, 5, labelType=cv2.DIST_LABEL_PIXEL
+        )
         # within reach only (beyond it the guide is 0): label k (from 1) is the k-th structure
         # pixel in row-major order
         zy, zx = np.nonzero(reached)
@@ -168,9 +170,16 @@ def _edges(smooth: np.ndarray, unknown: np.ndarray):
     hi, lo = percentile(values, _HIGH), percentile(values, _LOW)  # (np.percentile imports numpy.ma: 7 ms)
     if hi <= 0:
         return np.zeros(unknown.shape, bool), (gx, gy)
-    e = cv2.Canny(np.ascontiguousarray(np.clip(gx, -32767, 32767).astype(np.int16)),
-                  np.ascontiguousarray(np.clip(gy, -32767, 32767).astype(np.int16)),
-                  float(lo), float(hi), L2gradient=True) > 0
+    e = (
+        cv2.Canny(
+            np.ascontiguousarray(np.clip(gx, -32767, 32767).astype(np.int16)),
+            np.ascontiguousarray(np.clip(gy, -32767, 32767).astype(np.int16)),
+            float(lo),
+            float(hi),
+            L2gradient=True,
+        )
+        > 0
+    )
     return e & far, (gx, gy)
 
 
@@ -189,7 +198,7 @@ def _entries(comp: np.ndarray, n: int, unknown: np.ndarray, hole: np.ndarray):
         touch = near[cy, cx]
         j = np.argmin(np.where(touch, dist[cy, cx], np.inf))
         p = np.array([cx[j], cy[j]], float)
-        sel = (cx - p[0]) ** 2 + (cy - p[1]) ** 2 <= _AXIS_RADIUS ** 2
+        sel = (cx - p[0]) ** 2 + (cy - p[1]) ** 2 <= _AXIS_RADIUS**2
         pts = np.stack([cx[sel], cy[sel]], 1).astype(float)
         if len(pts) < 5:
             continue
@@ -214,7 +223,9 @@ def _side_colours(rgb8: np.ndarray | None, lum: np.ndarray, p: np.ndarray, t: np
     aside = np.arange(2, 6, dtype=float)
     out = []
     for sgn in (1.0, -1.0):
-        pts = p[None, None, :] - t[None, None, :] * back[:, None, None] + sgn * nrm[None, None, :] * aside[None, :, None]
+        pts = (
+            p[None, None, :] - t[None, None, :] * back[:, None, None] + sgn * nrm[None, None, :] * aside[None, :, None]
+        )
         xy = np.rint(pts.reshape(-1, 2)).astype(np.int64)
         ok = (xy[:, 0] >= 0) & (xy[:, 0] < w) & (xy[:, 1] >= 0) & (xy[:, 1] < h)
         xy = xy[ok]
@@ -234,13 +245,16 @@ def _lab(rgb8: np.ndarray) -> np.ndarray:
     hold: OpenCV builds its tables on the first call, 67 ms of a ``weft fill`` process."""
     c = rgb8.astype(np.float64) / 255.0
     lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-    xyz = lin @ np.array([[0.412453, 0.357580, 0.180423], [0.212671, 0.715160, 0.072169],
-                          [0.019334, 0.119193, 0.950227]]).T
+    xyz = (
+        lin
+        @ np.array([[0.412453, 0.357580, 0.180423], [0.212671, 0.715160, 0.072169], [0.019334, 0.119193, 0.950227]]).T
+    )
     xyz /= np.array([0.950456, 1.0, 1.088754])
     f = np.where(xyz > 0.008856, np.cbrt(xyz), 7.787 * xyz + 16.0 / 116.0)
     lightness = np.where(xyz[:, 1] > 0.008856, 116.0 * f[:, 1] - 16.0, 903.3 * xyz[:, 1])
-    return np.stack([lightness * 255.0 / 100.0, 500.0 * (f[:, 0] - f[:, 1]) + 128.0,
-                     200.0 * (f[:, 1] - f[:, 2]) + 128.0], axis=1)
+    return np.stack(
+        [lightness * 255.0 / 100.0, 500.0 * (f[:, 0] - f[:, 1]) + 128.0, 200.0 * (f[:, 1] - f[:, 2]) + 128.0], axis=1
+    )
 
 
 def _pairs(entries, sides) -> list[tuple[int, int]]:
@@ -283,8 +297,9 @@ def _hermite(p0, t0, p1, t1, n: int = 400) -> np.ndarray:
     length = float(np.hypot(*(p1 - p0)))
     m0, m1 = np.asarray(t0, float) * length, -np.asarray(t1, float) * length
     s = np.linspace(0.0, 1.0, n)[:, None]
-    return ((2 * s ** 3 - 3 * s ** 2 + 1) * p0 + (s ** 3 - 2 * s ** 2 + s) * m0
-            + (-2 * s ** 3 + 3 * s ** 2) * p1 + (s ** 3 - s ** 2) * m1)
+    return (
+        (2 * s**3 - 3 * s**2 + 1) * p0 + (s**3 - 2 * s**2 + s) * m0 + (-2 * s**3 + 3 * s**2) * p1 + (s**3 - s**2) * m1
+    )
 
 
 def _orient(struct: np.ndarray, nx_: np.ndarray, ny_: np.ndarray, seeds) -> np.ndarray:

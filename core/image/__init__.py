@@ -23,7 +23,25 @@ from .files import (
 )
 
 __all__ = [
-    "DEFAULT_MAX_PIXELS", "ImageInfo", "Loaded", "PcaBasis", "atomic_write_bytes", "encode_image", "file_bit_depth", "from_pca",
-    "get_max_pixels", "load_image", "luminance", "pca_basis", "pca_grey", "read_recipe", "resize",
-    "rgb_to_yiq", "save_image", "set_max_pixels", "to_pca", "validate_image", "yiq_to_rgb",
+    "DEFAULT_MAX_PIXELS",
+    "ImageInfo",
+    "Loaded",
+    "PcaBasis",
+    "atomic_write_bytes",
+    "encode_image",
+    "file_bit_depth",
+    "from_pca",
+    "get_max_pixels",
+    "load_image",
+    "luminance",
+    "pca_basis",
+    "pca_grey",
+    "read_recipe",
+    "resize",
+    "rgb_to_yiq",
+    "save_image",
+    "set_max_pixels",
+    "to_pca",
+    "validate_image",
+    "yiq_to_rgb",
 ]

@@ -18,12 +18,16 @@ import threading
 
 _CODEC_LOCK = threading.Lock()
 # Lines the image libraries print themselves (on the process's stderr, below Python).
-_CODEC_LINE = re.compile(r"^(libpng (warning|error)|Corrupt JPEG data|Premature end of JPEG|Warning:|Invalid SOS|"
-                         r"Bogus |Unsupported marker|TIFF|.*: (Warning|Error), )")
+_CODEC_LINE = re.compile(
+    r"^(libpng (warning|error)|Corrupt JPEG data|Premature end of JPEG|Warning:|Invalid SOS|"
+    r"Bogus |Unsupported marker|TIFF|.*: (Warning|Error), )"
+)
 # libjpeg's warnings that mean the scan (the pixels) is damaged; stray bytes before the end marker
 # (a few, after a whole scan) are harmless and are not among them.
-_JPEG_DAMAGE = re.compile(r"premature end of data segment|Premature end of JPEG file|bad Huffman code|"
-                          r"must resync|Invalid SOS|extraneous bytes before marker 0xd[0-7]")
+_JPEG_DAMAGE = re.compile(
+    r"premature end of data segment|Premature end of JPEG file|bad Huffman code|"
+    r"must resync|Invalid SOS|extraneous bytes before marker 0xd[0-7]"
+)
 _JPEG_STRAY = re.compile(r"(\d+) extraneous bytes before marker 0xd9")
 _STRAY_BYTES_OK = 16
 
@@ -75,5 +79,3 @@ def _scan_damage(said: list[str]) -> str | None:
         if stray and int(stray.group(1)) > _STRAY_BYTES_OK:
             return f"the scan ends {stray.group(1)} bytes before its end marker"
     return None
-
-

@@ -29,14 +29,15 @@ from PIL import Image, UnidentifiedImageError
 from ..errors import ImageError, InvalidParameter, WeftError
 from ..readfile import open_regular, shown
 from .codec_output import _codec_output, _scan_damage
-from .temporaries import _writer_tag
 from .colour import _check_float_image, luminance
+from .temporaries import _writer_tag
 
 # A corrupt file is reported once, by us, as one line: OpenCV's own warnings would add a second.
 cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
 
 # --------------------------------------------------------------------------------------------------
 # Validation and resizing
+
 
 def validate_image(image: np.ndarray, what: str = "image") -> np.ndarray:
     """Check an image and return it as C-contiguous float32 in [0, 1] (the input itself if it is one).
@@ -67,8 +68,12 @@ def validate_image(image: np.ndarray, what: str = "image") -> np.ndarray:
     return image
 
 
-_INTERPOLATIONS = {"cubic": cv2.INTER_CUBIC, "linear": cv2.INTER_LINEAR, "area": cv2.INTER_AREA,
-                   "nearest": cv2.INTER_NEAREST_EXACT}
+_INTERPOLATIONS = {
+    "cubic": cv2.INTER_CUBIC,
+    "linear": cv2.INTER_LINEAR,
+    "area": cv2.INTER_AREA,
+    "nearest": cv2.INTER_NEAREST_EXACT,
+}
 
 
 def resize(image: np.ndarray, size: tuple[int, int], interpolation: str = "cubic") -> np.ndarray:
@@ -85,13 +90,20 @@ def resize(image: np.ndarray, size: tuple[int, int], interpolation: str = "cubic
         nearest neighbour (``INTER_NEAREST_EXACT``: pixel centres, as Pillow and scikit-image).
     """
     image = validate_image(image)
-    if not (isinstance(size, (tuple, list)) and len(size) == 2
-            and all(isinstance(s, numbers.Integral) and not isinstance(s, bool) and s >= 1 for s in size)):
-        raise InvalidParameter(f"parameter 'size' = {size!r} must be (width, height), both >= 1",
-                               name="size", value=size)
+    if not (
+        isinstance(size, (tuple, list))
+        and len(size) == 2
+        and all(isinstance(s, numbers.Integral) and not isinstance(s, bool) and s >= 1 for s in size)
+    ):
+        raise InvalidParameter(
+            f"parameter 'size' = {size!r} must be (width, height), both >= 1", name="size", value=size
+        )
     if interpolation not in _INTERPOLATIONS:
-        raise InvalidParameter(f"parameter 'interpolation' = {interpolation!r} is not one of "
-                               f"{', '.join(_INTERPOLATIONS)}", name="interpolation", value=interpolation)
+        raise InvalidParameter(
+            f"parameter 'interpolation' = {interpolation!r} is not one of {', '.join(_INTERPOLATIONS)}",
+            name="interpolation",
+            value=interpolation,
+        )
     out = cv2.resize(image, (int(size[0]), int(size[1])), interpolation=_INTERPOLATIONS[interpolation])
     return np.clip(out, 0.0, 1.0, out=out) if interpolation == "cubic" else out
 
@@ -133,6 +145,7 @@ def set_max_pixels(n: int | None) -> None:
 # --------------------------------------------------------------------------------------------------
 # Loading
 
+
 @dataclass(frozen=True)
 class ImageInfo:
     """What :func:`load_image` found and did.
@@ -163,13 +176,27 @@ class Loaded(NamedTuple):
 _PIL_LOCK = threading.Lock()
 _GREY_MODES = {"1", "L", "LA", "La", "I", "I;16", "I;16L", "I;16B", "I;16N", "F"}
 _ALPHA_MODES = {"RGBA", "RGBa", "LA", "La", "PA"}
-_SIGNATURES = {b"\x89PNG": "PNG", b"\xff\xd8\xff": "JPEG", b"II*\0": "TIFF", b"MM\0*": "TIFF", b"BM": "BMP",
-               b"GIF8": "GIF", b"RIFF": "WEBP"}
+_SIGNATURES = {
+    b"\x89PNG": "PNG",
+    b"\xff\xd8\xff": "JPEG",
+    b"II*\0": "TIFF",
+    b"MM\0*": "TIFF",
+    b"BM": "BMP",
+    b"GIF8": "GIF",
+    b"RIFF": "WEBP",
+}
 # EXIF orientation -> transform showing the stored pixels upright, as Pillow's exif_transpose. OpenCV
 # applies it itself (IMREAD_ANYCOLOR without IMREAD_IGNORE_ORIENTATION); this is for the Pillow fallback.
-_ORIENT = {1: lambda a: a, 2: lambda a: a[:, ::-1], 3: lambda a: a[::-1, ::-1], 4: lambda a: a[::-1],
-           5: lambda a: a.swapaxes(0, 1), 6: lambda a: a.swapaxes(0, 1)[:, ::-1],
-           7: lambda a: a[::-1, ::-1].swapaxes(0, 1), 8: lambda a: a.swapaxes(0, 1)[::-1]}
+_ORIENT = {
+    1: lambda a: a,
+    2: lambda a: a[:, ::-1],
+    3: lambda a: a[::-1, ::-1],
+    4: lambda a: a[::-1],
+    5: lambda a: a.swapaxes(0, 1),
+    6: lambda a: a.swapaxes(0, 1)[:, ::-1],
+    7: lambda a: a[::-1, ::-1].swapaxes(0, 1),
+    8: lambda a: a.swapaxes(0, 1)[::-1],
+}
 
 
 def _one_line(err: BaseException) -> str:
@@ -177,8 +204,11 @@ def _one_line(err: BaseException) -> str:
 
 
 def _os_error(name: str, err: OSError) -> ImageError:
-    problem = {FileNotFoundError: "no such file", IsADirectoryError: "is a directory",
-               PermissionError: "permission denied"}.get(type(err), f"cannot read ({err.strerror or _one_line(err)})")
+    problem = {
+        FileNotFoundError: "no such file",
+        IsADirectoryError: "is a directory",
+        PermissionError: "permission denied",
+    }.get(type(err), f"cannot read ({err.strerror or _one_line(err)})")
     if getattr(err, "errno", None) == errno.ELOOP:
         problem = "a symbolic link loop"
     return ImageError(f"{shown(name)}: {problem}", path=name)
@@ -252,15 +282,16 @@ def _tiff_size(f) -> tuple[int, int] | None:
     entries = f.read(12 * count)
     found = {}
     for i in range(len(entries) // 12):
-        tag, kind, n = struct.unpack(end + "HHI", entries[12 * i:12 * i + 8])
+        tag, kind, n = struct.unpack(end + "HHI", entries[12 * i : 12 * i + 8])
         if tag in (256, 257) and n == 1 and kind in (3, 4):
-            value = entries[12 * i + 8:12 * i + 12]
-            found[tag] = struct.unpack(end + ("H" if kind == 3 else "I"), value[:2 if kind == 3 else 4])[0]
+            value = entries[12 * i + 8 : 12 * i + 12]
+            found[tag] = struct.unpack(end + ("H" if kind == 3 else "I"), value[: 2 if kind == 3 else 4])[0]
     return (found[256], found[257]) if 256 in found and 257 in found and min(found.values()) > 0 else None
 
 
-def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: str | None = None,
-               alpha: bool = False) -> Loaded:
+def load_image(
+    path: str | os.PathLike, *, max_pixels: int | None = None, mode: str | None = None, alpha: bool = False
+) -> Loaded:
     """Load PNG, JPEG, TIFF, BMP, WebP or GIF (8 or 16 bits per sample) as float32 in [0, 1].
 
     Parameters
@@ -293,8 +324,9 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
     """
     name = os.fsdecode(path)
     if mode not in (None, "rgb", "grey"):
-        raise InvalidParameter(f"parameter 'mode' = {mode!r} is not one of None, 'rgb', 'grey'",
-                               name="mode", value=mode)
+        raise InvalidParameter(
+            f"parameter 'mode' = {mode!r} is not one of None, 'rgb', 'grey'", name="mode", value=mode
+        )
     limit = get_max_pixels() if max_pixels is None else _check_limit(max_pixels)
     try:
         with open_regular(name, "image file", error=ImageError) as f:
@@ -315,9 +347,11 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
                     had_alpha = src_mode in _ALPHA_MODES or "transparency" in im.info
                     orientation = _exif_orientation(im)
             if width * height > limit:
-                raise ImageError(f"{shown(name)}: {width}x{height} = {width * height / 1e6:.1f} megapixels exceeds the "
-                                 f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS or max_pixels to raise it)",
-                                 path=name)
+                raise ImageError(
+                    f"{shown(name)}: {width}x{height} = {width * height / 1e6:.1f} megapixels exceeds the "
+                    f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS or max_pixels to raise it)",
+                    path=name,
+                )
             f.seek(0)
             data = np.fromfile(f, dtype=np.uint8)
     except ImageError:
@@ -345,8 +379,9 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
                     try:
                         arr = _decode_pillow(data)
                     except Exception as e:  # noqa: BLE001
-                        raise ImageError(f"{shown(name)}: truncated or corrupt {fmt} data ({_one_line(e)})",
-                                         path=name) from e
+                        raise ImageError(
+                            f"{shown(name)}: truncated or corrupt {fmt} data ({_one_line(e)})", path=name
+                        ) from e
                 elif arr.ndim == 3:
                     arr = arr[..., 2::-1]  # BGR(A) -> RGB
         damage = _scan_damage(said) if fmt == "JPEG" else None
@@ -357,8 +392,11 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
         if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] == 3)):
             raise ValueError(f"unexpected decoder output of shape {arr.shape}")
         if arr.dtype not in (np.uint8, np.uint16):
-            raise ImageError(f"{shown(name)}: unsupported sample type {arr.dtype} (only 8- and 16-bit images are "
-                             "supported: save it with 8 or 16 bits per sample)", path=name)
+            raise ImageError(
+                f"{shown(name)}: unsupported sample type {arr.dtype} (only 8- and 16-bit images are "
+                "supported: save it with 8 or 16 bits per sample)",
+                path=name,
+            )
         # OpenCV expands grey+alpha to three equal channels; Pillow calls 16-bit grey+alpha PNG "RGBA",
         # so for PNG the IHDR colour type (0 grey, 4 grey+alpha) decides.
         if arr.ndim == 3 and (src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] in (0, 4))):
@@ -371,19 +409,34 @@ def load_image(path: str | os.PathLike, *, max_pixels: int | None = None, mode: 
     except Exception as e:  # noqa: BLE001 - never let a raw cv2/numpy error escape
         raise ImageError(f"{shown(name)}: cannot decode {fmt} data ({_one_line(e)})", path=name) from e
 
-    notes = [text for cond, text in [
-        (orientation != 1, f"EXIF orientation {orientation} applied"), (had_alpha, "alpha channel dropped"),
-        (src_mode in ("P", "PA"), "palette expanded to RGB"), (src_mode == "CMYK", "CMYK converted to RGB"),
-        (animated, "first frame of an animation used")] if cond]
+    notes = [
+        text
+        for cond, text in [
+            (orientation != 1, f"EXIF orientation {orientation} applied"),
+            (had_alpha, "alpha channel dropped"),
+            (src_mode in ("P", "PA"), "palette expanded to RGB"),
+            (src_mode == "CMYK", "CMYK converted to RGB"),
+            (animated, "first frame of an animation used"),
+        ]
+        if cond
+    ]
     if mode == "rgb" and image.ndim == 2:
         image = np.repeat(image[..., None], 3, axis=2)
         notes.append("grey expanded to RGB")
     elif mode == "grey" and image.ndim == 3:
         image = np.ascontiguousarray(luminance(image))
         notes.append("converted to grey (Rec. 601 luminance)")
-    info = ImageInfo(path=name, format=fmt, width=image.shape[1], height=image.shape[0],
-                     channels=1 if image.ndim == 2 else 3, bit_depth=8 * arr.itemsize, had_alpha=had_alpha,
-                     orientation=orientation, notes=tuple(notes))
+    info = ImageInfo(
+        path=name,
+        format=fmt,
+        width=image.shape[1],
+        height=image.shape[0],
+        channels=1 if image.ndim == 2 else 3,
+        bit_depth=8 * arr.itemsize,
+        had_alpha=had_alpha,
+        orientation=orientation,
+        notes=tuple(notes),
+    )
     return Loaded(image, info)
 
 
@@ -448,26 +501,43 @@ def _keyed_alpha(data: np.ndarray, arr: np.ndarray) -> np.ndarray | None:
     return None
 
 
-def _loaded_alpha(arr: np.ndarray, name: str, fmt: str, orientation: int, src_mode: str, animated: bool,
-                  mode: str | None) -> Loaded:
+def _loaded_alpha(
+    arr: np.ndarray, name: str, fmt: str, orientation: int, src_mode: str, animated: bool, mode: str | None
+) -> Loaded:
     image = arr.astype(np.float32, order="C") / np.float32(np.iinfo(arr.dtype).max)
-    notes = [text for cond, text in [
-        (orientation != 1, f"EXIF orientation {orientation} applied"), (True, "alpha channel kept"),
-        (src_mode in ("P", "PA"), "palette expanded to RGB"), (animated, "first frame of an animation used")] if cond]
+    notes = [
+        text
+        for cond, text in [
+            (orientation != 1, f"EXIF orientation {orientation} applied"),
+            (True, "alpha channel kept"),
+            (src_mode in ("P", "PA"), "palette expanded to RGB"),
+            (animated, "first frame of an animation used"),
+        ]
+        if cond
+    ]
     if mode == "rgb" and image.shape[2] == 2:
         image = np.ascontiguousarray(image[..., [0, 0, 0, 1]])
         notes.append("grey expanded to RGB")
     elif mode == "grey" and image.shape[2] == 4:
         image = np.ascontiguousarray(np.stack([luminance(image[..., :3]), image[..., 3]], axis=2))
         notes.append("converted to grey (Rec. 601 luminance)")
-    info = ImageInfo(path=name, format=fmt, width=image.shape[1], height=image.shape[0],
-                     channels=image.shape[2], bit_depth=8 * arr.itemsize, had_alpha=True,
-                     orientation=orientation, notes=tuple(notes))
+    info = ImageInfo(
+        path=name,
+        format=fmt,
+        width=image.shape[1],
+        height=image.shape[0],
+        channels=image.shape[2],
+        bit_depth=8 * arr.itemsize,
+        had_alpha=True,
+        orientation=orientation,
+        notes=tuple(notes),
+    )
     return Loaded(image, info)
 
 
 # --------------------------------------------------------------------------------------------------
 # Saving
+
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` so that readers see the old file or the new one, never half of one.
@@ -517,8 +587,9 @@ def _png_chunk(kind: bytes, body: bytes) -> bytes:
     return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
 
 
-def save_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | None = None,
-               bit_depth: int = 8, quality: int = 95) -> None:
+def save_image(
+    path: str | os.PathLike, image: np.ndarray, *, recipe: str | None = None, bit_depth: int = 8, quality: int = 95
+) -> None:
     """Save an image atomically (see :func:`atomic_write_bytes`) in the format of its extension.
 
     The bytes are :func:`encode_image`'s (same parameters); this only adds the atomic write.
@@ -526,8 +597,9 @@ def save_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | None
     atomic_write_bytes(Path(path), encode_image(path, image, recipe=recipe, bit_depth=bit_depth, quality=quality))
 
 
-def encode_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | None = None,
-                 bit_depth: int = 8, quality: int = 95) -> bytes:
+def encode_image(
+    path: str | os.PathLike, image: np.ndarray, *, recipe: str | None = None, bit_depth: int = 8, quality: int = 95
+) -> bytes:
     """The bytes :func:`save_image` writes to ``path`` (format from its extension; nothing is written).
 
     Parameters
@@ -554,11 +626,14 @@ def encode_image(path: str | os.PathLike, image: np.ndarray, *, recipe: str | No
     target = Path(path)
     ext, where = target.suffix.lower(), str(target)
     if ext not in _SAVE_FORMATS:
-        raise ImageError(f"{target}: cannot save {ext or 'without an extension'} (allowed extensions: "
-                         f"{', '.join(_SAVE_FORMATS)})", path=where)
+        raise ImageError(
+            f"{target}: cannot save {ext or 'without an extension'} (allowed extensions: {', '.join(_SAVE_FORMATS)})",
+            path=where,
+        )
     if bit_depth not in (8, 16) or isinstance(bit_depth, bool):
-        raise InvalidParameter(f"parameter 'bit_depth' = {bit_depth!r} must be 8 or 16",
-                               name="bit_depth", value=bit_depth)
+        raise InvalidParameter(
+            f"parameter 'bit_depth' = {bit_depth!r} must be 8 or 16", name="bit_depth", value=bit_depth
+        )
     if _SAVE_FORMATS[ext] == "JPEG" and bit_depth == 16:
         raise ImageError(f"{target}: JPEG cannot store 16-bit samples (use bit_depth=8, or .png or .tif)", path=where)
     if isinstance(quality, bool) or not isinstance(quality, numbers.Integral) or not 0 <= quality <= 100:
@@ -609,8 +684,8 @@ def _tiff_with_alpha(data: bytes) -> bytes:
     if order is None:
         return data
     (offset,) = struct.unpack(order + "I", data[4:8])
-    (count,) = struct.unpack(order + "H", data[offset:offset + 2])
-    entries = [data[offset + 2 + 12 * i:offset + 14 + 12 * i] for i in range(count)]
+    (count,) = struct.unpack(order + "H", data[offset : offset + 2])
+    entries = [data[offset + 2 + 12 * i : offset + 14 + 12 * i] for i in range(count)]
     tags = [struct.unpack(order + "H", e[:2])[0] for e in entries]
     if 338 in tags:
         return data

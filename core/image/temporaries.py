@@ -69,5 +69,3 @@ def _running(pid: int) -> bool:
     except (PermissionError, OSError, OverflowError):
         return True
     return True
-
-

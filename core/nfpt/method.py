@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -11,11 +12,12 @@ from ..errors import GeometryError, InvalidParameter
 from ..image import validate_image
 from ..jobs import CancelToken, Progress
 from ..params import out_of_range, param
-from ..rectify import FIGURES as RECTIFY_FIGURES, FeatureLines, View, WarpParams
+from ..rectify import FIGURES as RECTIFY_FIGURES
+from ..rectify import FeatureLines, View, WarpParams
 from ..rectify.detect import suggest_for_studio
 from ..registry import InputSpec, Method, Result
 from ..studio import LINES, Figure, Geometry, Studio
-from .synthesis import SMOOTH_SIGMA, Synthesis, distance_weights, synthesize_patches
+from .synthesis import Synthesis, synthesize_patches
 
 DEFAULT_BLOCK = 48
 DEFAULT_OVERLAP = 12
@@ -29,37 +31,89 @@ class NfptParams(WarpParams):
     """Parameters of ``weft nfpt`` (Yan, Lee & Lin): rectification (the fields of ``WarpParams``),
     synthesis, repair, re-projection."""
 
-    size: tuple = param(None, kind="size", lo=8, hi=16384, optional=True,
-                        help="size WIDTHxHEIGHT of the synthesized frontal texture; default twice the rectified one")
-    block: int = param(DEFAULT_BLOCK, lo=8, hi=512, symbol="B", help="side of the square patches copied: larger "
-                                                                     "keeps larger texture elements (whole bricks) "
-                                                                     "whole, smaller mixes them more")
-    overlap: int = param(DEFAULT_OVERLAP, lo=2, hi=256,
-                         help="how much each patch overlaps those already placed (the L-shaped neighbourhood): more"
-                              " matches and hides seams better; at most block/2")
-    sigma_d: float = param(None, kind="float", lo=0.1, hi=256.0, optional=True, symbol="σ_d", step=0.1,
-                           help="eq. 1: how far from the patch's edge, in pixels, the match still weighs pixels "
-                                "fully; small = only the edge counts (default overlap / 2)")
-    sigma_s: float = param(0.35, lo=0.01, hi=10.0, symbol="σ_s", step=0.01,
-                           help="eq. 2: how much the match favours feature pixels, those unlike the patch's "
-                                "dominant colour (mortar, cracks); smaller weighs features more (intensity 0..1)")
-    tol: int = param(2, lo=1, hi=64, help="variety: pick at random among the tol best-matching patches (1 = always "
-                                          "the best)")
-    repair: bool = param(True, help="steps 4-7: re-make, pixel by pixel, the pixels along each seam where the two "
-                                    "patches disagree, so broken lines join")
+    size: tuple = param(
+        None,
+        kind="size",
+        lo=8,
+        hi=16384,
+        optional=True,
+        help="size WIDTHxHEIGHT of the synthesized frontal texture; default twice the rectified one",
+    )
+    block: int = param(
+        DEFAULT_BLOCK,
+        lo=8,
+        hi=512,
+        symbol="B",
+        help="side of the square patches copied: larger "
+        "keeps larger texture elements (whole bricks) "
+        "whole, smaller mixes them more",
+    )
+    overlap: int = param(
+        DEFAULT_OVERLAP,
+        lo=2,
+        hi=256,
+        help="how much each patch overlaps those already placed (the L-shaped neighbourhood): more"
+        " matches and hides seams better; at most block/2",
+    )
+    sigma_d: float = param(
+        None,
+        kind="float",
+        lo=0.1,
+        hi=256.0,
+        optional=True,
+        symbol="σ_d",
+        step=0.1,
+        help="eq. 1: how far from the patch's edge, in pixels, the match still weighs pixels "
+        "fully; small = only the edge counts (default overlap / 2)",
+    )
+    sigma_s: float = param(
+        0.35,
+        lo=0.01,
+        hi=10.0,
+        symbol="σ_s",
+        step=0.01,
+        help="eq. 2: how much the match favours feature pixels, those unlike the patch's "
+        "dominant colour (mortar, cracks); smaller weighs features more (intensity 0..1)",
+    )
+    tol: int = param(
+        2, lo=1, hi=64, help="variety: pick at random among the tol best-matching patches (1 = always the best)"
+    )
+    repair: bool = param(
+        True,
+        help="steps 4-7: re-make, pixel by pixel, the pixels along each seam where the two "
+        "patches disagree, so broken lines join",
+    )
     band: int = param(2, lo=1, hi=16, help="repair band: how many pixels on each side of a seam may be re-made")
-    threshold: float = param(0.1, lo=0.0, hi=1.0, step=0.01,
-                             help="repair: how different the two patches must be at a pixel (RMS over channels, "
-                                  "intensity 0..1) for it to be re-made; lower repairs more")
-    n: int = param(5, lo=3, hi=15, help="repair: side of the neighbourhood matched when a pixel is re-made (odd); "
-                                        "larger follows larger structures")
-    smooth: bool = param(False, help="step 7: blur the re-made pixels slightly (Gaussian) to hide what the repair "
-                                     "leaves")
-    view: View = param(None, kind="geometry", type=View, optional=True,
-                       help="put the result into this view: a JSON file (or the JSON text, starting with {), {\"quad\": [[x, y] x 4], \"size\": "
-                           "[w, h]} or view image_lines + texture frontal_lines; texture pixel coordinates")
-    into_photo: bool = param(False, help="put the larger synthesized texture back into the photo in place of the "
-                                         "textured plane (a bigger wall)")
+    threshold: float = param(
+        0.1,
+        lo=0.0,
+        hi=1.0,
+        step=0.01,
+        help="repair: how different the two patches must be at a pixel (RMS over channels, "
+        "intensity 0..1) for it to be re-made; lower repairs more",
+    )
+    n: int = param(
+        5,
+        lo=3,
+        hi=15,
+        help="repair: side of the neighbourhood matched when a pixel is re-made (odd); "
+        "larger follows larger structures",
+    )
+    smooth: bool = param(
+        False, help="step 7: blur the re-made pixels slightly (Gaussian) to hide what the repair leaves"
+    )
+    view: View = param(
+        None,
+        kind="geometry",
+        type=View,
+        optional=True,
+        help='put the result into this view: a JSON file (or the JSON text, starting with {), {"quad": [[x, y] x 4], "size": '
+        "[w, h]} or view image_lines + texture frontal_lines; texture pixel coordinates",
+    )
+    into_photo: bool = param(
+        False,
+        help="put the larger synthesized texture back into the photo in place of the textured plane (a bigger wall)",
+    )
 
     def check(self) -> None:
         if self.overlap * 2 > self.block:
@@ -67,8 +121,9 @@ class NfptParams(WarpParams):
         if self.n % 2 == 0:
             raise InvalidParameter(f"parameter 'n' = {self.n} must be odd (3, 5, 7, ...)", name="n", value=self.n)
         if self.view is not None and self.into_photo:
-            raise InvalidParameter("parameters 'view' and 'into_photo' exclude each other: give one of them",
-                                   name="view", value=self.view)
+            raise InvalidParameter(
+                "parameters 'view' and 'into_photo' exclude each other: give one of them", name="view", value=self.view
+            )
 
 
 def synthesize(
@@ -144,8 +199,19 @@ def synthesize(
     :mod:`weft.core.nfpt.synthesis` (luminance P_diff, units and sigmas, ``|P - M|``, the tol rule, the
     mismatch test, coherent repair candidates).
     """
-    params = NfptParams(size=size, block=block, overlap=overlap, sigma_d=sigma_d, sigma_s=sigma_s, tol=tol,
-                        repair=repair, band=band, threshold=threshold, n=n, smooth=smooth)
+    params = NfptParams(
+        size=size,
+        block=block,
+        overlap=overlap,
+        sigma_d=sigma_d,
+        sigma_s=sigma_s,
+        tol=tol,
+        repair=repair,
+        band=band,
+        threshold=threshold,
+        n=n,
+        smooth=smooth,
+    )
     tex = validate_image(texture, "texture")
     syn = _synthesize(tex, params, mask=mask, rng=rng, progress=progress, cancel=cancel)
     return syn if return_details else syn.image
@@ -163,8 +229,8 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], 
     positions at once: two spectra of the weighted template and the inverse) and a choice over every
     source position; within 0.4..1.6x of real runs (``python -m benchmarks.estimates``).
     """
-    from ..limits import dft_seconds
     from ..grid import block_grid
+    from ..limits import dft_seconds
 
     h, w = texture_shape[:2]
     width, height = out_size
@@ -181,8 +247,11 @@ def _check_limits(tex: np.ndarray, size: tuple[int, int], params: NfptParams) ->
     check_output_size(width, height)
     h, w = tex.shape[:2]
     seconds = estimate_seconds(tex.shape, size, params.block, params.overlap)
-    check_duration(seconds, f"NFPT synthesis of {width}x{height} from a {w}x{h} texture with {params.block} px patches",
-                   "use a larger block, a smaller size or a smaller part of the texture")
+    check_duration(
+        seconds,
+        f"NFPT synthesis of {width}x{height} from a {w}x{h} texture with {params.block} px patches",
+        "use a larger block, a smaller size or a smaller part of the texture",
+    )
 
 
 def _synthesize(tex: np.ndarray, params: NfptParams, *, mask=None, rng=None, progress=None, cancel=None) -> Synthesis:
@@ -190,10 +259,24 @@ def _synthesize(tex: np.ndarray, params: NfptParams, *, mask=None, rng=None, pro
     size = params.size if params.size is not None else (2 * w, 2 * h)
     _check_limits(tex, size, params)
     sigma_d = params.sigma_d if params.sigma_d is not None else params.overlap / 2.0
-    return synthesize_patches(tex, size, block=params.block, overlap=params.overlap, sigma_d=sigma_d,
-                              sigma_s=params.sigma_s, tol=params.tol, repair=params.repair, band=params.band,
-                              threshold=params.threshold, n=params.n, smooth=params.smooth, mask=mask, rng=rng,
-                              progress=progress, cancel=cancel)
+    return synthesize_patches(
+        tex,
+        size,
+        block=params.block,
+        overlap=params.overlap,
+        sigma_d=sigma_d,
+        sigma_s=params.sigma_s,
+        tol=params.tol,
+        repair=params.repair,
+        band=params.band,
+        threshold=params.threshold,
+        n=params.n,
+        smooth=params.smooth,
+        mask=mask,
+        rng=rng,
+        progress=progress,
+        cancel=cancel,
+    )
 
 
 @dataclass(frozen=True)
@@ -282,12 +365,23 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
     homography = None
     if lines is not None:
         rep = ProgressReporter(progress, "rectify", 1)
-        rect = rf.Rectifier(photo).rectify(lines.image_lines, lines.frontal_lines, lines.frontal_size,
-                                           warp=params.warp, a=params.a, b=params.b, p=params.p)
+        rect = rf.Rectifier(photo).rectify(
+            lines.image_lines,
+            lines.frontal_lines,
+            lines.frontal_size,
+            warp=params.warp,
+            a=params.a,
+            b=params.b,
+            p=params.p,
+        )
         rep.update(1, preview=rect.image)
         source, homography = rect.image, rect.homography
-        mask = cv2.erode(rect.mask.astype(np.uint8), np.ones((2 * _MASK_ERODE + 1,) * 2, np.uint8),
-                         borderType=cv2.BORDER_CONSTANT, borderValue=1).astype(bool)
+        mask = cv2.erode(
+            rect.mask.astype(np.uint8),
+            np.ones((2 * _MASK_ERODE + 1,) * 2, np.uint8),
+            borderType=cv2.BORDER_CONSTANT,
+            borderValue=1,
+        ).astype(bool)
         figures.update({f"rectify_{k}": v for k, v in rect.figures.items()})
         if mask.all():
             mask = None
@@ -306,8 +400,18 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
             out, cover = plan.apply(syn.image, supersample=rv.SUPERSAMPLE, alpha=True)
             figures["view_coverage"] = round(float(cover.mean()), 4)
         else:
-            plan = rv.into_photo_plan(rect.plan, lines.image_lines, lines.frontal_lines, lines.frontal_size,
-                                      (pw, ph), (tw, th), warp=params.warp, a=params.a, b=params.b, p=params.p)
+            plan = rv.into_photo_plan(
+                rect.plan,
+                lines.image_lines,
+                lines.frontal_lines,
+                lines.frontal_size,
+                (pw, ph),
+                (tw, th),
+                warp=params.warp,
+                a=params.a,
+                b=params.b,
+                p=params.p,
+            )
             # warped is premultiplied (black outside, edge pixels scaled by their coverage): "over"
             warped, alpha = plan.apply(syn.image, supersample=rv.SUPERSAMPLE, alpha=True)
             if warped.ndim == 3:
@@ -343,7 +447,7 @@ def warm_up() -> None:
 METHOD = Method(
     name="nfpt",
     summary="NFPT (Yan, Lee & Lin): rectify a texture photo from feature lines, synthesize it patch by patch "
-            "with feature-weighted matching and seam repair, put it back into a view",
+    "with feature-weighted matching and seam repair, put it back into a view",
     params=NfptParams,
     inputs=(InputSpec("photo", "the photo of the texture (or a frontal texture, without --lines)", min_side=8),),
     run=_run,
@@ -351,23 +455,39 @@ METHOD = Method(
     studio=Studio(
         title="Non-frontal textures (Yan, Lee & Lin)",
         canvas="photo",
-        geometry=(Geometry(LINES, on=("photo",), param="lines",
-                           help="drag to draw feature lines; drag an end to move it; click a line + "
-                                "Delete to remove it", suggest=suggest_for_studio,
-                           # (a run without lines takes the photo as frontal: of a perspective photo,
-                           # a collage with hard seams)
-                           needed="draw feature lines on the photo (or press Suggest lines, or Quad…: click "
-                                  "the plane's four corners)"),),
-        preview_params=("size",), compare=("photo",), examples={"photo": "perspective"},
-        auto=lambda params, shapes: {"sigma_d": params.overlap / 2.0}, rank=3,
+        geometry=(
+            Geometry(
+                LINES,
+                on=("photo",),
+                param="lines",
+                help="drag to draw feature lines; drag an end to move it; click a line + Delete to remove it",
+                suggest=suggest_for_studio,
+                # (a run without lines takes the photo as frontal: of a perspective photo,
+                # a collage with hard seams)
+                needed="draw feature lines on the photo (or press Suggest lines, or Quad…: click "
+                "the plane's four corners)",
+            ),
+        ),
+        preview_params=("size",),
+        compare=("photo",),
+        examples={"photo": "perspective"},
+        auto=lambda params, shapes: {"sigma_d": params.overlap / 2.0},
+        rank=3,
         limits=lambda params, shapes: {"overlap": (2, params.block // 2)},
         # the warp's a, b, p shape the line-based warps only; the repair's settings need the repair
-        idle=lambda params, shapes: ({"a", "b", "p"} if params.warp == "homography" else set())
-        | (set() if params.repair else {"band", "threshold", "n", "smooth"}),
-        figures={**{f"rectify_{k}": f.prefixed("rectification") if f.unit == "px" else f
-                    for k, f in RECTIFY_FIGURES.items()},
-                 "patches": Figure("patches"), "repaired_pixels": Figure("repaired pixels"),
-                 "repaired_fraction": Figure("repaired", "%", digits=2),
-                 "view_coverage": Figure("view coverage", "%"),
-                 "photo_replaced_fraction": Figure("photo replaced", "%")}),
+        idle=lambda params, shapes: (
+            ({"a", "b", "p"} if params.warp == "homography" else set())
+            | (set() if params.repair else {"band", "threshold", "n", "smooth"})
+        ),
+        figures={
+            **{
+                f"rectify_{k}": f.prefixed("rectification") if f.unit == "px" else f for k, f in RECTIFY_FIGURES.items()
+            },
+            "patches": Figure("patches"),
+            "repaired_pixels": Figure("repaired pixels"),
+            "repaired_fraction": Figure("repaired", "%", digits=2),
+            "view_coverage": Figure("view coverage", "%"),
+            "photo_replaced_fraction": Figure("photo replaced", "%"),
+        },
+    ),
 )

@@ -51,16 +51,16 @@ what was measured where it mattered:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
 from ..errors import ImageError
+from ..grid import block_grid
 from ..image import luminance, validate_image
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng, out_of_range
-from ..grid import block_grid
 
 __all__ = ["Synthesis", "synthesize_patches", "distance_weights", "SMOOTH_SIGMA"]
 
@@ -80,8 +80,11 @@ class Synthesis:
 
     def figures(self) -> dict:
         h, w = self.image.shape[:2]
-        return {"patches": self.patches, "repaired_pixels": int(self.repaired),
-                "repaired_fraction": round(self.repaired / float(h * w), 5)}
+        return {
+            "patches": self.patches,
+            "repaired_pixels": int(self.repaired),
+            "repaired_fraction": round(self.repaired / float(h * w), 5),
+        }
 
 
 def distance_weights(block: int, top: int, left: int, sigma_d: float) -> np.ndarray:
@@ -94,7 +97,7 @@ def distance_weights(block: int, top: int, left: int, sigma_d: float) -> np.ndar
     xs = np.arange(block, dtype=np.float64)[None, :]
     dy = np.maximum(top - 0.5 - ys, 0.0) if top else np.zeros_like(ys)
     dx = np.maximum(left - 0.5 - xs, 0.0) if left else np.zeros_like(xs)
-    in_l = ((ys < top) | (xs < left))
+    in_l = (ys < top) | (xs < left)
     d = np.where((ys < top) & (xs < left), np.hypot(dy, dx), np.maximum(dy, dx))
     wd = np.exp(-d * d / (2.0 * sigma_d * sigma_d)) / (math.sqrt(2.0 * math.pi) * sigma_d)
     return np.ascontiguousarray(np.where(in_l, wd, 0.0))
@@ -129,7 +132,7 @@ def _seam_band(cut: np.ndarray, in_l: np.ndarray, top: int, left: int, band: int
     edge[1:, :] |= pad[1:, :] != pad[:-1, :]
     edge[:-1, :] |= pad[1:, :] != pad[:-1, :]
     k = np.ones((2 * band + 1, 2 * band + 1), np.uint8)
-    near = cv2.dilate(edge.astype(np.uint8), k)[1:b + 1, 1:b + 1].astype(bool)
+    near = cv2.dilate(edge.astype(np.uint8), k)[1 : b + 1, 1 : b + 1].astype(bool)
     return near & in_l
 
 
@@ -156,12 +159,11 @@ class _Search:
         self.tw_buf = np.zeros((self.n_h, self.n_w), np.float32)
         # per-patch spectra and the cost map go into these: fresh arrays every patch made glibc trim
         # and re-fault the heap (a third of the time in the kernel for a 512² source)
-        self._fwd, self._spec, self._cross, self._cmap = (np.empty((self.n_h, self.n_w), np.float32)
-                                                          for _ in range(4))
+        self._fwd, self._spec, self._cross, self._cmap = (np.empty((self.n_h, self.n_w), np.float32) for _ in range(4))
 
     def _padded(self, img: np.ndarray) -> np.ndarray:
         out = np.zeros((self.n_h, self.n_w), np.float32)
-        out[:self.hs, :self.ws] = img
+        out[: self.hs, : self.ws] = img
         return out
 
     def cost(self, canvas_y: np.ndarray, canvas: np.ndarray, y0: int, x0: int, wd: np.ndarray):
@@ -170,20 +172,35 @@ class _Search:
 
         from .._kernels import nfpt as _k
 
-        const = _k.l_template(canvas_y, canvas, y0, x0, wd.shape[0], wd, self.sigma_s, self.levels, self.mean,
-                              self.w_buf, self.tw_buf)
+        const = _k.l_template(
+            canvas_y, canvas, y0, x0, wd.shape[0], wd, self.sigma_s, self.levels, self.mean, self.w_buf, self.tw_buf
+        )
         spec = cv2.mulSpectrums(self.spec2, cv2.dft(self.w_buf, dst=self._fwd), 0, c=self._spec, conjB=True)
         cross = cv2.mulSpectrums(self.spec1, cv2.dft(self.tw_buf, dst=self._fwd), 0, c=self._cross, conjB=True)
         cv2.scaleAdd(cross, -2.0, spec, dst=spec)
         return cv2.idft(spec, dst=self._cmap, flags=cv2.DFT_REAL_OUTPUT | cv2.DFT_SCALE), const
 
 
-def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int, overlap: int,
-                       sigma_d: float, sigma_s: float, tol: int, repair: bool, band: int, threshold: float,
-                       n: int, smooth: bool, shift: int = 0, mask: np.ndarray | None = None,
-                       rng: None | int | np.random.Generator = None,
-                       progress: Callable[[Progress], None] | None = None,
-                       cancel: CancelToken | None = None) -> Synthesis:
+def synthesize_patches(
+    texture: np.ndarray,
+    size: tuple[int, int],
+    *,
+    block: int,
+    overlap: int,
+    sigma_d: float,
+    sigma_s: float,
+    tol: int,
+    repair: bool,
+    band: int,
+    threshold: float,
+    n: int,
+    smooth: bool,
+    shift: int = 0,
+    mask: np.ndarray | None = None,
+    rng: None | int | np.random.Generator = None,
+    progress: Callable[[Progress], None] | None = None,
+    cancel: CancelToken | None = None,
+) -> Synthesis:
     """The engine of :func:`weft.core.nfpt.synthesize` (parameters already validated; see there)."""
     import cv2
 
@@ -202,8 +219,10 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
             raise ImageError(f"source mask is {mask.shape[1]}x{mask.shape[0]}, the texture {ws}x{hs}: they must match")
     valid = _valid_positions(mask, (hs, ws), block)
     if not valid.any():
-        raise ImageError(f"no {block}x{block} patch of the source lies wholly inside its valid part "
-                         f"(the rectified area is too small for the block; use a smaller --block)")
+        raise ImageError(
+            f"no {block}x{block} patch of the source lies wholly inside its valid part "
+            f"(the rectified area is too small for the block; use a smaller --block)"
+        )
     rng = as_rng(rng)
     width, height = size
     ys, _, _, hc = block_grid(height, block, overlap, False)  # the patch grid quilting uses too
@@ -218,7 +237,7 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
     canvas_y = np.zeros((hc, wc), np.float32)
     pos = np.full((hc, wc), -1, np.int32)
     todo = np.zeros((hc, wc), np.uint8)
-    flat_index = (np.arange(hs, dtype=np.int32)[:, None] * ws + np.arange(ws, dtype=np.int32)[None, :])
+    flat_index = np.arange(hs, dtype=np.int32)[:, None] * ws + np.arange(ws, dtype=np.int32)[None, :]
     wd_cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
     us = rng.random((rows, cols))
     ph, pw = valid.shape
@@ -252,7 +271,7 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
                 cmap, const = search.cost(canvas_y, canvas, y0, x0, wd)
                 k = int(_k.select(cmap, const, valid, tol, us[i, j]))
             sy, sx = divmod(k, pw)
-            new = tex[sy:sy + block, sx:sx + block]
+            new = tex[sy : sy + block, sx : sx + block]
             foot = (slice(y0, y0 + block), slice(x0, x0 + block))
             if top or left:
                 old = canvas[foot]
@@ -266,8 +285,8 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
             else:
                 cut = np.ones((block, block), bool)
             canvas[foot][cut] = new[cut]
-            canvas_y[foot][cut] = src_y[sy:sy + block, sx:sx + block][cut]
-            pos[foot][cut] = flat_index[sy:sy + block, sx:sx + block][cut]
+            canvas_y[foot][cut] = src_y[sy : sy + block, sx : sx + block][cut]
+            pos[foot][cut] = flat_index[sy : sy + block, sx : sx + block][cut]
         report.update(i + 1, preview=preview)
 
     repaired = 0
@@ -279,7 +298,7 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
         for c0 in range(0, len(order), step):
             if cancel is not None:
                 cancel.raise_if_cancelled()
-            _k.repair(canvas, pos, todo, tex, allowed, half, shift, order[c0:c0 + step])
+            _k.repair(canvas, pos, todo, tex, allowed, half, shift, order[c0 : c0 + step])
         done = todo[:height, :width] == 2
         repaired = int(done.sum())
         if smooth and repaired:
@@ -292,5 +311,10 @@ def synthesize_patches(texture: np.ndarray, size: tuple[int, int], *, block: int
     out = np.ascontiguousarray(canvas[:height, :width])
     if nc == 1:
         out = np.ascontiguousarray(out[..., 0])
-    return Synthesis(out, rows * cols, repaired, np.ascontiguousarray(pos[:height, :width]),
-                     np.ascontiguousarray(todo[:height, :width] == 2))
+    return Synthesis(
+        out,
+        rows * cols,
+        repaired,
+        np.ascontiguousarray(pos[:height, :width]),
+        np.ascontiguousarray(todo[:height, :width] == 2),
+    )

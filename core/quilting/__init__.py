@@ -29,10 +29,23 @@ FFT loses little to cancellation.
 """
 
 from .checks import estimate_seconds, memory_estimate
-from .engine import RULES, _K, _Pass, _pad_to, _quilt_pass  # noqa: F401 (tests compare _K to the kernel)
+from .engine import _K, RULES, _pad_to, _Pass, _quilt_pass  # noqa: F401 (tests compare _K to the kernel)
 from .method import METHOD, warm_up
-from .params import (CORR_SIGMA, CORRESPONDENCES, ITERATIVE_BLOCK, MIN_BLOCK, MIN_OVERLAP, MODES, SYNTH_BLOCK_MAX, SYNTH_TOL,
-                     TRANSFER_BLOCK, QuiltParams, synth_block, synth_tol, transfer_schedule)
+from .params import (
+    CORR_SIGMA,
+    CORRESPONDENCES,
+    ITERATIVE_BLOCK,
+    MIN_BLOCK,
+    MIN_OVERLAP,
+    MODES,
+    SYNTH_BLOCK_MAX,
+    SYNTH_TOL,
+    TRANSFER_BLOCK,
+    QuiltParams,
+    synth_block,
+    synth_tol,
+    transfer_schedule,
+)
 from .synthesis import synthesize
 from .transfer import transfer
 

@@ -1,14 +1,15 @@
 """Checks shared by quilting's synthesis and transfer: input sizes, and the up-front limits (time and memory estimates)."""
+
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
 from ..errors import InvalidParameter
+from ..grid import block_grid
 from ..image import validate_image
 from ..params import out_of_range
-from ..grid import block_grid
 from .params import ITERATIVE_BLOCK, TRANSFER_BLOCK, QuiltParams, _round_half_up, synth_block, transfer_schedule
 
 # --------------------------------------------------------------------------------------------
@@ -23,8 +24,7 @@ def _check_texture(texture) -> np.ndarray:
 def _check_block_fits(block: int, tex: np.ndarray) -> None:
     h, w = tex.shape[:2]
     if block > min(h, w):
-        raise out_of_range("block", block, 2, min(h, w), f"must fit in the texture, {w}x{h}",
-                           input="texture")
+        raise out_of_range("block", block, 2, min(h, w), f"must fit in the texture, {w}x{h}", input="texture")
 
 
 def _check_overlap(block: int, overlap: int) -> None:
@@ -36,7 +36,10 @@ def _check_tile_size(block: int, w: int, h: int) -> None:
     if min(w, h) < block:
         raise InvalidParameter(
             f"parameter 'size' = {w}x{h} is too small for a tileable output with block = {block} "
-            f"(each side must be at least the block)", name="size", value=(w, h))
+            f"(each side must be at least the block)",
+            name="size",
+            value=(w, h),
+        )
 
 
 def _finish(img: np.ndarray, channels: int) -> np.ndarray:
@@ -66,8 +69,9 @@ BYTES_PER_OUTPUT_PIXEL = {"synthesis": 40, "transfer": 50}
 BYTES_PER_SOURCE_PIXEL = 60
 
 
-def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
-                     passes: list[tuple[int, int]], *, tile: bool = False) -> float:
+def estimate_seconds(
+    texture_shape: tuple[int, ...], out_size: tuple[int, int], passes: list[tuple[int, int]], *, tile: bool = False
+) -> float:
     """Estimated running time of quilting on the 2-core reference machine (see :mod:`weft.core.limits`).
 
     Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel
@@ -86,17 +90,23 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int],
     for block, overlap in passes:
         blocks = _blocks(height, width, block, overlap, tile)
         positions = (h - block + 1) * (w - block + 1)
-        total += blocks * ((channels + 1) * dft + SELECT_SECONDS_PER_POSITION * positions
-                            + SECONDS_PER_BLOCK + SECONDS_PER_BLOCK_SIDE * block)
+        total += blocks * (
+            (channels + 1) * dft
+            + SELECT_SECONDS_PER_POSITION * positions
+            + SECONDS_PER_BLOCK
+            + SECONDS_PER_BLOCK_SIDE * block
+        )
     return total
 
 
-def _memory_need(tex_shape: tuple[int, ...], out_w: int, out_h: int, passes: list[tuple[int, int]], *,
-                 tile: bool, transfer: bool) -> float:
+def _memory_need(
+    tex_shape: tuple[int, ...], out_w: int, out_h: int, passes: list[tuple[int, int]], *, tile: bool, transfer: bool
+) -> float:
     """Estimated peak bytes of quilting ``out_w`` x ``out_h`` from a texture of ``tex_shape``."""
     h, w = tex_shape[:2]
-    need = (BYTES_PER_OUTPUT_PIXEL["transfer" if transfer else "synthesis"] * out_w * out_h
-            + BYTES_PER_SOURCE_PIXEL * h * w)
+    need = (
+        BYTES_PER_OUTPUT_PIXEL["transfer" if transfer else "synthesis"] * out_w * out_h + BYTES_PER_SOURCE_PIXEL * h * w
+    )
     if transfer:  # two block rows of texture-sized spectra (the row in use and the one computed ahead)
         import cv2
 
@@ -109,7 +119,11 @@ def _transfer_passes(params: QuiltParams) -> list[tuple[int, int, float]]:
     """Block, overlap and alpha of each pass of a transfer with these parameters (defaults resolved)."""
     n = params.iterations
     b = params.block if params.block is not None else (TRANSFER_BLOCK if n == 1 else ITERATIVE_BLOCK)
-    ov = params.overlap if params.overlap is not None else max(1, min(b - 1, _round_half_up(b / 3 if n == 1 else 2 * b / 3)))
+    ov = (
+        params.overlap
+        if params.overlap is not None
+        else max(1, min(b - 1, _round_half_up(b / 3 if n == 1 else 2 * b / 3)))
+    )
     return transfer_schedule(n, block=b, overlap=ov, alpha=params.alpha)
 
 
@@ -129,24 +143,33 @@ def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: QuiltParams) 
     return _memory_need(tex, out_w, out_h, [(b, ov)], tile=params.tile, transfer=False)
 
 
-def _check_limits(tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[int, int]], *,
-                  tile: bool, transfer: bool) -> None:
+def _check_limits(
+    tex: np.ndarray, out_w: int, out_h: int, passes: list[tuple[int, int]], *, tile: bool, transfer: bool
+) -> None:
     """Refuse up front an output over the pixel limit, beyond available memory, or too long to quilt."""
     from ..limits import check_duration, check_memory, check_output_size
 
     check_output_size(out_w, out_h, "the target" if transfer else "parameter 'size'")
     h, w = tex.shape[:2]
     need = _memory_need(tex.shape, out_w, out_h, passes, tile=tile, transfer=transfer)
-    check_memory(need, f"quilting {out_w}x{out_h} from a {w}x{h} texture",
-                 f"use a smaller {'target' if transfer else 'size'} or a smaller part of the texture")
+    check_memory(
+        need,
+        f"quilting {out_w}x{out_h} from a {w}x{h} texture",
+        f"use a smaller {'target' if transfer else 'size'} or a smaller part of the texture",
+    )
     seconds = estimate_seconds(tex.shape, (out_w, out_h), passes, tile=tile)
     blocks = sum(_blocks(out_h, out_w, b, o, tile) for b, o in passes)
     first = passes[0][0]
-    what = (f"{'transfer' if transfer else 'quilting'} of {out_w}x{out_h} from a {w}x{h} texture "
-            f"({blocks:,} blocks of {first if len(passes) == 1 else f'{first} to {passes[-1][0]}'} px"
-            f"{f' in {len(passes)} passes' if len(passes) > 1 else ''})")
-    advice = ("use a larger block, fewer iterations, a smaller target or a smaller part of the texture" if transfer
-              else "use a larger block, a smaller size or a smaller part of the texture")
+    what = (
+        f"{'transfer' if transfer else 'quilting'} of {out_w}x{out_h} from a {w}x{h} texture "
+        f"({blocks:,} blocks of {first if len(passes) == 1 else f'{first} to {passes[-1][0]}'} px"
+        f"{f' in {len(passes)} passes' if len(passes) > 1 else ''})"
+    )
+    advice = (
+        "use a larger block, fewer iterations, a smaller target or a smaller part of the texture"
+        if transfer
+        else "use a larger block, a smaller size or a smaller part of the texture"
+    )
     check_duration(seconds, what, advice)
 
 

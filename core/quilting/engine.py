@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import codes as _K  # the kernel's array codes, without importing numba (a test checks it)
 from ..grid import block_grid
 from ..jobs import CancelToken, ProgressReporter
 from ..seams import accumulated_costs
+from . import codes as _K  # the kernel's array codes, without importing numba (a test checks it)
 
 RULES = ("tol", "epsilon", "sampled")
 
@@ -58,15 +58,18 @@ class _Pass:
     w_prev: float = 0.0
     w_corr: float = 0.0
     engine: str = "auto"  # "auto", "numba" or "numpy" (tests compare the two)
-    avoid: int | None = None  # radius of _forbid_continuations, -1 off; None: AVOID_RADIUS for synthesis, off for transfer
+    avoid: int | None = (
+        None  # radius of _forbid_continuations, -1 off; None: AVOID_RADIUS for synthesis, off for transfer
+    )
     usage: float | None = None  # weight of _penalise_usage, 0 off; None: USAGE_WEIGHT for synthesis, off for transfer
-    seam_pool: int | None = None  # candidates per tol of the seam rule, 0 off; None: SEAM_POOL for synthesis, off for transfer
+    seam_pool: int | None = (
+        None  # candidates per tol of the seam rule, 0 off; None: SEAM_POOL for synthesis, off for transfer
+    )
 
 
-
-
-def _forbid_continuations(cross: np.ndarray, ph: int, pw: int, y0: int, x0: int,
-                          neighbours: list[tuple[int, int, int, int]], radius: int) -> None:
+def _forbid_continuations(
+    cross: np.ndarray, ph: int, pw: int, y0: int, x0: int, neighbours: list[tuple[int, int, int, int]], radius: int
+) -> None:
     """Forbid the source positions that would continue a neighbouring block's piece of the sample.
 
     A block whose neighbour (at canvas (ny, nx)) came from source (nsy, nsx) matches that
@@ -117,13 +120,15 @@ def _penalise_usage(cross: np.ndarray, usage: np.ndarray, ph: int, pw: int, b: i
     mean = float(usage.mean())
     if mean <= 0.0:
         return
-    under = cv2.boxFilter(usage, cv2.CV_32F, (b, b), normalize=False, anchor=(0, 0),
-                          borderType=cv2.BORDER_CONSTANT)[:ph, :pw]
+    under = cv2.boxFilter(usage, cv2.CV_32F, (b, b), normalize=False, anchor=(0, 0), borderType=cv2.BORDER_CONSTANT)[
+        :ph, :pw
+    ]
     cross[:ph, :pw] -= np.float32(0.5 * weight / (b * b * mean)) * under
 
 
-def _neighbours(chosen: np.ndarray, i: int, j: int, ys: list[int], xs: list[int], hc: int, wc: int,
-                tile: bool) -> list[tuple[int, int, int, int]]:
+def _neighbours(
+    chosen: np.ndarray, i: int, j: int, ys: list[int], xs: list[int], hc: int, wc: int, tile: bool
+) -> list[tuple[int, int, int, int]]:
     """(source y, source x, canvas y, canvas x) of the blocks already placed that overlap block (i, j)."""
     rows, cols = chosen.shape[:2]
     cand = [(i, j - 1, 0, 0), (i - 1, j, 0, 0), (i - 1, j - 1, 0, 0), (i - 1, j + 1, 0, 0)]
@@ -208,27 +213,39 @@ class _Source:
             m = np.zeros((b, b), dtype=bool)
             m[:top] = True
             m[:, :left] = True
-            m[:, b - right:] = True  # an empty slice when right == 0
-            m[b - bottom:] = True
+            m[:, b - right :] = True  # an empty slice when right == 0
+            m[b - bottom :] = True
             kernel += np.float32(p.w_overlap) * m
         kernel += np.float32(p.w_prev)
         out = np.zeros((self.ph, self.pw), dtype=np.float32)
         if kernel.any():
-            out += cv2.filter2D(self.sq_src, cv2.CV_32F, kernel, anchor=(0, 0),
-                                borderType=cv2.BORDER_CONSTANT)[: self.ph, : self.pw]
+            out += cv2.filter2D(self.sq_src, cv2.CV_32F, kernel, anchor=(0, 0), borderType=cv2.BORDER_CONSTANT)[
+                : self.ph, : self.pw
+            ]
         if p.w_corr and self.sq_c is not None:
             box = np.full((b, b), np.float32(p.w_corr), dtype=np.float32)
-            out += cv2.filter2D(self.sq_c, cv2.CV_32F, box, anchor=(0, 0),
-                                borderType=cv2.BORDER_CONSTANT)[: self.ph, : self.pw]
+            out += cv2.filter2D(self.sq_c, cv2.CV_32F, box, anchor=(0, 0), borderType=cv2.BORDER_CONSTANT)[
+                : self.ph, : self.pw
+            ]
         out = np.ascontiguousarray(out)
         self._cache[key] = out
         return out
 
 
-def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.random.Generator, *,
-                prev: np.ndarray | None = None, corr: tuple[np.ndarray, np.ndarray] | None = None,
-                report: ProgressReporter | None = None, cancel: CancelToken | None = None,
-                channels_out: int = 3, record: dict | None = None) -> tuple[np.ndarray, int]:
+def _quilt_pass(
+    tex: np.ndarray,
+    out_h: int,
+    out_w: int,
+    p: _Pass,
+    rng: np.random.Generator,
+    *,
+    prev: np.ndarray | None = None,
+    corr: tuple[np.ndarray, np.ndarray] | None = None,
+    report: ProgressReporter | None = None,
+    cancel: CancelToken | None = None,
+    channels_out: int = 3,
+    record: dict | None = None,
+) -> tuple[np.ndarray, int]:
     """One pass of quilting; returns the (out_h, out_w, C) image and the number of blocks.
 
     With ``record`` (a dict), ``record["sources"]`` is set to the (out_h, out_w, 2) int32 source
@@ -263,10 +280,10 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
             for j in range(cols):
                 x0 = xs[j]
                 bw = min(b, wc - x0)
-                canvas[y0:y0 + bh, x0:x0 + bw] = tex[sy[i, j]:sy[i, j] + bh, sx[i, j]:sx[i, j] + bw]
+                canvas[y0 : y0 + bh, x0 : x0 + bw] = tex[sy[i, j] : sy[i, j] + bh, sx[i, j] : sx[i, j] + bw]
                 if sources is not None:
-                    sources[y0:y0 + bh, x0:x0 + bw, 0] = (sy[i, j] + np.arange(bh))[:, None]
-                    sources[y0:y0 + bh, x0:x0 + bw, 1] = (sx[i, j] + np.arange(bw))[None, :]
+                    sources[y0 : y0 + bh, x0 : x0 + bw, 0] = (sy[i, j] + np.arange(bh))[:, None]
+                    sources[y0 : y0 + bh, x0 : x0 + bw, 1] = (sx[i, j] + np.arange(bw))[None, :]
             if report is not None:
                 report.update(i + 1, preview=preview)
         if record is not None:
@@ -278,13 +295,23 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     synthesis = prev is None and corr is None
     pool = p.seam_pool if p.seam_pool is not None else (SEAM_POOL if synthesis else 0)
     pool = pool * p.tol if p.mode == "mincut" and p.rule == "tol" and pool > 0 else 0
-    use_numpy = (p.engine == "numpy" or p.engine == "auto" and not p.poisson and synthesis
-                 and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS and "weft.core._kernels.quilting" not in sys.modules)
+    use_numpy = (
+        p.engine == "numpy"
+        or p.engine == "auto"
+        and not p.poisson
+        and synthesis
+        and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS
+        and "weft.core._kernels.quilting" not in sys.modules
+    )
     if use_numpy:
         place, template, blend = _place_block_numpy, _make_template_numpy, None
         error, cut = _block_error_numpy, _cut_mask_into_numpy
-        by_best, by_tol, by_eps, by_sampled = (_choose_best_numpy, _choose_tol_numpy, _choose_epsilon_numpy,
-                                               _choose_sampled_numpy)
+        by_best, by_tol, by_eps, by_sampled = (
+            _choose_best_numpy,
+            _choose_tol_numpy,
+            _choose_epsilon_numpy,
+            _choose_sampled_numpy,
+        )
         by_seam, best_k, seam_error, seam_cut, block_error = _by_seam_numpy, None, None, None, None
     else:
         from .._kernels import quilting as _k  # numba loads on first use, not with the CLI
@@ -292,8 +319,13 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
 
         place, template, blend = _k.place_block, _k.make_template, _k.poisson_band
         error, cut = _k.block_error, _seams.cut_mask
-        by_seam, best_k, seam_error, seam_cut, block_error = (_by_seam, _k.best_k, _k.seam_error, _seams.cut_mask,
-                                                              _k.block_error)
+        by_seam, best_k, seam_error, seam_cut, block_error = (
+            _by_seam,
+            _k.best_k,
+            _k.seam_error,
+            _seams.cut_mask,
+            _k.block_error,
+        )
         by_best, by_tol, by_eps, by_sampled = _k.choose_best, _k.choose_tol, _k.choose_epsilon, _k.choose_sampled
     # one kernel per rule (a run compiles only the one it uses); all take (cross, sq, const, cost, u, seed)
     if p.rule == "sampled":
@@ -361,8 +393,26 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
             out = []
             specs = row_specs[i % 2]
             for j in range(cols):
-                cst = template(prev_c, prev_c, corr_t, ys[i], xs[j], b, 0, 0, 0, 0, wrap,
-                               0.0, p.w_prev, p.w_corr, src.mean, src.mean_c, tbuf_s, tcorr_s)
+                cst = template(
+                    prev_c,
+                    prev_c,
+                    corr_t,
+                    ys[i],
+                    xs[j],
+                    b,
+                    0,
+                    0,
+                    0,
+                    0,
+                    wrap,
+                    0.0,
+                    p.w_prev,
+                    p.w_corr,
+                    src.mean,
+                    src.mean_c,
+                    tbuf_s,
+                    tcorr_s,
+                )
                 spec = cv2.mulSpectrums(spectrum_c, cv2.dft(tcorr_s, dst=fwd_s), 0, c=specs[j], conjB=True)
                 if p.w_prev:
                     for c in range(nc):
@@ -391,8 +441,26 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                 if overlaps or row_static is not None:
                     spec, const = (None, 0.0) if row_static is None else row_static[j]
                     if overlaps:
-                        const += template(canvas, prev_c, corr_t, y0, x0, b, top, left, right, bottom, wrap,
-                                          p.w_overlap, 0.0, 0.0, src.mean, src.mean_c, tbuf, tcorr)
+                        const += template(
+                            canvas,
+                            prev_c,
+                            corr_t,
+                            y0,
+                            x0,
+                            b,
+                            top,
+                            left,
+                            right,
+                            bottom,
+                            wrap,
+                            p.w_overlap,
+                            0.0,
+                            0.0,
+                            src.mean,
+                            src.mean_c,
+                            tbuf,
+                            tcorr,
+                        )
                         for c in range(nc):
                             cv2.dft(tbuf[c], dst=fwd)
                             if spec is None:
@@ -405,13 +473,31 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                         n_overlap = b * b - (b - top - bottom) * (b - left - right)
                         _penalise_usage(cross, usage, src.ph, src.pw, b, usage_weight * random_error * n_overlap)
                     if avoid >= 0:
-                        _forbid_continuations(cross, src.ph, src.pw, y0, x0,
-                                              _neighbours(chosen, i, j, ys, xs, hc, wc, wrap), avoid)
+                        _forbid_continuations(
+                            cross, src.ph, src.pw, y0, x0, _neighbours(chosen, i, j, ys, xs, hc, wc, wrap), avoid
+                        )
                     sq = src.sq((top, left, right, bottom), p)
                     seam_cut_done = bool(pool and overlaps)
                     if seam_cut_done:  # the winner's cut is left in mask
-                        pick = by_seam(cross, sq, float(const), cost_buf, pool, candidates, canvas, filled, tex,
-                                        ip, err, mask, best_k, block_error, seam_cut, seam_error, src.pw)
+                        pick = by_seam(
+                            cross,
+                            sq,
+                            float(const),
+                            cost_buf,
+                            pool,
+                            candidates,
+                            canvas,
+                            filled,
+                            tex,
+                            ip,
+                            err,
+                            mask,
+                            best_k,
+                            block_error,
+                            seam_cut,
+                            seam_error,
+                            src.pw,
+                        )
                     else:
                         pick = int(choose(cross, sq, float(const), cost_buf, us[i, j], seeds[i, j]))
                     ip[_K.P_SY], ip[_K.P_SX] = divmod(pick, src.pw)
@@ -425,10 +511,11 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
                 chosen[i, j] = ip[_K.P_SY], ip[_K.P_SX]
                 if usage is not None:
                     sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
-                    usage[sy:sy + b, sx:sx + b] += mask if mincut and overlaps else np.float32(1.0)
+                    usage[sy : sy + b, sx : sx + b] += mask if mincut and overlaps else np.float32(1.0)
                 if sources is not None:
-                    _record(sources, y0, x0, int(ip[_K.P_SY]), int(ip[_K.P_SX]), b,
-                            mask if mincut and overlaps else None)
+                    _record(
+                        sources, y0, x0, int(ip[_K.P_SY]), int(ip[_K.P_SX]), b, mask if mincut and overlaps else None
+                    )
                 if blend is not None and p.poisson:
                     blend(canvas, old, label, win, p.band)
             if report is not None:
@@ -441,8 +528,25 @@ def _quilt_pass(tex: np.ndarray, out_h: int, out_w: int, p: _Pass, rng: np.rando
     return canvas[:out_h, :out_w], rows * cols
 
 
-def _by_seam(cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, ip, err, mask,
-             best_k, block_error, cut, seam_error, pw) -> int:
+def _by_seam(
+    cross,
+    sq,
+    const,
+    cost_buf,
+    pool,
+    candidates,
+    canvas,
+    filled,
+    tex,
+    ip,
+    err,
+    mask,
+    best_k,
+    block_error,
+    cut,
+    seam_error,
+    pw,
+) -> int:
     """The seam rule: of the ``pool`` lowest-cost positions (the tol rule's candidates), the one
     whose minimum-error cut runs through the least error (``seam_error``; ties: the earlier
     candidate). The overlap SSD ranks a block by its whole overlap, but what shows is the error
@@ -543,7 +647,7 @@ def _vertical_accs_numpy(strips: list[np.ndarray]) -> list[np.ndarray]:
     if len(strips) > 1 and all(s.shape == strips[0].shape for s in strips):
         acc = accumulated_costs(np.concatenate(strips))
         k = strips[0].shape[0]
-        return [acc[i * k:(i + 1) * k] for i in range(len(strips))]
+        return [acc[i * k : (i + 1) * k] for i in range(len(strips))]
     return [accumulated_costs(s) for s in strips]
 
 
@@ -617,13 +721,17 @@ def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: in
     zero = np.zeros(k, dtype=np.int64)
     strips, sides = [], []
     if left > 0:
-        strips.append(err[:, :, :left]); sides.append("left")
+        strips.append(err[:, :, :left])
+        sides.append("left")
     if top > 0:
-        strips.append(err[:, :top, :].transpose(0, 2, 1)); sides.append("top")  # (K, w, top): rows = columns
+        strips.append(err[:, :top, :].transpose(0, 2, 1))
+        sides.append("top")  # (K, w, top): rows = columns
     if right > 0:
-        strips.append(err[:, :, w - right:]); sides.append("right")
+        strips.append(err[:, :, w - right :])
+        sides.append("right")
     if bottom > 0:
-        strips.append(err[:, h - bottom:, :].transpose(0, 2, 1)); sides.append("bottom")
+        strips.append(err[:, h - bottom :, :].transpose(0, 2, 1))
+        sides.append("bottom")
     accs = dict(zip(sides, _vertical_accs_numpy(strips)))
     if left > 0 and top > 0:
         ev, eh = accs["left"], accs["top"]
@@ -650,18 +758,38 @@ def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: in
     return mask
 
 
-def _make_template_numpy(canvas, prev, corr_t, y0, x0, b, top, left, right, bottom, wrap,
-                         w_overlap, w_prev, w_corr, mean, mean_c, tbuf, tcorr):
+def _make_template_numpy(
+    canvas,
+    prev,
+    corr_t,
+    y0,
+    x0,
+    b,
+    top,
+    left,
+    right,
+    bottom,
+    wrap,
+    w_overlap,
+    w_prev,
+    w_corr,
+    mean,
+    mean_c,
+    tbuf,
+    tcorr,
+):
     """The kernel's ``make_template`` for synthesis (overlap term only), in numpy (same values)."""
     if w_prev or w_corr:
-        raise RuntimeError("internal: the numpy engine quilts synthesis only (_quilt_pass never sends it transfer terms)")
+        raise RuntimeError(
+            "internal: the numpy engine quilts synthesis only (_quilt_pass never sends it transfer terms)"
+        )
     hc, wc, nc = canvas.shape
     iy = (y0 + np.arange(b)) % hc
     ix = (x0 + np.arange(b)) % wc
     m = np.zeros((b, b), dtype=bool)
     m[:top] = m[:, :left] = True
-    m[:, b - right:] = True
-    m[b - bottom:] = True
+    m[:, b - right :] = True
+    m[b - bottom :] = True
     o = canvas[np.ix_(iy, ix)].astype(np.float64) - mean
     v = np.where(m[..., None], w_overlap * o, 0.0)
     tbuf[:, :b, :b] = v.transpose(2, 0, 1)
@@ -678,13 +806,13 @@ def _block_errors_numpy(canvas, filled, tex, ip, positions) -> np.ndarray:
     top, left, right, bottom = (int(ip[i]) for i in (_K.P_TOP, _K.P_LEFT, _K.P_RIGHT, _K.P_BOTTOM))
     iy = (y0 + np.arange(b)) % hc
     ix = (x0 + np.arange(b)) % wc
-    blocks = np.stack([tex[sy:sy + b, sx:sx + b] for sy, sx in positions])
+    blocks = np.stack([tex[sy : sy + b, sx : sx + b] for sy, sx in positions])
     d = canvas[np.ix_(iy, ix)][None] - blocks
     e = (d * d).astype(np.float64).sum(axis=3)
     strips = np.zeros((b, b), dtype=bool)
     strips[:top] = strips[:, :left] = True
-    strips[:, b - right:] = True
-    strips[b - bottom:] = True
+    strips[:, b - right :] = True
+    strips[b - bottom :] = True
     e[:, ~(strips & (filled[np.ix_(iy, ix)] != 0))] = 0.0
     return e
 
@@ -707,8 +835,9 @@ def _seam_errors_numpy(err: np.ndarray, mask: np.ndarray) -> np.ndarray:
     return np.cumsum(vals, axis=1)[:, -1]
 
 
-def _by_seam_numpy(cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, ip, err, mask,
-                   *kernels_and_pw) -> int:
+def _by_seam_numpy(
+    cross, sq, const, cost_buf, pool, candidates, canvas, filled, tex, ip, err, mask, *kernels_and_pw
+) -> int:
     """:func:`_by_seam` in numpy, the candidates' cuts computed together (same choice, the
     winner's cut left in ``mask``)."""
     pw = kernels_and_pw[-1]
@@ -741,7 +870,7 @@ def _place_block_numpy(canvas, filled, tex, ip, mask, *work):
         iy, ix = slice(y0, y0 + b), slice(x0, x0 + b)
     else:  # a tileable canvas's last blocks wrap around
         iy, ix = np.ix_((y0 + np.arange(b)) % hc, (x0 + np.arange(b)) % wc)
-    block = tex[sy:sy + b, sx:sx + b]
+    block = tex[sy : sy + b, sx : sx + b]
     if ip[_K.P_MODE] == _K.MODE_MINCUT and (top or left or right or bottom):
         m = mask.astype(bool)
         canvas[iy, ix] = np.where(m[..., None], block, canvas[iy, ix])

@@ -1,7 +1,8 @@
 """``weft quilt``: the method the registry, the command line and the studio run (see the package)."""
+
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -40,13 +41,31 @@ def _run(inputs: Mapping[str, np.ndarray], params: QuiltParams, *, rng=None, pro
             blocks = _blocks(h, w, block, ov, params.tile)
         from ..metrics import verbatim_fraction
 
-        return Result(image, {"block": block, "blocks": blocks,
-                              "verbatim_fraction": round(verbatim_fraction(record["sources"], texture.shape), 4)})
+        return Result(
+            image,
+            {
+                "block": block,
+                "blocks": blocks,
+                "verbatim_fraction": round(verbatim_fraction(record["sources"], texture.shape), 4),
+            },
+        )
     if params.size is not None:
-        raise InvalidParameter("parameter 'size' cannot be given with a target: the transfer has the target's size",
-                               name="size", value=params.size)
-    images = _transfer(texture, target, params, source_map=maps["source_map"], target_map=maps["target_map"],
-                       return_all=True, rng=rng, progress=progress, cancel=cancel)
+        raise InvalidParameter(
+            "parameter 'size' cannot be given with a target: the transfer has the target's size",
+            name="size",
+            value=params.size,
+        )
+    images = _transfer(
+        texture,
+        target,
+        params,
+        source_map=maps["source_map"],
+        target_map=maps["target_map"],
+        return_all=True,
+        rng=rng,
+        progress=progress,
+        cancel=cancel,
+    )
     image = images[-1]
     return Result(image, {"iterations": len(images)})
 
@@ -61,8 +80,11 @@ def _auto(params: QuiltParams, shapes: Mapping[str, tuple]) -> dict:
     if params.block is None and "texture" not in shapes:
         return {}
     block = params.block or synth_block(shapes["texture"])
-    return {"block": block, "overlap": params.overlap if params.overlap is not None else max(1, -(-block // 6)),
-            "tol": params.tol or synth_tol(block)}
+    return {
+        "block": block,
+        "overlap": params.overlap if params.overlap is not None else max(1, -(-block // 6)),
+        "tol": params.tol or synth_tol(block),
+    }
 
 
 def _limits(params: QuiltParams, shapes: Mapping[str, tuple]) -> dict:
@@ -113,7 +135,7 @@ def warm_up() -> None:
 METHOD = Method(
     name="quilt",
     summary="image quilting (Efros & Freeman): synthesize a larger texture from blocks of a sample, "
-            "or transfer it onto a target",
+    "or transfer it onto a target",
     params=QuiltParams,
     inputs=(
         InputSpec("texture", "the sample texture image", min_side=2),
@@ -128,13 +150,22 @@ METHOD = Method(
     studio=Studio(
         title="Image quilting (Efros & Freeman)",
         canvas="texture",
-        geometry=(Geometry(SQUARE, on=("texture",),
-                           help="drag a square: the source region (blocks come only from it)"),),
-        preview_inputs=("target", "target_map"), preview_params=("size",), auto=_auto, limits=_limits,
+        geometry=(
+            Geometry(SQUARE, on=("texture",), help="drag a square: the source region (blocks come only from it)"),
+        ),
+        preview_inputs=("target", "target_map"),
+        preview_params=("size",),
+        auto=_auto,
+        limits=_limits,
         idle=_idle,
         compare=("target", "texture"),
-        examples={"texture": "wood-grain", "target": "astronaut"}, rank=1,
-        figures={"block": Figure("block", "px"), "blocks": Figure("blocks"),
-                 "verbatim_fraction": Figure("largest verbatim copy", "%", "of the sample", digits=2),
-                 "iterations": Figure("passes")}),
+        examples={"texture": "wood-grain", "target": "astronaut"},
+        rank=1,
+        figures={
+            "block": Figure("block", "px"),
+            "blocks": Figure("blocks"),
+            "verbatim_fraction": Figure("largest verbatim copy", "%", "of the sample", digits=2),
+            "iterations": Figure("passes"),
+        },
+    ),
 )

@@ -1,9 +1,9 @@
 """Image quilting's parameters (:class:`QuiltParams`) and the iterative transfer's pass schedule."""
+
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-
 
 from ..errors import InvalidParameter
 from ..params import Params, out_of_range, param
@@ -45,60 +45,120 @@ class QuiltParams(Params):
     it; at smaller blocks they cost time and gain nothing (the quilting benchmark's figures).
     """
 
-    mode: str = param("mincut", choices=MODES,
-                      help="how blocks join: random = side by side (seams show); overlap = matched where they "
-                           "overlap; mincut = also cut along the least visible path (smoothest)")
-    block: int = param(None, kind="int", lo=2, hi=1024, optional=True, symbol="B",
-                       help="size of the pieces copied from the sample: larger keeps whole structures (a brick with"
-                            " its joints) but repeats more of the sample, smaller breaks them up (default 7/16 of "
-                            "the texture's shorter side, at most 56; transfer 9, iterative 31)")
-    overlap: int = param(None, kind="int", lo=1, hi=1023, optional=True,
-                         help="how much neighbouring blocks share, the seam is cut inside it: more hides seams "
-                              "better and costs time; smaller than block (default block/6 rounded up; transfer "
-                              "block/3, iterative 2*block/3)")
+    mode: str = param(
+        "mincut",
+        choices=MODES,
+        help="how blocks join: random = side by side (seams show); overlap = matched where they "
+        "overlap; mincut = also cut along the least visible path (smoothest)",
+    )
+    block: int = param(
+        None,
+        kind="int",
+        lo=2,
+        hi=1024,
+        optional=True,
+        symbol="B",
+        help="size of the pieces copied from the sample: larger keeps whole structures (a brick with"
+        " its joints) but repeats more of the sample, smaller breaks them up (default 7/16 of "
+        "the texture's shorter side, at most 56; transfer 9, iterative 31)",
+    )
+    overlap: int = param(
+        None,
+        kind="int",
+        lo=1,
+        hi=1023,
+        optional=True,
+        help="how much neighbouring blocks share, the seam is cut inside it: more hides seams "
+        "better and costs time; smaller than block (default block/6 rounded up; transfer "
+        "block/3, iterative 2*block/3)",
+    )
     size: tuple = param(
-        None, kind="size", lo=1, hi=16384, optional=True,
+        None,
+        kind="size",
+        lo=1,
+        hi=16384,
+        optional=True,
         help="output size WIDTHxHEIGHT; default twice the texture's size (transfer: the target's)",
     )
-    tol: int = param(None, kind="int", lo=1, hi=100000, optional=True,
-                     help="variety: each block is drawn at random from the tol best matches; 1 always takes the "
-                          "best (seamless, but a spot may repeat), more varies the result with rougher seams "
-                          "(default 2, 6 from block 48; transfer 1); min-cut synthesis keeps, of the 4 x tol best, "
-                          "the one with the least visible cut")
-    rule: str = param("tol", choices=RULES,
-                      help="how a block is picked among the matches: tol = among the tol best; epsilon = any within"
-                           " (1+epsilon) x the best error; sampled = the best 10% of a random 10% (quicker, "
-                           "rougher)")
-    epsilon: float = param(0.1, lo=0.0, hi=10.0, symbol="ε", step=0.01,
-                           help="rule epsilon: how much worse than the best match a block may be; larger gives more"
-                                " variety and more visible seams")
+    tol: int = param(
+        None,
+        kind="int",
+        lo=1,
+        hi=100000,
+        optional=True,
+        help="variety: each block is drawn at random from the tol best matches; 1 always takes the "
+        "best (seamless, but a spot may repeat), more varies the result with rougher seams "
+        "(default 2, 6 from block 48; transfer 1); min-cut synthesis keeps, of the 4 x tol best, "
+        "the one with the least visible cut",
+    )
+    rule: str = param(
+        "tol",
+        choices=RULES,
+        help="how a block is picked among the matches: tol = among the tol best; epsilon = any within"
+        " (1+epsilon) x the best error; sampled = the best 10% of a random 10% (quicker, "
+        "rougher)",
+    )
+    epsilon: float = param(
+        0.1,
+        lo=0.0,
+        hi=10.0,
+        symbol="ε",
+        step=0.01,
+        help="rule epsilon: how much worse than the best match a block may be; larger gives more"
+        " variety and more visible seams",
+    )
     tile: bool = param(False, help="make the output a tile: it repeats without a seam left-right and top-bottom")
-    poisson: bool = param(False, help="smooth away colour steps across every seam by a Poisson blend of a band "
-                                      "around it (modes overlap, mincut)")
-    band: int = param(4, lo=1, hi=5, help="width in pixels of the smoothed band around each seam (with poisson): "
-                                          "wider hides larger colour steps")
-    iterations: int = param(1, lo=1, hi=10, symbol="N",
-                            help="transfer passes: each pass uses blocks a third smaller and follows the picture's "
-                                 "detail more closely")
-    alpha: float = param(0.1, lo=0.0, hi=1.0, symbol="α", step=0.05,
-                         help="transfer: texture against picture; near 0 the result follows the picture faithfully,"
-                              " near 1 it stays a clean texture (first pass; later passes go linearly to 0.9)")
-    correspondence: str = param("blur", choices=CORRESPONDENCES,
-                                help="transfer: what the picture is matched on: blurred luminance (broad shapes) or"
-                                     " raw luminance (fine detail); ignored when --source-map and --target-map are "
-                                     "given")
-    remap: bool = param(True, help="transfer: give the target's correspondence map the texture's brightness and "
-                                   "contrast first, so dark and bright areas are not all drawn from the texture's "
-                                   "few extreme spots")
+    poisson: bool = param(
+        False,
+        help="smooth away colour steps across every seam by a Poisson blend of a band "
+        "around it (modes overlap, mincut)",
+    )
+    band: int = param(
+        4,
+        lo=1,
+        hi=5,
+        help="width in pixels of the smoothed band around each seam (with poisson): wider hides larger colour steps",
+    )
+    iterations: int = param(
+        1,
+        lo=1,
+        hi=10,
+        symbol="N",
+        help="transfer passes: each pass uses blocks a third smaller and follows the picture's detail more closely",
+    )
+    alpha: float = param(
+        0.1,
+        lo=0.0,
+        hi=1.0,
+        symbol="α",
+        step=0.05,
+        help="transfer: texture against picture; near 0 the result follows the picture faithfully,"
+        " near 1 it stays a clean texture (first pass; later passes go linearly to 0.9)",
+    )
+    correspondence: str = param(
+        "blur",
+        choices=CORRESPONDENCES,
+        help="transfer: what the picture is matched on: blurred luminance (broad shapes) or"
+        " raw luminance (fine detail); ignored when --source-map and --target-map are "
+        "given",
+    )
+    remap: bool = param(
+        True,
+        help="transfer: give the target's correspondence map the texture's brightness and "
+        "contrast first, so dark and bright areas are not all drawn from the texture's "
+        "few extreme spots",
+    )
 
     def check(self) -> None:
         if self.block is not None and self.overlap is not None and self.overlap >= self.block:
-            raise out_of_range("overlap", self.overlap, 1, self.block - 1,
-                               f"must be smaller than block = {self.block}")
+            raise out_of_range("overlap", self.overlap, 1, self.block - 1, f"must be smaller than block = {self.block}")
         if self.poisson and self.mode == "random":
-            raise InvalidParameter("parameter 'poisson' = true needs mode overlap or mincut "
-                                   "(random blocks do not overlap, so there is no seam to blend)",
-                                   name="poisson", value=True)
+            raise InvalidParameter(
+                "parameter 'poisson' = true needs mode overlap or mincut "
+                "(random blocks do not overlap, so there is no seam to blend)",
+                name="poisson",
+                value=True,
+            )
 
 
 def synth_block(texture_shape: tuple[int, ...]) -> int:
@@ -121,8 +181,9 @@ def _round_half_up(x: float) -> int:
     return int(math.floor(x + 0.5))
 
 
-def transfer_schedule(iterations: int, *, block: int = ITERATIVE_BLOCK, overlap: int | None = None,
-                      alpha: float = 0.1) -> list[tuple[int, int, float]]:
+def transfer_schedule(
+    iterations: int, *, block: int = ITERATIVE_BLOCK, overlap: int | None = None, alpha: float = 0.1
+) -> list[tuple[int, int, float]]:
     """Block, overlap and alpha of every pass of iterative texture transfer.
 
     Parameters

@@ -1,15 +1,16 @@
 """Quilting synthesis, E&F §2: :func:`synthesize`."""
+
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
+from ..grid import block_grid
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
-from ..grid import block_grid
-from .engine import _Pass, _quilt_pass
 from .checks import _check_block_fits, _check_limits, _check_overlap, _check_texture, _check_tile_size, _finish
+from .engine import _Pass, _quilt_pass
 from .params import QuiltParams, synth_block, synth_tol
 
 # --------------------------------------------------------------------------------------------
@@ -102,13 +103,24 @@ def synthesize(
     portion of T_prev"); the output is quilted on a canvas of whole blocks and cropped; SSDs are
     summed over colour channels.
     """
-    params = QuiltParams(mode=mode, block=block, overlap=overlap, size=size, tol=tol, rule=rule,
-                         epsilon=epsilon, tile=tile, poisson=poisson, band=band)
+    params = QuiltParams(
+        mode=mode,
+        block=block,
+        overlap=overlap,
+        size=size,
+        tol=tol,
+        rule=rule,
+        epsilon=epsilon,
+        tile=tile,
+        poisson=poisson,
+        band=band,
+    )
     return _synthesize(texture, params, rng=rng, progress=progress, cancel=cancel, record=record)
 
 
-def _synthesize(texture: np.ndarray, params: QuiltParams, *, rng=None, progress=None, cancel=None,
-                record: dict | None = None) -> np.ndarray:
+def _synthesize(
+    texture: np.ndarray, params: QuiltParams, *, rng=None, progress=None, cancel=None, record: dict | None = None
+) -> np.ndarray:
     """:func:`synthesize` with its options in ``params`` (``None`` block and tol: the synthesis defaults)."""
     tex = _check_texture(texture)
     if params.block is None or params.tol is None:
@@ -131,13 +143,13 @@ def _synthesize(texture: np.ndarray, params: QuiltParams, *, rng=None, progress=
         from ..limits import check_output_size
 
         check_output_size(out_w, out_h)
-    p = _Pass(params.mode, b, ov, params.rule, params.tol, params.epsilon, params.tile,
-              params.poisson, params.band)
+    p = _Pass(params.mode, b, ov, params.rule, params.tol, params.epsilon, params.tile, params.poisson, params.band)
     rng = as_rng(rng)
     rows = len(block_grid(out_h, b, ov if params.mode != "random" else 0, params.tile and params.mode != "random")[0])
     report = ProgressReporter(progress, "quilting", rows)
     if params.mode == "random":
         p = _Pass("random", b, 0, "tol", 1, 0.0, False, False, 1)
-    img, _ = _quilt_pass(tex, out_h, out_w, p, rng, report=report, cancel=cancel, channels_out=tex.shape[2],
-                         record=record)
+    img, _ = _quilt_pass(
+        tex, out_h, out_w, p, rng, report=report, cancel=cancel, channels_out=tex.shape[2], record=record
+    )
     return _finish(img, tex.shape[2])

@@ -1,18 +1,26 @@
 """Quilting texture transfer, E&F §3 and Ngo's iterative transfer: :func:`transfer`."""
+
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
 from ..errors import ImageError, InvalidParameter
+from ..grid import block_grid
 from ..image import luminance, validate_image
 from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
-from ..grid import block_grid
+from .checks import (
+    _check_block_fits,
+    _check_limits,
+    _check_overlap,
+    _check_texture,
+    _check_tile_size,
+    _finish,
+    _transfer_passes,
+)
 from .engine import _Pass, _quilt_pass
-from .checks import (_check_block_fits, _check_limits, _check_overlap, _check_texture, _check_tile_size, _finish,
-                     _transfer_passes)
 from .params import CORR_SIGMA, QuiltParams
 
 # --------------------------------------------------------------------------------------------
@@ -31,15 +39,18 @@ def _correspondence_maps(tex, target, kind, source_map, target_map):
 
     if (source_map is None) != (target_map is None):
         missing = "target_map" if target_map is None else "source_map"
-        raise InvalidParameter(f"parameter '{missing}' is required when the other correspondence map is given",
-                               name=missing)
+        raise InvalidParameter(
+            f"parameter '{missing}' is required when the other correspondence map is given", name=missing
+        )
     if source_map is not None:
         sm = validate_image(source_map, "source map")
         tm = validate_image(target_map, "target map")
         for m, ref, what, of in ((sm, tex, "source map", "texture"), (tm, target, "target map", "target")):
             if m.shape[:2] != ref.shape[:2]:
-                raise ImageError(f"{what} is {m.shape[1]}x{m.shape[0]} but the {of} is "
-                                 f"{ref.shape[1]}x{ref.shape[0]}; they must be the same size")
+                raise ImageError(
+                    f"{what} is {m.shape[1]}x{m.shape[0]} but the {of} is "
+                    f"{ref.shape[1]}x{ref.shape[0]}; they must be the same size"
+                )
         cs = luminance(sm) if sm.ndim == 3 else sm
         ct = luminance(tm) if tm.ndim == 3 else tm
         return np.ascontiguousarray(cs, np.float32), np.ascontiguousarray(ct, np.float32)
@@ -127,21 +138,55 @@ def transfer(
     -------
     float32 array (H, W[, 3]) with the texture's channels, or a list of them (``return_all``).
     """
-    params = QuiltParams(mode=mode, block=block, overlap=overlap, tol=tol, rule=rule, epsilon=epsilon,
-                         tile=tile, poisson=poisson, band=band, iterations=iterations, alpha=alpha,
-                         correspondence=correspondence, remap=remap)
-    return _transfer(texture, target, params, source_map=source_map, target_map=target_map, return_all=return_all,
-                     rng=rng, progress=progress, cancel=cancel)
+    params = QuiltParams(
+        mode=mode,
+        block=block,
+        overlap=overlap,
+        tol=tol,
+        rule=rule,
+        epsilon=epsilon,
+        tile=tile,
+        poisson=poisson,
+        band=band,
+        iterations=iterations,
+        alpha=alpha,
+        correspondence=correspondence,
+        remap=remap,
+    )
+    return _transfer(
+        texture,
+        target,
+        params,
+        source_map=source_map,
+        target_map=target_map,
+        return_all=return_all,
+        rng=rng,
+        progress=progress,
+        cancel=cancel,
+    )
 
 
-def _transfer(texture: np.ndarray, target: np.ndarray, params: QuiltParams, *, source_map=None, target_map=None,
-              return_all: bool = False, rng=None, progress=None, cancel=None) -> np.ndarray | list[np.ndarray]:
+def _transfer(
+    texture: np.ndarray,
+    target: np.ndarray,
+    params: QuiltParams,
+    *,
+    source_map=None,
+    target_map=None,
+    return_all: bool = False,
+    rng=None,
+    progress=None,
+    cancel=None,
+) -> np.ndarray | list[np.ndarray]:
     """:func:`transfer` with its options in ``params`` (``None`` tol: the transfer default, 1)."""
     if params.tol is None:
         params = params.replace(tol=1)
     if params.mode == "random":
-        raise InvalidParameter("parameter 'mode' = 'random' is not one of overlap, mincut "
-                               "(transfer matches blocks on their overlap)", name="mode", value="random")
+        raise InvalidParameter(
+            "parameter 'mode' = 'random' is not one of overlap, mincut (transfer matches blocks on their overlap)",
+            name="mode",
+            value="random",
+        )
     tex = _check_texture(texture)
     tgt = validate_image(target, "target")
     H, W = tgt.shape[:2]
@@ -161,12 +206,25 @@ def _transfer(texture: np.ndarray, target: np.ndarray, params: QuiltParams, *, s
     results = []
     prev = None
     for i, (bi, oi, ai) in enumerate(schedule):
-        p = _Pass(params.mode, bi, oi, params.rule, params.tol, params.epsilon, params.tile,
-                  params.poisson, params.band, w_overlap=ai, w_prev=ai if i > 0 else 0.0, w_corr=1.0 - ai)
+        p = _Pass(
+            params.mode,
+            bi,
+            oi,
+            params.rule,
+            params.tol,
+            params.epsilon,
+            params.tile,
+            params.poisson,
+            params.band,
+            w_overlap=ai,
+            w_prev=ai if i > 0 else 0.0,
+            w_corr=1.0 - ai,
+        )
         rows = len(block_grid(H, bi, oi, params.tile)[0])
         report = ProgressReporter(progress, f"transfer {i + 1}/{n}", rows)
-        img, _ = _quilt_pass(tex, H, W, p, rng, prev=prev, corr=(cs, ct), report=report, cancel=cancel,
-                             channels_out=tex.shape[2])
+        img, _ = _quilt_pass(
+            tex, H, W, p, rng, prev=prev, corr=(cs, ct), report=report, cancel=cancel, channels_out=tex.shape[2]
+        )
         prev = np.ascontiguousarray(img)
         results.append(_finish(img, tex.shape[2]))
     return results if return_all else results[-1]

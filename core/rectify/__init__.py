@@ -31,13 +31,45 @@ the photo (:mod:`weft.core.rectify.detect`).
 from .detect import REFUSAL, Suggestion, suggest_lines
 from .homography import HomographyFit, apply_homography, fit_homography
 from .lines import FeatureLines, line_correspondences, load_feature_lines, parse_feature_lines
-from .method import (FIGURES, INTERPOLATIONS, METHOD, Rectified, Rectifier, RectifyParams, WarpParams, homography_figure,
-                     rectify, rectify_feature_lines, scale_lines, warm_up)
+from .method import (
+    FIGURES,
+    INTERPOLATIONS,
+    METHOD,
+    Rectified,
+    Rectifier,
+    RectifyParams,
+    WarpParams,
+    homography_figure,
+    rectify,
+    rectify_feature_lines,
+    scale_lines,
+    warm_up,
+)
 from .view import View, load_view
 from .warps import PLANAR_TOL_PX, WARPS, WarpPlan, homography_plan, plan_warp
 
 __all__ = [
-    "FeatureLines", "HomographyFit", "REFUSAL", "Suggestion", "suggest_lines", "Rectified", "Rectifier", "RectifyParams", "View", "WARPS", "WarpParams", "WarpPlan",
-    "apply_homography", "fit_homography", "line_correspondences", "load_feature_lines", "load_view",
-    "parse_feature_lines", "plan_warp", "rectify", "rectify_feature_lines", "scale_lines", "METHOD",
+    "FeatureLines",
+    "HomographyFit",
+    "REFUSAL",
+    "Suggestion",
+    "suggest_lines",
+    "Rectified",
+    "Rectifier",
+    "RectifyParams",
+    "View",
+    "WARPS",
+    "WarpParams",
+    "WarpPlan",
+    "apply_homography",
+    "fit_homography",
+    "line_correspondences",
+    "load_feature_lines",
+    "load_view",
+    "parse_feature_lines",
+    "plan_warp",
+    "rectify",
+    "rectify_feature_lines",
+    "scale_lines",
+    "METHOD",
 ]

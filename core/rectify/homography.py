@@ -23,8 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GeometryError
-from .lines import (FAR_MARGIN, MIN_ANGLE_DEG, Correspondences, _homogeneous_lines, all_parallel,
-                    line_correspondences)
+from .lines import FAR_MARGIN, MIN_ANGLE_DEG, Correspondences, _homogeneous_lines, all_parallel, line_correspondences
 
 __all__ = ["HomographyFit", "fit_homography", "homography_from_points", "apply_homography"]
 
@@ -61,8 +60,12 @@ class HomographyFit:
     correspondences: Correspondences
 
     def figures(self) -> dict:
-        return {"points": self.points, "inliers": self.inliers, "rms_points_px": round(self.rms_points, 4),
-                "rms_lines_px": round(self.rms_lines, 4)}
+        return {
+            "points": self.points,
+            "inliers": self.inliers,
+            "rms_points_px": round(self.rms_points, 4),
+            "rms_lines_px": round(self.rms_lines, 4),
+        }
 
 
 def apply_homography(h: np.ndarray, pts: np.ndarray) -> np.ndarray:
@@ -84,8 +87,10 @@ def _check_spread(pts: np.ndarray, what: str) -> None:
     c = pts - pts.mean(axis=0)
     sv = np.linalg.svd(c, compute_uv=False)
     if len(sv) < 2 or sv[1] <= 1e-3 * max(sv[0], 1e-12):
-        raise GeometryError(f"the {len(pts)} intersection points in {what} lie on one line: a homography "
-                            f"needs 4 points with no 3 on a line (draw lines in two directions)")
+        raise GeometryError(
+            f"the {len(pts)} intersection points in {what} lie on one line: a homography "
+            f"needs 4 points with no 3 on a line (draw lines in two directions)"
+        )
 
 
 def homography_from_points(dst: np.ndarray, src: np.ndarray) -> np.ndarray:
@@ -108,8 +113,14 @@ def homography_from_points(dst: np.ndarray, src: np.ndarray) -> np.ndarray:
     return np.linalg.inv(ts) @ hn @ td
 
 
-def _residuals_and_jacobian(h8: np.ndarray, dst_pts: np.ndarray, src_pts: np.ndarray,
-                            line_pts: np.ndarray, line_coef: np.ndarray, jac: bool = True):
+def _residuals_and_jacobian(
+    h8: np.ndarray,
+    dst_pts: np.ndarray,
+    src_pts: np.ndarray,
+    line_pts: np.ndarray,
+    line_coef: np.ndarray,
+    jac: bool = True,
+):
     """Residuals (points: 2 per point; lines: 1 per end point) and their Jacobian in the 8 params."""
     h = np.append(h8, 1.0)
     allp = np.vstack([dst_pts, line_pts])
@@ -206,8 +217,9 @@ def _normalise_sign(h: np.ndarray, dst_size: tuple[int, int]) -> np.ndarray:
     centre = np.array([(w - 1) / 2, (hgt - 1) / 2, 1.0])
     s = float(h[2] @ centre)
     if not math.isfinite(s) or abs(s) < 1e-300:
-        raise GeometryError("the feature lines map the centre of the frontal frame to infinity "
-                            "(the lines are inconsistent)")
+        raise GeometryError(
+            "the feature lines map the centre of the frontal frame to infinity (the lines are inconsistent)"
+        )
     return h / s
 
 
@@ -215,9 +227,16 @@ def _normalise_sign(h: np.ndarray, dst_size: tuple[int, int]) -> np.ndarray:
 # refinement, or the fit itself): the refinement rejects non-finite costs, so numpy need not warn
 # (a warning would be a second line on the CLI's stderr).
 @np.errstate(divide="ignore", invalid="ignore", over="ignore")
-def fit_homography(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int, int],
-                   src_size: tuple[int, int], *, robust: bool = True, min_angle: float = MIN_ANGLE_DEG,
-                   margin: float = FAR_MARGIN) -> HomographyFit:
+def fit_homography(
+    dst_lines: np.ndarray,
+    src_lines: np.ndarray,
+    dst_size: tuple[int, int],
+    src_size: tuple[int, int],
+    *,
+    robust: bool = True,
+    min_angle: float = MIN_ANGLE_DEG,
+    margin: float = FAR_MARGIN,
+) -> HomographyFit:
     """The homography mapping the destination frame onto the source frame, from line pairs.
 
     Parameters
@@ -248,11 +267,14 @@ def fit_homography(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple
     """
     n = len(dst_lines)
     if n < 4:
-        raise GeometryError(f"a homography needs at least 4 feature lines, got {n} "
-                            f"(draw 4 or more lines in at least two directions)")
+        raise GeometryError(
+            f"a homography needs at least 4 feature lines, got {n} (draw 4 or more lines in at least two directions)"
+        )
     if all_parallel([dst_lines, src_lines], min_angle):
-        raise GeometryError(f"all {n} feature lines are parallel (within {min_angle:g}°): they do not cross, "
-                            f"so they give no points; draw lines in at least two directions")
+        raise GeometryError(
+            f"all {n} feature lines are parallel (within {min_angle:g}°): they do not cross, "
+            f"so they give no points; draw lines in at least two directions"
+        )
     corr = line_correspondences(dst_lines, src_lines, dst_size, src_size, min_angle=min_angle, margin=margin)
     k = len(corr)
     if k < 4:
@@ -260,7 +282,8 @@ def fit_homography(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple
         raise GeometryError(
             f"only {k} of the {pairs} line pairs meet at a usable point (need 4): {corr.skipped_parallel} are "
             f"parallel within {min_angle:g}° and {corr.skipped_far} meet far outside the frame; "
-            f"draw lines that cross each other inside the texture")
+            f"draw lines that cross each other inside the texture"
+        )
     _check_spread(corr.dst, "the frontal frame")
     _check_spread(corr.src, "the photo")
     import cv2
@@ -286,5 +309,11 @@ def fit_homography(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple
     coef = _homogeneous_lines(src_lines)
     coef = np.vstack([coef, coef])
     d_lin = ends[:, 0] * coef[:, 0] + ends[:, 1] * coef[:, 1] + coef[:, 2]
-    return HomographyFit(h, k, int((d_pts <= RANSAC_PX).sum()), float(np.sqrt(np.mean(d_pts ** 2))),
-                         float(np.sqrt(np.mean(d_lin ** 2))), corr)
+    return HomographyFit(
+        h,
+        k,
+        int((d_pts <= RANSAC_PX).sum()),
+        float(np.sqrt(np.mean(d_pts**2))),
+        float(np.sqrt(np.mean(d_lin**2))),
+        corr,
+    )

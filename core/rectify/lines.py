@@ -18,9 +18,10 @@ one), the key, the line index and the value.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -28,8 +29,16 @@ from ..errors import GeometryError
 from ..geometry import FeatureLines
 
 __all__ = [
-    "FeatureLines", "Correspondences", "load_feature_lines", "parse_feature_lines", "check_lines",
-    "line_correspondences", "MIN_LENGTH", "OUTSIDE_TOLERANCE", "MIN_ANGLE_DEG", "FAR_MARGIN",
+    "FeatureLines",
+    "Correspondences",
+    "load_feature_lines",
+    "parse_feature_lines",
+    "check_lines",
+    "line_correspondences",
+    "MIN_LENGTH",
+    "OUTSIDE_TOLERANCE",
+    "MIN_ANGLE_DEG",
+    "FAR_MARGIN",
 ]
 
 MIN_LENGTH = 1.0  # pixels: a shorter line has no usable direction
@@ -50,8 +59,15 @@ def load_feature_lines(path_or_json: str | Path) -> FeatureLines:
     return FeatureLines.parse(path_or_json)
 
 
-def check_lines(lines: np.ndarray, size: tuple[int, int], *, key: str, frame: str,
-                tolerance: float = OUTSIDE_TOLERANCE, input: str | None = None) -> None:
+def check_lines(
+    lines: np.ndarray,
+    size: tuple[int, int],
+    *,
+    key: str,
+    frame: str,
+    tolerance: float = OUTSIDE_TOLERANCE,
+    input: str | None = None,
+) -> None:
     """Raise GeometryError if a line is shorter than :data:`MIN_LENGTH` or leaves the frame.
 
     Parameters
@@ -120,10 +136,17 @@ def _on_segment(point: np.ndarray, line: np.ndarray, slack: float) -> bool:
     return -slack <= t <= length + slack
 
 
-def line_correspondences(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int, int],
-                         src_size: tuple[int, int], *, min_angle: float = MIN_ANGLE_DEG,
-                         margin: float = FAR_MARGIN, segments_only: bool = False,
-                         segment_slack: float = 3.0) -> Correspondences:
+def line_correspondences(
+    dst_lines: np.ndarray,
+    src_lines: np.ndarray,
+    dst_size: tuple[int, int],
+    src_size: tuple[int, int],
+    *,
+    min_angle: float = MIN_ANGLE_DEG,
+    margin: float = FAR_MARGIN,
+    segments_only: bool = False,
+    segment_slack: float = 3.0,
+) -> Correspondences:
     """Intersections of every pair of lines, as point correspondences between two frames.
 
     Parameters
@@ -184,16 +207,23 @@ def line_correspondences(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size:
             if not ok:
                 continue
             if segments_only and not all(
-                    _on_segment(pt, lines[k], segment_slack)
-                    for pt, lines in ((pts[0], dst_lines), (pts[1], src_lines)) for k in (i, j)):
+                _on_segment(pt, lines[k], segment_slack)
+                for pt, lines in ((pts[0], dst_lines), (pts[1], src_lines))
+                for k in (i, j)
+            ):
                 off += 1
                 continue
             dst_pts.append(pts[0])
             src_pts.append(pts[1])
             pairs.append((i, j))
-    return Correspondences(np.array(dst_pts, dtype=np.float64).reshape(-1, 2),
-                           np.array(src_pts, dtype=np.float64).reshape(-1, 2),
-                           np.array(pairs, dtype=np.int64).reshape(-1, 2), parallel, far, off)
+    return Correspondences(
+        np.array(dst_pts, dtype=np.float64).reshape(-1, 2),
+        np.array(src_pts, dtype=np.float64).reshape(-1, 2),
+        np.array(pairs, dtype=np.int64).reshape(-1, 2),
+        parallel,
+        far,
+        off,
+    )
 
 
 def all_parallel(lines: Sequence[np.ndarray], min_angle: float = MIN_ANGLE_DEG) -> bool:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Mapping
 
 import numpy as np
 
@@ -16,7 +16,6 @@ from ..studio import Figure
 from .lines import FeatureLines, load_feature_lines
 from .warps import WARPS, WarpPlan, homography_plan, plan_warp
 
-
 INTERPOLATIONS = ("cubic", "linear", "lanczos")
 
 
@@ -24,37 +23,71 @@ INTERPOLATIONS = ("cubic", "linear", "lanczos")
 class WarpParams(Params):
     """The rectification parameters, shared by ``weft rectify`` and ``weft nfpt`` (which add theirs)."""
 
-    lines: FeatureLines = param(None, kind="geometry", type=FeatureLines, optional=True,
-                                help="the lines drawn on the photo and where each lies seen from the front: a JSON "
-                                     "file {image_lines, frontal_lines, frontal_size}, or that JSON text itself, "
-                                     "starting with { (nfpt without lines takes the photo as frontal)")
-    warp: str = param("homography", choices=WARPS,
-                      help="how the photo is straightened: homography = exact for a flat surface, outvotes a badly "
-                           "drawn line; morph = the paper's view morph, for surfaces that are not one plane (needs "
-                           "8 points off one plane); lines = Beier-Neely field morph, bends between the lines, for "
-                           "gently curved surfaces")
-    a: float = param(1.0, lo=0.001, hi=1000.0, symbol="a", step=0.1,
-                     help="Beier-Neely (morph, lines): distance in pixels within which a line pulls at full "
-                          "strength (weight (length^p / (a + dist))^b); small values make the warp snap to the "
-                          "lines, large ones smooth it")
-    b: float = param(2.0, lo=0.0, hi=4.0, symbol="b", step=0.1,
-                     help="Beier-Neely (morph, lines): how fast a line's pull falls off with distance; higher keeps"
-                          " each line's effect local")
-    p: float = param(0.5, lo=0.0, hi=2.0, symbol="p", step=0.1,
-                     help="Beier-Neely (morph, lines): how much more long lines pull than short ones (0 = all "
-                          "equal)")
+    lines: FeatureLines = param(
+        None,
+        kind="geometry",
+        type=FeatureLines,
+        optional=True,
+        help="the lines drawn on the photo and where each lies seen from the front: a JSON "
+        "file {image_lines, frontal_lines, frontal_size}, or that JSON text itself, "
+        "starting with { (nfpt without lines takes the photo as frontal)",
+    )
+    warp: str = param(
+        "homography",
+        choices=WARPS,
+        help="how the photo is straightened: homography = exact for a flat surface, outvotes a badly "
+        "drawn line; morph = the paper's view morph, for surfaces that are not one plane (needs "
+        "8 points off one plane); lines = Beier-Neely field morph, bends between the lines, for "
+        "gently curved surfaces",
+    )
+    a: float = param(
+        1.0,
+        lo=0.001,
+        hi=1000.0,
+        symbol="a",
+        step=0.1,
+        help="Beier-Neely (morph, lines): distance in pixels within which a line pulls at full "
+        "strength (weight (length^p / (a + dist))^b); small values make the warp snap to the "
+        "lines, large ones smooth it",
+    )
+    b: float = param(
+        2.0,
+        lo=0.0,
+        hi=4.0,
+        symbol="b",
+        step=0.1,
+        help="Beier-Neely (morph, lines): how fast a line's pull falls off with distance; higher keeps"
+        " each line's effect local",
+    )
+    p: float = param(
+        0.5,
+        lo=0.0,
+        hi=2.0,
+        symbol="p",
+        step=0.1,
+        help="Beier-Neely (morph, lines): how much more long lines pull than short ones (0 = all equal)",
+    )
 
 
 @dataclass(frozen=True)
 class RectifyParams(WarpParams):
     """Parameters of ``weft rectify`` (and the rectification step of ``weft nfpt``)."""
 
-    size: tuple = param(None, kind="size", lo=2, hi=16384, optional=True,
-                        help="size WIDTHxHEIGHT of the rectified image; default the lines' frontal_size "
-                             "(frontal coordinates are scaled to it)")
-    interpolation: str = param("cubic", choices=INTERPOLATIONS,
-                               help="resampling of the photo: cubic (sharp), linear (quick, softer), lanczos "
-                                    "(sharpest, may ring at hard edges)")
+    size: tuple = param(
+        None,
+        kind="size",
+        lo=2,
+        hi=16384,
+        optional=True,
+        help="size WIDTHxHEIGHT of the rectified image; default the lines' frontal_size "
+        "(frontal coordinates are scaled to it)",
+    )
+    interpolation: str = param(
+        "cubic",
+        choices=INTERPOLATIONS,
+        help="resampling of the photo: cubic (sharp), linear (quick, softer), lanczos "
+        "(sharpest, may ring at hard edges)",
+    )
 
 
 @dataclass(frozen=True)
@@ -112,21 +145,51 @@ class Rectifier:
 
     def __init__(self, photo: np.ndarray, *, interpolation: str = "cubic") -> None:
         if interpolation not in INTERPOLATIONS:
-            raise InvalidParameter(f"parameter 'interpolation' = {interpolation!r} is not one of "
-                                   f"{', '.join(INTERPOLATIONS)}", name="interpolation", value=interpolation)
+            raise InvalidParameter(
+                f"parameter 'interpolation' = {interpolation!r} is not one of {', '.join(INTERPOLATIONS)}",
+                name="interpolation",
+                value=interpolation,
+            )
         self.photo = validate_image(photo, "photo")
         self.size = (self.photo.shape[1], self.photo.shape[0])
         self.interpolation = interpolation
 
-    def plan(self, image_lines, frontal_lines, frontal_size, *, warp: str = "homography", a: float = 1.0,
-             b: float = 2.0, p: float = 0.5) -> WarpPlan:
+    def plan(
+        self,
+        image_lines,
+        frontal_lines,
+        frontal_size,
+        *,
+        warp: str = "homography",
+        a: float = 1.0,
+        b: float = 2.0,
+        p: float = 0.5,
+    ) -> WarpPlan:
         """Fit the warp only (see :func:`rectify` for the parameters)."""
         frontal_size = _check_size(frontal_size)
-        return plan_warp(np.asarray(frontal_lines, dtype=np.float64), np.asarray(image_lines, dtype=np.float64),
-                         frontal_size, self.size, warp=warp, a=a, b=b, p=p, src_input="photo")
+        return plan_warp(
+            np.asarray(frontal_lines, dtype=np.float64),
+            np.asarray(image_lines, dtype=np.float64),
+            frontal_size,
+            self.size,
+            warp=warp,
+            a=a,
+            b=b,
+            p=p,
+            src_input="photo",
+        )
 
-    def rectify(self, image_lines, frontal_lines, frontal_size, *, warp: str = "homography", a: float = 1.0,
-                b: float = 2.0, p: float = 0.5) -> Rectified:
+    def rectify(
+        self,
+        image_lines,
+        frontal_lines,
+        frontal_size,
+        *,
+        warp: str = "homography",
+        a: float = 1.0,
+        b: float = 2.0,
+        p: float = 0.5,
+    ) -> Rectified:
         """Fit the warp and resample the photo into the frontal frame (see :func:`rectify`)."""
         return self.apply(self.plan(image_lines, frontal_lines, frontal_size, warp=warp, a=a, b=b, p=p))
 
@@ -134,8 +197,7 @@ class Rectifier:
         """Resample with a known homography (frontal -> photo): no fitting at all."""
         frontal_size = _check_size(frontal_size)
         w, h = frontal_size
-        return self.apply(homography_plan(homography, frontal_size, self.size,
-                                          positive_at=((w - 1) / 2, (h - 1) / 2)))
+        return self.apply(homography_plan(homography, frontal_size, self.size, positive_at=((w - 1) / 2, (h - 1) / 2)))
 
     def apply(self, plan: WarpPlan) -> Rectified:
         """Resample the photo with a fitted plan."""
@@ -158,8 +220,18 @@ def _check_size(size) -> tuple[int, int]:
     return w, h
 
 
-def rectify(photo: np.ndarray, image_lines, frontal_lines, frontal_size, *, warp: str = "homography",
-            a: float = 1.0, b: float = 2.0, p: float = 0.5, interpolation: str = "cubic") -> Rectified:
+def rectify(
+    photo: np.ndarray,
+    image_lines,
+    frontal_lines,
+    frontal_size,
+    *,
+    warp: str = "homography",
+    a: float = 1.0,
+    b: float = 2.0,
+    p: float = 0.5,
+    interpolation: str = "cubic",
+) -> Rectified:
     """Rectify a photo of a texture seen at an angle, from corresponding feature lines (§3).
 
     Parameters
@@ -200,13 +272,22 @@ def rectify(photo: np.ndarray, image_lines, frontal_lines, frontal_size, *, warp
     ImageError
         A photo that is not a valid image.
     """
-    return Rectifier(photo, interpolation=interpolation).rectify(image_lines, frontal_lines, frontal_size,
-                                                                 warp=warp, a=a, b=b, p=p)
+    return Rectifier(photo, interpolation=interpolation).rectify(
+        image_lines, frontal_lines, frontal_size, warp=warp, a=a, b=b, p=p
+    )
 
 
-def rectify_feature_lines(photo: np.ndarray, lines: FeatureLines | str, *, size: tuple[int, int] | None = None,
-                          warp: str = "homography", a: float = 1.0, b: float = 2.0, p: float = 0.5,
-                          interpolation: str = "cubic") -> Rectified:
+def rectify_feature_lines(
+    photo: np.ndarray,
+    lines: FeatureLines | str,
+    *,
+    size: tuple[int, int] | None = None,
+    warp: str = "homography",
+    a: float = 1.0,
+    b: float = 2.0,
+    p: float = 0.5,
+    interpolation: str = "cubic",
+) -> Rectified:
     """:func:`rectify` with parsed feature lines (or a JSON file name / JSON text).
 
     ``size`` (optional) rescales the frontal frame: the frontal lines are scaled from
@@ -223,14 +304,23 @@ def rectify_feature_lines(photo: np.ndarray, lines: FeatureLines | str, *, size:
 
 def _run(inputs: Mapping[str, np.ndarray], params: RectifyParams, *, rng=None, progress=None, cancel=None) -> Result:
     if params.lines is None:
-        raise InvalidParameter("weft rectify needs --lines L.json (feature lines on the photo and in the frontal frame)",
-                               name="lines")
+        raise InvalidParameter(
+            "weft rectify needs --lines L.json (feature lines on the photo and in the frontal frame)", name="lines"
+        )
     lines = params.lines
     report = ProgressReporter(progress, "rectify", 1)
     if cancel is not None:
         cancel.raise_if_cancelled()
-    out = rectify_feature_lines(inputs["photo"], lines, size=params.size, warp=params.warp, a=params.a, b=params.b,
-                                p=params.p, interpolation=params.interpolation)
+    out = rectify_feature_lines(
+        inputs["photo"],
+        lines,
+        size=params.size,
+        warp=params.warp,
+        a=params.a,
+        b=params.b,
+        p=params.p,
+        interpolation=params.interpolation,
+    )
     report.update(1, preview=out.image)
     figures = dict(out.figures)
     if out.homography is not None:
@@ -241,9 +331,14 @@ def _run(inputs: Mapping[str, np.ndarray], params: RectifyParams, *, rng=None, p
 #: How people read the rectification's figures (a method that rectifies, e.g. NFPT, shows them in its
 #: status line through its studio description; the report keeps the keys).
 FIGURES = {
-    "points": Figure("points"), "inliers": Figure("inliers"), "rms_points_px": Figure("error", "px", digits=2),
-    "rms_lines_px": Figure("line error", "px", digits=2), "lines": Figure("lines"),
-    "plane_rms_px": Figure("plane error", "px", digits=2), "warp": Figure("warp"), "view": Figure("view"),
+    "points": Figure("points"),
+    "inliers": Figure("inliers"),
+    "rms_points_px": Figure("error", "px", digits=2),
+    "rms_lines_px": Figure("line error", "px", digits=2),
+    "lines": Figure("lines"),
+    "plane_rms_px": Figure("plane error", "px", digits=2),
+    "warp": Figure("warp"),
+    "view": Figure("view"),
     "coverage": Figure("coverage", "%"),
 }
 

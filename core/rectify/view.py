@@ -19,7 +19,6 @@ view that the texture does not cover are black (0).
 from __future__ import annotations
 
 import json
-
 import math
 import numbers
 from dataclasses import dataclass
@@ -29,9 +28,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import GeometryError
+from ..geometry import _short
+from ..geometry import as_lines as _as_lines
+from ..geometry import as_size as _as_size
+from ..geometry import read_json_or_file as read_json
 from ..params import MAX_SIDE
 from .homography import apply_homography
-from ..geometry import _short, as_lines as _as_lines, as_size as _as_size, read_json_or_file as read_json
 from .lines import check_lines
 from .warps import WarpPlan, homography_plan, plan_warp
 
@@ -76,12 +78,12 @@ class View:
         return hash(json.dumps(self.to_json()))
 
     @classmethod
-    def parse(cls, text: str | Path, name: str = "view") -> "View":
+    def parse(cls, text: str | Path, name: str = "view") -> View:
         """Command-line text: the JSON object itself (starts with ``{``) or a JSON file's name."""
         return load_view(text)
 
     @classmethod
-    def coerce(cls, value: Any, name: str = "view") -> "View":
+    def coerce(cls, value: Any, name: str = "view") -> View:
         if isinstance(value, View):
             return value
         if isinstance(value, dict):
@@ -91,7 +93,7 @@ class View:
         raise GeometryError(f"parameter '{name}' = {_short(repr(value))} must be a view (a quad or line pairs)")
 
     @classmethod
-    def from_json(cls, data: Any, name: str = "view", base=None) -> "View":
+    def from_json(cls, data: Any, name: str = "view", base=None) -> View:
         from ..geometry import _from_json_or_path
 
         return _from_json_or_path(cls, data, name, base, "view")
@@ -106,11 +108,20 @@ def parse_view(data: Any, *, source: str = "") -> View:
         size = _as_size(data["size"], "size") if "size" in data else None
         if "quad" in data:
             q = data["quad"]
-            if (not isinstance(q, list) or len(q) != 4 or not all(
-                    isinstance(c, list) and len(c) == 2 and all(isinstance(v, numbers.Real) and not isinstance(v, bool)
-                                                                for v in c) for c in q)):
-                raise GeometryError(f"quad = {_short(q)} must be four corners [[x, y], ...] (top-left, top-right, "
-                                    f"bottom-right, bottom-left)")
+            if (
+                not isinstance(q, list)
+                or len(q) != 4
+                or not all(
+                    isinstance(c, list)
+                    and len(c) == 2
+                    and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in c)
+                    for c in q
+                )
+            ):
+                raise GeometryError(
+                    f"quad = {_short(q)} must be four corners [[x, y], ...] (top-left, top-right, "
+                    f"bottom-right, bottom-left)"
+                )
             quad = np.array(q, dtype=np.float64)
             if not np.all(np.isfinite(quad)):
                 raise GeometryError(f"quad = {_short(q)} has a NaN or infinite coordinate")
@@ -118,14 +129,16 @@ def parse_view(data: Any, *, source: str = "") -> View:
         if "image_lines" in data or "frontal_lines" in data:
             for key in ("image_lines", "frontal_lines"):
                 if key not in data:
-                    raise GeometryError(f"no \"{key}\" (a view by lines needs image_lines in the view and the "
-                                        f"matching frontal_lines in the texture)")
+                    raise GeometryError(
+                        f'no "{key}" (a view by lines needs image_lines in the view and the '
+                        f"matching frontal_lines in the texture)"
+                    )
             vl = _as_lines(data["image_lines"], "image_lines")
             tl = _as_lines(data["frontal_lines"], "frontal_lines")
             if len(vl) != len(tl):
                 raise GeometryError(f"{len(vl)} image_lines but {len(tl)} frontal_lines: they must pair up")
             return View(size, view_lines=vl, texture_lines=tl)
-        raise GeometryError("a view needs a \"quad\" (4 corners) or \"image_lines\" + \"frontal_lines\"")
+        raise GeometryError('a view needs a "quad" (4 corners) or "image_lines" + "frontal_lines"')
     except GeometryError as e:
         raise GeometryError(prefix + str(e)) from None
 
@@ -153,15 +166,16 @@ def quad_homography(quad: np.ndarray, texture_size: tuple[int, int]) -> np.ndarr
         a, b, c = q[i], q[(i + 1) % 4], q[(i + 2) % 4]
         cross = (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])
         if abs(cross) < 1e-6 * max(1.0, float(np.ptp(q)) ** 2):
-            raise GeometryError(f"quad corners {i}, {(i + 1) % 4}, {(i + 2) % 4} lie on one line: "
-                                f"{_short(q.tolist())}")
+            raise GeometryError(f"quad corners {i}, {(i + 1) % 4}, {(i + 2) % 4} lie on one line: {_short(q.tolist())}")
     signs = []
     for i in range(4):
         a, b, c = q[i], q[(i + 1) % 4], q[(i + 2) % 4]
         signs.append(np.sign((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])))
     if len(set(signs)) != 1:
-        raise GeometryError(f"quad {_short(q.tolist())} is not convex (corners must go round: top-left, top-right, "
-                            f"bottom-right, bottom-left)")
+        raise GeometryError(
+            f"quad {_short(q.tolist())} is not convex (corners must go round: top-left, top-right, "
+            f"bottom-right, bottom-left)"
+        )
     w, h = texture_size
     rect = np.array([[-0.5, -0.5], [w - 0.5, -0.5], [w - 0.5, h - 0.5], [-0.5, h - 0.5]])
     import cv2
@@ -169,8 +183,16 @@ def quad_homography(quad: np.ndarray, texture_size: tuple[int, int]) -> np.ndarr
     return cv2.getPerspectiveTransform(q.astype(np.float32), rect.astype(np.float32)).astype(np.float64)
 
 
-def view_plan(view: View, texture_size: tuple[int, int], default_size: tuple[int, int], *,
-              warp: str = "homography", a: float = 1.0, b: float = 2.0, p: float = 0.5) -> WarpPlan:
+def view_plan(
+    view: View,
+    texture_size: tuple[int, int],
+    default_size: tuple[int, int],
+    *,
+    warp: str = "homography",
+    a: float = 1.0,
+    b: float = 2.0,
+    p: float = 0.5,
+) -> WarpPlan:
     """The warp that puts a texture of ``texture_size`` into ``view``.
 
     Parameters
@@ -196,14 +218,36 @@ def view_plan(view: View, texture_size: tuple[int, int], default_size: tuple[int
     # goes on), they only must not be zero-length
     check_lines(view.view_lines, size, key="view line", frame="the view")
     check_lines(view.texture_lines, texture_size, key="texture line", frame="the texture", tolerance=math.inf)
-    return plan_warp(view.view_lines, view.texture_lines, size, texture_size, warp=warp, a=a, b=b, p=p,
-                     dst_name="the view", src_name="the texture", dst_key="view line", src_key="texture line",
-                     check=False)
+    return plan_warp(
+        view.view_lines,
+        view.texture_lines,
+        size,
+        texture_size,
+        warp=warp,
+        a=a,
+        b=b,
+        p=p,
+        dst_name="the view",
+        src_name="the texture",
+        dst_key="view line",
+        src_key="texture line",
+        check=False,
+    )
 
 
-def into_photo_plan(rect_plan: WarpPlan, image_lines: np.ndarray, frontal_lines: np.ndarray,
-                    frontal_size: tuple[int, int], photo_size: tuple[int, int], texture_size: tuple[int, int], *,
-                    warp: str = "homography", a: float = 1.0, b: float = 2.0, p: float = 0.5) -> WarpPlan:
+def into_photo_plan(
+    rect_plan: WarpPlan,
+    image_lines: np.ndarray,
+    frontal_lines: np.ndarray,
+    frontal_size: tuple[int, int],
+    photo_size: tuple[int, int],
+    texture_size: tuple[int, int],
+    *,
+    warp: str = "homography",
+    a: float = 1.0,
+    b: float = 2.0,
+    p: float = 0.5,
+) -> WarpPlan:
     """The warp that puts a synthesized texture into the photo, over the rectified plane.
 
     The texture (``texture_size``) is centred on the frontal frame (``frontal_size``): its pixel

@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import GeometryError, InvalidParameter
-from .homography import HomographyFit, apply_homography, fit_homography, homography_from_points
 from ..geometry import _short
+from .homography import HomographyFit, apply_homography, fit_homography, homography_from_points
 from .lines import check_lines, line_correspondences
 
 __all__ = ["WARPS", "WarpPlan", "plan_warp", "homography_plan", "PLANAR_TOL_PX"]
@@ -63,8 +63,9 @@ class WarpPlan:
     fit: HomographyFit | None = None
     figures: dict = field(default_factory=dict)
 
-    def apply(self, image: np.ndarray, *, interpolation: str = "cubic", supersample: int = 1,
-              alpha: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    def apply(
+        self, image: np.ndarray, *, interpolation: str = "cubic", supersample: int = 1, alpha: bool = False
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Resample ``image`` (the source frame) into the destination frame.
 
         Parameters
@@ -90,8 +91,11 @@ class WarpPlan:
 
         flags = _INTERP.get(interpolation)
         if flags is None:
-            raise InvalidParameter(f"parameter 'interpolation' = {interpolation!r} is not one of "
-                                   f"{', '.join(_INTERP)}", name="interpolation", value=interpolation)
+            raise InvalidParameter(
+                f"parameter 'interpolation' = {interpolation!r} is not one of {', '.join(_INTERP)}",
+                name="interpolation",
+                value=interpolation,
+            )
         sw, sh = self.src_size
         if image.shape[1] != sw or image.shape[0] != sh:
             raise GeometryError(f"the warp was fitted for a {sw}x{sh} image, not {image.shape[1]}x{image.shape[0]}")
@@ -101,17 +105,24 @@ class WarpPlan:
         # frame would ring into them: a cubic kernel's negative lobes over the step to 0); samples
         # outside are 0, so a supersampled pixel is its colour premultiplied by its coverage.
         if self.kind == "homography" and s == 1 and _all_in_front(self.homography, self.dst_size):
-            out = cv2.warpPerspective(image, self.homography, (dw, dh), flags=flags | cv2.WARP_INVERSE_MAP,
-                                      borderMode=cv2.BORDER_REPLICATE)
+            out = cv2.warpPerspective(
+                image, self.homography, (dw, dh), flags=flags | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
+            )
             ones = np.ones((sh, sw), np.uint8)
-            cover = cv2.warpPerspective(ones, self.homography, (dw, dh), flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
-                                        borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+            cover = cv2.warpPerspective(
+                ones,
+                self.homography,
+                (dw, dh),
+                flags=cv2.INTER_NEAREST | cv2.WARP_INVERSE_MAP,
+                borderMode=cv2.BORDER_CONSTANT,
+                borderValue=0,
+            )
             mask = cover.astype(bool)
             out[~mask] = 0.0
         else:
             mx, my = self._maps(s)
             out = cv2.remap(image, mx, my, flags, borderMode=cv2.BORDER_REPLICATE)
-            inside = ((mx >= -0.5) & (mx <= sw - 0.5) & (my >= -0.5) & (my <= sh - 0.5))
+            inside = (mx >= -0.5) & (mx <= sw - 0.5) & (my >= -0.5) & (my <= sh - 0.5)
             out[~inside] = 0.0
             if s > 1:
                 out = cv2.resize(out, (dw, dh), interpolation=cv2.INTER_AREA)
@@ -144,7 +155,7 @@ class WarpPlan:
         gx, gy = np.meshgrid(xs, ys)
         fx = cv2.remap(mx, gx, gy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
         fy = cv2.remap(my, gx, gy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-        bad = (mx < -1e5)
+        bad = mx < -1e5
         if bad.any():
             badf = cv2.remap(bad.astype(np.float32), gx, gy, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE) > 0
             fx[badf] = -1e6
@@ -197,8 +208,14 @@ def _check_beier_neely(a: float, b: float, p: float) -> None:
             raise out_of_range(name, v, lo, hi, "Beier-Neely weight (length^p / (a + dist))^b")
 
 
-def homography_plan(h: np.ndarray, dst_size: tuple[int, int], src_size: tuple[int, int],
-                    fit: HomographyFit | None = None, *, positive_at: tuple[float, float] | None = None) -> WarpPlan:
+def homography_plan(
+    h: np.ndarray,
+    dst_size: tuple[int, int],
+    src_size: tuple[int, int],
+    fit: HomographyFit | None = None,
+    *,
+    positive_at: tuple[float, float] | None = None,
+) -> WarpPlan:
     """A plan from a known homography ``h`` (destination -> source): the fast path when it is given.
 
     The sign of ``h`` matters (its third coordinate must be positive where the plane is in front of
@@ -213,11 +230,25 @@ def homography_plan(h: np.ndarray, dst_size: tuple[int, int], src_size: tuple[in
     return WarpPlan("homography", tuple(dst_size), tuple(src_size), homography=h, fit=fit, figures=figures)
 
 
-def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int, int],
-              src_size: tuple[int, int], *, warp: str = "homography", a: float = 1.0, b: float = 2.0,
-              p: float = 0.5, robust: bool = True, planar_tol: float = PLANAR_TOL_PX,
-              check: bool = True, dst_name: str = "the frontal frame", src_name: str = "the photo",
-              dst_key: str = "frontal line", src_key: str = "image line", src_input: str | None = None) -> WarpPlan:
+def plan_warp(
+    dst_lines: np.ndarray,
+    src_lines: np.ndarray,
+    dst_size: tuple[int, int],
+    src_size: tuple[int, int],
+    *,
+    warp: str = "homography",
+    a: float = 1.0,
+    b: float = 2.0,
+    p: float = 0.5,
+    robust: bool = True,
+    planar_tol: float = PLANAR_TOL_PX,
+    check: bool = True,
+    dst_name: str = "the frontal frame",
+    src_name: str = "the photo",
+    dst_key: str = "frontal line",
+    src_key: str = "image line",
+    src_input: str | None = None,
+) -> WarpPlan:
     """Fit a warp that maps the source frame onto the destination frame from corresponding lines.
 
     Parameters
@@ -283,8 +314,20 @@ def plan_warp(dst_lines: np.ndarray, src_lines: np.ndarray, dst_size: tuple[int,
     return _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, mx, my, dst_name, src_name)
 
 
-def _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, mx, my,
-                dst_name="the frontal frame", src_name="the photo") -> WarpPlan:
+def _morph_plan(
+    dst_lines,
+    src_lines,
+    dst_size,
+    src_size,
+    a,
+    b,
+    p,
+    planar_tol,
+    mx,
+    my,
+    dst_name="the frontal frame",
+    src_name="the photo",
+) -> WarpPlan:
     import cv2
 
     from .._kernels import warps as _k
@@ -295,33 +338,39 @@ def _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, m
         raise GeometryError(
             f"--warp morph needs at least 8 feature points for the fundamental matrix; the {len(dst_lines)} lines "
             f"cross at only {k} usable points ({corr.skipped_parallel} pairs parallel, {corr.skipped_far} meeting far "
-            f"outside the frame, {corr.skipped_off_segment} not crossing on the segments)")
+            f"outside the frame, {corr.skipped_off_segment} not crossing on the segments)"
+        )
     for pts, frame in ((corr.dst, dst_name), (corr.src, src_name)):
         # several lines crossing at one point give one point, however many pairs they make
         distinct = len(np.unique(np.round(pts, 2), axis=0))
         if distinct < 8:
             raise GeometryError(
                 f"--warp morph needs at least 8 distinct feature points for the fundamental matrix; the {k} crossings "
-                f"of the {len(dst_lines)} lines are only {distinct} distinct points in {frame}")
+                f"of the {len(dst_lines)} lines are only {distinct} distinct points in {frame}"
+            )
     h = homography_from_points(corr.dst, corr.src)
     with np.errstate(divide="ignore", invalid="ignore"):  # a degenerate fit may send a point to infinity
         res = apply_homography(h, corr.dst) - corr.src
-    rms = float(np.sqrt((res ** 2).sum(axis=1).mean()))
+    rms = float(np.sqrt((res**2).sum(axis=1).mean()))
     if not math.isfinite(rms):
-        raise GeometryError(f"--warp morph: the {k} feature points do not determine a fundamental matrix "
-                            f"(no homography of them is finite: a degenerate configuration)")
+        raise GeometryError(
+            f"--warp morph: the {k} feature points do not determine a fundamental matrix "
+            f"(no homography of them is finite: a degenerate configuration)"
+        )
     if rms <= planar_tol:
         raise GeometryError(
             f"--warp morph: all {k} feature points fit one homography within {rms:.2f} px, so they lie on one plane, "
-            f"where the fundamental matrix is undetermined; use --warp homography (exact for a plane)")
+            f"where the fundamental matrix is undetermined; use --warp homography (exact for a plane)"
+        )
     f, _ = cv2.findFundamentalMat(corr.src, corr.dst, cv2.FM_8POINT)
     if f is None or f.shape != (3, 3) or not np.all(np.isfinite(f)):
         raise GeometryError(f"--warp morph: the {k} feature points do not determine a fundamental matrix")
     size = (max(dst_size[0], src_size[0]), max(dst_size[1], src_size[1]))
     ok, h_src, h_dst = cv2.stereoRectifyUncalibrated(corr.src, corr.dst, f, size)
     if not ok or not (np.all(np.isfinite(h_src)) and np.all(np.isfinite(h_dst))):
-        raise GeometryError("--warp morph: cannot pre-warp the two frames to parallel views "
-                            "(an epipole lies inside a frame)")
+        raise GeometryError(
+            "--warp morph: cannot pre-warp the two frames to parallel views (an epipole lies inside a frame)"
+        )
     # Scale both pre-warps so that their third coordinate is positive on the frames.
     h_src = _positive(h_src, src_size)
     h_dst = _positive(h_dst, dst_size)

@@ -16,11 +16,10 @@ import io
 import os
 from contextlib import redirect_stdout
 
+import weft_results
 from docutils import nodes
 from docutils.parsers.rst import Directive
 from docutils.statemachine import StringList
-
-import weft_results
 
 
 def _cell(text: str) -> str:
@@ -75,10 +74,15 @@ def parameter_lines(method_name: str) -> list[str]:
     method = registry.get(method_name)
     inputs = ", ".join(
         (f"``{i.name.upper()}``" if i.is_positional else f"``--{i.name.replace('_', '-')} IMAGE``")
-        + ("" if i.required else " (optional)") + f": {_escape(i.help)}" for i in method.inputs)
+        + ("" if i.required else " (optional)")
+        + f": {_escape(i.help)}"
+        for i in method.inputs
+    )
     lines = [f"``weft {method_name}`` -- {_escape(method.summary)}.", "", f"Inputs: {inputs}.", ""]
-    rows = [[f"``{s.option}``", _escape(s.symbol or ""), _range(s), _default(s), _escape(s.help)]
-            for s in specs(method.params)]
+    rows = [
+        [f"``{s.option}``", _escape(s.symbol or ""), _range(s), _default(s), _escape(s.help)]
+        for s in specs(method.params)
+    ]
     return lines + list_table(["option", "symbol", "range", "default", "what it changes"], rows, [14, 6, 16, 8, 56])
 
 
@@ -109,8 +113,9 @@ class _Generated(Directive):
     def run(self):
         node = nodes.section()
         node.document = self.state.document
-        self.state.nested_parse(StringList(self.lines(), source=f"<{self.name} {self.arguments[0]}>"),
-                                self.content_offset, node)
+        self.state.nested_parse(
+            StringList(self.lines(), source=f"<{self.name} {self.arguments[0]}>"), self.content_offset, node
+        )
         return node.children
 
 

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 RESULTS = Path(__file__).resolve().parents[2] / "benchmarks" / "results"
 
@@ -63,124 +64,217 @@ def _yes(v) -> str:
 
 
 _METHOD_TIMES = (
-    Column("case", "case"), Column("size", "output", _size), Column("median_s", "median s", "{:.3f}"),
-    Column("min_s", "min s", "{:.3f}"), Column("peak_mib", "peak MiB (numpy)", "{:.0f}"),
+    Column("case", "case"),
+    Column("size", "output", _size),
+    Column("median_s", "median s", "{:.3f}"),
+    Column("min_s", "min s", "{:.3f}"),
+    Column("peak_mib", "peak MiB (numpy)", "{:.0f}"),
     Column("speedup_2_threads", "2 jobs at once", "{:.2f}x"),
     Column("weft_process_s", "whole weft process s", "{:.2f}"),
     Column("gmic_process_s", "whole G'MIC process s", "{:.2f}"),
 )
 _QUALITY = (
-    Column("case", "case"), Column("coherence", "coherence", "{:.4f}"),
-    Column("completeness", "completeness", "{:.4f}"), Column("fidelity", "fidelity", "{:.3f}"),
+    Column("case", "case"),
+    Column("coherence", "coherence", "{:.4f}"),
+    Column("completeness", "completeness", "{:.4f}"),
+    Column("fidelity", "fidelity", "{:.3f}"),
     Column("coherence_median", "coherence, median of seeds", "{:.4f}"),
     Column("completeness_median", "completeness, median of seeds", "{:.4f}"),
     Column("verbatim_max", "largest verbatim copy (of the sample)", "{:.3f}"),
-    Column("snr_db", "SNR dB", "{:.1f}"), Column("psnr_db", "PSNR dB", "{:.1f}"),
+    Column("snr_db", "SNR dB", "{:.1f}"),
+    Column("psnr_db", "PSNR dB", "{:.1f}"),
     Column("psnr_cubic_db", "cubic PSNR dB", "{:.1f}"),
 )
 
 SUITES: dict[str, Suite] = {
-    "methods": Suite(_METHOD_TIMES, "python -m benchmarks 'quilt-*' 'fast-*' 'rectify-*' 'nfpt-*' 'affine-*'",
-                     "Compute time of one run with the inputs decoded (the studio's and the batch's cost); "
-                     "the whole-process columns time the ``weft`` command against G'MIC on the same file."),
-    "methods/quality": Suite(_QUALITY, "python -m benchmarks 'quilt-*' 'fast-*' 'nfpt-*' 'affine-*'",
-                             "Quality figures of the same runs (``weft.core.metrics``): coherence and "
-                             "completeness lower is better, fidelity, SNR and PSNR higher."),
-    "batch": Suite((
-        Column("recipe", "recipe"), Column("pool", "pool"), Column("items_per_s", "items/s", "{:.2f}"),
-        Column("vs_one_worker", "vs 1 worker", "{:.2f}x"), Column("item_s", "s per item on its worker", "{:.3f}"),
-        Column("item_cpu_s", "CPU s per item", "{:.3f}"), Column("busy", "workers busy", _pct),
-        Column("startup_s", "pool start s", "{:.1f}"), Column("load_avg", "load average", "{:.1f}")),
+    "methods": Suite(
+        _METHOD_TIMES,
+        "python -m benchmarks 'quilt-*' 'fast-*' 'rectify-*' 'nfpt-*' 'affine-*'",
+        "Compute time of one run with the inputs decoded (the studio's and the batch's cost); "
+        "the whole-process columns time the ``weft`` command against G'MIC on the same file.",
+    ),
+    "methods/quality": Suite(
+        _QUALITY,
+        "python -m benchmarks 'quilt-*' 'fast-*' 'nfpt-*' 'affine-*'",
+        "Quality figures of the same runs (``weft.core.metrics``): coherence and "
+        "completeness lower is better, fidelity, SNR and PSNR higher.",
+    ),
+    "batch": Suite(
+        (
+            Column("recipe", "recipe"),
+            Column("pool", "pool"),
+            Column("items_per_s", "items/s", "{:.2f}"),
+            Column("vs_one_worker", "vs 1 worker", "{:.2f}x"),
+            Column("item_s", "s per item on its worker", "{:.3f}"),
+            Column("item_cpu_s", "CPU s per item", "{:.3f}"),
+            Column("busy", "workers busy", _pct),
+            Column("startup_s", "pool start s", "{:.1f}"),
+            Column("load_avg", "load average", "{:.1f}"),
+        ),
         "python -m benchmarks.batch",
-        "``weft batch`` over frames of 640x480 on local worker processes and on a local Dask cluster."),
-    "memory": Suite((
-        Column("job", "job"), Column("peak_mib", "peak resident memory MiB", "{:.0f}"),
-        Column("seconds", "wall s", "{:.1f}"), Column("under_2_gib", "under 2 GiB", _yes)),
-        "python -m benchmarks.memory", "Peak resident memory of the whole ``weft`` process on large jobs."),
-    "cold": Suite((
-        Column("command", "command"), Column("cold_s", "first run s", "{:.1f}"), Column("warm_s", "later runs s", "{:.1f}"),
-        Column("ratio", "first / later", "{:.1f}x"), Column("cold_first_words_s", "first words s", "{:.1f}"),
-        Column("cold_silent_s", "longest silence s", "{:.1f}")),
+        "``weft batch`` over frames of 640x480 on local worker processes and on a local Dask cluster.",
+    ),
+    "memory": Suite(
+        (
+            Column("job", "job"),
+            Column("peak_mib", "peak resident memory MiB", "{:.0f}"),
+            Column("seconds", "wall s", "{:.1f}"),
+            Column("under_2_gib", "under 2 GiB", _yes),
+        ),
+        "python -m benchmarks.memory",
+        "Peak resident memory of the whole ``weft`` process on large jobs.",
+    ),
+    "cold": Suite(
+        (
+            Column("command", "command"),
+            Column("cold_s", "first run s", "{:.1f}"),
+            Column("warm_s", "later runs s", "{:.1f}"),
+            Column("ratio", "first / later", "{:.1f}x"),
+            Column("cold_first_words_s", "first words s", "{:.1f}"),
+            Column("cold_silent_s", "longest silence s", "{:.1f}"),
+        ),
         "python -m benchmarks.cold",
         "A first run compiles the method's kernels into numba's cache; later runs load them "
-        "(``weft warm-up`` does the first run ahead of time)."),
-    "gui_latency": Suite((
-        Column("measure", "what"), Column("median_ms", "median latency ms", "{:.0f}"),
-        Column("p95_ms", "95th percentile ms", "{:.0f}"), Column("max_stall_ms", "longest GUI stall ms", "{:.0f}"),
-        Column("previews", "previews shown"), Column("values", "values / moves"), Column("method", "method")),
+        "(``weft warm-up`` does the first run ahead of time).",
+    ),
+    "gui_latency": Suite(
+        (
+            Column("measure", "what"),
+            Column("median_ms", "median latency ms", "{:.0f}"),
+            Column("p95_ms", "95th percentile ms", "{:.0f}"),
+            Column("max_stall_ms", "longest GUI stall ms", "{:.0f}"),
+            Column("previews", "previews shown"),
+            Column("values", "values / moves"),
+            Column("method", "method"),
+        ),
         "python -m benchmarks.gui_latency",
-        "From a slider's change (or a brush's mouse move) to the preview on screen, in the real window."),
+        "From a slider's change (or a brush's mouse move) to the preview on screen, in the real window.",
+    ),
 }
 
 
 def _fill_aggregates(half: str) -> Callable[[dict], list[dict]]:
     def rows(data: dict) -> list[dict]:
         return [{"tool": tool, **figures} for tool, figures in data["aggregates"][half].items()]
+
     return rows
 
 
 def _fill_cases(data: dict) -> list[dict]:
-    return [{**r, "defects": ", ".join(r.get("defects") or []) or "none"}
-            for r in data["rows"] if r.get("tool") == "weft" and r.get("half") == "check"]
+    return [
+        {**r, "defects": ", ".join(r.get("defects") or []) or "none"}
+        for r in data["rows"]
+        if r.get("tool") == "weft" and r.get("half") == "check"
+    ]
 
 
 def _rectify_rows(data: dict) -> list[dict]:
-    return [{"detector": who, "kind": kind, **figures}
-            for who, kinds in data["aggregates"].items() for kind, figures in kinds.items()]
+    return [
+        {"detector": who, "kind": kind, **figures}
+        for who, kinds in data["aggregates"].items()
+        for kind, figures in kinds.items()
+    ]
 
 
 def _limits_rows(data: dict) -> list[dict]:
     out = []
     for case in ("uncrop_colour", "uncrop_grey", "hole"):
         for run in data["fill"].get(case, []):
-            out.append({"job": f"fill, {case.replace('_', ' ')}", "side": run["side"], "seconds": run["seconds"],
-                        "added_mib": run["added_bytes"] / 2**20})
+            out.append(
+                {
+                    "job": f"fill, {case.replace('_', ' ')}",
+                    "side": run["side"],
+                    "seconds": run["seconds"],
+                    "added_mib": run["added_bytes"] / 2**20,
+                }
+            )
     for kind, runs in data.get("quilting", {}).items():
         for run in runs if isinstance(runs, list) else ():
-            out.append({"job": f"quilting {kind}, block {run.get('block')}", "seconds": run["seconds"],
-                        "added_mib": run["peak_bytes"] / 2**20})
+            out.append(
+                {
+                    "job": f"quilting {kind}, block {run.get('block')}",
+                    "seconds": run["seconds"],
+                    "added_mib": run["peak_bytes"] / 2**20,
+                }
+            )
     return out
 
 
 _FILL_AGG = (
-    Column("tool", "tool"), Column("cases", "cases"), Column("coherence_median", "coherence, median", "{:.2f}"),
-    Column("coherence_worst", "coherence, worst", "{:.2f}"), Column("defects", "cases with a defect"),
+    Column("tool", "tool"),
+    Column("cases", "cases"),
+    Column("coherence_median", "coherence, median", "{:.2f}"),
+    Column("coherence_worst", "coherence, worst", "{:.2f}"),
+    Column("defects", "cases with a defect"),
     Column("known_changed_cases", "cases with known pixels changed beyond the band"),
     Column("time_median_s", "whole process s, median", "{:.2f}"),
     Column("within_gmic_time", "cases within G'MIC's time"),
 )
 
-SUITES.update({
-    "fill_suite": Suite(_FILL_AGG, "python -m benchmarks.fill_suite",
-                        "The fill suite's check half (cases the defaults were not chosen on): each tool's "
-                        "coherence (lower is better), its defects (detail below 0.8x or above 1.25x the "
-                        "truth's, a seam more than 0.15 from the truth's, coherence over 1.2x the best "
-                        "peer's) and its whole-process time.", rows=_fill_aggregates("check")),
-    "fill_suite/tuning": Suite(_FILL_AGG, "python -m benchmarks.fill_suite",
-                               "The tuning half, on which the defaults were chosen.",
-                               rows=_fill_aggregates("tuning")),
-    "fill_suite/cases": Suite((
-        Column("case", "case"), Column("note", "what it is"), Column("coherence", "coherence", "{:.2f}"),
-        Column("detail_ratio", "detail / truth's", "{:.2f}"), Column("seam_diff", "seam - truth's", "{:+.2f}"),
-        Column("process_s", "s", "{:.2f}"), Column("defects", "defects")),
-        "python -m benchmarks.fill_suite", "weft's default on each case of the check half.", rows=_fill_cases),
-    "rectify_suggest": Suite((
-        Column("detector", "detector"), Column("kind", "cases"), Column("cases", "n"),
-        Column("success", "success", _pct), Column("wrong_warps", "wrong warps"), Column("refused", "refused"),
-        Column("median_angle_err_deg", "angle error, median deg", "{:.2f}"),
-        Column("median_aspect_err", "aspect error, median", "{:.1%}"),
-        Column("median_ms_per_mp", "ms per megapixel", "{:.0f}"), Column("first_run_ms", "first call ms", "{:.0f}")),
-        "python -m benchmarks.rectify_suggest",
-        "Suggested feature lines on perspective views with a known homography (straight structure, textures "
-        "without straight lines, and noise that must be refused), against a plain baseline (Hough lines and "
-        "the two largest clusters). Success: the rectified result is within a similarity of the truth (right "
-        "angle within 1 deg, aspect within 2 %).", rows=_rectify_rows),
-    "limits": Suite((
-        Column("job", "job"), Column("side", "canvas side px"), Column("seconds", "s", "{:.1f}"),
-        Column("added_mib", "memory added MiB", "{:.0f}")),
-        "python -m benchmarks.limits",
-        "The runs the up-front memory and time checks are fitted to.", rows=_limits_rows),
-})
+SUITES.update(
+    {
+        "fill_suite": Suite(
+            _FILL_AGG,
+            "python -m benchmarks.fill_suite",
+            "The fill suite's check half (cases the defaults were not chosen on): each tool's "
+            "coherence (lower is better), its defects (detail below 0.8x or above 1.25x the "
+            "truth's, a seam more than 0.15 from the truth's, coherence over 1.2x the best "
+            "peer's) and its whole-process time.",
+            rows=_fill_aggregates("check"),
+        ),
+        "fill_suite/tuning": Suite(
+            _FILL_AGG,
+            "python -m benchmarks.fill_suite",
+            "The tuning half, on which the defaults were chosen.",
+            rows=_fill_aggregates("tuning"),
+        ),
+        "fill_suite/cases": Suite(
+            (
+                Column("case", "case"),
+                Column("note", "what it is"),
+                Column("coherence", "coherence", "{:.2f}"),
+                Column("detail_ratio", "detail / truth's", "{:.2f}"),
+                Column("seam_diff", "seam - truth's", "{:+.2f}"),
+                Column("process_s", "s", "{:.2f}"),
+                Column("defects", "defects"),
+            ),
+            "python -m benchmarks.fill_suite",
+            "weft's default on each case of the check half.",
+            rows=_fill_cases,
+        ),
+        "rectify_suggest": Suite(
+            (
+                Column("detector", "detector"),
+                Column("kind", "cases"),
+                Column("cases", "n"),
+                Column("success", "success", _pct),
+                Column("wrong_warps", "wrong warps"),
+                Column("refused", "refused"),
+                Column("median_angle_err_deg", "angle error, median deg", "{:.2f}"),
+                Column("median_aspect_err", "aspect error, median", "{:.1%}"),
+                Column("median_ms_per_mp", "ms per megapixel", "{:.0f}"),
+                Column("first_run_ms", "first call ms", "{:.0f}"),
+            ),
+            "python -m benchmarks.rectify_suggest",
+            "Suggested feature lines on perspective views with a known homography (straight structure, textures "
+            "without straight lines, and noise that must be refused), against a plain baseline (Hough lines and "
+            "the two largest clusters). Success: the rectified result is within a similarity of the truth (right "
+            "angle within 1 deg, aspect within 2 %).",
+            rows=_rectify_rows,
+        ),
+        "limits": Suite(
+            (
+                Column("job", "job"),
+                Column("side", "canvas side px"),
+                Column("seconds", "s", "{:.1f}"),
+                Column("added_mib", "memory added MiB", "{:.0f}"),
+            ),
+            "python -m benchmarks.limits",
+            "The runs the up-front memory and time checks are fitted to.",
+            rows=_limits_rows,
+        ),
+    }
+)
 
 
 def _parts(name: str) -> tuple[str, str, str]:
@@ -214,10 +308,14 @@ def load(suite: str) -> dict | None:
 
 def _machine(m) -> str:
     if isinstance(m, dict):
-        bits = [m.get("cpu"), f"{m['cores']} cores" if m.get("cores") else None,
-                f"{m['memory_gib']} GiB" if m.get("memory_gib") else None, m.get("system"),
-                f"Python {m['python']}" if m.get("python") else None,
-                f"load average {m['load_average']}" if m.get("load_average") is not None else None]
+        bits = [
+            m.get("cpu"),
+            f"{m['cores']} cores" if m.get("cores") else None,
+            f"{m['memory_gib']} GiB" if m.get("memory_gib") else None,
+            m.get("system"),
+            f"Python {m['python']}" if m.get("python") else None,
+            f"load average {m['load_average']}" if m.get("load_average") is not None else None,
+        ]
         return ", ".join(str(b) for b in bits if b)
     return str(m) if m else "not recorded"
 
@@ -248,13 +346,15 @@ def render(name: str) -> list[str]:
     data = load(base)
     command = (data or {}).get("command") or (suite.command if suite else f"python -m benchmarks.{base}")
     if data is None:
-        return [f".. note:: No results file ``benchmarks/results/{base}.json`` yet: "
-                f"run ``{command}`` to make it.", ""]
+        return [f".. note:: No results file ``benchmarks/results/{base}.json`` yet: run ``{command}`` to make it.", ""]
     try:
         rows = suite.rows(data) if suite and suite.rows else data["rows"]
     except (KeyError, TypeError, ValueError, AttributeError):
-        return [f".. note:: ``benchmarks/results/{base}.json`` does not have the figures this table "
-                f"shows: run ``{command}`` again.", ""]
+        return [
+            f".. note:: ``benchmarks/results/{base}.json`` does not have the figures this table "
+            f"shows: run ``{command}`` again.",
+            "",
+        ]
     if flt and "=" in flt:
         key, value = flt.split("=", 1)
         rows = [r for r in rows if str(r.get(key)) == value]
@@ -265,9 +365,12 @@ def render(name: str) -> list[str]:
         lines += [suite.about, ""]
     quick = " A quick run (smaller inputs, fewer repeats)." if data.get("quick") else ""
     note = f" {_rst_escape(data['note'])[0].upper()}{_rst_escape(data['note'])[1:]}." if data.get("note") else ""
-    lines += [f"Measured {data.get('date', 'at an unrecorded date')} on {_rst_escape(_machine(data.get('machine')))}."
-              f"{note}{quick} Reproduce with ``{command}`` "
-              f"(file ``benchmarks/results/{base}.json``).", ""]
+    lines += [
+        f"Measured {data.get('date', 'at an unrecorded date')} on {_rst_escape(_machine(data.get('machine')))}."
+        f"{note}{quick} Reproduce with ``{command}`` "
+        f"(file ``benchmarks/results/{base}.json``).",
+        "",
+    ]
     if not rows or not columns:
         return lines + ["The file has no rows to show.", ""]
     from weft_docs import list_table

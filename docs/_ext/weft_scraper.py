@@ -21,8 +21,10 @@ class PictureScraper:
 
     def __call__(self, block, block_vars, gallery_conf):
         here = Path(os.getcwd())
-        written = sorted((p for p in here.iterdir() if p.suffix.lower() in SUFFIXES and p.is_file()),
-                         key=lambda p: p.stat().st_mtime_ns)
+        written = sorted(
+            (p for p in here.iterdir() if p.suffix.lower() in SUFFIXES and p.is_file()),
+            key=lambda p: p.stat().st_mtime_ns,
+        )
         paths = []
         for picture in written:
             target = Path(next(block_vars["image_path_iterator"]))

@@ -45,8 +45,9 @@ def no_cup_area() -> np.ndarray:
 
 def frames(count: int = 4) -> list[np.ndarray]:
     wall = cv2.imread(str(RESOURCES / "perspective-frontal.png"))
-    return [cv2.resize(wall[40:280, 24 * i:24 * i + 320], (160, 120), interpolation=cv2.INTER_AREA)
-            for i in range(count)]
+    return [
+        cv2.resize(wall[40:280, 24 * i : 24 * i + 320], (160, 120), interpolation=cv2.INTER_AREA) for i in range(count)
+    ]
 
 
 def oval_mask() -> np.ndarray:
@@ -64,8 +65,13 @@ def main() -> None:
     (HERE / "frames").mkdir(exist_ok=True)
     for i, frame in enumerate(frames()):
         cv2.imwrite(str(HERE / "frames" / f"frame_{i}.png"), frame)
-    recipe = {"weft": 1, "method": "fast", "params": {"metric": "target", "p": 0.05},
-              "inputs": {"texture": "../../resources/gravel.png", "target": "frames/frame_0.png"}, "seed": 1}
+    recipe = {
+        "weft": 1,
+        "method": "fast",
+        "params": {"metric": "target", "p": 0.05},
+        "inputs": {"texture": "../../resources/gravel.png", "target": "frames/frame_0.png"},
+        "seed": 1,
+    }
     (HERE / "look.json").write_text(json.dumps(recipe, indent=1) + "\n")
 
 

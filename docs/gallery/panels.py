@@ -17,8 +17,7 @@ def label(img: np.ndarray, text: str) -> np.ndarray:
     lines = text.split("|")
     strip = np.full((8 + 17 * len(lines), img.shape[1], 3), 255, np.uint8)
     for i, line in enumerate(lines):
-        cv2.putText(strip, line.strip(), (6, 17 + 17 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.42, (20, 20, 20), 1,
-                    cv2.LINE_AA)
+        cv2.putText(strip, line.strip(), (6, 17 + 17 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.42, (20, 20, 20), 1, cv2.LINE_AA)
     return np.concatenate([img, strip.astype(np.float32) / 255.0], axis=0)
 
 
@@ -30,5 +29,5 @@ def grid(panels: list[np.ndarray], cols: int, gap: int = 6) -> np.ndarray:
     out = np.ones((rows * h + (rows - 1) * gap, cols * w + (cols - 1) * gap, 3), np.float32)
     for i, p in enumerate(panels):
         r, c = divmod(i, cols)
-        out[r * (h + gap):r * (h + gap) + p.shape[0], c * (w + gap):c * (w + gap) + p.shape[1]] = p
+        out[r * (h + gap) : r * (h + gap) + p.shape[0], c * (w + gap) : c * (w + gap) + p.shape[1]] = p
     return out

@@ -6,24 +6,17 @@ Smith & Bhalerao model a texture as one prototype patch and an affine transform 
 Every panel is computed by ``weft.core.affine`` with fixed seeds.
 """
 
-
 from __future__ import annotations
-
-import sys
-from pathlib import Path
 
 import cv2
 import numpy as np
-
-
-from weft.core.affine import (analyse, field_model, make_prototype, match_boundaries,
-                         render, synthesize)
-from benchmarks.fixtures.procedural import cells, weave
 from panels import grid, label  # docs/gallery/panels.py
+from weft.core.affine import analyse, field_model, make_prototype, match_boundaries, render, synthesize
 from weft.core.examples import example
 from weft.core.image import load_image, save_image
 from weft.core.metrics import snr_db
 
+from benchmarks.fixtures.procedural import cells, weave
 
 
 def _textures() -> list[tuple[str, np.ndarray]]:
@@ -83,7 +76,7 @@ def transfer() -> np.ndarray:
     shaken = synthesize(photo, prototype_image=scales, prototype=proto_rect, boundary="shaker", rng=1)
     crop = lambda img: img[:, 22:278]  # the photo is 300x200: show 256 columns of it
     x, y, s = proto_rect
-    snake_proto = cv2.resize(snake[y:y + s, x:x + s], (256, 256), interpolation=cv2.INTER_NEAREST)
+    snake_proto = cv2.resize(snake[y : y + s, x : x + s], (256, 256), interpolation=cv2.INTER_NEAREST)
     panels = [
         label(scales, "scales (transforms analysed)"),
         label(snake_proto, "colour prototype 64x64|from another texture"),
@@ -92,8 +85,10 @@ def transfer() -> np.ndarray:
         label(crop(photo), "photo 300x200"),
         label(crop(plain), "scales onto the photo, its|lowpass and colour kept"),
         label(crop(shaken), "... with the shaker box"),
-        label(crop(synthesize(photo, prototype_image=weave(512), prototype=(224, 224, 64), boundary="shaker",
-                               rng=1)), "basket weave onto the photo,|shaker box"),
+        label(
+            crop(synthesize(photo, prototype_image=weave(512), prototype=(224, 224, 64), boundary="shaker", rng=1)),
+            "basket weave onto the photo,|shaker box",
+        ),
     ]
     return grid(panels, 4)
 

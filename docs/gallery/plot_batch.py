@@ -11,7 +11,6 @@ from frame to frame. This script does per frame what one worker of the batch doe
 from pathlib import Path
 
 import numpy as np
-
 from panels import grid, label
 from weft.core import registry
 from weft.core.image import load_image, save_image
@@ -34,6 +33,8 @@ for frame in frames:
     result, _ = render(method, params, {**recipe.inputs, "target": str(frame)}, recipe.seed)
     outputs.append(result.image)
 panels = [label(load_image(f).image, f.name) for f in frames]
-panels += [label(np.repeat(o[..., None], 3, axis=2) if o.ndim == 2 else o, f"out/{Path(f).stem}.png")
-           for f, o in zip(frames, outputs)]
+panels += [
+    label(np.repeat(o[..., None], 3, axis=2) if o.ndim == 2 else o, f"out/{Path(f).stem}.png")
+    for f, o in zip(frames, outputs)
+]
 save_image("batch-frames.png", grid(panels, len(frames)))

@@ -7,19 +7,13 @@ propose where to copy from next. Every panel is made by ``weft.core.fast.transfe
 seed.
 """
 
-
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
-
+from panels import grid, label  # docs/gallery/panels.py
 from weft.core.examples import example
 from weft.core.fast import transfer
 from weft.core.image import load_image, resize, save_image
-from panels import grid, label  # docs/gallery/panels.py
-
 
 
 def styles() -> np.ndarray:
@@ -31,7 +25,7 @@ def styles() -> np.ndarray:
         out = transfer(photo, mode="novel", magnify=m, p=p, p_l=p_l, rng=7)
         # Show the same region at the photo's scale x2: the middle of the magnified result.
         h, w = out.shape[:2]
-        crop = out[h // 4:h // 4 + h // 2, w // 4:w // 4 + w // 2] if m > 1 else out
+        crop = out[h // 4 : h // 4 + h // 2, w // 4 : w // 4 + w // 2] if m > 1 else out
         panels.append(label(resize(crop, tile, interpolation="area"), f"m={m}  p={p}  p_l={p_l}"))
     return grid(panels, 3)
 

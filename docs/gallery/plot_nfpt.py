@@ -7,20 +7,16 @@ synthesize it patch by patch, and put it back into a view. Every panel is comput
 fixed seed; the printed figures are those in the captions.
 """
 
-
 from __future__ import annotations
-
-import sys
-from pathlib import Path
 
 import cv2
 import numpy as np
-
 from weft.core.examples import RESOURCES, example
 from weft.core.image import load_image, resize, save_image
 from weft.core.metrics import coherence
 from weft.core.nfpt import nfpt, synthesize
 from weft.core.rectify import load_feature_lines, rectify, rectify_feature_lines
+
 from benchmarks.fixtures.synthetic import folded_case, perspective_case
 
 LINES = RESOURCES / "perspective-lines.json"
@@ -52,7 +48,7 @@ def _row(panels: list[np.ndarray], gap: int = 6) -> np.ndarray:
     parts = []
     for i, p in enumerate(panels):
         pad = np.ones((h, p.shape[1], 3), np.float32)
-        pad[:p.shape[0]] = p
+        pad[: p.shape[0]] = p
         parts.append(pad)
         if i < len(panels) - 1:
             parts.append(np.ones((h, gap, 3), np.float32))
@@ -64,7 +60,7 @@ def _stack(rows: list[np.ndarray], gap: int = 10) -> np.ndarray:
     parts = []
     for i, r in enumerate(rows):
         pad = np.ones((r.shape[0], w, 3), np.float32)
-        pad[:, :r.shape[1]] = r
+        pad[:, : r.shape[1]] = r
         parts.append(pad)
         if i < len(rows) - 1:
             parts.append(np.ones((gap, w, 3), np.float32))
@@ -74,14 +70,21 @@ def _stack(rows: list[np.ndarray], gap: int = 10) -> np.ndarray:
 def _draw_lines(img: np.ndarray, lines: np.ndarray, colour=(255, 220, 0)) -> np.ndarray:
     u8 = (np.clip(_rgb(img), 0, 1) * 255).astype(np.uint8).copy()
     for x1, y1, x2, y2 in lines:
-        cv2.line(u8, (int(round(x1 * 4)), int(round(y1 * 4))), (int(round(x2 * 4)), int(round(y2 * 4))), colour, 1,
-                 cv2.LINE_AA, shift=2)
+        cv2.line(
+            u8,
+            (int(round(x1 * 4)), int(round(y1 * 4))),
+            (int(round(x2 * 4)), int(round(y2 * 4))),
+            colour,
+            1,
+            cv2.LINE_AA,
+            shift=2,
+        )
     return u8.astype(np.float32) / 255.0
 
 
 def _comparison_row(photo, image_lines, crop_box, rectified, truth, size, title):
     x, y, w, h = crop_box
-    crop = photo[y:y + h, x:x + w]
+    crop = photo[y : y + h, x : x + w]
     without = synthesize(crop, size=size, rng=SEED)
     with_ = synthesize(rectified, size=size, rng=SEED)
     figs = {
@@ -90,14 +93,22 @@ def _comparison_row(photo, image_lines, crop_box, rectified, truth, size, title)
     }
     print(title, {k: tuple(round(v, 4) for v in f) for k, f in figs.items()})
     hh = 250
-    return _row([
-        _label(_fit(_draw_lines(photo, image_lines), hh), f"(a) {title}", "feature lines in yellow"),
-        _label(_fit(without, hh), "(b) synthesis without rectification",
-               f"coherence {figs['without'][0]:.3f} own source, {figs['without'][1]:.3f} true"),
-        _label(_fit(rectified, hh), "(c) rectified (homography from the lines)", ""),
-        _label(_fit(with_, hh), "(d) synthesis with rectification",
-               f"coherence {figs['with'][0]:.3f} own source, {figs['with'][1]:.3f} true"),
-    ])
+    return _row(
+        [
+            _label(_fit(_draw_lines(photo, image_lines), hh), f"(a) {title}", "feature lines in yellow"),
+            _label(
+                _fit(without, hh),
+                "(b) synthesis without rectification",
+                f"coherence {figs['without'][0]:.3f} own source, {figs['without'][1]:.3f} true",
+            ),
+            _label(_fit(rectified, hh), "(c) rectified (homography from the lines)", ""),
+            _label(
+                _fit(with_, hh),
+                "(d) synthesis with rectification",
+                f"coherence {figs['with'][0]:.3f} own source, {figs['with'][1]:.3f} true",
+            ),
+        ]
+    )
 
 
 def comparison() -> np.ndarray:
@@ -116,8 +127,9 @@ def comparison() -> np.ndarray:
 
     cv2.fillConvexPoly(mask, np.round(apply_homography(case.homography, corners)).astype(np.int32), 1)
     box = _largest_rectangle(cv2.erode(mask, np.ones((5, 5), np.uint8)))
-    bottom = _comparison_row(case.photo, case.image_lines, box, rect, case.frontal, (320, 320),
-                             "gravel at 50° (synthetic)")
+    bottom = _comparison_row(
+        case.photo, case.image_lines, box, rect, case.frontal, (320, 320), "gravel at 50° (synthetic)"
+    )
     return _stack([top, bottom])
 
 
@@ -146,11 +158,13 @@ def views() -> np.ndarray:
     quad = '{"quad": [[40, 150], [440, 120], [470, 330], [10, 340]], "size": [480, 360]}'
     floor = nfpt(photo, str(LINES), size=(768, 576), view=quad, rng=SEED)
     hh = 300
-    return _row([
-        _label(_fit(photo, hh), "the photo"),
-        _label(_fit(into.image, hh), "--into-photo: the wall replaced by a", "768x576 synthesis (2.25x its area)"),
-        _label(_fit(floor.image, hh), "--view quad.json: the synthesis laid", "as a floor"),
-    ])
+    return _row(
+        [
+            _label(_fit(photo, hh), "the photo"),
+            _label(_fit(into.image, hh), "--into-photo: the wall replaced by a", "768x576 synthesis (2.25x its area)"),
+            _label(_fit(floor.image, hh), "--view quad.json: the synthesis laid", "as a floor"),
+        ]
+    )
 
 
 def warps() -> np.ndarray:
@@ -163,17 +177,23 @@ def warps() -> np.ndarray:
     psnr = psnr_db(case.frontal[m:-m, m:-m], r.image[m:-m, m:-m])
     diff = np.clip(np.abs(r.image - case.frontal) * 4, 0, 1)
     hh = 220
-    top = _row([
-        _label(_fit(_draw_lines(case.photo, case.image_lines), hh), "photo 640x480 (noise 0.01),",
-               "10 grid lines (0.3 px noise)"),
-        _label(_fit(r.image, hh), "--warp homography", f"PSNR {psnr:.1f} dB on the interior"),
-        _label(_fit(case.frontal, hh), "ground truth", ""),
-        _label(_fit(diff, hh), "|difference| x 4", ""),
-    ])
+    top = _row(
+        [
+            _label(
+                _fit(_draw_lines(case.photo, case.image_lines), hh),
+                "photo 640x480 (noise 0.01),",
+                "10 grid lines (0.3 px noise)",
+            ),
+            _label(_fit(r.image, hh), "--warp homography", f"PSNR {psnr:.1f} dB on the interior"),
+            _label(_fit(case.frontal, hh), "ground truth", ""),
+            _label(_fit(diff, hh), "|difference| x 4", ""),
+        ]
+    )
     tex = resize(load_image(example("gravel")).image, (400, 300), interpolation="cubic")
     fold = folded_case(tex)
-    panels = [_label(_fit(_draw_lines(fold.photo, fold.image_lines), hh), "a texture folded 35° (two planes),",
-                     "19 segments")]
+    panels = [
+        _label(_fit(_draw_lines(fold.photo, fold.image_lines), hh), "a texture folded 35° (two planes),", "19 segments")
+    ]
     for warp in ("homography", "lines", "morph"):
         out = rectify(fold.photo, fold.image_lines, fold.frontal_lines, fold.frontal_size, warp=warp)
         sel = out.mask & (fold.frontal > 0)
@@ -194,12 +214,14 @@ def repair() -> np.ndarray:
     marked[fixed.repaired_mask] = [0.1, 0.9, 0.2]
     z = lambda a: cv2.resize(a[:96, :96], (288, 288), interpolation=cv2.INTER_NEAREST)
     print("repair", fixed.figures())
-    return _row([
-        _label(z(raw.image), "min-cut seams, no repair"),
-        _label(z(marked), f"mismatched pixels ({fixed.repaired} of 160x160)"),
-        _label(z(fixed.image), "after pixel re-synthesis"),
-        _label(z(smooth.image), "... and --smooth (step 7)"),
-    ])
+    return _row(
+        [
+            _label(z(raw.image), "min-cut seams, no repair"),
+            _label(z(marked), f"mismatched pixels ({fixed.repaired} of 160x160)"),
+            _label(z(fixed.image), "after pixel re-synthesis"),
+            _label(z(smooth.image), "... and --smooth (step 7)"),
+        ]
+    )
 
 
 # %%

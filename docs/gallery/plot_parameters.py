@@ -8,7 +8,6 @@ the effect reads the same at full size.
 """
 
 import numpy as np
-
 from panels import grid, label
 from weft.core import registry
 from weft.core.examples import example
@@ -37,8 +36,7 @@ def strip(method: str, inputs: dict, name: str, values: list, **fixed) -> np.nda
 # The side of the blocks copied from the sample. Small blocks break the bricks into pieces; large
 # blocks keep whole bricks and their joints, and copy more of the sample at once.
 
-save_image("param-quilt-block.png", strip("quilt", {"texture": brick}, "block", [8, 16, 32, 48],
-                                          size=(128, 128)))
+save_image("param-quilt-block.png", strip("quilt", {"texture": brick}, "block", [8, 16, 32, 48], size=(128, 128)))
 
 # %%
 # Quilting: tol
@@ -47,8 +45,7 @@ save_image("param-quilt-block.png", strip("quilt", {"texture": brick}, "block", 
 # (seams vanish but the same spot repeats); larger values vary the result at the cost of
 # visible seams.
 
-save_image("param-quilt-tol.png", strip("quilt", {"texture": gravel}, "tol", [1, 2, 8, 64],
-                                        size=(128, 128), block=24))
+save_image("param-quilt-tol.png", strip("quilt", {"texture": gravel}, "tol", [1, 2, 8, 64], size=(128, 128), block=24))
 
 # %%
 # Quilting transfer: alpha
@@ -56,8 +53,10 @@ save_image("param-quilt-tol.png", strip("quilt", {"texture": gravel}, "tol", [1,
 # In a transfer, how much a block must agree with its neighbours (alpha near 1: smooth texture)
 # against how much it must follow the picture (alpha near 0: a faithful picture).
 
-save_image("param-quilt-alpha.png", strip("quilt", {"texture": gravel, "target": camera}, "alpha",
-                                          [0.0, 0.3, 0.6, 0.9], block=9, overlap=3))
+save_image(
+    "param-quilt-alpha.png",
+    strip("quilt", {"texture": gravel, "target": camera}, "alpha", [0.0, 0.3, 0.6, 0.9], block=9, overlap=3),
+)
 
 # %%
 # Fast transfer: p
@@ -66,8 +65,10 @@ save_image("param-quilt-alpha.png", strip("quilt", {"texture": gravel, "target":
 # long coherent copies of the texture; higher values follow the picture more closely, in
 # smaller pieces.
 
-save_image("param-fast-p.png", strip("fast", {"texture": gravel, "target": camera}, "p",
-                                     [0.0, 0.05, 0.3, 1.0], metric="target"))
+save_image(
+    "param-fast-p.png",
+    strip("fast", {"texture": gravel, "target": camera}, "p", [0.0, 0.05, 0.3, 1.0], metric="target"),
+)
 
 # %%
 # Fast transfer: n
@@ -75,8 +76,9 @@ save_image("param-fast-p.png", strip("fast", {"texture": gravel, "target": camer
 # The side of the neighbourhood compared. Small neighbourhoods copy fine grain; larger ones
 # carry larger structures of the texture.
 
-save_image("param-fast-n.png", strip("fast", {"texture": gravel, "target": camera}, "n", [3, 5, 7, 11],
-                                     metric="target"))
+save_image(
+    "param-fast-n.png", strip("fast", {"texture": gravel, "target": camera}, "n", [3, 5, 7, 11], metric="target")
+)
 
 # %%
 # Fill: band

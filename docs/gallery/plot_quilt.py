@@ -7,15 +7,9 @@ Every picture here is made by ``weft.core.quilting`` and ``weft.core.blending`` 
 examples with fixed seeds; running the script writes the same PNG files.
 """
 
-
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
-
-
 from weft.core.blending import poisson_blend, pyramid_blend
 from weft.core.examples import example
 from weft.core.image import load_image, save_image
@@ -30,7 +24,7 @@ def row(images: list[np.ndarray]) -> np.ndarray:
     parts = []
     for k, img in enumerate(images):
         pad = np.ones((h, img.shape[1]), dtype=np.float32)
-        pad[h - img.shape[0]:] = img
+        pad[h - img.shape[0] :] = img
         parts.append(pad)
         if k < len(images) - 1:
             parts.append(np.ones((h, GAP), dtype=np.float32))
@@ -46,10 +40,12 @@ def row(images: list[np.ndarray]) -> np.ndarray:
 
 brick = load_image(example("brick")).image[:128, :128].copy()
 common = dict(size=(256, 256), block=32, overlap=6, rng=7)
-modes = [synthesize(brick, mode="random", **common),
-         synthesize(brick, mode="overlap", **common),
-         synthesize(brick, mode="mincut", **common),
-         synthesize(brick, mode="mincut", poisson=True, **common)]
+modes = [
+    synthesize(brick, mode="random", **common),
+    synthesize(brick, mode="overlap", **common),
+    synthesize(brick, mode="mincut", **common),
+    synthesize(brick, mode="mincut", poisson=True, **common),
+]
 save_image("quilt-modes.png", row([brick] + modes))
 
 

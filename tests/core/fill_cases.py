@@ -3,7 +3,6 @@ fixtures) and a rectangular hole."""
 
 import numpy as np
 import pytest
-
 from weft.core.examples import example
 from weft.core.image import load_image
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
-
 from weft.core.errors import InvalidParameter, WeftError
 
 # Per example: generous enough for the first example to compile numba kernels in a fresh clone

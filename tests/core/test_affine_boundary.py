@@ -2,15 +2,23 @@
 
 import numpy as np
 import pytest
-
-from weft.core.affine import (analyse, field_model, field_transforms, make_prototype, match_boundaries, render,
-                         synthesize, total_boundary_error)
+from weft.core.affine import (
+    analyse,
+    field_model,
+    field_transforms,
+    make_prototype,
+    match_boundaries,
+    render,
+    synthesize,
+    total_boundary_error,
+)
 from weft.core.affine.boundary import _Canvas
-from benchmarks.fixtures.procedural import cells
 from weft.core.affine.model import Grid
 from weft.core.errors import InvalidParameter
 from weft.core.examples import example
 from weft.core.image import load_image
+
+from benchmarks.fixtures.procedural import cells
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from weft.core.affine import centroid_pairs, centroids, cos2_window, segment_sums
 from weft.core.errors import InvalidParameter
 
@@ -15,9 +14,9 @@ def test_cos2_windows_overlapping_by_half_sum_to_one(B):
     total = np.zeros((4 * B, 4 * B))
     for y in range(0, 3 * B + 1, h):
         for x in range(0, 3 * B + 1, h):
-            total[y:y + B, x:x + B] += win
+            total[y : y + B, x : x + B] += win
     # Everywhere covered by the full two-by-two overlap the windows sum to one (§3.1).
-    np.testing.assert_allclose(total[h:3 * B + h, h:3 * B + h], 1.0, atol=1e-6)
+    np.testing.assert_allclose(total[h : 3 * B + h, h : 3 * B + h], 1.0, atol=1e-6)
     assert win.max() <= 1.0 and win.min() > 0.0  # sin²(π(a+½)/B): no exact zero on the grid
 
 

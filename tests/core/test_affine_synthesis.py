@@ -5,15 +5,23 @@ import threading
 
 import numpy as np
 import pytest
-
 from weft.core import metrics
-from weft.core.affine import (METHOD, AffineParams, analyse, decompose, make_prototype, prototype_from_patch, render,
-                         synthesize)
-from benchmarks.fixtures.procedural import cells, weave
+from weft.core.affine import (
+    METHOD,
+    AffineParams,
+    analyse,
+    decompose,
+    make_prototype,
+    prototype_from_patch,
+    render,
+    synthesize,
+)
 from weft.core.errors import Cancelled, GeometryError, ImageError, InvalidParameter
 from weft.core.examples import example
 from weft.core.image import load_image, resize
 from weft.core.jobs import CancelToken
+
+from benchmarks.fixtures.procedural import cells, weave
 
 
 @pytest.fixture(scope="module")
@@ -133,8 +141,9 @@ def test_model_is_reusable_and_cheap_to_render(scales):
     b = render(model)
     np.testing.assert_array_equal(a, b)
     assert model.sampling.shape == (model.grid.count, 2, 2)
-    np.testing.assert_allclose(model.transforms @ model.sampling, np.broadcast_to(np.eye(2), model.sampling.shape),
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        model.transforms @ model.sampling, np.broadcast_to(np.eye(2), model.sampling.shape), atol=1e-9
+    )
     assert np.all(np.abs(model.shifts) <= model.grid.radius)
 
 

@@ -3,7 +3,6 @@
 import cv2
 import numpy as np
 import pytest
-
 from weft.core.affine import analyse, candidate_transforms, correlate_shifts, regularise_pairs
 from weft.core.affine.transforms import MAX_SCALE, MIN_SCALE, PAIRINGS, singular_values
 
@@ -31,8 +30,7 @@ def _warp_about_centre(img, T):
     Mxy = np.array([[Ti[1, 1], Ti[1, 0]], [Ti[0, 1], Ti[0, 0]]])  # OpenCV wants (x, y)
     off = np.array([c, c]) - Mxy @ np.array([c, c])
     A = np.hstack([Mxy, off[:, None]])
-    return cv2.warpAffine(img, A, (n, n), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REFLECT)
+    return cv2.warpAffine(img, A, (n, n), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REFLECT)
 
 
 @pytest.fixture(scope="module")
@@ -54,9 +52,9 @@ def _centre_patch(model):
 
 
 def test_rotation_by_30_scale_by_1_2_is_among_the_candidates_and_chosen(rotated_case):
-    from weft.core.affine.spectral import centroids
     from weft.core.affine.analysis import _central
     from weft.core.affine.model import decompose, make_prototype
+    from weft.core.affine.spectral import centroids
 
     proto_img, target, T, rect, B = rotated_case
     # §2.2: the eight candidates from the centroid pairs contain T (within the centroids' bias)
@@ -64,7 +62,7 @@ def test_rotation_by_30_scale_by_1_2_is_among_the_candidates_and_chosen(rotated_
     mu_p = centroids(_central(proto.highpass, B), lowcut=1 / B).mu[0]
     n = target.shape[0]
     o = (n - B) // 2
-    mu_t = centroids(decompose(target, B).high[o:o + B, o:o + B], lowcut=1 / B).mu[0]
+    mu_t = centroids(decompose(target, B).high[o : o + B, o : o + B], lowcut=1 / B).mu[0]
     cands = candidate_transforms(mu_p, mu_t)
     rel = np.linalg.norm(cands - T, axis=(1, 2)) / np.linalg.norm(T)
     assert rel.min() < 0.15
@@ -132,15 +130,15 @@ def test_correlation_finds_a_known_shift():
     frame = cv2.GaussianBlur(rng.random((L, L)).astype(np.float32), (0, 0), 1.5)
     for ty, tx in [(0, 0), (3, -2), (-8, 8), (5, 7)]:
         # the target is the frame moved by t: target[a] = frame[R + a - t]
-        target = frame[R - ty:R - ty + B, R - tx:R - tx + B]
+        target = frame[R - ty : R - ty + B, R - tx : R - tx + B]
         shifts, peak = correlate_shifts(frame[None, None], (target - target.mean())[None], R)
         # the raw correlation of eq. 23 is not normalised: check it on a zero-mean frame too
         f0 = frame - frame.mean()
-        t0 = f0[R - ty:R - ty + B, R - tx:R - tx + B]
+        t0 = f0[R - ty : R - ty + B, R - tx : R - tx + B]
         s0, _ = correlate_shifts(f0[None, None], t0[None], R)
         assert tuple(s0[0, 0]) == (ty, tx)
     # turned candidates: a frame turned by 180° is found as the turned candidate
     turned = frame[::-1, ::-1]
-    target = (turned - turned.mean())[R:R + B, R:R + B]
+    target = (turned - turned.mean())[R : R + B, R : R + B]
     s, p = correlate_shifts((frame - frame.mean())[None, None], target[None], R, turned=True)
     assert s.shape == (1, 2, 2) and tuple(s[0, 1]) == (0, 0) and p[0, 1] > p[0, 0]

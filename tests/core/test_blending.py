@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 import scipy.sparse
 import scipy.sparse.linalg
-
-from weft.core.blending import BlendParams, METHOD, max_levels, poisson_blend, pyramid_blend
+from weft.core.blending import METHOD, BlendParams, max_levels, poisson_blend, pyramid_blend
 from weft.core.errors import ImageError, InvalidParameter
 
 

@@ -4,7 +4,6 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.core.errors import WeftError
 from weft.core.examples import RESOURCES, example, examples
 from weft.core.image import load_image

@@ -4,11 +4,10 @@ import threading
 
 import numpy as np
 import pytest
-
 from weft.core import metrics
 from weft.core.errors import Cancelled, ImageError, InvalidParameter
 from weft.core.examples import example
-from weft.core.fast import FastParams, METHOD, _transfer, transfer
+from weft.core.fast import METHOD, FastParams, _transfer, transfer
 from weft.core.image import load_image, resize, rgb_to_yiq
 from weft.core.jobs import CancelToken
 
@@ -77,7 +76,8 @@ def test_full_metric_trades_fidelity_for_coherence(gravel, camera):
 def test_random_candidates_shrink_patches(gravel, camera):
     def coherent_fraction(p):
         return METHOD.run({"texture": gravel, "target": camera}, FastParams(metric="target", p=p), rng=5).figures[
-            "coherent_fraction"]
+            "coherent_fraction"
+        ]
 
     assert coherent_fraction(0.0) > coherent_fraction(0.5) > coherent_fraction(1.0)
 
@@ -239,7 +239,8 @@ def test_the_largest_neighbourhoods_stay_inside_the_kernels_buffers(tmp_path):
         "    for metric in ('full', 'target', 'artistic'):\n"
         "        out = transfer(src, tgt, n=n, metric=metric, p=0.1, rng=3)\n"
         "        assert out.shape == tgt.shape and set(np.unique(out)) <= set(np.unique(src)), (n, metric)\n"
-        "print('ok')\n")
+        "print('ok')\n"
+    )
     env = {**os.environ, "NUMBA_BOUNDSCHECK": "1", "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
     done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]

@@ -6,7 +6,6 @@ import re
 
 import numpy as np
 import pytest
-
 from weft.core import registry
 from weft.core.examples import RESOURCES, example
 from weft.core.geometry import FeatureLines
@@ -19,7 +18,7 @@ SNAKE = re.compile(r"\b[a-z0-9]+(?:_[a-z0-9]+)+\b")
 def _hole(side: int) -> np.ndarray:
     """A mask with a white square in the middle (what to fill)."""
     mask = np.zeros((side, side), np.float32)
-    mask[side // 3:side // 2, side // 3:side // 2] = 1.0
+    mask[side // 3 : side // 2, side // 3 : side // 2] = 1.0
     return mask
 
 
@@ -43,8 +42,11 @@ CASES = [
     ("quilt", lambda: {"texture": _small("brick", 64), "target": _small("astronaut", 48)}, {}),
     ("affine", lambda: {"texture": _small("cat-fur", 96)}, {"block": 16, "boundary": "shaker"}),
     ("fill", lambda: {"image": _small("brick", 64), "mask": _hole(64)}, {}),
-    ("nfpt", lambda: {"photo": load_image(example("perspective")).image},
-     {"lines": _lines(), "size": (64, 64), "block": 32, "overlap": 8, "into_photo": True}),
+    (
+        "nfpt",
+        lambda: {"photo": load_image(example("perspective")).image},
+        {"lines": _lines(), "size": (64, 64), "block": 32, "overlap": 8, "into_photo": True},
+    ),
 ]
 
 
@@ -69,13 +71,14 @@ def test_every_studio_method_has_a_case_above():
 
 
 def test_a_figure_renders_its_value_in_words_and_units():
-    assert Figure("largest verbatim copy", "%", "of the sample", digits=2).render(0.0532) == \
-        "largest verbatim copy 5.3 % of the sample"
+    assert (
+        Figure("largest verbatim copy", "%", "of the sample", digits=2).render(0.0532)
+        == "largest verbatim copy 5.3 % of the sample"
+    )
     assert Figure("coherent pixels", "%", digits=2).render(0.83) == "coherent pixels 83 %"
     assert Figure("error", "px", digits=2).prefixed("rectification").render(1.2) == "rectification error 1.2 px"
     assert Figure("blocks").render(np.int64(36)) == "blocks 36"
     assert Figure("repair").render(True) == "repair yes" and Figure("repair").render(np.False_) == "repair no"
     assert Figure("warp").render("homography") == "warp homography"
     # lists and missing values are left to the report; a key no table names reads as its words
-    assert describe_figures({"homography": [[1, 0], [0, 1]], "prototype": None, "odd_count": 3}, {}) == \
-        ["odd count 3"]
+    assert describe_figures({"homography": [[1, 0], [0, 1]], "prototype": None, "odd_count": 3}, {}) == ["odd count 3"]

@@ -4,13 +4,12 @@ weft.core.metrics on small cases), the blend band, alpha, uncrop geometry and th
 import cv2
 import numpy as np
 import pytest
-
 from weft.core import metrics
 from weft.core.errors import InvalidParameter, WeftError
 from weft.core.examples import example
 from weft.core.fill import ENGINES, FillParams, fill, fill_quilt
-from weft.core.fill.hybrid import fill_hybrid
 from weft.core.fill.band import band_region, blend_band
+from weft.core.fill.hybrid import fill_hybrid
 from weft.core.image import load_image
 
 from .fill_cases import brick, gravel, square_hole  # noqa: F401 (fixtures)
@@ -251,8 +250,13 @@ def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
     from weft.core.fill.method import STUDIO, fill_image
 
     colour = np.ascontiguousarray(load_image(example("chelsea")).image[:96, :120])
-    for image, params in ((colour, FillParams()), (gravel, FillParams()), (colour, FillParams(engine="hybrid")),
-                          (gravel, FillParams(extend=(0, 0, 30, 0))), (gravel, FillParams(extend=(0, 0, 16, 0)))):
+    for image, params in (
+        (colour, FillParams()),
+        (gravel, FillParams()),
+        (colour, FillParams(engine="hybrid")),
+        (gravel, FillParams(extend=(0, 0, 30, 0))),
+        (gravel, FillParams(extend=(0, 0, 16, 0))),
+    ):
         resolved = STUDIO.resolved(params, {"image": image.shape})
         mask = None if params.extend is not None else square_hole(image.shape)
         _, figures = fill_image(image, mask, params=params, rng=0)
@@ -310,9 +314,8 @@ def test_every_scalar_figure_has_a_human_reading_in_the_studio_description(case,
 def test_numpy_cut_and_solver_agree_with_the_kernels():
     """weft.core.fill.cut (numpy) against weft.core.seams / weft.core._kernels.poisson (numba)."""
     from weft.core._kernels.poisson import poisson_cg as kernel_cg
-    from weft.core.fill.cut import min_cut, poisson_cg
+    from weft.core.fill.cut import _vertical_path, min_cut, poisson_cg
     from weft.core.seams import min_cut_mask, min_error_path
-    from weft.core.fill.cut import _vertical_path
 
     rng = np.random.default_rng(5)
     err = rng.random((20, 9))
@@ -480,8 +483,9 @@ def test_quilt_refines_colour_pictures_only():
     grey = load_image(example("brick")).image[:96, :96]
     square = square_hole(grey.shape)
     assert not refines(grey, square) and not refines(np.repeat(grey[..., None], 3, axis=2), square)
-    assert np.array_equal(fill_quilt(grey, square, patch=16, rng=1), fill_quilt(grey, square, patch=16, rng=1,
-                                                                                  refine=False))
+    assert np.array_equal(
+        fill_quilt(grey, square, patch=16, rng=1), fill_quilt(grey, square, patch=16, rng=1, refine=False)
+    )
 
 
 def test_default_fill_loads_neither_numba_nor_numpy_ma():
@@ -575,8 +579,9 @@ def test_quilt_draws_no_mortar_line_into_a_thin_gap(monkeypatch):
     line; the overlap constrains nothing there, and at seeds 1 and 9 a continued copy drew a second
     mortar line into it (the seam figure 0.26 over the truth's). A copy is now continued into a thin
     gap only if it agrees with the gap's diffusion from its sides."""
-    from benchmarks.fill import build_brick
     from weft.core.fill import quilt
+
+    from benchmarks.fill import build_brick
 
     case = build_brick()
     image = case.known_part.astype(np.float32) / 255.0
@@ -625,7 +630,7 @@ def test_quilt_front_finds_numpys_first_maximum(seed):
         assert front.first_max() == np.unravel_index(int(np.argmax(score)), score.shape)
         y0 = int(rng.integers(0, 97))
         y1 = int(rng.integers(y0 + 1, 98))
-        score[y0:y1, int(rng.integers(0, 61)):] = rng.integers(-1, 6, size=1)[0]
+        score[y0:y1, int(rng.integers(0, 61)) :] = rng.integers(-1, 6, size=1)[0]
         front.update(y0, y1)
 
 
@@ -664,8 +669,9 @@ def fill_image_figures(image, seed, **params):
 def test_a_grey_picture_stored_as_rgb_gets_the_thin_gap_check_too(monkeypatch):
     """The thin-gap check is for pictures without colour, however they are stored: the benchmark's
     brick as RGB fills as the grey one does, and without the check its seed 1 draws the line again."""
-    from benchmarks.fill import build_brick
     from weft.core.fill import quilt
+
+    from benchmarks.fill import build_brick
 
     case = build_brick()
     grey = case.known_part.astype(np.float32) / 255.0

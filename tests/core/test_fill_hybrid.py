@@ -5,7 +5,6 @@ smearing, bounds of the issue's metrics on small cases, cancelling and one-line 
 
 import numpy as np
 import pytest
-
 from weft.core import metrics
 from weft.core.errors import Cancelled, ImageError, InvalidParameter, WeftError
 from weft.core.fill import fill, fill_quilt
@@ -102,13 +101,19 @@ def test_refine_progress_and_cancel(gravel):
 @pytest.mark.parametrize(
     "kwargs, error, message",
     [
-        ({"init": np.zeros((96, 95), np.float32)}, ImageError,
-         "the starting fill has shape (96, 95) but the image (96, 96)"),
+        (
+            {"init": np.zeros((96, 95), np.float32)},
+            ImageError,
+            "the starting fill has shape (96, 95) but the image (96, 96)",
+        ),
         ({"iterations": 0}, InvalidParameter, "parameter 'iterations' = 0 must be an integer 1..64 or None"),
         ({"patch": 64}, InvalidParameter, "parameter 'patch' = 64 must be an integer 3..63"),
-        ({"source": np.zeros((96, 96), bool)}, ImageError,
-         "the source region holds no whole 7x7 patch: leave at least a 7x7 square of known pixels to copy from "
-         "(or use a smaller patch)"),
+        (
+            {"source": np.zeros((96, 96), bool)},
+            ImageError,
+            "the source region holds no whole 7x7 patch: leave at least a 7x7 square of known pixels to copy from "
+            "(or use a smaller patch)",
+        ),
     ],
 )
 def test_refine_bad_inputs_are_one_line_errors(gravel, kwargs, error, message):
@@ -195,7 +200,9 @@ def test_patchmatch_with_a_band_refines_it_and_leaves_every_other_known_pixel(gr
     # on the benchmark's 320 px gravel), a smeared fill 0.1-0.5
     truth_detail = metrics.fill_detail(gravel, hole)
     assert 0.65 * truth_detail <= np.median([metrics.fill_detail(o, hole) for o in outs]) <= 1.25 * truth_detail
-    assert np.median([metrics.fill_coherence(o, hole, gravel) for o in outs]) <= 0.75 * metrics.fill_coherence(gravel, hole)
+    assert np.median([metrics.fill_coherence(o, hole, gravel) for o in outs]) <= 0.75 * metrics.fill_coherence(
+        gravel, hole
+    )
 
 
 def test_refine_searching_the_worst_patches_only():

@@ -4,7 +4,6 @@ import cv2
 import numpy as np
 import pytest
 from skimage import data
-
 from weft.core import metrics as M
 from weft.core.errors import ImageError
 

@@ -5,7 +5,6 @@ holes at the border, cancelling, and one-line errors for bad inputs."""
 import cv2
 import numpy as np
 import pytest
-
 from weft.core.errors import Cancelled, ImageError, InvalidParameter, WeftError
 from weft.core.examples import example
 from weft.core.fill.patchmatch import fill_patchmatch
@@ -15,12 +14,12 @@ from weft.core.metrics import fill_coherence, fill_detail, fill_seam
 
 
 def _image(name, h, w, y=0, x=0):
-    return np.ascontiguousarray(load_image(example(name)).image[y:y + h, x:x + w]).astype(np.float32)
+    return np.ascontiguousarray(load_image(example(name)).image[y : y + h, x : x + w]).astype(np.float32)
 
 
 def _square_hole(h, w, y, x, side):
     hole = np.zeros((h, w), bool)
-    hole[y:y + side, x:x + side] = True
+    hole[y : y + side, x : x + side] = True
     return hole
 
 
@@ -157,11 +156,17 @@ def test_an_empty_hole_returns_the_image_unchanged(gravel):
         ({"patch": 7.0}, InvalidParameter, "parameter 'patch' = 7.0 must be an integer 3..63"),
         ({"levels": 0}, InvalidParameter, "parameter 'levels' = 0 must be an integer 1..64 or None"),
         ({"iterations": "3"}, InvalidParameter, "parameter 'iterations' = '3' must be an integer 1..64 or None"),
-        ({"image": np.zeros((96, 96, 5), np.float32)}, ImageError,
-         "image must be (H, W) or (H, W, C) with C = 1..4 channels, got shape (96, 96, 5)"),
+        (
+            {"image": np.zeros((96, 96, 5), np.float32)},
+            ImageError,
+            "image must be (H, W) or (H, W, C) with C = 1..4 channels, got shape (96, 96, 5)",
+        ),
         ({"image": np.zeros((96, 96), np.uint8)}, ImageError, "image must be float in [0, 1], got uint8"),
-        ({"image": np.zeros((5, 96), np.float32), "hole": np.ones((5, 96), bool)}, ImageError,
-         "image is 96x5: smaller than the 7x7 patch"),
+        (
+            {"image": np.zeros((5, 96), np.float32), "hole": np.ones((5, 96), bool)},
+            ImageError,
+            "image is 96x5: smaller than the 7x7 patch",
+        ),
     ],
 )
 def test_bad_inputs_are_one_line_errors(gravel, kwargs, error, message):
@@ -178,8 +183,10 @@ def test_a_source_without_a_whole_patch_is_refused(gravel):
     hole = _square_hole(96, 96, 36, 36, 24)
     source = np.zeros((96, 96), bool)
     source[::2, ::2] = True  # plenty of pixels, but no 7x7 square of them
-    message = ("the source region holds no whole 7x7 patch: leave at least a 7x7 square of known pixels "
-               "to copy from (or use a smaller patch)")
+    message = (
+        "the source region holds no whole 7x7 patch: leave at least a 7x7 square of known pixels "
+        "to copy from (or use a smaller patch)"
+    )
     with pytest.raises(ImageError, match=r"^the source region holds no whole 7x7 patch"):
         fill_patchmatch(gravel, hole, source)
     everything = np.ones((96, 96), bool)
@@ -193,10 +200,10 @@ def test_a_source_without_a_whole_patch_is_refused(gravel):
     assert np.array_equal(out[~hole], gravel[~hole])
 
 
-
 @pytest.mark.parametrize("bias, takes_neighbours_offset", [(0.0, False), (1.0, True)])
 def test_a_coherence_bias_lets_propagation_take_a_neighbours_offset_within_the_margin(bias, takes_neighbours_offset):
-    from weft.core.fill.search import Flat as _Flat, _try
+    from weft.core.fill.search import Flat as _Flat
+    from weft.core.fill.search import _try
 
     p = 3
     img = np.random.default_rng(5).random((20, 20, 1)).astype(np.float32)

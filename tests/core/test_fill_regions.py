@@ -4,7 +4,6 @@ leaves the interior fill as it is without the uncrop."""
 import cv2
 import numpy as np
 import pytest
-
 from weft.core.examples import example
 from weft.core.fill import FillParams, fill
 from weft.core.fill.method import fill_image

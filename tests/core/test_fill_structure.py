@@ -10,7 +10,6 @@ import json
 import cv2
 import numpy as np
 import pytest
-
 from weft.app.cli import main
 from weft.core.errors import ImageError, InvalidParameter
 from weft.core.fill import FillParams, fill, fill_image
@@ -40,7 +39,7 @@ def _hole_on(radius, degrees, hole_radius):
     yy, xx = np.mgrid[:SIZE, :SIZE]
     a = np.radians(degrees)
     py, px = CENTRE[0] + radius * np.sin(a), CENTRE[1] + radius * np.cos(a)
-    return (yy - py) ** 2 + (xx - px) ** 2 <= hole_radius ** 2
+    return (yy - py) ** 2 + (xx - px) ** 2 <= hole_radius**2
 
 
 def _distance_to_circle(radius):
@@ -146,8 +145,9 @@ def test_the_guide_is_checked_by_the_engine():
 
 
 def test_structure_yes_with_another_engine_or_a_texture_is_refused():
-    with pytest.raises(InvalidParameter,
-                       match="parameter 'structure' = yes needs the patchmatch engine .or auto., not 'quilt'"):
+    with pytest.raises(
+        InvalidParameter, match="parameter 'structure' = yes needs the patchmatch engine .or auto., not 'quilt'"
+    ):
         FillParams(engine="quilt", structure="yes")
     with pytest.raises(InvalidParameter, match=r"parameter 'patch' = 64 is outside 3..63 with 'structure'"):
         FillParams(structure="yes", patch=64)
@@ -192,8 +192,22 @@ def test_the_command_line_option(tmp_path, capsys):
     save_image(tmp_path / "disc.png", img)
     save_image(tmp_path / "mask.png", hole.astype(np.float32))
     out = tmp_path / "out.png"
-    code = main(["fill", str(tmp_path / "disc.png"), "--mask", str(tmp_path / "mask.png"), "--structure",
-                 "yes", "-o", str(out), "--seed", "1", "--report", "-q"])
+    code = main(
+        [
+            "fill",
+            str(tmp_path / "disc.png"),
+            "--mask",
+            str(tmp_path / "mask.png"),
+            "--structure",
+            "yes",
+            "-o",
+            str(out),
+            "--seed",
+            "1",
+            "--report",
+            "-q",
+        ]
+    )
     captured = capsys.readouterr()
     assert code == 0, captured.err
     report = json.loads(captured.out)
@@ -207,8 +221,21 @@ def test_the_command_line_option(tmp_path, capsys):
     assert np.array_equal(load_image(again).image, load_image(out).image)
     # with the quilt engine: one line naming the parameter, exit 2, nothing written
     out2 = tmp_path / "out2.png"
-    code = main(["fill", str(tmp_path / "disc.png"), "--mask", str(tmp_path / "mask.png"), "--structure",
-                 "yes", "--engine", "quilt", "-o", str(out2), "-q"])
+    code = main(
+        [
+            "fill",
+            str(tmp_path / "disc.png"),
+            "--mask",
+            str(tmp_path / "mask.png"),
+            "--structure",
+            "yes",
+            "--engine",
+            "quilt",
+            "-o",
+            str(out2),
+            "-q",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 2 and not out2.exists()
     assert err.strip().count("\n") == 0 and "parameter 'structure' = yes needs the patchmatch engine" in err
@@ -235,7 +262,11 @@ def test_auto_runs_patchmatch_with_the_guide_where_it_finds_edges_to_continue():
     ground = _hole_on(40, 225, 12)
     border = np.zeros(rim.shape, bool)
     border[:, :14] = True
-    for image, hole, kw in ((img, ground, {}), (img[..., 0], rim, {}), (img, border, {}),
-                            (img, rim, {"structure": "no"})):
+    for image, hole, kw in (
+        (img, ground, {}),
+        (img[..., 0], rim, {}),
+        (img, border, {}),
+        (img, rim, {"structure": "no"}),
+    ):
         _, f = fill_image(image, hole, params=FillParams(**kw), rng=1)
         assert f["engine"] == "hybrid" and "edges_continued" not in f, kw

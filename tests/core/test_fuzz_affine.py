@@ -20,7 +20,6 @@ import numpy as np
 import pytest
 from hypothesis import event, given, settings
 from hypothesis import strategies as st
-
 from weft.core.affine import (
     AffineModel,
     Prototype,
@@ -43,6 +42,7 @@ from weft.core.affine import (
 from weft.core.affine.transforms import MAX_SCALE, MIN_SCALE, singular_values
 from weft.core.errors import WeftError
 from weft.core.geometry import Square
+
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
@@ -122,11 +122,22 @@ def rect_problem(rect, shape) -> bool:
 
 # --- the prototype rectangle -------------------------------------------------------------------
 
+
 @settings(max_examples=300, deadline=None)
-@given(rect=st.one_of(_rects, st.tuples(_coord, _coord, _side).map(lambda r: f"{r[0]},{r[1]},{r[2]}"),
-                      st.text(max_size=10), st.lists(st.integers(-3, 20), max_size=4),
-                      st.tuples(st.floats(-2, 20), st.floats(-2, 20), st.floats(-2, 20)), st.none(), st.just(8)),
-       h=st.integers(1, 24), w=st.integers(1, 24), name=st.sampled_from(["prototype", "analysis_prototype"]))
+@given(
+    rect=st.one_of(
+        _rects,
+        st.tuples(_coord, _coord, _side).map(lambda r: f"{r[0]},{r[1]},{r[2]}"),
+        st.text(max_size=10),
+        st.lists(st.integers(-3, 20), max_size=4),
+        st.tuples(st.floats(-2, 20), st.floats(-2, 20), st.floats(-2, 20)),
+        st.none(),
+        st.just(8),
+    ),
+    h=st.integers(1, 24),
+    w=st.integers(1, 24),
+    name=st.sampled_from(["prototype", "analysis_prototype"]),
+)
 def test_parse_and_check_rect(rect, h, w, name):
     """``Square.parse`` + ``check_rect``: a square inside the image, or an error naming the parameter."""
     values = None
@@ -150,8 +161,11 @@ def test_parse_and_check_rect(rect, h, w, name):
     assert parsed == values and not rect_problem(parsed, (h, w))
 
 
-@given(x=st.integers(-20, -1) | st.integers(0, 8), y=st.integers(-20, -1) | st.integers(0, 8),
-       s=st.sampled_from([8, 10, 16]))
+@given(
+    x=st.integers(-20, -1) | st.integers(0, 8),
+    y=st.integers(-20, -1) | st.integers(0, 8),
+    s=st.sampled_from([8, 10, 16]),
+)
 @settings(max_examples=60, deadline=None)
 def test_check_rect_refuses_a_corner_outside(x, y, s):
     """``check_rect`` alone (its callers may skip ``Square.parse``): a negative corner is outside too."""
@@ -178,19 +192,27 @@ def test_default_rect(h, w, block):
 
 # --- synthesize end to end ---------------------------------------------------------------------
 
+
 @fuzz(300)
-@given(tex=textures(small=True), data=st.data(),
-       block=st.sampled_from([8] * 16 + [10, 12, 16] + [0, 7, 30]),
-       segments=st.sampled_from([8] * 16 + [4, 6, 32] + [0, 2, 5]),
-       lowpass=st.sampled_from(["add", "absorb"]), colour=st.sampled_from(["pca", "yuv"]),
-       propagate=st.booleans(), refine=st.integers(0, 2),
-       boundary=st.sampled_from(["auto", "none", "partial", "shaker"]),
-       shaker_start=st.sampled_from(["partial", "analysis"]),
-       mode=st.sampled_from(["analyse", "analyse", "reuse", "field"]),
-       field=st.sampled_from(["swirl", "zoom", "rotate"]), strength=st.floats(0.0, 2.0),
-       seed=st.integers(0, 2**16))
-def test_synthesize_fuzz(tex, data, block, segments, lowpass, colour, propagate, refine, boundary, shaker_start,
-                         mode, field, strength, seed):
+@given(
+    tex=textures(small=True),
+    data=st.data(),
+    block=st.sampled_from([8] * 16 + [10, 12, 16] + [0, 7, 30]),
+    segments=st.sampled_from([8] * 16 + [4, 6, 32] + [0, 2, 5]),
+    lowpass=st.sampled_from(["add", "absorb"]),
+    colour=st.sampled_from(["pca", "yuv"]),
+    propagate=st.booleans(),
+    refine=st.integers(0, 2),
+    boundary=st.sampled_from(["auto", "none", "partial", "shaker"]),
+    shaker_start=st.sampled_from(["partial", "analysis"]),
+    mode=st.sampled_from(["analyse", "analyse", "reuse", "field"]),
+    field=st.sampled_from(["swirl", "zoom", "rotate"]),
+    strength=st.floats(0.0, 2.0),
+    seed=st.integers(0, 2**16),
+)
+def test_synthesize_fuzz(
+    tex, data, block, segments, lowpass, colour, propagate, refine, boundary, shaker_start, mode, field, strength, seed
+):
     h, w = tex.shape[:2]
     problems: set[str] = set()
     if block < 8 or block > 256 or block % 2:
@@ -202,9 +224,21 @@ def test_synthesize_fuzz(tex, data, block, segments, lowpass, colour, propagate,
         other = data.draw(textures(small=True), label="other")
     source = other if other is not None else tex
     rect = data.draw(rects_for(source.shape), label="prototype")
-    kwargs = {"prototype": rect, "prototype_image": other, "block": block, "segments": segments, "lowpass": lowpass,
-                  "colour": colour, "propagate": propagate, "refine": refine, "boundary": boundary, "iterations": 3,
-                  "per_radius": 1, "shaker_start": shaker_start, "rng": seed}
+    kwargs = {
+        "prototype": rect,
+        "prototype_image": other,
+        "block": block,
+        "segments": segments,
+        "lowpass": lowpass,
+        "colour": colour,
+        "propagate": propagate,
+        "refine": refine,
+        "boundary": boundary,
+        "iterations": 3,
+        "per_radius": 1,
+        "shaker_start": shaker_start,
+        "rng": seed,
+    }
     out_hw = (h, w)
     # the oracle: what is wrong with this call by the documented rules, as the words the error must use
     source_name = "prototype image" if other is not None else "texture"
@@ -251,9 +285,15 @@ def test_synthesize_fuzz(tex, data, block, segments, lowpass, colour, propagate,
 
 # --- analyse and render with swapped prototypes -------------------------------------------------
 
+
 @fuzz(80)
-@given(tex=textures(), block=st.sampled_from([8, 8, 10, 12]), lowpass=st.sampled_from(["add", "absorb"]),
-       refine=st.integers(0, 3), data=st.data())
+@given(
+    tex=textures(),
+    block=st.sampled_from([8, 8, 10, 12]),
+    lowpass=st.sampled_from(["add", "absorb"]),
+    refine=st.integers(0, 3),
+    data=st.data(),
+)
 def test_analyse_and_render_any_prototype(tex, block, lowpass, refine, data):
     h, w = tex.shape[:2]
     if block > min(h, w):
@@ -307,9 +347,15 @@ def test_make_prototype_at_every_border(tex, data):
 
 # --- spectra and candidate transforms ----------------------------------------------------------
 
+
 @fuzz(80)
-@given(kind=st.sampled_from(KINDS), n=st.sampled_from([4, 8, 9, 16]), k=st.integers(1, 3),
-       segments=st.sampled_from([4, 8, 32]) | st.integers(-2, 7), seed=st.integers(0, 999))
+@given(
+    kind=st.sampled_from(KINDS),
+    n=st.sampled_from([4, 8, 9, 16]),
+    k=st.integers(1, 3),
+    segments=st.sampled_from([4, 8, 32]) | st.integers(-2, 7),
+    seed=st.integers(0, 999),
+)
 def test_centroids_and_candidates_never_nan(kind, n, k, segments, seed):
     patches = np.stack([texture(kind, n, n, False, seed + i) for i in range(k)])
     if segments < 4 or segments % 2:
@@ -347,10 +393,16 @@ def test_cos2_window(n):
 
 # --- boundary matching and fields --------------------------------------------------------------
 
+
 @fuzz(60)
-@given(tex=textures(), mode=st.sampled_from(["none", "partial", "shaker", "bogus"]),
-       start=st.sampled_from(["partial", "analysis", "x"]), iterations=st.integers(-1, 4),
-       per_radius=st.integers(-1, 3), seed=st.integers(0, 99))
+@given(
+    tex=textures(),
+    mode=st.sampled_from(["none", "partial", "shaker", "bogus"]),
+    start=st.sampled_from(["partial", "analysis", "x"]),
+    iterations=st.integers(-1, 4),
+    per_radius=st.integers(-1, 3),
+    seed=st.integers(0, 99),
+)
 def test_match_boundaries_fuzz(tex, mode, start, iterations, per_radius, seed):
     model = analyse(tex, block=8, segments=8, refine=0, propagate=False)
     problems = set()
@@ -363,8 +415,9 @@ def test_match_boundaries_fuzz(tex, mode, start, iterations, per_radius, seed):
     if per_radius < 1:
         problems.add("'per_radius'")
     try:
-        matched, report = match_boundaries(model, mode, iterations=iterations, per_radius=per_radius, start=start,
-                                           rng=seed)
+        matched, report = match_boundaries(
+            model, mode, iterations=iterations, per_radius=per_radius, start=start, rng=seed
+        )
     except WeftError as e:
         assert problems, str(e)
         one_line_naming(e, problems)
@@ -380,8 +433,13 @@ def test_match_boundaries_fuzz(tex, mode, start, iterations, per_radius, seed):
 
 
 @fuzz(40)
-@given(tex=textures(), field=st.sampled_from(["swirl", "zoom", "rotate", "none", "twirl"]),
-       strength=st.floats(0.0, 2.0), oh=st.integers(8, 30), ow=st.integers(8, 30))
+@given(
+    tex=textures(),
+    field=st.sampled_from(["swirl", "zoom", "rotate", "none", "twirl"]),
+    strength=st.floats(0.0, 2.0),
+    oh=st.integers(8, 30),
+    ow=st.integers(8, 30),
+)
 def test_field_model_fuzz(tex, field, strength, oh, ow):
     proto = make_prototype(tex, block=8)
     try:
@@ -396,9 +454,12 @@ def test_field_model_fuzz(tex, field, strength, oh, ow):
 
 
 @fuzz(60)
-@given(block=st.sampled_from([8, 7, 9, 0, -8, 258, 8.0, True, "8", None]),
-       segments=st.sampled_from([8, 3, 5, 0, -4, 8.0, True, "8", None]),
-       lowpass=st.sampled_from(["add", "absorb", "ADD", "", None]), colour=st.sampled_from(["pca", "yuv", "rgb", None]))
+@given(
+    block=st.sampled_from([8, 7, 9, 0, -8, 258, 8.0, True, "8", None]),
+    segments=st.sampled_from([8, 3, 5, 0, -4, 8.0, True, "8", None]),
+    lowpass=st.sampled_from(["add", "absorb", "ADD", "", None]),
+    colour=st.sampled_from(["pca", "yuv", "rgb", None]),
+)
 def test_analyse_arguments_are_named(block, segments, lowpass, colour):
     """``analyse`` called directly (no Params class in front): wrong arguments are named."""
     tex = texture("noise", 16, 16, True, 0)

@@ -8,9 +8,9 @@ or raises ``WeftError`` in one line; never another exception, never NaN.
 import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
-
 from weft.core.errors import WeftError
 from weft.core.rectify import rectify
+
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, fuzz
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
@@ -24,10 +24,12 @@ _fx, _fy = st.sampled_from([0.0, 4.0, 8.0, 15.0]), st.sampled_from([0.0, 4.0, 8.
 _frontal_line = st.tuples(_fx, _fy, _fx, _fy).map(list)
 
 
-
 @fuzz(80)
-@given(image_lines=st.lists(_line, min_size=0, max_size=6), data=st.data(),
-       warp=st.sampled_from(["homography", "morph", "lines"]))
+@given(
+    image_lines=st.lists(_line, min_size=0, max_size=6),
+    data=st.data(),
+    warp=st.sampled_from(["homography", "morph", "lines"]),
+)
 def test_rectify_with_degenerate_lines(image_lines, data, warp):
     frontal_size = (16, 12)
     frontal = data.draw(st.lists(_frontal_line, min_size=len(image_lines), max_size=len(image_lines)))

@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from weft.core import metrics
 from weft.core.blending import max_levels, poisson_blend, pyramid_blend
 from weft.core.errors import ImageError, InvalidParameter, WeftError
@@ -32,6 +31,7 @@ from weft.core.image import (
     yiq_to_rgb,
 )
 from weft.core.seams import min_cut_mask, min_error_path, overlap_error
+
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
@@ -57,6 +57,7 @@ _kind = st.sampled_from(KINDS)
 
 
 # --- blending ----------------------------------------------------------------------------------
+
 
 @st.composite
 def masks(draw, h, w):
@@ -92,8 +93,17 @@ _side = st.integers(1, 16)
 
 
 @fuzz(150)
-@given(h=_side, w=_side, fg_kind=_kind, bg_kind=_kind, fg_colour=st.booleans(), bg_colour=st.booleans(),
-       levels=st.integers(0, 6) | st.sampled_from([2.0, True, "3"]), data=st.data(), seed=st.integers(0, 999))
+@given(
+    h=_side,
+    w=_side,
+    fg_kind=_kind,
+    bg_kind=_kind,
+    fg_colour=st.booleans(),
+    bg_colour=st.booleans(),
+    levels=st.integers(0, 6) | st.sampled_from([2.0, True, "3"]),
+    data=st.data(),
+    seed=st.integers(0, 999),
+)
 def test_pyramid_blend_fuzz(h, w, fg_kind, bg_kind, fg_colour, bg_colour, levels, data, seed):
     fg = image(fg_kind, h, w, fg_colour, seed)
     bg = image(bg_kind, h, w, bg_colour, seed + 1)
@@ -123,11 +133,19 @@ def test_pyramid_blend_fuzz(h, w, fg_kind, bg_kind, fg_colour, bg_colour, levels
 
 
 @fuzz(100)
-@given(h=_side, w=_side, t_kind=_kind, s_kind=_kind, t_colour=st.booleans(), s_colour=st.booleans(),
-       wrap=st.booleans(), data=st.data(), seed=st.integers(0, 999),
-       tol=st.sampled_from([1e-6, 1e-3, 0.5, np.float32(1e-4), np.float64(1e-5)] * 2
-                           + [0, 1, -1e-3, float("nan"), "x"]),
-       max_iter=st.sampled_from([None, None, 1, 50, 5000] * 2 + [0, -3, 2.5, True, "x"]))
+@given(
+    h=_side,
+    w=_side,
+    t_kind=_kind,
+    s_kind=_kind,
+    t_colour=st.booleans(),
+    s_colour=st.booleans(),
+    wrap=st.booleans(),
+    data=st.data(),
+    seed=st.integers(0, 999),
+    tol=st.sampled_from([1e-6, 1e-3, 0.5, np.float32(1e-4), np.float64(1e-5)] * 2 + [0, 1, -1e-3, float("nan"), "x"]),
+    max_iter=st.sampled_from([None, None, 1, 50, 5000] * 2 + [0, -3, 2.5, True, "x"]),
+)
 def test_poisson_blend_fuzz(h, w, t_kind, s_kind, t_colour, s_colour, wrap, data, seed, tol, max_iter):
     target = image(t_kind, h, w, t_colour, seed)
     source = image(s_kind, h, w, s_colour, seed + 1)
@@ -156,8 +174,11 @@ def test_poisson_blend_fuzz(h, w, t_kind, s_kind, t_colour, s_colour, wrap, data
 
 @pytest.mark.parametrize("which", ["foreground", "background", "mask"])
 def test_blend_mismatched_sizes_name_which(which):
-    imgs = {"foreground": np.zeros((8, 8), np.float32), "background": np.zeros((8, 8), np.float32),
-            "mask": np.zeros((8, 8), np.float32)}
+    imgs = {
+        "foreground": np.zeros((8, 8), np.float32),
+        "background": np.zeros((8, 8), np.float32),
+        "mask": np.zeros((8, 8), np.float32),
+    }
     imgs[which] = np.zeros((8, 9), np.float32)
     with pytest.raises(ImageError) as info:
         pyramid_blend(imgs["foreground"], imgs["background"], imgs["mask"], levels=2)
@@ -169,8 +190,15 @@ def test_blend_mismatched_sizes_name_which(which):
     one_line_naming(info.value, [names[which]])
 
 
-@pytest.mark.parametrize("bad", [np.full((4, 4), 1.5, np.float32), np.full((4, 4), np.nan, np.float32),
-                                 np.zeros((4, 4, 2), np.float32), np.zeros((4,), np.float32)])
+@pytest.mark.parametrize(
+    "bad",
+    [
+        np.full((4, 4), 1.5, np.float32),
+        np.full((4, 4), np.nan, np.float32),
+        np.zeros((4, 4, 2), np.float32),
+        np.zeros((4,), np.float32),
+    ],
+)
 def test_blend_bad_mask_is_named(bad):
     img = np.zeros((4, 4), np.float32)
     for blend in (lambda: pyramid_blend(img, img, bad, levels=1), lambda: poisson_blend(img, img, bad)):
@@ -180,6 +208,7 @@ def test_blend_bad_mask_is_named(bad):
 
 
 # --- seams -------------------------------------------------------------------------------------
+
 
 def _best_path_cost(err: np.ndarray) -> float:
     """Brute-force reference: least total error of an 8-connected top-to-bottom path."""
@@ -198,8 +227,11 @@ _errors = st.builds(
         "zero": lambda: np.zeros((h, w)),
         "integer": lambda: np.random.default_rng(seed).integers(0, 3, (h, w)),
     }[kind](),
-    st.sampled_from(["random", "random", "constant", "zero", "integer"]), st.integers(1, 12), st.integers(1, 12),
-    st.integers(0, 999))
+    st.sampled_from(["random", "random", "constant", "zero", "integer"]),
+    st.integers(1, 12),
+    st.integers(1, 12),
+    st.integers(0, 999),
+)
 
 
 @fuzz(150)
@@ -218,10 +250,15 @@ def test_min_error_path_is_optimal_and_connected(err):
 @given(err=_errors, data=st.data())
 def test_min_cut_mask_fuzz(err, data):
     h, w = err.shape
-    sides = {k: data.draw(st.integers(0, lim) | st.sampled_from([-1, lim + 1, 2.0, True]), label=k)
-             for k, lim in (("left", w), ("top", h), ("right", w), ("bottom", h))}
-    bad = {k for k, v in sides.items()
-           if isinstance(v, (bool, float)) or not 0 <= v <= (w if k in ("left", "right") else h)}
+    sides = {
+        k: data.draw(st.integers(0, lim) | st.sampled_from([-1, lim + 1, 2.0, True]), label=k)
+        for k, lim in (("left", w), ("top", h), ("right", w), ("bottom", h))
+    }
+    bad = {
+        k
+        for k, v in sides.items()
+        if isinstance(v, (bool, float)) or not 0 <= v <= (w if k in ("left", "right") else h)
+    }
     try:
         mask = min_cut_mask(err, **sides)
     except WeftError as e:
@@ -232,7 +269,7 @@ def test_min_cut_mask_fuzz(err, data):
     assert mask.shape == (h, w) and mask.dtype == bool
     left, top, right, bottom = (sides[k] for k in ("left", "top", "right", "bottom"))
     # outside every overlap strip the new block shows
-    assert mask[top:h - bottom, left:w - right].all()
+    assert mask[top : h - bottom, left : w - right].all()
     if not any(sides.values()):
         assert mask.all()
     if left and not (top or right or bottom):  # one vertical cut: old pixels left of it, new from it on
@@ -242,8 +279,13 @@ def test_min_cut_mask_fuzz(err, data):
 
 
 def test_seams_refuse_bad_error_surfaces():
-    for bad, word in ((np.zeros((0, 3)), "shape"), (np.zeros(5), "shape"), (np.full((2, 2), np.nan), "NaN"),
-                      (np.array([["a", "b"]]), "real"), (np.ones((2, 2), complex), "real")):
+    for bad, word in (
+        (np.zeros((0, 3)), "shape"),
+        (np.zeros(5), "shape"),
+        (np.full((2, 2), np.nan), "NaN"),
+        (np.array([["a", "b"]]), "real"),
+        (np.ones((2, 2), complex), "real"),
+    ):
         for call in (min_error_path, min_cut_mask):
             with pytest.raises(ImageError) as info:
                 call(bad)
@@ -270,9 +312,18 @@ _msides = st.sampled_from([7, 8, 9, 12, 16] * 3 + [1, 5, 6])
 
 
 @fuzz(80)
-@given(kind_a=_kind, kind_b=_kind, ha=_msides, wa=_msides, hb=_msides, wb=_msides, colour=st.booleans(),
-       patch=st.sampled_from([1, 3, 7] * 3 + [0, 9, 17]), stride=st.sampled_from([1, 2, 5] * 3 + [0]),
-       seed=st.integers(0, 999))
+@given(
+    kind_a=_kind,
+    kind_b=_kind,
+    ha=_msides,
+    wa=_msides,
+    hb=_msides,
+    wb=_msides,
+    colour=st.booleans(),
+    patch=st.sampled_from([1, 3, 7] * 3 + [0, 9, 17]),
+    stride=st.sampled_from([1, 2, 5] * 3 + [0]),
+    seed=st.integers(0, 999),
+)
 def test_patch_metrics_fuzz(kind_a, kind_b, ha, wa, hb, wb, colour, patch, stride, seed):
     a = image(kind_a, ha, wa, colour, seed)
     b = image(kind_b, hb, wb, colour, seed + 1)
@@ -308,8 +359,15 @@ def test_patch_metrics_fuzz(kind_a, kind_b, ha, wa, hb, wb, colour, patch, strid
 
 
 @fuzz(80)
-@given(kind_a=_kind, kind_b=_kind, h=_msides, w=_msides, colour=st.booleans(), seed=st.integers(0, 999),
-       sigma=st.sampled_from([0.0, 1.0, 3.0, 50.0] * 2 + [-1.0, float("nan"), float("inf"), "3"]))
+@given(
+    kind_a=_kind,
+    kind_b=_kind,
+    h=_msides,
+    w=_msides,
+    colour=st.booleans(),
+    seed=st.integers(0, 999),
+    sigma=st.sampled_from([0.0, 1.0, 3.0, 50.0] * 2 + [-1.0, float("nan"), float("inf"), "3"]),
+)
 def test_fidelity_snr_psnr_fuzz(kind_a, kind_b, h, w, colour, seed, sigma):
     a = image(kind_a, h, w, colour, seed)
     b = image(kind_b, h, w, colour, seed + 1)
@@ -351,9 +409,11 @@ def test_fidelity_snr_psnr_fuzz(kind_a, kind_b, h, w, colour, seed, sigma):
 
 def test_metrics_refuse_mismatched_shapes():
     a = np.zeros((8, 8), np.float32)
-    for fn, names in ((metrics.snr_db, ("original image", "synthesized image")),
-                      (metrics.psnr_db, ("original image", "synthesized image")),
-                      (metrics.fidelity, ("output image", "target image"))):
+    for fn, names in (
+        (metrics.snr_db, ("original image", "synthesized image")),
+        (metrics.psnr_db, ("original image", "synthesized image")),
+        (metrics.fidelity, ("output image", "target image")),
+    ):
         with pytest.raises(ImageError) as info:
             fn(a, np.zeros((8, 9), np.float32))
         assert all(n in str(info.value) for n in names) and "\n" not in str(info.value)
@@ -361,9 +421,15 @@ def test_metrics_refuse_mismatched_shapes():
 
 # --- colour ------------------------------------------------------------------------------------
 
+
 @fuzz(100)
-@given(kind=_kind, h=st.integers(1, 9), w=st.integers(1, 9), seed=st.integers(0, 999),
-       rank=st.sampled_from(["full", "grey", "tint"]))
+@given(
+    kind=_kind,
+    h=st.integers(1, 9),
+    w=st.integers(1, 9),
+    seed=st.integers(0, 999),
+    rank=st.sampled_from(["full", "grey", "tint"]),
+)
 def test_colour_helpers_fuzz(kind, h, w, seed, rank):
     rgb = image(kind, h, w, True, seed)
     if rank == "grey":  # rank-1 colours: all on the grey axis
@@ -419,10 +485,16 @@ _coord = st.integers(-5, 24)
 
 
 @fuzz(300)
-@given(text=st.one_of(st.tuples(_coord, _coord, st.integers(-2, 30)).map(lambda t: ",".join(map(str, t))),
-                      st.text(max_size=10), st.sampled_from(["1,2", "1,2,3,4", "1.5,2,8", " 3 , 4 , 8 ", "", ",,",
-                                                             "nan,0,8", "0,0,1e3", "0x1,0,8"])),
-       h=st.integers(1, 20), w=st.integers(1, 20), name=st.sampled_from(["region", "prototype"]))
+@given(
+    text=st.one_of(
+        st.tuples(_coord, _coord, st.integers(-2, 30)).map(lambda t: ",".join(map(str, t))),
+        st.text(max_size=10),
+        st.sampled_from(["1,2", "1,2,3,4", "1.5,2,8", " 3 , 4 , 8 ", "", ",,", "nan,0,8", "0,0,1e3", "0x1,0,8"]),
+    ),
+    h=st.integers(1, 20),
+    w=st.integers(1, 20),
+    name=st.sampled_from(["region", "prototype"]),
+)
 def test_parse_and_crop_square(text, h, w, name):
     img = image("noise", h, w, True, 0)
     try:
@@ -446,7 +518,7 @@ def test_parse_and_crop_square(text, h, w, name):
         assert x + s > w or y + s > h, f"{square} fits {w}x{h} yet: {e}"
         return
     assert x + s <= w and y + s <= h
-    assert crop.shape == (s, s, 3) and np.array_equal(crop, img[y:y + s, x:x + s])
+    assert crop.shape == (s, s, 3) and np.array_equal(crop, img[y : y + s, x : x + s])
 
 
 @given(x=st.integers(-8, 8), y=st.integers(-8, 8), s=st.integers(-3, 12))

@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 from hypothesis import event, given
 from hypothesis import strategies as st
-
 from weft.core.errors import GeometryError, WeftError
 from weft.core.nfpt import nfpt, synthesize
 from weft.core.rectify import FeatureLines, rectify
 from weft.core.rectify.view import View
+
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, check_image, fuzz, one_line_naming
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
@@ -70,14 +70,23 @@ _PARAMS = {
 
 
 @fuzz(200)
-@given(kind=st.sampled_from(KINDS), hs=_sides, ws=_sides, colour=st.booleans(), seed=st.integers(0, 2**16),
-       repair=st.booleans(), smooth=st.booleans(), data=st.data(),
-       broken=st.lists(st.sampled_from(sorted(_PARAMS)), max_size=2).map(set) | st.just(set()),
-       mask_kind=st.sampled_from(["none", "none", "random", "all", "empty", "corner", "shape"]))
+@given(
+    kind=st.sampled_from(KINDS),
+    hs=_sides,
+    ws=_sides,
+    colour=st.booleans(),
+    seed=st.integers(0, 2**16),
+    repair=st.booleans(),
+    smooth=st.booleans(),
+    data=st.data(),
+    broken=st.lists(st.sampled_from(sorted(_PARAMS)), max_size=2).map(set) | st.just(set()),
+    mask_kind=st.sampled_from(["none", "none", "random", "all", "empty", "corner", "shape"]),
+)
 def test_synthesize_fuzz(kind, hs, ws, colour, seed, repair, smooth, data, broken, mask_kind):
     values = {name: data.draw(bad if name in broken else good, label=name) for name, (good, bad) in _PARAMS.items()}
     size, block, overlap, sigma_d, sigma_s, tol, band, threshold, n = (
-        values[k] for k in ("size", "block", "overlap", "sigma_d", "sigma_s", "tol", "band", "threshold", "n"))
+        values[k] for k in ("size", "block", "overlap", "sigma_d", "sigma_s", "tol", "band", "threshold", "n")
+    )
     tex = texture(kind, hs, ws, colour, seed)
     rng = np.random.default_rng(seed)
     mask = None
@@ -122,14 +131,31 @@ def test_synthesize_fuzz(kind, hs, ws, colour, seed, repair, smooth, data, broke
             if mask_kind == "empty" or (mask_kind == "corner" and block > 8):
                 problems.add("block")  # "no BxB patch of the source lies wholly inside its valid part"
             elif mask_kind == "random":
-                ok = any(mask[y:y + block, x:x + block].all() for y in range(hs - block + 1)
-                         for x in range(ws - block + 1))
+                ok = any(
+                    mask[y : y + block, x : x + block].all()
+                    for y in range(hs - block + 1)
+                    for x in range(ws - block + 1)
+                )
                 if not ok:
                     problems.add("block")
     try:
-        syn = synthesize(tex, size=size, block=block, overlap=overlap, sigma_d=sigma_d, sigma_s=sigma_s, tol=tol,
-                         repair=repair, band=band, threshold=threshold, n=n, smooth=smooth, mask=mask, rng=seed,
-                         return_details=True)
+        syn = synthesize(
+            tex,
+            size=size,
+            block=block,
+            overlap=overlap,
+            sigma_d=sigma_d,
+            sigma_s=sigma_s,
+            tol=tol,
+            repair=repair,
+            band=band,
+            threshold=threshold,
+            n=n,
+            smooth=smooth,
+            mask=mask,
+            rng=seed,
+            return_details=True,
+        )
     except WeftError as e:
         event("refused")
         assert problems, f"valid call refused: {e}"
@@ -144,8 +170,10 @@ def test_synthesize_fuzz(kind, hs, ws, colour, seed, repair, smooth, data, broke
     if mask is not None:
         assert mask.ravel()[syn.pos].all()
     if kind in ("flat", "black") and not smooth:  # a flat source gives the same flat texture
-        assert np.array_equal(np.unique(out.reshape(-1, out.shape[-1] if colour else 1), axis=0),
-                              np.unique(tex.reshape(-1, tex.shape[-1] if colour else 1), axis=0))
+        assert np.array_equal(
+            np.unique(out.reshape(-1, out.shape[-1] if colour else 1), axis=0),
+            np.unique(tex.reshape(-1, tex.shape[-1] if colour else 1), axis=0),
+        )
     elif kind in ("flat", "black"):
         assert np.allclose(out, tex[0, 0], atol=1e-6)
     assert 0 <= syn.repaired <= out_h * out_w
@@ -162,10 +190,28 @@ _line = st.tuples(_x, _y, _x, _y).map(lambda ln: list(ln) if ln[:2] != ln[2:] el
 _fx, _fy = st.sampled_from([0.0, 4.0, 8.0, 15.0]), st.sampled_from([0.0, 4.0, 8.0, 11.0])
 _frontal_line = st.tuples(_fx, _fy, _fx, _fy).map(lambda ln: list(ln) if ln[:2] != ln[2:] else [*ln[:3], 11.0 - ln[3]])
 # a perspective view of the frontal grid: lines that do work, to mix with the degenerate ones
-_GOOD_IMAGE = [[2, 2, 29, 4], [3, 21, 28, 19], [2, 2, 3, 21], [29, 4, 28, 19], [8, 3, 9, 20], [16, 3, 16, 20],
-               [2, 11, 29, 11], [22, 4, 21, 20], [2, 7, 29, 8]]
-_GOOD_FRONTAL = [[0, 0, 15, 0], [0, 11, 15, 11], [0, 0, 0, 11], [15, 0, 15, 11], [4, 0, 4, 11], [8, 0, 8, 11],
-                 [0, 6, 15, 6], [12, 0, 12, 11], [0, 3, 15, 3]]
+_GOOD_IMAGE = [
+    [2, 2, 29, 4],
+    [3, 21, 28, 19],
+    [2, 2, 3, 21],
+    [29, 4, 28, 19],
+    [8, 3, 9, 20],
+    [16, 3, 16, 20],
+    [2, 11, 29, 11],
+    [22, 4, 21, 20],
+    [2, 7, 29, 8],
+]
+_GOOD_FRONTAL = [
+    [0, 0, 15, 0],
+    [0, 11, 15, 11],
+    [0, 0, 0, 11],
+    [15, 0, 15, 11],
+    [4, 0, 4, 11],
+    [8, 0, 8, 11],
+    [0, 6, 15, 6],
+    [12, 0, 12, 11],
+    [0, 3, 15, 3],
+]
 _corner = st.tuples(st.sampled_from([-8.0, 0.0, 4.0, 15.0, 30.0]), st.sampled_from([-8.0, 0.0, 4.0, 12.0, 30.0]))
 
 
@@ -196,10 +242,16 @@ def feature_lines(draw):
 
 
 @fuzz(150)
-@given(lines=feature_lines(), warp=st.sampled_from(["homography", "morph", "lines"]),
-       kind=st.sampled_from(KINDS), colour=st.booleans(),
-       target=st.sampled_from(["plain", "plain", "into_photo", "quad", "view_lines"]), data=st.data(),
-       size=st.sampled_from([None, (16, 16), (24, 13)]), seed=st.integers(0, 999))
+@given(
+    lines=feature_lines(),
+    warp=st.sampled_from(["homography", "morph", "lines"]),
+    kind=st.sampled_from(KINDS),
+    colour=st.booleans(),
+    target=st.sampled_from(["plain", "plain", "into_photo", "quad", "view_lines"]),
+    data=st.data(),
+    size=st.sampled_from([None, (16, 16), (24, 13)]),
+    seed=st.integers(0, 999),
+)
 def test_nfpt_pipeline_with_degenerate_lines(lines, warp, kind, colour, target, data, size, seed):
     photo = texture(kind, PHOTO_H, PHOTO_W, colour, seed)
     image_lines, frontal_lines = lines
@@ -212,8 +264,9 @@ def test_nfpt_pipeline_with_degenerate_lines(lines, warp, kind, colour, target, 
         view = View(None, view_lines=np.array(vl), texture_lines=np.array(tl))
     try:
         fl = FeatureLines(image_lines, frontal_lines, FRONTAL)
-        res = nfpt(photo, fl, view=view, into_photo=target == "into_photo", warp=warp, size=size, block=8, overlap=2,
-                   rng=seed)
+        res = nfpt(
+            photo, fl, view=view, into_photo=target == "into_photo", warp=warp, size=size, block=8, overlap=2, rng=seed
+        )
     except WeftError as e:
         event(f"refused {warp}: {str(e)[:50]}")
         message = str(e)
@@ -244,8 +297,11 @@ def test_nfpt_pipeline_with_degenerate_lines(lines, warp, kind, colour, target, 
 
 
 @fuzz(120)
-@given(image_lines=st.lists(_line, min_size=0, max_size=9), data=st.data(),
-       warp=st.sampled_from(["morph", "morph", "lines", "homography"]))
+@given(
+    image_lines=st.lists(_line, min_size=0, max_size=9),
+    data=st.data(),
+    warp=st.sampled_from(["morph", "morph", "lines", "homography"]),
+)
 def test_rectify_degenerate_lines_warn_nothing(image_lines, data, warp):
     """``test_fuzz_geometry`` again, for morph especially (>= 8 points needed), with warnings as errors."""
     frontal = data.draw(st.lists(_frontal_line, min_size=len(image_lines), max_size=len(image_lines)))
@@ -268,8 +324,7 @@ GOOD_F = np.array(_GOOD_FRONTAL, dtype=np.float64)
 def _refused(image_lines, frontal_lines, warp, *words, size=FRONTAL):
     photo = texture("noise", PHOTO_H, PHOTO_W, False, 1)
     with pytest.raises(GeometryError) as info:
-        nfpt(photo, FeatureLines(image_lines, frontal_lines, size), warp=warp, size=(16, 16), block=8, overlap=2,
-             rng=0)
+        nfpt(photo, FeatureLines(image_lines, frontal_lines, size), warp=warp, size=(16, 16), block=8, overlap=2, rng=0)
     message = str(info.value)
     assert "\n" not in message
     assert all(w in message for w in words), message
@@ -315,9 +370,15 @@ def test_coincident_lines_give_no_points(warp):
 def test_morph_with_many_lines_through_two_points_is_refused_without_warnings():
     """Found by the fuzzing: 8 crossings that are only 2 distinct points in the frontal frame made the
     planarity test's homography send them to infinity ("invalid value encountered in divide")."""
-    image = [[25.66, 9.88, 3.63, 18.35], [1.52, 2.51, 8.34, 10.32], [2.0, 7.81, 7.27, 1.69],
-             [12.26, 4.09, 5.87, 22.77], [3.6, 4.54, 17.27, 15.62], [3.66, 18.48, 24.08, 20.74],
-             [1.33, 5.59, 16.01, 14.6]]
+    image = [
+        [25.66, 9.88, 3.63, 18.35],
+        [1.52, 2.51, 8.34, 10.32],
+        [2.0, 7.81, 7.27, 1.69],
+        [12.26, 4.09, 5.87, 22.77],
+        [3.6, 4.54, 17.27, 15.62],
+        [3.66, 18.48, 24.08, 20.74],
+        [1.33, 5.59, 16.01, 14.6],
+    ]
     frontal = [[4, 4, 0, 8], [8, 4, 16, 12], [8, 4, 8, 0], [4, 4, 4, 8], [8, 0, 8, 8], [4, 12, 8, 8], [0, 4, 12, 4]]
     photo = texture("noise", PHOTO_H, PHOTO_W, True, 3)
     with pytest.raises(GeometryError) as info:
@@ -333,16 +394,26 @@ def test_mismatched_line_counts_are_named(warp):
     assert "image_lines" in str(info.value) and "frontal_lines" in str(info.value)
 
 
-@pytest.mark.parametrize("quad", [
-    [[0, 0], [10, 0], [20, 0], [5, 10]],  # three corners on one line
-    [[0, 0], [15, 0], [0, 12], [15, 12]],  # crossed (bow tie)
-    [[0, 0], [0, 0], [15, 12], [0, 12]],  # two corners coincide
-])
+@pytest.mark.parametrize(
+    "quad",
+    [
+        [[0, 0], [10, 0], [20, 0], [5, 10]],  # three corners on one line
+        [[0, 0], [15, 0], [0, 12], [15, 12]],  # crossed (bow tie)
+        [[0, 0], [0, 0], [15, 12], [0, 12]],  # two corners coincide
+    ],
+)
 def test_degenerate_view_quad_is_named(quad):
     photo = texture("noise", PHOTO_H, PHOTO_W, False, 1)
     with pytest.raises(GeometryError) as info:
-        nfpt(photo, None, view=View(None, quad=np.array(quad, dtype=np.float64)), size=(16, 16), block=8, overlap=2,
-             rng=0)
+        nfpt(
+            photo,
+            None,
+            view=View(None, quad=np.array(quad, dtype=np.float64)),
+            size=(16, 16),
+            block=8,
+            overlap=2,
+            rng=0,
+        )
     assert "\n" not in str(info.value) and "quad" in str(info.value)
 
 
@@ -374,13 +445,27 @@ def test_frame_reaching_the_photo_edge_is_not_darkened(warp):
     darker) on pixels counted as inside, which NFPT then copied as texture."""
     photo = np.full((PHOTO_H, PHOTO_W), 0.7, np.float32)
     w, h = PHOTO_W - 1.0, PHOTO_H - 1.0
-    image = [[0, 0, w, 0], [0, h, w, h], [0, 0, 0, h], [w, 0, w, h], [w / 2, 0, w / 2, h], [0, h / 2, w, h / 2],
-             [0, 0, w, h], [w, 0, 0, h]]
+    image = [
+        [0, 0, w, 0],
+        [0, h, w, h],
+        [0, 0, 0, h],
+        [w, 0, w, h],
+        [w / 2, 0, w / 2, h],
+        [0, h / 2, w, h / 2],
+        [0, 0, w, h],
+        [w, 0, 0, h],
+    ]
     fw, fh = 20.0, 15.0  # a scaled frame: every sample between pixels, a half pixel past the corners
-    frontal = [[-0.5, -0.5, fw - 0.5, -0.5], [-0.5, fh - 0.5, fw - 0.5, fh - 0.5], [-0.5, -0.5, -0.5, fh - 0.5],
-               [fw - 0.5, -0.5, fw - 0.5, fh - 0.5], [fw / 2 - 0.5, -0.5, fw / 2 - 0.5, fh - 0.5],
-               [-0.5, fh / 2 - 0.5, fw - 0.5, fh / 2 - 0.5], [-0.5, -0.5, fw - 0.5, fh - 0.5],
-               [fw - 0.5, -0.5, -0.5, fh - 0.5]]
+    frontal = [
+        [-0.5, -0.5, fw - 0.5, -0.5],
+        [-0.5, fh - 0.5, fw - 0.5, fh - 0.5],
+        [-0.5, -0.5, -0.5, fh - 0.5],
+        [fw - 0.5, -0.5, fw - 0.5, fh - 0.5],
+        [fw / 2 - 0.5, -0.5, fw / 2 - 0.5, fh - 0.5],
+        [-0.5, fh / 2 - 0.5, fw - 0.5, fh / 2 - 0.5],
+        [-0.5, -0.5, fw - 0.5, fh - 0.5],
+        [fw - 0.5, -0.5, -0.5, fh - 0.5],
+    ]
     try:
         out = rectify(photo, image, frontal, (int(fw), int(fh)), warp=warp)
     except GeometryError as e:  # morph: the points of a plane
@@ -397,7 +482,15 @@ def test_into_photo_of_a_flat_photo_is_the_photo(warp):
     """Found by the fuzzing: the texture put back into the photo was composited with its coverage
     twice (a dark seam, down to 0.53 for 0.8) and rang against a black frame (up to 0.93)."""
     photo = np.full((PHOTO_H, PHOTO_W), 0.8, np.float32)
-    res = nfpt(photo, FeatureLines(GOOD_I, GOOD_F, FRONTAL), into_photo=True, warp=warp, size=(20, 16), block=8,
-               overlap=2, rng=0)
+    res = nfpt(
+        photo,
+        FeatureLines(GOOD_I, GOOD_F, FRONTAL),
+        into_photo=True,
+        warp=warp,
+        size=(20, 16),
+        block=8,
+        overlap=2,
+        rng=0,
+    )
     assert 0.3 < res.figures["photo_replaced_fraction"] < 1.0  # the plane's edge crosses the photo
     assert np.allclose(res.image, 0.8, atol=1e-5), (res.image.min(), res.image.max())

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
 from weft.core import registry
 from weft.core.errors import InvalidParameter, WeftError
 from weft.core.params import specs
+
 from tests.core.fuzzing import RUNTIME_WARNINGS_ARE_ERRORS, fuzz
 
 pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
@@ -26,10 +26,15 @@ pytestmark = RUNTIME_WARNINGS_ARE_ERRORS
 METHODS = registry.methods()
 
 _junk = st.one_of(
-    st.none(), st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True),
-    st.text(max_size=12), st.lists(st.integers(-5, 5), max_size=3), st.dictionaries(st.text(max_size=3),
-                                                                                     st.integers(), max_size=2),
-    st.just(b"bytes"), st.just(object()),
+    st.none(),
+    st.booleans(),
+    st.integers(-(10**6), 10**6),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=12),
+    st.lists(st.integers(-5, 5), max_size=3),
+    st.dictionaries(st.text(max_size=3), st.integers(), max_size=2),
+    st.just(b"bytes"),
+    st.just(object()),
 )
 
 
@@ -44,20 +49,43 @@ def _valid(spec) -> st.SearchStrategy:
     if spec.kind == "bool":
         return st.booleans()
     if spec.kind == "choice":
-        return st.sampled_from(spec.choices) | st.sampled_from([c.upper() for c in spec.choices if isinstance(c, str)] or [0])
+        return st.sampled_from(spec.choices) | st.sampled_from(
+            [c.upper() for c in spec.choices if isinstance(c, str)] or [0]
+        )
     if spec.kind == "size":
         side = st.integers(int(spec.lo or 1) - 1, min(int(spec.hi or 64), 96))
         return st.tuples(side, side) | st.builds(lambda w, h: f"{w}x{h}", side, side)
     if spec.kind == "geometry":  # typed geometry: Python callers' forms (a Square also takes "X,Y,S")
-        lines = {"image_lines": [[1, 1, 9, 1], [1, 9, 9, 9]], "frontal_lines": [[0, 0, 8, 0], [0, 8, 8, 8]],
-                 "frontal_size": [8, 8]}
-        return st.sampled_from(["0,0,8", "1,2,16", "x", (1, 2, 16), (-1, 0, 8), [0, 0, 7], lines, {"quad": 1},
-                                "/nonexistent/lines.json", json.dumps(lines)]) | st.text(max_size=16)
+        lines = {
+            "image_lines": [[1, 1, 9, 1], [1, 9, 9, 9]],
+            "frontal_lines": [[0, 0, 8, 0], [0, 8, 8, 8]],
+            "frontal_size": [8, 8],
+        }
+        return st.sampled_from(
+            [
+                "0,0,8",
+                "1,2,16",
+                "x",
+                (1, 2, 16),
+                (-1, 0, 8),
+                [0, 0, 7],
+                lines,
+                {"quad": 1},
+                "/nonexistent/lines.json",
+                json.dumps(lines),
+            ]
+        ) | st.text(max_size=16)
     if spec.kind == "str":
-        lines = json.dumps({"image_lines": [[1, 1, 9, 1], [1, 9, 9, 9]], "frontal_lines": [[0, 0, 8, 0], [0, 8, 8, 8]],
-                            "frontal_size": [8, 8]})
-        return st.sampled_from(["", "0,0,8", "1,2,16", "x", "{", "[]", lines, "/nonexistent/lines.json", "-1,0,8"]) \
-            | st.text(max_size=16)
+        lines = json.dumps(
+            {
+                "image_lines": [[1, 1, 9, 1], [1, 9, 9, 9]],
+                "frontal_lines": [[0, 0, 8, 0], [0, 8, 8, 8]],
+                "frontal_size": [8, 8],
+            }
+        )
+        return st.sampled_from(
+            ["", "0,0,8", "1,2,16", "x", "{", "[]", lines, "/nonexistent/lines.json", "-1,0,8"]
+        ) | st.text(max_size=16)
     raise AssertionError(f"unknown kind {spec.kind}")
 
 
@@ -122,6 +150,7 @@ def test_cli_text_parses_or_names_the_parameter(method, data):
 
 # --- end to end ----------------------------------------------------------------------------------
 
+
 def _image(seed: int, h: int, w: int, colour: bool) -> np.ndarray:
     rng = np.random.default_rng(seed)
     shape = (h, w, 3) if colour else (h, w)
@@ -129,9 +158,18 @@ def _image(seed: int, h: int, w: int, colour: bool) -> np.ndarray:
 
 
 @fuzz(20)
-@given(seed=st.integers(0, 2**16), hs=st.integers(6, 16), ws=st.integers(6, 16), colour=st.booleans(),
-       transfer=st.booleans(), n=st.sampled_from([3, 5]), p=st.floats(0, 1), p_l=st.floats(0, 1),
-       metric=st.sampled_from(["full", "target", "artistic"]), iterations=st.integers(1, 2))
+@given(
+    seed=st.integers(0, 2**16),
+    hs=st.integers(6, 16),
+    ws=st.integers(6, 16),
+    colour=st.booleans(),
+    transfer=st.booleans(),
+    n=st.sampled_from([3, 5]),
+    p=st.floats(0, 1),
+    p_l=st.floats(0, 1),
+    metric=st.sampled_from(["full", "target", "artistic"]),
+    iterations=st.integers(1, 2),
+)
 def test_fast_transfer_fuzz(seed, hs, ws, colour, transfer, n, p, p_l, metric, iterations):
     from weft.core.fast import transfer as fast_transfer
 
@@ -149,18 +187,36 @@ def test_fast_transfer_fuzz(seed, hs, ws, colour, transfer, n, p, p_l, metric, i
 
 
 @fuzz(20)
-@given(seed=st.integers(0, 2**16), hs=st.integers(6, 20), ws=st.integers(6, 20), colour=st.booleans(),
-       mode=st.sampled_from(["random", "overlap", "mincut"]), rule=st.sampled_from(["tol", "epsilon", "sampled"]),
-       tol=st.integers(1, 4), block=st.integers(2, 6), width=st.integers(1, 30), height=st.integers(1, 30),
-       poisson=st.booleans())
+@given(
+    seed=st.integers(0, 2**16),
+    hs=st.integers(6, 20),
+    ws=st.integers(6, 20),
+    colour=st.booleans(),
+    mode=st.sampled_from(["random", "overlap", "mincut"]),
+    rule=st.sampled_from(["tol", "epsilon", "sampled"]),
+    tol=st.integers(1, 4),
+    block=st.integers(2, 6),
+    width=st.integers(1, 30),
+    height=st.integers(1, 30),
+    poisson=st.booleans(),
+)
 def test_quilting_synthesize_fuzz(seed, hs, ws, colour, mode, rule, tol, block, width, height, poisson):
     from weft.core.quilting import synthesize
 
     texture = _image(seed, hs, ws, colour)
     overlap = max(1, block // 3)
     try:
-        out = synthesize(texture, size=(width, height), block=block, overlap=overlap, mode=mode, rule=rule, tol=tol,
-                         poisson=poisson, rng=seed)
+        out = synthesize(
+            texture,
+            size=(width, height),
+            block=block,
+            overlap=overlap,
+            mode=mode,
+            rule=rule,
+            tol=tol,
+            poisson=poisson,
+            rng=seed,
+        )
     except WeftError as e:  # a combination the method refuses must say which parameter
         assert any(k in str(e) for k in ("size", "block", "overlap", "tol", "poisson", "band")), str(e)
         return
@@ -171,20 +227,43 @@ def test_quilting_synthesize_fuzz(seed, hs, ws, colour, mode, rule, tol, block, 
 
 
 @fuzz(15)
-@given(seed=st.integers(0, 2**16), hs=st.integers(6, 20), ws=st.integers(6, 20), colour=st.booleans(),
-       th=st.integers(1, 24), tw=st.integers(1, 24), block=st.integers(2, 8), iterations=st.integers(1, 3),
-       alpha=st.floats(0, 1), mode=st.sampled_from(["overlap", "mincut"]),
-       correspondence=st.sampled_from(["blur", "luminance"]), remap=st.booleans(), poisson=st.booleans())
-def test_quilting_transfer_fuzz(seed, hs, ws, colour, th, tw, block, iterations, alpha, mode, correspondence, remap,
-                                poisson):
+@given(
+    seed=st.integers(0, 2**16),
+    hs=st.integers(6, 20),
+    ws=st.integers(6, 20),
+    colour=st.booleans(),
+    th=st.integers(1, 24),
+    tw=st.integers(1, 24),
+    block=st.integers(2, 8),
+    iterations=st.integers(1, 3),
+    alpha=st.floats(0, 1),
+    mode=st.sampled_from(["overlap", "mincut"]),
+    correspondence=st.sampled_from(["blur", "luminance"]),
+    remap=st.booleans(),
+    poisson=st.booleans(),
+)
+def test_quilting_transfer_fuzz(
+    seed, hs, ws, colour, th, tw, block, iterations, alpha, mode, correspondence, remap, poisson
+):
     from weft.core.quilting import transfer
 
     texture = _image(seed, hs, ws, colour)
     target = _image(seed + 1, th, tw, colour)
     try:
-        outs = transfer(texture, target, block=block, overlap=max(1, block // 3), alpha=alpha, iterations=iterations,
-                        mode=mode, correspondence=correspondence, remap=remap, poisson=poisson, return_all=True,
-                        rng=seed)
+        outs = transfer(
+            texture,
+            target,
+            block=block,
+            overlap=max(1, block // 3),
+            alpha=alpha,
+            iterations=iterations,
+            mode=mode,
+            correspondence=correspondence,
+            remap=remap,
+            poisson=poisson,
+            return_all=True,
+            rng=seed,
+        )
     except WeftError as e:
         assert "\n" not in str(e)
         assert any(k in str(e) for k in ("block", "overlap", "tile")), str(e)
@@ -198,9 +277,16 @@ def test_quilting_transfer_fuzz(seed, hs, ws, colour, th, tw, block, iterations,
 
 
 @fuzz(15)
-@given(seed=st.integers(0, 2**16), hs=st.integers(3, 12), ws=st.integers(3, 12), colour=st.booleans(),
-       mode=st.sampled_from(["superres", "novel"]), magnify=st.integers(1, 4), p_l=st.floats(0, 1),
-       iterations=st.integers(1, 2))
+@given(
+    seed=st.integers(0, 2**16),
+    hs=st.integers(3, 12),
+    ws=st.integers(3, 12),
+    colour=st.booleans(),
+    mode=st.sampled_from(["superres", "novel"]),
+    magnify=st.integers(1, 4),
+    p_l=st.floats(0, 1),
+    iterations=st.integers(1, 2),
+)
 def test_fast_superres_and_novel_fuzz(seed, hs, ws, colour, mode, magnify, p_l, iterations):
     from weft.core.fast import transfer as fast_transfer
 

@@ -4,25 +4,30 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.core import registry
 from weft.core.errors import GeometryError, InvalidParameter
 from weft.core.geometry import FeatureLines, LineDraft, Square
 from weft.core.params import Recipe
 from weft.core.studio import reduce_for_preview
 
-LINES = {"image_lines": [[1, 1, 30, 2], [2, 20, 31, 22]], "frontal_lines": [[0, 0, 32, 0], [0, 20, 32, 20]],
-         "frontal_size": [32, 24]}
+LINES = {
+    "image_lines": [[1, 1, 30, 2], [2, 20, 31, 22]],
+    "frontal_lines": [[0, 0, 32, 0], [0, 20, 32, 20]],
+    "frontal_size": [32, 24],
+}
 
 
-@pytest.mark.parametrize("text, fragment", [
-    ("a,b", "parameter 'region' = 'a,b' must be X,Y,SIDE"),
-    ("1,2", "must be X,Y,S"),
-    ("-1,0,8", "the corner -1,0 must not be negative"),
-    ("0,0,1", "the side 1 must be at least 2"),
-    ((1, 2, 8.5), "must be X,Y,SIDE"),
-    ((True, 2, 8), "must be X,Y,SIDE"),
-])
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ("a,b", "parameter 'region' = 'a,b' must be X,Y,SIDE"),
+        ("1,2", "must be X,Y,S"),
+        ("-1,0,8", "the corner -1,0 must not be negative"),
+        ("0,0,1", "the side 1 must be at least 2"),
+        ((1, 2, 8.5), "must be X,Y,SIDE"),
+        ((True, 2, 8), "must be X,Y,SIDE"),
+    ],
+)
 def test_one_square_parser_with_one_line_errors(text, fragment):
     with pytest.raises(InvalidParameter) as e:
         Square.parse(text)

@@ -15,7 +15,6 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 from PIL import Image, ImageOps
-
 from weft.core import image as ci
 from weft.core.errors import ImageError, InvalidParameter, WeftError
 from weft.core.image import (
@@ -171,14 +170,16 @@ def test_grey_alpha_stays_grey(tmp_path):
 
 def _png_by_hand(path, pixels, colour_type):
     """A minimal 16-bit PNG written chunk by chunk (Pillow cannot write 16-bit grey+alpha)."""
+
     def chunk(kind, body):
         return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
 
     h, w = pixels.shape[:2]
     rows = b"".join(b"\0" + pixels[i].astype(">u2").tobytes() for i in range(h))
     ihdr = struct.pack(">IIBBBBB", w, h, 16, colour_type, 0, 0, 0)
-    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(rows))
-                     + chunk(b"IEND", b""))
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
+    )
     return path
 
 
@@ -227,8 +228,10 @@ def test_cmyk_jpeg_is_converted(tmp_path):
     assert img.shape == (8, 8, 3) and "CMYK converted to RGB" in info.notes
 
 
-@pytest.mark.parametrize("fmt, ext, kw", [("BMP", ".bmp", {}), ("WEBP", ".webp", {"lossless": True}),
-                                          ("TIFF", ".tif", {}), ("PNG", ".png", {})])
+@pytest.mark.parametrize(
+    "fmt, ext, kw",
+    [("BMP", ".bmp", {}), ("WEBP", ".webp", {"lossless": True}), ("TIFF", ".tif", {}), ("PNG", ".png", {})],
+)
 def test_other_formats_load(tmp_path, fmt, ext, kw):
     a = rgb8(seed=4, shape=(7, 5, 3))
     pil_save(tmp_path / f"x{ext}", Image.fromarray(a), fmt, **kw)
@@ -335,11 +338,14 @@ def test_exif_orientation_6_rotates_other_formats(tmp_path, fmt, ext):
 # Recipes in PNG
 
 
-@pytest.mark.parametrize("recipe, chunk", [
-    ('{"method": "quilt", "block": 32}', b"tEXt"),
-    ("caf\u00e9 \u00b1 latin-1 only\nsecond line", b"tEXt"),
-    ('{"name": "雪の織物 ✓ €"}', b"iTXt"),
-])
+@pytest.mark.parametrize(
+    "recipe, chunk",
+    [
+        ('{"method": "quilt", "block": 32}', b"tEXt"),
+        ("caf\u00e9 \u00b1 latin-1 only\nsecond line", b"tEXt"),
+        ('{"name": "雪の織物 ✓ €"}', b"iTXt"),
+    ],
+)
 def test_recipe_round_trip(tmp_path, recipe, chunk):
     x = rng_image((5, 4, 3))
     path = tmp_path / "r.png"
@@ -408,8 +414,15 @@ def test_save_refuses_unknown_extension(tmp_path):
 def test_save_refuses_16bit_jpeg_and_bad_parameters(tmp_path):
     with pytest.raises(ImageError, match="JPEG.*16-bit"):
         save_image(tmp_path / "a.jpg", rng_image((2, 2)), bit_depth=16)
-    for kw in ({"bit_depth": 12}, {"bit_depth": True}, {"quality": 101}, {"quality": -1}, {"quality": 9.5},
-               {"recipe": b"bytes"}, {"recipe": "nul\0inside"}):
+    for kw in (
+        {"bit_depth": 12},
+        {"bit_depth": True},
+        {"quality": 101},
+        {"quality": -1},
+        {"quality": 9.5},
+        {"recipe": b"bytes"},
+        {"recipe": "nul\0inside"},
+    ):
         with pytest.raises(InvalidParameter):
             save_image(tmp_path / "a.png", rng_image((2, 2)), **kw)
     with pytest.raises(ImageError, match="NaN"):
@@ -521,8 +534,10 @@ def test_decompression_bomb_refused_from_header(tmp_path, monkeypatch):
     before = Image.MAX_IMAGE_PIXELS
     with pytest.raises(ImageError) as e:
         load_image(path)
-    assert str(e.value) == (f"{path}: 60000x60000 = 3600.0 megapixels exceeds the limit of 50 megapixels "
-                            "(set WEFT_MAX_PIXELS or max_pixels to raise it)")
+    assert str(e.value) == (
+        f"{path}: 60000x60000 = 3600.0 megapixels exceeds the limit of 50 megapixels "
+        "(set WEFT_MAX_PIXELS or max_pixels to raise it)"
+    )
     assert_one_line_error(e, path)
     assert Image.MAX_IMAGE_PIXELS == before  # Pillow's own setting restored
 
@@ -647,10 +662,13 @@ def test_read_error_after_header(tmp_path, monkeypatch):
 def test_pillow_fallback_matches_opencv(tmp_path, monkeypatch, kind):
     a = rgb8(seed=7, shape=(5, 6, 3))
     pim = {
-        "rgb": Image.fromarray(a), "grey": Image.fromarray(a[..., 0]),
+        "rgb": Image.fromarray(a),
+        "grey": Image.fromarray(a[..., 0]),
         "rgba": Image.fromarray(np.dstack([a, a[..., :1]]), "RGBA"),
-        "la": Image.fromarray(a[..., :2], "LA"), "palette": Image.fromarray(a).convert("P"),
-        "grey16": Image.fromarray((a[..., 0].astype(np.uint16) * 257)), "gif": Image.fromarray(a).convert("P"),
+        "la": Image.fromarray(a[..., :2], "LA"),
+        "palette": Image.fromarray(a).convert("P"),
+        "grey16": Image.fromarray(a[..., 0].astype(np.uint16) * 257),
+        "gif": Image.fromarray(a).convert("P"),
     }[kind]
     path = pil_save(tmp_path / ("x.gif" if kind == "gif" else "x.png"), pim)
     via_cv2 = load_image(path)
@@ -708,20 +726,23 @@ def test_validate_image_conversions():
     assert validate_image(np.ones((2, 2))).max() == 1.0
 
 
-@pytest.mark.parametrize("bad, expected", [
-    (np.full((2, 2), np.nan, np.float32), "NaN"),
-    (np.full((2, 2), np.inf), "infinite"),
-    (np.full((2, 2), -0.01), "outside [0, 1]"),
-    (np.full((2, 2, 3), 1.5), "outside [0, 1]"),
-    (np.zeros((2, 2, 4)), "shape"),
-    (np.zeros((2, 2, 1)), "shape"),
-    (np.zeros(5), "shape"),
-    (np.zeros((1, 2, 3, 3)), "shape"),
-    (np.zeros((0, 5)), "empty"),
-    (np.zeros((2, 2), np.int32), "dtype"),
-    (np.zeros((2, 2), bool), "dtype"),
-    (np.zeros((2, 2), np.complex64), "dtype"),
-])
+@pytest.mark.parametrize(
+    "bad, expected",
+    [
+        (np.full((2, 2), np.nan, np.float32), "NaN"),
+        (np.full((2, 2), np.inf), "infinite"),
+        (np.full((2, 2), -0.01), "outside [0, 1]"),
+        (np.full((2, 2, 3), 1.5), "outside [0, 1]"),
+        (np.zeros((2, 2, 4)), "shape"),
+        (np.zeros((2, 2, 1)), "shape"),
+        (np.zeros(5), "shape"),
+        (np.zeros((1, 2, 3, 3)), "shape"),
+        (np.zeros((0, 5)), "empty"),
+        (np.zeros((2, 2), np.int32), "dtype"),
+        (np.zeros((2, 2), bool), "dtype"),
+        (np.zeros((2, 2), np.complex64), "dtype"),
+    ],
+)
 def test_validate_image_rejects(bad, expected):
     with pytest.raises(ImageError) as e:
         validate_image(bad, what="texture")
@@ -737,8 +758,10 @@ def test_validate_uint8_property(a):
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(hnp.arrays(np.uint16, st.tuples(st.integers(1, 6), st.integers(1, 6), st.sampled_from([3]))),
-       st.sampled_from([".png", ".tif"]))
+@given(
+    hnp.arrays(np.uint16, st.tuples(st.integers(1, 6), st.integers(1, 6), st.sampled_from([3]))),
+    st.sampled_from([".png", ".tif"]),
+)
 def test_16bit_round_trip_property(tmp_path, a, ext):
     path = tmp_path / f"p{ext}"
     save_image(path, a, bit_depth=16)
@@ -875,15 +898,20 @@ def test_module_has_no_bgr_leak(tmp_path):
 
 def _png16_with_trns(path, samples: np.ndarray, key: tuple[int, ...]) -> None:
     """A 16-bit grey (colour type 0) or RGB (type 2) PNG whose transparency is a tRNS colour key."""
+
     def chunk(kind: bytes, body: bytes) -> bytes:
         return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
 
     h, w = samples.shape[:2]
     colour_type = 0 if samples.ndim == 2 else 2
     raw = b"".join(b"\0" + samples[y].astype(">u2").tobytes() for y in range(h))
-    Path(path).write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, colour_type, 0, 0, 0))
-                           + chunk(b"tRNS", struct.pack(f">{len(key)}H", *key))
-                           + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+    Path(path).write_bytes(
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, colour_type, 0, 0, 0))
+        + chunk(b"tRNS", struct.pack(f">{len(key)}H", *key))
+        + chunk(b"IDAT", zlib.compress(raw))
+        + chunk(b"IEND", b"")
+    )
 
 
 @pytest.mark.parametrize("colour", [False, True], ids=["grey", "rgb"])

@@ -14,7 +14,6 @@ from collections import defaultdict
 
 import numpy as np
 import pytest
-
 import weft.core.errors
 from weft.core.errors import WeftError
 from weft.core.jobs import Cancelled, CancelToken, JobResult, JobRunner, Progress, ProgressReporter

@@ -13,7 +13,6 @@ import time
 import tracemalloc
 
 import numpy as np
-
 from weft.core.jobs import JobRunner
 
 HANG = 10.0  # seconds: far beyond any sequence here; only a deadlock reaches it
@@ -50,7 +49,9 @@ def _sequence(rng: random.Random) -> None:
         op = rng.random()
         if op < 0.7:
             kind = rng.choice(["cooperative", "raise", "ignore", "instant"])
-            jobs.append(runner.submit(rng.choice(SLOTS), _job, kind, 0.0 if kind == "instant" else rng.uniform(0, 0.003)))
+            jobs.append(
+                runner.submit(rng.choice(SLOTS), _job, kind, 0.0 if kind == "instant" else rng.uniform(0, 0.003))
+            )
         elif op < 0.85:
             runner.cancel(rng.choice(SLOTS))
         elif op < 0.9:

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from weft.core.image import save_image
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -40,8 +39,7 @@ def setup(tmp_path_factory):
     return tmp
 
 
-def run_blend(setup, *, package_writable=True, home_writable=True, numba_dir_writable=None, tmpdir=None,
-              no_temp=False):
+def run_blend(setup, *, package_writable=True, home_writable=True, numba_dir_writable=None, tmpdir=None, no_temp=False):
     """``weft blend --mode poisson`` on the package copy; returns (exit code, stderr, env)."""
     pkg = setup / "pkg"
     cache = pkg / "weft" / "core" / "_kernels" / "__pycache__"
@@ -59,11 +57,16 @@ def run_blend(setup, *, package_writable=True, home_writable=True, numba_dir_wri
     env["TMPDIR"] = str(tmpdir if tmpdir is not None else setup / "tmp")
     Path(env["TMPDIR"]).mkdir(exist_ok=True)
     env["PYTHONPATH"] = str(pkg)
-    patch = ("import weft.core._kernels as k; k.fallback_cache_root = lambda: " + repr(str(setup / "file" / "t")) + "; "
-             if no_temp else "")
-    code = (f"import sys; {patch}from weft.app.cli import main; sys.exit(main(['blend', {str(setup / 'fg.png')!r}, "
-            f"{str(setup / 'bg.png')!r}, '--mask', {str(setup / 'mask.png')!r}, '--mode', 'poisson', "
-            f"'-o', {str(setup / 'out.png')!r}]))")
+    patch = (
+        "import weft.core._kernels as k; k.fallback_cache_root = lambda: " + repr(str(setup / "file" / "t")) + "; "
+        if no_temp
+        else ""
+    )
+    code = (
+        f"import sys; {patch}from weft.app.cli import main; sys.exit(main(['blend', {str(setup / 'fg.png')!r}, "
+        f"{str(setup / 'bg.png')!r}, '--mask', {str(setup / 'mask.png')!r}, '--mode', 'poisson', "
+        f"'-o', {str(setup / 'out.png')!r}]))"
+    )
     r = subprocess.run([sys.executable, "-c", code], cwd=setup, env=env, capture_output=True, text=True, timeout=300)
     assert (setup / "out.png").exists() or r.returncode != 0
     return r.returncode, r.stderr, env
@@ -73,7 +76,9 @@ def test_unwritable_numba_cache_dir_runs(setup):
     code, err, _ = run_blend(setup, numba_dir_writable=False)
     assert code == 0, err
     assert err == ""
-    assert list((setup / "pkg" / "weft" / "core" / "_kernels" / "__pycache__").glob("poisson.poisson_cg-*.nbi"))  # numba's next folder
+    assert list(
+        (setup / "pkg" / "weft" / "core" / "_kernels" / "__pycache__").glob("poisson.poisson_cg-*.nbi")
+    )  # numba's next folder
 
 
 def test_unwritable_package_folder_runs(setup):
@@ -90,8 +95,9 @@ def test_unwritable_home_runs(setup):
 
 def test_nothing_writable_falls_back_to_a_private_temp_folder_that_stays_warm(setup):
     tmpdir = setup / "tmp-all"
-    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
-                             tmpdir=tmpdir)
+    code, err, _ = run_blend(
+        setup, package_writable=False, home_writable=False, numba_dir_writable=False, tmpdir=tmpdir
+    )
     assert code == 0, err  # was: weft: internal error: RuntimeError: cannot cache function ...: no locator
     assert err == ""
     folder = tmpdir / f"weft-numba-{os.getuid()}"
@@ -99,8 +105,9 @@ def test_nothing_writable_falls_back_to_a_private_temp_folder_that_stays_warm(se
     index = list(folder.glob("*/poisson.poisson_cg-*.nbi"))
     assert index
     stamp = index[0].stat().st_mtime_ns
-    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
-                             tmpdir=tmpdir)
+    code, err, _ = run_blend(
+        setup, package_writable=False, home_writable=False, numba_dir_writable=False, tmpdir=tmpdir
+    )
     assert code == 0 and err == ""
     assert index[0].stat().st_mtime_ns == stamp  # loaded from there, not compiled and saved again
 
@@ -110,16 +117,16 @@ def test_a_temp_folder_open_to_others_is_not_used(setup):
     folder = tmpdir / f"weft-numba-{os.getuid()}"
     folder.mkdir(parents=True)
     folder.chmod(0o777)  # someone could plant cache files (pickles) there
-    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
-                             tmpdir=tmpdir)
+    code, err, _ = run_blend(
+        setup, package_writable=False, home_writable=False, numba_dir_writable=False, tmpdir=tmpdir
+    )
     assert code == 0, err
     assert err.startswith("weft: " + NO_CACHE)
     assert not list(folder.iterdir())
 
 
 def test_no_writable_folder_at_all_runs_uncached_with_a_one_line_notice(setup):
-    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False,
-                             no_temp=True)
+    code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False, no_temp=True)
     assert code == 0, err
     lines = err.splitlines()
     assert len(lines) == 1 and lines[0].startswith("weft: " + NO_CACHE)
@@ -158,7 +165,7 @@ def _cut_cache_files(folder: Path) -> int:
     files = [p for p in folder.rglob("*") if p.suffix in (".nbi", ".nbc")]
     for p in files:
         data = p.read_bytes()
-        p.write_bytes(data[:len(data) // 2])
+        p.write_bytes(data[: len(data) // 2])
     return len(files)
 
 
@@ -170,8 +177,9 @@ def test_a_cache_cut_short_is_dropped_recompiled_and_said_once(setup):
     code, err, _ = run_blend(setup, numba_dir_writable=True)
     assert code == 0, err  # was: exit 1, EOFError: Ran out of input, on every run
     lines = err.splitlines()
-    assert lines and all(line.startswith("weft: numba's cache of ") and "dropped and compiled again" in line
-                         for line in lines), err
+    assert lines and all(
+        line.startswith("weft: numba's cache of ") and "dropped and compiled again" in line for line in lines
+    ), err
     assert any("poisson" in line for line in lines)
     code, err, _ = run_blend(setup, numba_dir_writable=True)  # repaired: loads quietly
     assert code == 0 and err == "", err

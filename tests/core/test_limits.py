@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from weft.app import cli
 from weft.core import fast, limits, nfpt, quilting
 from weft.core.errors import WeftError
@@ -51,8 +50,11 @@ def test_iterative_transfer_counts_every_pass():
     assert five > 4 * one  # the later passes have smaller blocks, so more of them
     limits.set_max_seconds((five + one) / 2)
     quilting.transfer(tex, target, iterations=1, block=31, overlap=21, rng=1)  # one pass fits the limit
-    with pytest.raises(LimitError, match=r"^transfer of 128x128 from a 64x64 texture \(.* blocks of 31 to 9 px in 5 "
-                                         r"passes\) would take about .*fewer iterations"):
+    with pytest.raises(
+        LimitError,
+        match=r"^transfer of 128x128 from a 64x64 texture \(.* blocks of 31 to 9 px in 5 "
+        r"passes\) would take about .*fewer iterations",
+    ):
         quilting.transfer(tex, target, iterations=5, progress=_never_called)
 
 
@@ -66,8 +68,11 @@ def test_quilting_estimate_scales_with_blocks_and_texture():
 
 def test_output_over_the_pixel_limit_is_refused_naming_what_set_it():
     set_max_pixels(10_000)
-    with pytest.raises(LimitError, match=r"^parameter 'size': an output of 200x100 = 0\.0 megapixels exceeds the limit "
-                                         r"of 0\.01 megapixels"):
+    with pytest.raises(
+        LimitError,
+        match=r"^parameter 'size': an output of 200x100 = 0\.0 megapixels exceeds the limit "
+        r"of 0\.01 megapixels",
+    ):
         quilting.synthesize(_tex(), size=(200, 100), block=16, progress=_never_called)
     with pytest.raises(LimitError, match=r"^parameter 'size': an output of 128x128"):
         quilting.synthesize(_tex(), block=16, mode="random")  # default size: twice the texture
@@ -85,8 +90,11 @@ def test_output_over_the_pixel_limit_is_refused_naming_what_set_it():
 def test_more_memory_than_available_is_refused(monkeypatch):
     monkeypatch.setattr(limits, "available_memory", lambda: 20 * 2**20)  # 20 MiB free
     target = np.zeros((1024, 1024, 3), np.float32)  # 1 Mpx x 50 B > 20 MiB
-    with pytest.raises(LimitError, match=r"^fast transfer of 1024x1024 needs about 50 MiB of memory, 20 MiB is "
-                                         r"available: make the output smaller$"):
+    with pytest.raises(
+        LimitError,
+        match=r"^fast transfer of 1024x1024 needs about 50 MiB of memory, 20 MiB is "
+        r"available: make the output smaller$",
+    ):
         fast.transfer(_tex(), target, progress=_never_called)
     with pytest.raises(LimitError, match=r"^quilting 1024x1024 from a 64x64 texture needs about"):
         quilting.synthesize(_tex(), size=(1024, 1024), block=32, progress=_never_called)
@@ -99,8 +107,11 @@ def test_nfpt_too_long_is_refused():
     est = nfpt.estimate_seconds(tex.shape, (256, 256), 16, 4)
     assert est > 0
     limits.set_max_seconds(est / 2)
-    with pytest.raises(LimitError, match=r"^NFPT synthesis of 256x256 from a 128x128 texture with 16 px patches "
-                                         r"would take about"):
+    with pytest.raises(
+        LimitError,
+        match=r"^NFPT synthesis of 256x256 from a 128x128 texture with 16 px patches "
+        r"would take about",
+    ):
         nfpt.synthesize(tex, size=(256, 256), block=16, overlap=4, progress=_never_called)
 
 
@@ -124,13 +135,15 @@ def test_cli_refuses_a_long_job_in_one_line_and_writes_nothing(tmp_path, capsys,
 
     monkeypatch.setenv("WEFT_MAX_SECONDS", "5")
     out = tmp_path / "out.png"
-    code = cli.main(["quilt", str(example("gravel")), "--size", "4096x4096", "--block", "4", "--overlap", "1",
-                     "-o", str(out)])
+    code = cli.main(
+        ["quilt", str(example("gravel")), "--size", "4096x4096", "--block", "4", "--overlap", "1", "-o", str(out)]
+    )
     err = capsys.readouterr().err
     assert code == 2 and not out.exists()
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
-    assert err.startswith("weft: quilting of 4096x4096 from a 256x256 texture (1,863,225 blocks of 4 px) would take "
-                          "about "), err
+    assert err.startswith(
+        "weft: quilting of 4096x4096 from a 256x256 texture (1,863,225 blocks of 4 px) would take about "
+    ), err
     assert "(limit 5.0 s)" in err
 
 
@@ -144,12 +157,18 @@ def test_transfer_memory_counts_its_rows_of_spectra(monkeypatch):
     of 50 B per output pixel and 60 B per texture pixel; a synthesis of the same size has no rows."""
     monkeypatch.setattr(limits, "available_memory", lambda: 30 * 2**20)
     tex, target = _tex(256, colour=False), _tex(512, colour=False)
-    with pytest.raises(LimitError, match=r"^quilting 512x512 from a 256x256 texture needs about 59 MiB of memory, "
-                                         r"30 MiB is available: use a smaller target or a smaller part of the texture$"):
+    with pytest.raises(
+        LimitError,
+        match=r"^quilting 512x512 from a 256x256 texture needs about 59 MiB of memory, "
+        r"30 MiB is available: use a smaller target or a smaller part of the texture$",
+    ):
         quilting.transfer(tex, target, progress=_never_called)
     monkeypatch.setattr(limits, "available_memory", lambda: 10 * 2**20)
-    with pytest.raises(LimitError, match=r"^quilting 512x512 from a 256x256 texture needs about 14 MiB of memory, "
-                                         r"10 MiB is available: use a smaller size or"):
+    with pytest.raises(
+        LimitError,
+        match=r"^quilting 512x512 from a 256x256 texture needs about 14 MiB of memory, "
+        r"10 MiB is available: use a smaller size or",
+    ):
         quilting.synthesize(tex, size=(512, 512), block=32, progress=_never_called)
 
 
@@ -170,27 +189,50 @@ def _fake_system(tmp_path, monkeypatch, cgroup_line: str, files: dict[str, str],
 
 
 def test_a_cgroup_v2_limit_below_the_hosts_memory_is_what_is_available(tmp_path, monkeypatch):
-    _fake_system(tmp_path, monkeypatch, "0::/job", {
-        "job/memory.max": "629145600\n", "job/memory.current": "104857600\n",
-        "job/memory.stat": "anon 80000000\ninactive_file 20971520\n", "memory.max": "max\n"})
+    _fake_system(
+        tmp_path,
+        monkeypatch,
+        "0::/job",
+        {
+            "job/memory.max": "629145600\n",
+            "job/memory.current": "104857600\n",
+            "job/memory.stat": "anon 80000000\ninactive_file 20971520\n",
+            "memory.max": "max\n",
+        },
+    )
     assert limits.available_memory() == 629145600 - (104857600 - 20971520)  # 600 MiB limit, 80 MiB used
 
 
 def test_a_parent_cgroups_limit_applies_and_the_hosts_when_smaller(tmp_path, monkeypatch):
-    _fake_system(tmp_path, monkeypatch, "4:memory:/outer/inner", {
-        "memory/outer/inner/memory.limit_in_bytes": "9223372036854771712\n",
-        "memory/outer/inner/memory.usage_in_bytes": "0\n",
-        "memory/outer/memory.limit_in_bytes": str(300 * 2**20), "memory/outer/memory.usage_in_bytes": str(100 * 2**20)})
+    _fake_system(
+        tmp_path,
+        monkeypatch,
+        "4:memory:/outer/inner",
+        {
+            "memory/outer/inner/memory.limit_in_bytes": "9223372036854771712\n",
+            "memory/outer/inner/memory.usage_in_bytes": "0\n",
+            "memory/outer/memory.limit_in_bytes": str(300 * 2**20),
+            "memory/outer/memory.usage_in_bytes": str(100 * 2**20),
+        },
+    )
     assert limits.available_memory() == 200 * 2**20
-    _fake_system(tmp_path / "b", monkeypatch, "0::/", {"memory.max": str(8 * 2**30), "memory.current": "0"},
-                 meminfo_kib=2**20)
+    _fake_system(
+        tmp_path / "b", monkeypatch, "0::/", {"memory.max": str(8 * 2**30), "memory.current": "0"}, meminfo_kib=2**20
+    )
     assert limits.available_memory() == 2**30  # the host has less than the group allows
 
 
 def test_ulimit_v_bounds_what_is_available(monkeypatch):
     resource = pytest.importorskip("resource")
-    monkeypatch.setattr(resource, "getrlimit", lambda which: (limits._vm_size() + 50 * 2**20, resource.RLIM_INFINITY)
-                        if which == resource.RLIMIT_AS else (resource.RLIM_INFINITY, resource.RLIM_INFINITY))
+    monkeypatch.setattr(
+        resource,
+        "getrlimit",
+        lambda which: (
+            (limits._vm_size() + 50 * 2**20, resource.RLIM_INFINITY)
+            if which == resource.RLIMIT_AS
+            else (resource.RLIM_INFINITY, resource.RLIM_INFINITY)
+        ),
+    )
     assert 45 * 2**20 < limits.available_memory() <= 50 * 2**20
 
 
@@ -225,11 +267,28 @@ def test_a_job_too_large_for_its_container_is_refused_up_front(tmp_path):
         rng = np.random.default_rng(0)
         save_image(tmp_path / "tex.png", rng.random((64, 64, 3), dtype=np.float32))
         save_image(tmp_path / "big.png", rng.random((4096, 4096), dtype=np.float32))
-        script = (f"echo $$ > {group}/cgroup.procs && exec \"$@\"")
-        done = subprocess.run(["sh", "-c", script, "sh", sys.executable, "-c",
-                               "import sys; from weft.app.cli import main; sys.exit(main())", "fast",
-                               str(tmp_path / "tex.png"), "--target", str(tmp_path / "big.png"), "-o",
-                               str(tmp_path / "o.png"), "-q"], capture_output=True, text=True, timeout=300)
+        script = f'echo $$ > {group}/cgroup.procs && exec "$@"'
+        done = subprocess.run(
+            [
+                "sh",
+                "-c",
+                script,
+                "sh",
+                sys.executable,
+                "-c",
+                "import sys; from weft.app.cli import main; sys.exit(main())",
+                "fast",
+                str(tmp_path / "tex.png"),
+                "--target",
+                str(tmp_path / "big.png"),
+                "-o",
+                str(tmp_path / "o.png"),
+                "-q",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert done.returncode == 2, done.stderr
         assert "of memory" in done.stderr and "is available" in done.stderr and done.stderr.count("\n") == 1
         assert not (tmp_path / "o.png").exists()
@@ -244,7 +303,9 @@ def _colour_png(tmp_path, side: int):
     from weft.core.image import load_image, save_image
 
     path = tmp_path / "small.png"
-    save_image(path, load_image(limits.__file__.rsplit("/core/", 1)[0] + "/resources/astronaut.png").image[:side, :side])
+    save_image(
+        path, load_image(limits.__file__.rsplit("/core/", 1)[0] + "/resources/astronaut.png").image[:side, :side]
+    )
     return path
 
 
@@ -272,8 +333,21 @@ def test_small_quilting_blocks_count_their_per_block_cost(tmp_path, capsys):
 
     limits.set_max_seconds(5)
     save_image(tmp_path / "t.png", _tex(128))
-    code = cli.main(["quilt", str(tmp_path / "t.png"), "--size", "300x300", "--block", "4", "--overlap", "1",
-                     "-o", str(tmp_path / "o.png"), "-q"])
+    code = cli.main(
+        [
+            "quilt",
+            str(tmp_path / "t.png"),
+            "--size",
+            "300x300",
+            "--block",
+            "4",
+            "--overlap",
+            "1",
+            "-o",
+            str(tmp_path / "o.png"),
+            "-q",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 2 and "would take about" in err and err.count("\n") == 1, err
     assert not (tmp_path / "o.png").exists()

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from weft.core.errors import GeometryError, InvalidParameter
 from weft.core.geometry import MAX_SIDE, Margins, Mask
 from weft.core.image import load_image
@@ -24,7 +23,9 @@ def test_brush_eraser_and_lasso_pixels():
     m = Mask.empty(20, 10).painted_line((2, 5), (12, 5), radius=1)
     assert m.bits[5, 2:13].all() and m.bits[4, 7] and m.bits[6, 7] and not m.bits[2, 7]
     assert m.bbox() == (1, 4, 14, 7)  # radius 1 around the segment: one pixel beyond each end and side
-    assert Mask.empty(9, 9).painted_line((4, 4), (4, 4), radius=2).area == 21  # a disc: centres within 2.5 px (d² in 0,1,2,4,5)
+    assert (
+        Mask.empty(9, 9).painted_line((4, 4), (4, 4), radius=2).area == 21
+    )  # a disc: centres within 2.5 px (d² in 0,1,2,4,5)
     erased = m.painted_line((7, 5), (7, 5), radius=1, value=False)  # a dot of the eraser
     assert not erased.bits[5, 7] and erased.bits[5, 2] and erased.area < m.area
     lasso = Mask.empty(20, 20).painted_polygon([(5, 5), (15, 5), (15, 15), (5, 15)])
@@ -45,7 +46,9 @@ def test_png_round_trip_is_one_bit(tmp_path):
 
 
 def test_size_check_names_both_sizes():
-    with pytest.raises(GeometryError, match="the mask is 20x10 but the image is 64x48; a mask must be the size of its image"):
+    with pytest.raises(
+        GeometryError, match="the mask is 20x10 but the image is 64x48; a mask must be the size of its image"
+    ):
         Mask.empty(20, 10).check_size((48, 64, 3))
     with pytest.raises(GeometryError, match=f"side over {MAX_SIDE}"):
         Mask(np.zeros((1, MAX_SIDE + 1), bool))

@@ -9,7 +9,6 @@ import cv2
 import numpy as np
 import pytest
 from skimage import data
-
 from weft.core.errors import ImageError, InvalidParameter, WeftError
 from weft.core.metrics import _nearest_distances, coherence, completeness, fidelity, snr_db
 
@@ -309,7 +308,9 @@ def test_verbatim_region_of_nothing_copied_and_bad_maps():
     from weft.core.metrics import verbatim_fraction, verbatim_region
 
     assert verbatim_region(np.full((5, 6, 2), -1, np.int32)) == 0
-    with pytest.raises(ImageError, match=r"source map has shape \(5, 6\) and type int32; it must be \(H, W, 2\) integers"):
+    with pytest.raises(
+        ImageError, match=r"source map has shape \(5, 6\) and type int32; it must be \(H, W, 2\) integers"
+    ):
         verbatim_region(np.zeros((5, 6), np.int32))
     with pytest.raises(ImageError, match="must be"):
         verbatim_region(np.zeros((5, 6, 2), np.float32))

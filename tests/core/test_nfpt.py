@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from weft.core import metrics
 from weft.core.errors import Cancelled, GeometryError, ImageError, InvalidParameter
 from weft.core.examples import example
@@ -70,7 +69,7 @@ def test_feature_weight_is_eq_2_and_3():
     w = np.zeros((16, 16), np.float32)
     tw = np.zeros((16, 16), np.float32)
     const = _k.l_template(canvas[..., 0], canvas, 0, 0, 8, wd, 0.35, 32, 0.5, w, tw)
-    g = lambda f: np.exp(-(f - 1) ** 2 / (2 * 0.35 ** 2)) / (np.sqrt(2 * np.pi) * 0.35)
+    g = lambda f: np.exp(-((f - 1) ** 2) / (2 * 0.35**2)) / (np.sqrt(2 * np.pi) * 0.35)
     assert w[3, 0] == pytest.approx(wd[3, 0] + g(0.0), rel=1e-5)  # background: M = 0.5
     assert w[2, 0] == pytest.approx(wd[2, 0] + g(0.4), rel=1e-5)  # feature: |P - M| = 0.4
     assert w[2, 0] > w[3, 0] and (w[:, 2:] == 0).all()
@@ -116,13 +115,16 @@ def test_progress_per_patch_row_with_preview_and_cancel(gravel):
         synthesize(gravel, size=(96, 96), block=32, overlap=8, rng=1, progress=cancel_after_first, cancel=token)
 
 
-@pytest.mark.parametrize("kwargs, fragment", [
-    (dict(overlap=20, block=32), "parameter 'overlap' = 20 is outside 2..16"),
-    (dict(n=4), "parameter 'n' = 4 must be odd"),
-    (dict(block=200), "parameter 'block' = 200 is outside 8..96 \\(must fit in the source texture, 96x96\\)"),
-    (dict(sigma_s=0.0), "parameter 'sigma_s' = 0 is outside 0.01..10"),
-    (dict(size=(4, 4)), "parameter 'size' = 4x4 has a side outside 8..16384"),
-])
+@pytest.mark.parametrize(
+    "kwargs, fragment",
+    [
+        (dict(overlap=20, block=32), "parameter 'overlap' = 20 is outside 2..16"),
+        (dict(n=4), "parameter 'n' = 4 must be odd"),
+        (dict(block=200), "parameter 'block' = 200 is outside 8..96 \\(must fit in the source texture, 96x96\\)"),
+        (dict(sigma_s=0.0), "parameter 'sigma_s' = 0 is outside 0.01..10"),
+        (dict(size=(4, 4)), "parameter 'size' = 4x4 has a side outside 8..16384"),
+    ],
+)
 def test_bad_parameters(gravel, kwargs, fragment):
     with pytest.raises(InvalidParameter, match=fragment):
         synthesize(gravel, **kwargs)
@@ -155,7 +157,9 @@ def test_method_runs_with_params_and_reports_figures(photo):
     params = NfptParams(lines=LINES_JSON, size=(96, 96), block=32, overlap=8)
     result = METHOD.run({"photo": photo}, params, rng=1)
     assert result.image.shape == (96, 96, 3)
-    assert {"patches", "repaired_pixels", "repaired_fraction", "rectify_rms_lines_px", "homography"} <= set(result.figures)
+    assert {"patches", "repaired_pixels", "repaired_fraction", "rectify_rms_lines_px", "homography"} <= set(
+        result.figures
+    )
     assert NfptParams().block == 48  # defaults construct (the studio builds them for every method)
     with pytest.raises(InvalidParameter, match="'view' and 'into_photo' exclude each other"):
         NfptParams(view={"quad": [[0, 0], [9, 0], [9, 9], [0, 9]]}, into_photo=True)
@@ -177,6 +181,6 @@ def test_fft_search_equals_the_direct_sum_of_eq_3(fur):
     assert (w[wd == 0] == 0).all() and (w[wd > 0] > wd[wd > 0]).all()  # W_d + W_s on the L only
     t = canvas_y[7:23, 9:25].astype(np.float64)
     for py, px in [(0, 0), (10, 20), (24, 34), (3, 30)]:
-        s = src_y[py:py + 16, px:px + 16].astype(np.float64)
+        s = src_y[py : py + 16, px : px + 16].astype(np.float64)
         direct = (w * (t - s) ** 2).sum()
         assert cmap[py, px] + const == pytest.approx(direct, rel=1e-3, abs=1e-4)

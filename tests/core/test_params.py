@@ -1,10 +1,9 @@
 """Parameter dataclasses: validation messages, specs for the front ends, recipe round trips."""
 
-from dataclasses import dataclass, FrozenInstanceError
+from dataclasses import FrozenInstanceError, dataclass
 
 import numpy as np
 import pytest
-
 from weft.core.errors import InvalidParameter, WeftError
 from weft.core.params import Params, Recipe, Spec, as_rng, out_of_range, param, parse_size, specs
 
@@ -126,7 +125,7 @@ def test_recipe_json_round_trip(tmp_path):
         ("{not json", "not valid JSON"),
         ("[]", "must be a JSON object"),
         ('{"weft": 2, "method": "quilt"}', "version 1"),
-        ('{"weft": 1}', "no \"method\""),
+        ('{"weft": 1}', 'no "method"'),
         ('{"weft": 1, "method": "quilt", "seed": -1}', "non-negative integer"),
         ('{"weft": 1, "method": "quilt", "inputs": {"texture": 3}}', "map input names to file paths"),
     ],

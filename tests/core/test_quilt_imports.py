@@ -26,8 +26,10 @@ def test_small_synthesis_loads_neither_numba_nor_scipy_sparse():
 def test_the_command_line_loads_no_scipy_fft_until_a_method_needs_it():
     """``weft`` imports every method's module (the registry); affine's spectral code imported
     scipy.fft at the top, 0.12 s of every process's start (``weft fill``, ``weft quilt``...)."""
-    script = ("import sys; from weft.core import registry; assert 'affine' in registry.methods(); "
-              "print('scipy.fft' in sys.modules)")
+    script = (
+        "import sys; from weft.core import registry; assert 'affine' in registry.methods(); "
+        "print('scipy.fft' in sys.modules)"
+    )
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "False"

@@ -4,13 +4,23 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.core.errors import GeometryError, InvalidParameter
 from weft.core.examples import example
 from weft.core.image import load_image, resize
 from weft.core.metrics import psnr_db
-from weft.core.rectify import (FeatureLines, Rectifier, apply_homography, fit_homography, line_correspondences,
-                          load_feature_lines, parse_feature_lines, rectify, rectify_feature_lines, scale_lines)
+from weft.core.rectify import (
+    FeatureLines,
+    Rectifier,
+    apply_homography,
+    fit_homography,
+    line_correspondences,
+    load_feature_lines,
+    parse_feature_lines,
+    rectify,
+    rectify_feature_lines,
+    scale_lines,
+)
+
 from benchmarks.fixtures.synthetic import folded_case, perspective_case
 
 LINES_JSON = example("perspective").parent / "perspective-lines.json"
@@ -19,7 +29,7 @@ LINES_JSON = example("perspective").parent / "perspective-lines.json"
 def interior(img, frac=0.05):
     h, w = img.shape[:2]
     m = int(frac * min(h, w))
-    return img[m:h - m, m:w - m]
+    return img[m : h - m, m : w - m]
 
 
 @pytest.fixture(scope="module")
@@ -57,7 +67,7 @@ def test_synthetic_case_is_rectified_within_half_a_pixel(case):
     xs, ys = np.meshgrid(np.linspace(0, 399, 9), np.linspace(0, 299, 7))
     pts = np.column_stack([xs.ravel(), ys.ravel()])
     err = apply_homography(np.linalg.inv(case.homography) @ r.homography, pts) - pts
-    assert np.sqrt((err ** 2).sum(axis=1)).max() < 0.5
+    assert np.sqrt((err**2).sum(axis=1)).max() < 0.5
 
 
 def test_a_badly_drawn_line_is_outvoted(case):
@@ -67,7 +77,9 @@ def test_a_badly_drawn_line_is_outvoted(case):
     assert psnr_db(interior(case.frontal), interior(r.image)) >= 34
     plain = Rectifier(case.photo).apply(
         __import__("weft.core.rectify.warps", fromlist=["plan_warp"]).plan_warp(
-            case.frontal_lines, bad, case.frontal_size, (640, 480), robust=False))
+            case.frontal_lines, bad, case.frontal_size, (640, 480), robust=False
+        )
+    )
     assert psnr_db(interior(case.frontal), interior(plain.image)) < 34  # least squares alone is dragged off
 
 
@@ -165,20 +177,36 @@ SQUARE_DST = [[0, 0, 99, 0], [99, 0, 99, 99], [99, 99, 0, 99], [0, 99, 0, 0]]
 SQUARE_SRC = [[10, 10, 90, 20], [90, 20, 90, 80], [90, 80, 10, 90], [10, 90, 10, 10]]
 
 
-@pytest.mark.parametrize("src, dst, fragment", [
-    (SQUARE_SRC[:3], SQUARE_DST[:3], "at least 4 feature lines, got 3"),
-    ([[10, 10 + 20 * k, 90, 12 + 20 * k] for k in range(4)], [[0, 25 * k, 99, 25 * k] for k in range(4)],
-     "all 4 feature lines are parallel"),
-    ([[10, 10, 10, 10]] + SQUARE_SRC[1:], SQUARE_DST, "image line 0 has zero length"),
-    ([[10, 10, 900, 20]] + SQUARE_SRC[1:], SQUARE_DST, r"image line 0 end \(900, 20\) is outside the photo \(480x360\)"),
-    (SQUARE_SRC, SQUARE_DST[:1] + [[50, 50, 50, 50]] + SQUARE_DST[2:], "frontal line 1 has zero length"),
-    (SQUARE_SRC, SQUARE_DST[:3] + [[0, 99, 0, 500]], r"frontal line 3 end \(0, 500\) is outside the frontal frame"),
-    # two bundles of parallel lines that cross only far outside, plus one
-    ([[10, 10, 90, 10], [10, 30, 90, 30], [10, 50, 90, 50], [50, 10, 52, 90]],
-     [[0, 0, 99, 0], [0, 20, 99, 20], [0, 40, 99, 40], [50, 0, 50, 99]], "only 3 of the 6 line pairs meet"),
-    ([[10, 10, 90, 10], [10, 10, 10, 90], [20, 20, 80, 80], [30, 30, 70, 70]],
-     [[0, 0, 99, 0], [0, 0, 0, 99], [10, 10, 90, 90], [20, 20, 80, 80]], "lie on one line"),
-])
+@pytest.mark.parametrize(
+    "src, dst, fragment",
+    [
+        (SQUARE_SRC[:3], SQUARE_DST[:3], "at least 4 feature lines, got 3"),
+        (
+            [[10, 10 + 20 * k, 90, 12 + 20 * k] for k in range(4)],
+            [[0, 25 * k, 99, 25 * k] for k in range(4)],
+            "all 4 feature lines are parallel",
+        ),
+        ([[10, 10, 10, 10]] + SQUARE_SRC[1:], SQUARE_DST, "image line 0 has zero length"),
+        (
+            [[10, 10, 900, 20]] + SQUARE_SRC[1:],
+            SQUARE_DST,
+            r"image line 0 end \(900, 20\) is outside the photo \(480x360\)",
+        ),
+        (SQUARE_SRC, SQUARE_DST[:1] + [[50, 50, 50, 50]] + SQUARE_DST[2:], "frontal line 1 has zero length"),
+        (SQUARE_SRC, SQUARE_DST[:3] + [[0, 99, 0, 500]], r"frontal line 3 end \(0, 500\) is outside the frontal frame"),
+        # two bundles of parallel lines that cross only far outside, plus one
+        (
+            [[10, 10, 90, 10], [10, 30, 90, 30], [10, 50, 90, 50], [50, 10, 52, 90]],
+            [[0, 0, 99, 0], [0, 20, 99, 20], [0, 40, 99, 40], [50, 0, 50, 99]],
+            "only 3 of the 6 line pairs meet",
+        ),
+        (
+            [[10, 10, 90, 10], [10, 10, 10, 90], [20, 20, 80, 80], [30, 30, 70, 70]],
+            [[0, 0, 99, 0], [0, 0, 0, 99], [10, 10, 90, 90], [20, 20, 80, 80]],
+            "lie on one line",
+        ),
+    ],
+)
 def test_bad_lines_give_one_clear_line(photo, src, dst, fragment):
     with pytest.raises(GeometryError, match=fragment) as e:
         rectify(photo, src, dst, (100, 100))
@@ -190,11 +218,17 @@ def test_parse_errors_name_the_file_key_and_index(tmp_path):
     assert isinstance(parse_feature_lines(good), FeatureLines)
     cases = [
         ({k: v for k, v in good.items() if k != "frontal_lines"}, 'no "frontal_lines"'),
-        ({**good, "image_lines": SQUARE_SRC[:2] + [[1, 2, 3]] + SQUARE_SRC[3:]}, r"image_lines\[2\] = \[1, 2, 3\] must be"),
+        (
+            {**good, "image_lines": SQUARE_SRC[:2] + [[1, 2, 3]] + SQUARE_SRC[3:]},
+            r"image_lines\[2\] = \[1, 2, 3\] must be",
+        ),
         ({**good, "image_lines": SQUARE_SRC[:3]}, "3 image_lines but 4 frontal_lines"),
         ({**good, "frontal_size": [100, 0]}, "frontal_size = \\[100, 0\\] has a side outside"),
-        ({**good, "frontal_size": "big"}, "frontal_size = \"big\" must be \\[width, height\\]"),
-        ({**good, "frontal_size": [100.5, 100]}, "frontal_size = \\[100.5, 100\\] must be \\[width, height\\] in whole"),
+        ({**good, "frontal_size": "big"}, 'frontal_size = "big" must be \\[width, height\\]'),
+        (
+            {**good, "frontal_size": [100.5, 100]},
+            "frontal_size = \\[100.5, 100\\] must be \\[width, height\\] in whole",
+        ),
         ({**good, "image_lines": [[1, 2, 3, "x"]]}, r"image_lines\[0\]"),
     ]
     for data, fragment in cases:
@@ -203,7 +237,7 @@ def test_parse_errors_name_the_file_key_and_index(tmp_path):
         with pytest.raises(GeometryError, match=fragment) as e:
             load_feature_lines(path)
         assert str(e.value).startswith(str(path))
-    (tmp_path / "bad.json").write_text("{\"image_lines\": [")
+    (tmp_path / "bad.json").write_text('{"image_lines": [')
     with pytest.raises(GeometryError, match="bad.json: not valid JSON"):
         load_feature_lines(tmp_path / "bad.json")
     with pytest.raises(GeometryError, match="nowhere.json: no such feature-lines file"):

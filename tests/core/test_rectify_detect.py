@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
-
-from benchmarks.rectify_suggest import Case, camera, photograph, residual, text, tiles
 from weft.core.errors import GeometryError
 from weft.core.rectify import REFUSAL, rectify, suggest_lines
+
+from benchmarks.rectify_suggest import Case, photograph, residual, text, tiles
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,6 @@ import json
 
 import numpy as np
 import pytest
-
 from weft.core.errors import GeometryError
 from weft.core.examples import example
 from weft.core.image import load_image
@@ -41,10 +40,13 @@ def test_lines_view_matches_the_equivalent_quad(checker):
     h = np.linalg.inv(quad_homography(quad, (160, 120)))  # texture -> view
     view_corners = apply_homography(h, tex_corners)
     sides = lambda c: np.array([[*c[i], *c[(i + 1) % 4]] for i in range(4)])
-    view = parse_view({"image_lines": sides(view_corners).tolist(), "frontal_lines": sides(tex_corners).tolist(),
-                       "size": [300, 220]})
+    view = parse_view(
+        {"image_lines": sides(view_corners).tolist(), "frontal_lines": sides(tex_corners).tolist(), "size": [300, 220]}
+    )
     by_lines, _ = view_plan(view, (160, 120), (300, 220)).apply(checker)
-    by_quad, _ = view_plan(parse_view({"quad": quad.tolist(), "size": [300, 220]}), (160, 120), (300, 220)).apply(checker)
+    by_quad, _ = view_plan(parse_view({"quad": quad.tolist(), "size": [300, 220]}), (160, 120), (300, 220)).apply(
+        checker
+    )
     assert np.abs(by_lines - by_quad).mean() < 0.01
 
 
@@ -54,18 +56,26 @@ def test_view_without_size_takes_the_default(checker):
     assert plan.dst_size == (100, 80)
 
 
-@pytest.mark.parametrize("data, fragment", [
-    ({"quad": [[0, 0], [10, 0], [10, 10]]}, "quad = .* must be four corners"),
-    ({"quad": [[0, 0], [10, 0], [20, 0], [0, 10]]}, "quad corners 0, 1, 2 lie on one line"),
-    ({"quad": [[0, 0], [10, 10], [10, 0], [0, 10]]}, "is not convex"),
-    ({"image_lines": [[0, 0, 1, 1]]}, 'no "frontal_lines"'),
-    ({"image_lines": [[0, 0, 1, 1]], "frontal_lines": []}, "1 image_lines but 0 frontal_lines"),
-    ({"size": [10, 10]}, 'a view needs a "quad"'),
-    ({"quad": [[0, 0], [10, 0], [10, 10], [0, 10]], "size": [0, 10]}, "size = \\[0, 10\\] has a side outside"),
-    ({"image_lines": [[0, 0, 50, 0], [50, 0, 50, 40], [50, 40, 0, 40], [0, 40, 500, 0]],
-      "frontal_lines": [[0, 0, 9, 0], [9, 0, 9, 9], [9, 9, 0, 9], [0, 9, 0, 0]], "size": [60, 50]},
-     r"view line 3 end \(500, 0\) is outside the view \(60x50\)"),
-])
+@pytest.mark.parametrize(
+    "data, fragment",
+    [
+        ({"quad": [[0, 0], [10, 0], [10, 10]]}, "quad = .* must be four corners"),
+        ({"quad": [[0, 0], [10, 0], [20, 0], [0, 10]]}, "quad corners 0, 1, 2 lie on one line"),
+        ({"quad": [[0, 0], [10, 10], [10, 0], [0, 10]]}, "is not convex"),
+        ({"image_lines": [[0, 0, 1, 1]]}, 'no "frontal_lines"'),
+        ({"image_lines": [[0, 0, 1, 1]], "frontal_lines": []}, "1 image_lines but 0 frontal_lines"),
+        ({"size": [10, 10]}, 'a view needs a "quad"'),
+        ({"quad": [[0, 0], [10, 0], [10, 10], [0, 10]], "size": [0, 10]}, "size = \\[0, 10\\] has a side outside"),
+        (
+            {
+                "image_lines": [[0, 0, 50, 0], [50, 0, 50, 40], [50, 40, 0, 40], [0, 40, 500, 0]],
+                "frontal_lines": [[0, 0, 9, 0], [9, 0, 9, 9], [9, 9, 0, 9], [0, 9, 0, 0]],
+                "size": [60, 50],
+            },
+            r"view line 3 end \(500, 0\) is outside the view \(60x50\)",
+        ),
+    ],
+)
 def test_bad_views_give_one_clear_line(tmp_path, checker, data, fragment):
     path = tmp_path / "v.json"
     path.write_text(json.dumps(data))
@@ -81,15 +91,18 @@ def test_into_photo_inverts_the_rectification():
     photo = load_image(example("perspective")).image
     lines = load_feature_lines(LINES_JSON)
     rect = rectify_feature_lines(photo, lines)
-    plan = into_photo_plan(rect.plan, lines.image_lines, lines.frontal_lines, lines.frontal_size, (480, 360), (512, 384))
+    plan = into_photo_plan(
+        rect.plan, lines.image_lines, lines.frontal_lines, lines.frontal_size, (480, 360), (512, 384)
+    )
     back, alpha = plan.apply(rect.image, alpha=True)
     inside = alpha >= 1.0
     # the rectified wall put back where it came from reproduces the photo there
     assert inside.mean() > 0.35
     assert np.abs(back[inside] - photo[inside]).mean() < 0.03
     # a larger texture is centred on the frontal frame: the wall grows on every side
-    bigger = into_photo_plan(rect.plan, lines.image_lines, lines.frontal_lines, lines.frontal_size, (480, 360),
-                             (1024, 768))
+    bigger = into_photo_plan(
+        rect.plan, lines.image_lines, lines.frontal_lines, lines.frontal_size, (480, 360), (1024, 768)
+    )
     _, alpha2 = bigger.apply(np.zeros((768, 1024), np.float32), alpha=True)
     assert alpha2.mean() > alpha.mean() + 0.2
 
@@ -105,6 +118,6 @@ def test_into_photo_and_views_stop_at_the_horizon():
     horizon_y = -(plan.homography[2, 0] * 150 + plan.homography[2, 2]) / plan.homography[2, 1]
     assert 60 < horizon_y < 120
     mx, my = homography_maps(plan.homography, (300, 200))
-    assert (mx[: int(horizon_y) - 1] < -1e5).all() and (mx[int(horizon_y) + 2:] > -1e5).all()
+    assert (mx[: int(horizon_y) - 1] < -1e5).all() and (mx[int(horizon_y) + 2 :] > -1e5).all()
     out, alpha = plan.apply(np.full((100, 100), 0.5, np.float32), alpha=True)
     assert np.isfinite(out).all() and alpha[: int(horizon_y)].max() == 0.0 and alpha[190, 150] == 1.0

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from weft.core.errors import ImageError, InvalidParameter
 from weft.core.seams import min_cut_mask, min_error_path, overlap_error
 
@@ -26,7 +25,7 @@ def test_vertical_path_follows_the_only_cheap_route():
     mask = min_cut_mask(err, left=w)
     # left of the path the existing pixels stay, from the path on the new block shows
     for y in range(h):
-        assert not mask[y, : path[y]].any() and mask[y, path[y]:].all()
+        assert not mask[y, : path[y]].any() and mask[y, path[y] :].all()
 
 
 def test_path_prefers_lower_total_error_not_lower_first_step():

@@ -5,7 +5,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-
 from weft.core import registry
 from weft.core.errors import WeftError
 from weft.core.geometry import Margins, Mask
@@ -20,9 +19,13 @@ class HoleParams(Params):
     grow: Margins = param(None, kind="geometry", type=Margins, optional=True, help="margins")
 
 
-STUDIO = Studio(title="t", canvas="picture", preview_around="hole", masks_of={"source": ("texture", "picture")},
-                geometry=(Geometry(MASK, on=("picture",), input="hole"),
-                          Geometry(MARGINS, on=("picture",), param="grow")))
+STUDIO = Studio(
+    title="t",
+    canvas="picture",
+    preview_around="hole",
+    masks_of={"source": ("texture", "picture")},
+    geometry=(Geometry(MASK, on=("picture",), input="hole"), Geometry(MARGINS, on=("picture",), param="grow")),
+)
 
 
 def _inputs(h=300, w=400, hole=None):
@@ -73,7 +76,7 @@ def test_margins_are_off_in_the_crop_and_offset_the_paste():
     grown = np.zeros((305, 407, 3), np.float32)
     part = np.ones((y1 - y0, x1 - x0, 3), np.float32)
     pasted = around.paste(grown, part)
-    assert pasted[y0 + 5:y1 + 5, x0 + 7:x1 + 7].min() == 1.0 and pasted.sum() == part.sum()
+    assert pasted[y0 + 5 : y1 + 5, x0 + 7 : x1 + 7].min() == 1.0 and pasted.sum() == part.sum()
     assert around.paste(np.zeros((10, 10, 3), np.float32), part) is None  # does not fit: nothing
 
 
@@ -88,9 +91,14 @@ def test_no_crop_without_anything_painted_near_the_stroke_or_without_the_field()
     assert crop_around(STUDIO, inputs, HoleParams(), (10, 10, 20, 20)) is None
 
 
-HOLE = Method(name="hole-test", summary="t", params=HoleParams,
-              inputs=(InputSpec("picture", "p"), InputSpec("hole", "h", required=False)),
-              run=lambda inputs, params, **kw: Result(inputs["picture"]), studio=STUDIO)
+HOLE = Method(
+    name="hole-test",
+    summary="t",
+    params=HoleParams,
+    inputs=(InputSpec("picture", "p"), InputSpec("hole", "h", required=False)),
+    run=lambda inputs, params, **kw: Result(inputs["picture"]),
+    studio=STUDIO,
+)
 
 
 @pytest.fixture
@@ -106,35 +114,54 @@ def test_a_session_reads_its_mask_png_and_margins(hole_method, tmp_path):
     assert png == tmp_path / "s.weft.hole-test.hole.png"
     mask = Mask.empty(40, 30).painted_line((5, 5), (30, 20), 3)
     mask.save(png)
-    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
-                                   "geometry": {HOLE.name: {"hole": png.name, "grow": [1, 2, 3, 4]}}}))
+    session.write_text(
+        json.dumps(
+            {"weft_session": 1, "method": HOLE.name, "geometry": {HOLE.name: {"hole": png.name, "grow": [1, 2, 3, 4]}}}
+        )
+    )
     data = read_session(session)
     assert data["geometry"][HOLE.name] == {"hole": mask, "grow": Margins(1, 2, 3, 4)}
 
 
 def test_a_session_naming_a_missing_mask_or_bad_margins_says_which(hole_method, tmp_path):
     session = tmp_path / "s.weft.json"
-    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
-                                   "geometry": {HOLE.name: {"hole": "gone.png"}}}))
+    session.write_text(
+        json.dumps({"weft_session": 1, "method": HOLE.name, "geometry": {HOLE.name: {"hole": "gone.png"}}})
+    )
     with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: .*gone\.png"):
         read_session(session)
-    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
-                                   "geometry": {HOLE.name: {"grow": [1, -2, 3, 4]}}}))
+    session.write_text(
+        json.dumps({"weft_session": 1, "method": HOLE.name, "geometry": {HOLE.name: {"grow": [1, -2, 3, 4]}}})
+    )
     with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: parameter 'grow' = 1,-2,3,4: the top margin -2"):
         read_session(session)
 
 
 def test_a_session_read_with_a_dropped_list_leaves_out_a_missing_mask_and_says_so(hole_method, tmp_path):
     session = tmp_path / "s.weft.json"
-    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,
-                                   "geometry": {HOLE.name: {"hole": "gone.png", "grow": [1, 2, 3, 4]}}}))
+    session.write_text(
+        json.dumps(
+            {
+                "weft_session": 1,
+                "method": HOLE.name,
+                "geometry": {HOLE.name: {"hole": "gone.png", "grow": [1, 2, 3, 4]}},
+            }
+        )
+    )
     dropped = []
     data = read_session(session, dropped=dropped)
     assert data["geometry"][HOLE.name] == {"grow": Margins(1, 2, 3, 4)}
     assert len(dropped) == 1 and dropped[0].startswith(f"{session}: hole-test: ") and "gone.png" in dropped[0]
     assert dropped[0].endswith("; dropped")
-    session.write_text(json.dumps({"weft_session": 1, "method": HOLE.name,  # not a file name: still refused
-                                   "geometry": {HOLE.name: {"hole": 3}}}))
+    session.write_text(
+        json.dumps(
+            {
+                "weft_session": 1,
+                "method": HOLE.name,  # not a file name: still refused
+                "geometry": {HOLE.name: {"hole": 3}},
+            }
+        )
+    )
     with pytest.raises(WeftError, match=r"s\.weft\.json: hole-test: hole = 3 must be the name of a mask PNG"):
         read_session(session, dropped=[])
 

@@ -6,11 +6,10 @@ import threading
 
 import numpy as np
 import pytest
-from numba import njit
-
 import weft.core._kernels  # noqa: F401  (installs the compile-event listener)
+from numba import njit
 from weft.core import registry
-from weft.core.jobs import CancelToken, Cancelled
+from weft.core.jobs import Cancelled, CancelToken
 
 
 @pytest.fixture
@@ -22,10 +21,12 @@ def fake_methods(monkeypatch):
     monkeypatch.setattr(registry, "_warm", set())
     monkeypatch.setattr(registry, "_MODULES", {"a": "x", "b": "x", "c": "x"})
     for name in "abc":
+
         def warm(name=name):
             calls.append(name)
             if name in gates:
                 gates[name].wait(30)
+
         monkeypatch.setitem(registry._loaded, name, dataclasses.replace(base, name=name, warm_up=warm))
     return calls, gates
 
@@ -71,8 +72,10 @@ def test_watch_compiles_sees_a_real_compile_once_and_only_its_thread():
         return x + 1.0
 
     started = []
-    with registry.watch_compiles(on_start=lambda: started.append(threading.get_ident())) as everywhere, \
-            registry.watch_compiles(this_thread=True) as mine:
+    with (
+        registry.watch_compiles(on_start=lambda: started.append(threading.get_ident())) as everywhere,
+        registry.watch_compiles(this_thread=True) as mine,
+    ):
         other = threading.Thread(target=lambda: add_one(np.float32(1)))
         other.start()
         other.join(60)

@@ -21,8 +21,17 @@ from PIL import Image
 #: Files no loader may accept: each must give one line naming the file, and no output.
 BROKEN = ("empty", "text_as_png", "truncated_png", "truncated_jpeg", "bomb", "directory")
 #: Valid but unusual images: each must either work or be refused with one line naming the file.
-ODD = ("tiny_1x1", "thin_2x3000", "deep_16bit", "rgba", "palette", "grey_alpha", "cmyk_jpeg",
-       "animated_gif", "non_ascii")
+ODD = (
+    "tiny_1x1",
+    "thin_2x3000",
+    "deep_16bit",
+    "rgba",
+    "palette",
+    "grey_alpha",
+    "cmyk_jpeg",
+    "animated_gif",
+    "non_ascii",
+)
 
 
 def _pattern(h: int, w: int, channels: int = 3, seed: int = 0) -> np.ndarray:

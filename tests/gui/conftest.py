@@ -2,7 +2,6 @@
 
 import pytest
 from PySide6.QtCore import QSettings
-
 from weft.app.gui.main_window import MainWindow
 
 

@@ -12,8 +12,11 @@ def mouse(view, kind: str, scene_xy, buttons=Qt.MouseButton.LeftButton, key_modi
     pos = view.mapFromScene(QPointF(*scene_xy))
     local = QPointF(pos)
     global_ = QPointF(view.viewport().mapToGlobal(pos))
-    etype = {"press": QEvent.Type.MouseButtonPress, "move": QEvent.Type.MouseMove,
-             "release": QEvent.Type.MouseButtonRelease}[kind]
+    etype = {
+        "press": QEvent.Type.MouseButtonPress,
+        "move": QEvent.Type.MouseMove,
+        "release": QEvent.Type.MouseButtonRelease,
+    }[kind]
     button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
     held = buttons if kind != "release" else Qt.MouseButton.NoButton
     event = QMouseEvent(etype, local, global_, button, held, key_modifiers)

@@ -16,7 +16,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from PySide6.QtCore import QSettings, QTimer  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
-
 from weft.app.gui.main_window import MainWindow  # noqa: E402
 
 EDITS = {
@@ -56,10 +55,14 @@ def main() -> int:
         except (OSError, ValueError):
             return
         geometry = saved.get("geometry", {})
-        if (saved["params"]["fast"]["p"] == EDITS["p"] and geometry.get("fast", {}).get("region") == EDITS["prototype"]
-                and geometry.get("nfpt", {}).get("lines", {}).get("image_lines") == EDITS["image_lines"]
-                and saved["seed"] == EDITS["seed"] and saved["method"] == "fast"
-                and saved["inputs"].get("target") == target):
+        if (
+            saved["params"]["fast"]["p"] == EDITS["p"]
+            and geometry.get("fast", {}).get("region") == EDITS["prototype"]
+            and geometry.get("nfpt", {}).get("lines", {}).get("image_lines") == EDITS["image_lines"]
+            and saved["seed"] == EDITS["seed"]
+            and saved["method"] == "fast"
+            and saved["inputs"].get("target") == target
+        ):
             print("AUTOSAVED", flush=True)
             timer.stop()
 

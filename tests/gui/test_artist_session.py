@@ -4,7 +4,6 @@ import dataclasses
 
 import numpy as np
 from PySide6.QtCore import Qt
-
 from weft.core.errors import WeftError
 
 
@@ -35,8 +34,9 @@ def test_a_failed_render_marks_the_result_stale_until_a_render_succeeds(window, 
 def test_unticking_auto_starts_from_the_resolved_value_and_a_disabled_slider_says_why(window, qtbot):
     doc = window.doc
     doc.set_method("quilt")  # a transfer (the studio opens a target): block resolves to 9, overlap 3
-    qtbot.waitUntil(lambda: "block" in window.params_panel.rows
-                    and window.params_panel.row("block").auto.isVisible(), timeout=5000)
+    qtbot.waitUntil(
+        lambda: "block" in window.params_panel.rows and window.params_panel.row("block").auto.isVisible(), timeout=5000
+    )
     row = window.params_panel.row("block")
     assert row.auto.isChecked() and not row.editor.isEnabled()
     assert "auto" in row.editor.toolTip() and "now 9" in row.editor.toolTip()
@@ -71,8 +71,9 @@ def test_every_dock_is_in_the_view_menu_and_reset_layout_restores_it(window, qtb
     float_button = method.findChild(QAbstractButton, "qt_dockwidget_floatbutton")
     qtbot.mouseClick(float_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(method.isFloating, timeout=5000)
-    qtbot.mouseClick(window.examples_dock.findChild(QAbstractButton, "qt_dockwidget_closebutton"),
-                     Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(
+        window.examples_dock.findChild(QAbstractButton, "qt_dockwidget_closebutton"), Qt.MouseButton.LeftButton
+    )
     qtbot.waitUntil(lambda: not window.examples_dock.isVisible(), timeout=5000)
     _click_menu_item(qtbot, menu, window.reset_layout_action)
     qtbot.waitUntil(lambda: all(d.isVisible() and not d.isFloating() for d in docks), timeout=5000)
@@ -111,15 +112,21 @@ def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(wind
     window.input_tabs.setCurrentWidget(box)
     qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
     assert not window.inputs_pane._boxes["texture"].clear_button.isVisible()  # required: no Clear
-    with qtbot.waitSignal(window.renderer.shown, timeout=20000,
-                          check_params_cb=lambda shown: shown.final and "target" not in shown.recipe.inputs):
+    with qtbot.waitSignal(
+        window.renderer.shown,
+        timeout=20000,
+        check_params_cb=lambda shown: shown.final and "target" not in shown.recipe.inputs,
+    ):
         qtbot.mouseClick(box.clear_button, Qt.MouseButton.LeftButton)
     assert doc.image("target") is None and not box.clear_button.isEnabled()
     assert window.renderer.last.image.shape[:2] != target.shape[:2]  # plain synthesis now
     assert [a.text() for a in window.clear_input_menu.actions()] == ["target", "mask"]  # File > Clear Input
     assert not window.clear_input_menu.isEnabled()  # neither is open now
-    with qtbot.waitSignal(window.renderer.shown, timeout=20000,
-                          check_params_cb=lambda shown: shown.final and "target" in shown.recipe.inputs):
+    with qtbot.waitSignal(
+        window.renderer.shown,
+        timeout=20000,
+        check_params_cb=lambda shown: shown.final and "target" in shown.recipe.inputs,
+    ):
         qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # Undo
     assert doc.image("target") is target and box.clear_button.isEnabled()
     assert window.renderer.last.image.shape[:2] == target.shape[:2]
@@ -146,7 +153,6 @@ def _click_in_box_when_shown(qtbot, button):
 
 def test_quitting_with_unsaved_edits_offers_save_discard_cancel(window, qtbot, monkeypatch, tmp_path):
     from PySide6.QtWidgets import QFileDialog, QMessageBox
-
     from weft.app.gui.main_window import MainWindow
 
     monkeypatch.undo()  # the real question, not the conftest's answer ...
@@ -212,7 +218,7 @@ def test_square_handles_keep_their_size_on_screen_through_zooming(window, qtbot)
     before = view.scale_factor()
     for _ in range(3):
         qtbot.keyClick(window, Qt.Key.Key_Plus, Qt.KeyboardModifier.ControlModifier)
-    qtbot.waitUntil(lambda: abs(view.scale_factor() - before * 1.25 ** 3) < 1e-6, timeout=5000)
+    qtbot.waitUntil(lambda: abs(view.scale_factor() - before * 1.25**3) < 1e-6, timeout=5000)
     assert on_screen() == first
     qtbot.keyClick(window, Qt.Key.Key_0, Qt.KeyboardModifier.ControlModifier)
     assert on_screen() == first
@@ -222,8 +228,11 @@ def _fills_view(view) -> bool:
     w, h = view.image_size()
     shown = view.mapFromScene(0, 0, w, h).boundingRect()
     vp = view.viewport().rect()
-    return (abs(shown.width() - vp.width()) <= 3 or abs(shown.height() - vp.height()) <= 3) \
-        and shown.width() <= vp.width() + 3 and shown.height() <= vp.height() + 3
+    return (
+        (abs(shown.width() - vp.width()) <= 3 or abs(shown.height() - vp.height()) <= 3)
+        and shown.width() <= vp.width() + 3
+        and shown.height() <= vp.height() + 3
+    )
 
 
 def test_a_result_of_another_size_refits_unless_the_user_zoomed(window, qtbot):
@@ -303,12 +312,16 @@ def test_save_dialogs_start_in_the_last_folder_with_a_suggested_name(window, qtb
     out = tmp_path / "renders" / "mine.png"
     out.parent.mkdir()
     replies = iter([str(out), ""])
-    monkeypatch.setattr(QFileDialog, "getSaveFileName",
-                        lambda parent, caption, start, filters: asked.append(start) or (next(replies), ""))
+    monkeypatch.setattr(
+        QFileDialog,
+        "getSaveFileName",
+        lambda parent, caption, start, filters: asked.append(start) or (next(replies), ""),
+    )
     qtbot.keyClick(window, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier)  # Export Result…
     assert out.exists()
     canvas = window.doc.inputs[window.doc.studio.canvas].path
     from pathlib import Path
+
     assert asked[0] == str(Path.home() / f"{Path(canvas).stem}-fast.png")  # no folder used yet: home
     qtbot.keyClick(window, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
     assert asked[1] == str(out.parent / f"{Path(canvas).stem}-fast.json")  # the folder used last
@@ -347,7 +360,6 @@ def test_the_square_thumbnail_is_labelled(window, qtbot):
 
 def test_weft_image_target_opens_the_studio_on_those_images(window, qtbot, monkeypatch, tmp_path):
     import numpy as np
-
     from weft.app import cli
     from weft.app import gui as gui_package
     from weft.core.image import save_image
@@ -359,8 +371,10 @@ def test_weft_image_target_opens_the_studio_on_those_images(window, qtbot, monke
     monkeypatch.setattr(gui_package, "run_gui", lambda argv=None, *, images=None: opened.append(images) or 0)
     assert cli.main([str(tex), str(tgt)]) == 0 and opened == [[str(tex), str(tgt)]]
     window.open_images(opened[0])  # what run_gui does with them once the window is up
-    qtbot.waitUntil(lambda: window.doc.inputs["texture"].path == str(tex)
-                    and window.doc.inputs["target"].path == str(tgt), timeout=10000)
+    qtbot.waitUntil(
+        lambda: window.doc.inputs["texture"].path == str(tex) and window.doc.inputs["target"].path == str(tgt),
+        timeout=10000,
+    )
     assert window.doc.image("target").shape == (50, 60, 3)
 
 
@@ -410,8 +424,9 @@ def test_auto_block_follows_the_sample_and_its_source_region(window, qtbot):
     doc = window.doc
     doc.set_method("quilt")
     doc.clear_input("target")  # a synthesis: the wood-grain sample, 128x112
-    qtbot.waitUntil(lambda: "block" in window.params_panel.rows
-                    and window.params_panel.row("block").auto.isVisible(), timeout=5000)
+    qtbot.waitUntil(
+        lambda: "block" in window.params_panel.rows and window.params_panel.row("block").auto.isVisible(), timeout=5000
+    )
     row = window.params_panel.row("block")
     qtbot.waitUntil(lambda: "now 49" in row.editor.toolTip(), timeout=5000)  # 7/16 of 112
     view = window.views["texture"]
@@ -438,8 +453,9 @@ def test_a_slider_runs_only_over_what_the_open_inputs_allow(window, qtbot, tmp_p
     doc.set_method("quilt")
     doc.clear_input("target")  # synthesis
     window.open_input("texture", str(texture))
-    qtbot.waitUntil(lambda: doc.image("texture") is not None and doc.image("texture").shape[:2] == (128, 112),
-                    timeout=10000)
+    qtbot.waitUntil(
+        lambda: doc.image("texture") is not None and doc.image("texture").shape[:2] == (128, 112), timeout=10000
+    )
     qtbot.waitUntil(lambda: window.params_panel.row("block").auto.isVisible(), timeout=5000)
     row = window.params_panel.row("block")
     qtbot.mouseClick(row.auto, Qt.MouseButton.LeftButton)
@@ -450,8 +466,14 @@ def test_a_slider_runs_only_over_what_the_open_inputs_allow(window, qtbot, tmp_p
     slider.setFocus()
     qtbot.keyClick(slider, Qt.Key.Key_End)  # the far end, as a user drags it there
     qtbot.waitUntil(lambda: doc.current_params.block == 112, timeout=5000)
-    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.params.get("block") == 112
-                    and not window.renderer.running(), timeout=60000)
+    qtbot.waitUntil(
+        lambda: (
+            window.renderer.last.final
+            and window.renderer.last.recipe.params.get("block") == 112
+            and not window.renderer.running()
+        ),
+        timeout=60000,
+    )
     assert not window.result_view.stale.isVisible()
     overlap = window.params_panel.row("overlap")
     assert overlap.editor.maximum() == 111  # smaller than the block

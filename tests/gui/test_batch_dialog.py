@@ -8,7 +8,6 @@ from pathlib import Path
 
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction
-
 from weft.app.cli import main as cli_main
 from weft.app.gui.batch_dialog import BatchDialog
 from weft.core.image import load_image, read_recipe, save_image
@@ -22,7 +21,7 @@ def make_frames(folder: Path, n: int) -> list[Path]:
     out = []
     for i in range(n):
         p = folder / f"frame_{i:02d}.png"
-        save_image(p, photo[4 * i:4 * i + 60, 3 * i:3 * i + 80])
+        save_image(p, photo[4 * i : 4 * i + 60, 3 * i : 3 * i + 80])
         out.append(p)
     return out
 
@@ -60,8 +59,9 @@ def test_apply_to_folder_writes_what_weft_run_writes(window, qtbot, tmp_path):
         again.unlink()
     # Run again once the new seed's result is shown: its recipe has the new seed, so every frame is
     # redone with it...
-    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.seed == window.doc.seed,
-                    timeout=60000)
+    qtbot.waitUntil(
+        lambda: window.renderer.last.final and window.renderer.last.recipe.seed == window.doc.seed, timeout=60000
+    )
     with qtbot.waitSignal(dialog.batch_finished, timeout=120000) as done:
         qtbot.mouseClick(dialog.run_button, Qt.MouseButton.LeftButton)
     assert done.args[0] == "4 written" and window.doc.seed != seed

@@ -8,7 +8,6 @@ import cv2
 import numpy as np
 from PIL import Image
 from PySide6.QtCore import QPointF, QRectF
-
 from weft.app.cli import main as weft
 from weft.core.geometry import Mask
 from weft.core.image import file_bit_depth, read_recipe, save_image
@@ -34,8 +33,10 @@ def test_a_16_bit_source_exports_16_bit_png_and_weft_run_reproduces_it(window, q
     doc.set_method("fill")
     g = next(g for g in doc.studio.geometry if g.kind == MASK)
     window.open_input(doc.studio.canvas, str(source))
-    qtbot.waitUntil(lambda: doc.item(doc.studio.canvas) is not None
-                    and doc.item(doc.studio.canvas).path == str(source), timeout=10000)
+    qtbot.waitUntil(
+        lambda: doc.item(doc.studio.canvas) is not None and doc.item(doc.studio.canvas).path == str(source),
+        timeout=10000,
+    )
     h, w = doc.image(doc.studio.canvas).shape[:2]
     with qtbot.waitSignal(window.renderer.shown, timeout=60000, check_params_cb=lambda s: s.final):
         doc.set_mask(g.key, Mask.empty(w, h).painted_line((30, 30), (60, 34), 6), "Brush stroke")
@@ -82,8 +83,9 @@ def test_transparency_shows_as_a_checkerboard_with_its_outline(window, qtbot, tm
     doc = window.doc
     doc.set_method("fill")
     window.open_input(doc.studio.canvas, str(path))
-    qtbot.waitUntil(lambda: doc.item(doc.studio.canvas) is not None and doc.item(doc.studio.canvas).path == str(path),
-                    timeout=10000)
+    qtbot.waitUntil(
+        lambda: doc.item(doc.studio.canvas) is not None and doc.item(doc.studio.canvas).path == str(path), timeout=10000
+    )
     view = window.canvas_view
     qtbot.waitUntil(lambda: view.image is not None and view.image.shape[:2] == (72, 96), timeout=5000)
     view.actual_size()
@@ -126,6 +128,7 @@ def test_the_pixel_read_out_counts_0_255_and_0_65535_for_16_bit(window, qtbot, t
     canvas.centerOn(40.5, 30.5)
     mouse(canvas, "move", (40.5, 30.5), buttons=Qt.MouseButton.NoButton)
     stored = cv2.imread(str(source), cv2.IMREAD_UNCHANGED)[30, 40][::-1]  # (BGR -> RGB)
-    assert window.pixel_label.toolTip() == (f"{canvas.title}  x 40  y 30  {' '.join(str(int(v)) for v in stored)}"
-                                            f"  (16-bit)")
+    assert window.pixel_label.toolTip() == (
+        f"{canvas.title}  x 40  y 30  {' '.join(str(int(v)) for v in stored)}  (16-bit)"
+    )
     assert window.pixel_label.text() == window.pixel_label.toolTip()  # whole, not elided

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QPointF, Qt
 from PySide6.QtGui import QImage
-
 from weft.app.cli import main as weft
 from weft.core import registry
 from weft.core.errors import WeftError
@@ -64,21 +63,37 @@ def _mean_fill(inputs, params, *, rng=None, progress=None, cancel=None):
 
 
 MEAN_FILL = Method(
-    name="mean-fill", summary="fill a painted hole with the mean colour of the rest", params=MeanFillParams,
-    inputs=(InputSpec("picture", "the picture", alpha=True), InputSpec("hole", "white = fill", required=False),
-            InputSpec("swatch", "take the colour from this image instead", required=False)),
+    name="mean-fill",
+    summary="fill a painted hole with the mean colour of the rest",
+    params=MeanFillParams,
+    inputs=(
+        InputSpec("picture", "the picture", alpha=True),
+        InputSpec("hole", "white = fill", required=False),
+        InputSpec("swatch", "take the colour from this image instead", required=False),
+    ),
     run=_mean_fill,
-    studio=Studio(title="Mean fill", canvas="picture", preview_around="hole", own_inputs=("swatch",),
-                  figures={"hole_pixels": Figure("filled", "px")},
-                  geometry=(Geometry(MASK, on=("picture",), input="hole", help="paint the hole"),
-                            Geometry(MARGINS, on=("picture",), param="grow", help="drag an edge outward"))),
+    studio=Studio(
+        title="Mean fill",
+        canvas="picture",
+        preview_around="hole",
+        own_inputs=("swatch",),
+        figures={"hole_pixels": Figure("filled", "px")},
+        geometry=(
+            Geometry(MASK, on=("picture",), input="hole", help="paint the hole"),
+            Geometry(MARGINS, on=("picture",), param="grow", help="drag an edge outward"),
+        ),
+    ),
 )
 
 
 SHOW_SWATCH = Method(  # another method whose input has the name of mean-fill's own "swatch" input
-    name="show-swatch", summary="the swatch as it is", params=MeanFillParams,
-    inputs=(InputSpec("swatch", "a swatch"),), run=lambda inputs, params, **kw: Result(inputs["swatch"]),
-    studio=Studio(title="Show a swatch", canvas="swatch", rank=200))
+    name="show-swatch",
+    summary="the swatch as it is",
+    params=MeanFillParams,
+    inputs=(InputSpec("swatch", "a swatch"),),
+    run=lambda inputs, params, **kw: Result(inputs["swatch"]),
+    studio=Studio(title="Show a swatch", canvas="swatch", rank=200),
+)
 
 
 @pytest.fixture
@@ -158,13 +173,12 @@ def _painted(overlay) -> np.ndarray:
     """Where the mask's overlay is drawn (its alpha), as a bool (H, W) array."""
     image = overlay.image().convertToFormat(QImage.Format.Format_RGBA8888)
     rgba = np.frombuffer(image.constBits(), np.uint8).reshape(image.height(), image.bytesPerLine() // 4, 4)
-    return rgba[:, :image.width(), 3] > 0
+    return rgba[:, : image.width(), 3] > 0
 
 
 def _final_after(window, qtbot, action):
     """Do ``action`` and wait for the full-size result it causes."""
-    with qtbot.waitSignal(window.renderer.shown, timeout=10000,
-                          check_params_cb=lambda shown: shown.final):
+    with qtbot.waitSignal(window.renderer.shown, timeout=10000, check_params_cb=lambda shown: shown.final):
         action()
     return window.renderer.last
 
@@ -385,8 +399,9 @@ def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(stu
     assert Mask.read(tmp_path / "r.hole.png") == painted
 
 
-def test_mask_pngs_are_encoded_and_decoded_off_the_gui_thread(studio, qtbot, tmp_path, monkeypatch, capsys,
-                                                             private_recovery):
+def test_mask_pngs_are_encoded_and_decoded_off_the_gui_thread(
+    studio, qtbot, tmp_path, monkeypatch, capsys, private_recovery
+):
     """A mask's PNG (a large one takes a tenth of a second to encode) is encoded for an export, a
     recipe, a saved session and the autosave, and decoded when a session opens, never on the GUI
     thread; the files stay right (bit-exact round trip; weft run reproduces the export)."""
@@ -440,12 +455,16 @@ def _screen_drag(view, start_scene, steps_px, *, last=True, modifiers=Qt.Keyboar
     origin = QPointF(view.mapFromScene(QPointF(*start_scene)))
 
     def send(kind, at):
-        etype = {"press": QEvent.Type.MouseButtonPress, "move": QEvent.Type.MouseMove,
-                 "release": QEvent.Type.MouseButtonRelease}[kind]
+        etype = {
+            "press": QEvent.Type.MouseButtonPress,
+            "move": QEvent.Type.MouseMove,
+            "release": QEvent.Type.MouseButtonRelease,
+        }[kind]
         button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
         held = Qt.MouseButton.NoButton if kind == "release" else Qt.MouseButton.LeftButton
-        QApplication.sendEvent(view.viewport(), QMouseEvent(etype, at, QPointF(view.viewport().mapToGlobal(at)),
-                                                            button, held, modifiers))
+        QApplication.sendEvent(
+            view.viewport(), QMouseEvent(etype, at, QPointF(view.viewport().mapToGlobal(at)), button, held, modifiers)
+        )
 
     send("press", origin)
     for dx, dy in steps_px:
@@ -492,7 +511,7 @@ def test_a_brush_press_just_outside_the_image_paints_and_farther_out_or_with_shi
     result = _final_after(studio, qtbot, lambda: _screen_drag(view, (W + 3.0, H / 2), [(0, -4 * k), (0, -8 * k)]))
     assert doc.value("grow") is None and not margins.frame.isVisible()
     painted = _mask(studio)
-    assert painted is not None and painted.bits[:, W - 1].any() and not painted.bits[:, :W - 5].any()
+    assert painted is not None and painted.bits[:, W - 1].any() and not painted.bits[:, : W - 5].any()
     assert doc.undo_stack.text(doc.undo_stack.index() - 1) == "Brush stroke"
     assert result.image.shape == (H, W, 3)
     # 6 px out: beyond the circle -- the arrow shows, and the press drags the right edge
@@ -504,8 +523,13 @@ def test_a_brush_press_just_outside_the_image_paints_and_farther_out_or_with_shi
     assert doc.value("grow") == Margins(0, 0, 9, 0) and _mask(studio) == painted
     # with Shift a press 1 px outside drags the edges whatever the brush (the view refit to the grown frame)
     k = view.scale_factor()
-    _final_after(studio, qtbot, lambda: _screen_drag(view, (W / 2, H + 1.0), [(0, 4 * k), (0, 6 * k)],
-                                                      modifiers=Qt.KeyboardModifier.ShiftModifier))
+    _final_after(
+        studio,
+        qtbot,
+        lambda: _screen_drag(
+            view, (W / 2, H + 1.0), [(0, 4 * k), (0, 6 * k)], modifiers=Qt.KeyboardModifier.ShiftModifier
+        ),
+    )
     assert doc.value("grow") == Margins(0, 0, 9, 6) and _mask(studio) == painted
     # back inside: the brush's circle and the cross again
     mouse(view, "move", (W / 2, H / 2), buttons=Qt.MouseButton.NoButton)
@@ -618,8 +642,11 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
     around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     text = studio.result_label.full_text()
     # (a count of pixels describes the crop, not the picture: only the full result states it)
-    assert re.fullmatch(r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?; "
-                        r"the image's figures on release", text), text
+    assert re.fullmatch(
+        r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?; "
+        r"the image's figures on release",
+        text,
+    ), text
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
     assert studio.result_label.full_text().endswith(f"— filled {result.figures['hole_pixels']} px")
     previews, text = _slider_previewed(studio, qtbot, "amount")  # a slider's preview
@@ -785,10 +812,13 @@ def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, se
 
 
 SHOW_HOLE = Method(  # another method with a plain input named like mean-fill's painted mask
-    name="show-hole", summary="the hole image as it is", params=MeanFillParams,
+    name="show-hole",
+    summary="the hole image as it is",
+    params=MeanFillParams,
     inputs=(InputSpec("hole", "an image named like mean-fill's painted mask"),),
     run=lambda inputs, params, **kw: Result(inputs["hole"]),
-    studio=Studio(title="Show a hole", canvas="hole", rank=201))
+    studio=Studio(title="Show a hole", canvas="hole", rank=201),
+)
 
 
 @pytest.fixture
@@ -799,7 +829,8 @@ def show_hole():
 
 
 def test_an_image_opened_as_another_methods_input_of_the_masks_name_stays_out_of_the_recipe(
-        show_hole, studio, qtbot, tmp_path, capsys):
+    show_hole, studio, qtbot, tmp_path, capsys
+):
     doc = studio.doc
     hole = np.zeros((H, W), np.float32)
     hole[10:30, 10:30] = 1
@@ -1020,8 +1051,9 @@ def test_a_background_autosave_that_fails_says_so_in_one_line(studio, qtbot, pri
     private_recovery.parent.mkdir(parents=True, exist_ok=True)
     private_recovery.write_text("not a folder")
     studio.files._autosave_timer.setInterval(10)
-    with qtbot.waitSignal(studio.statusBar().messageChanged, timeout=10000,
-                          check_params_cb=lambda text: "autosave failed" in text) as said:
+    with qtbot.waitSignal(
+        studio.statusBar().messageChanged, timeout=10000, check_params_cb=lambda text: "autosave failed" in text
+    ) as said:
         _stroke(studio.canvas_view, [(20.5, 20.5), (30.5, 25.5)])
     text = said.args[0]
     assert text.startswith(f"{studio.recovery_file}: autosave failed (") and "\n" not in text
@@ -1067,21 +1099,32 @@ def test_a_crops_status_keeps_the_figures_its_method_marks_as_the_whole_images(q
     for a stroke's preview too; the rest only with the full result."""
     from weft.app.gui.render import Shown, describe
 
-    method = Method(name="whole-figures", summary="figures", params=MeanFillParams,
-                    inputs=(InputSpec("picture", "the picture"),), run=_mean_fill,
-                    studio=Studio(title="Whole figures", canvas="picture", rank=300,
-                                  figures={"engine": Figure("engine", whole=True),
-                                           "hole_pixels": Figure("filled", "px")}))
+    method = Method(
+        name="whole-figures",
+        summary="figures",
+        params=MeanFillParams,
+        inputs=(InputSpec("picture", "the picture"),),
+        run=_mean_fill,
+        studio=Studio(
+            title="Whole figures",
+            canvas="picture",
+            rank=300,
+            figures={"engine": Figure("engine", whole=True), "hole_pixels": Figure("filled", "px")},
+        ),
+    )
     registry.register(method)
     try:
         figures = {"engine": "quilt", "hole_pixels": 40, "canvas": [80, 64]}
         image = np.zeros((H, W, 3), np.float32)
         crop = describe(Shown(image, 1, 0.012, figures, False, method=method.name, crop=(40, 30, 40, 30)))
-        assert crop == "preview around the stroke in 12 ms — its 40x30 crop: engine quilt; the image's figures on release"
+        assert (
+            crop == "preview around the stroke in 12 ms — its 40x30 crop: engine quilt; the image's figures on release"
+        )
         full = describe(Shown(image, 2, 0.5, figures, True, method=method.name))
         assert full == f"result {W}x{H} in 500 ms — engine quilt, filled 40 px"
-        only_whole = describe(Shown(image, 3, 0.012, {"engine": "quilt"}, False, method=method.name,
-                                    crop=(40, 30, 20, 15)))
+        only_whole = describe(
+            Shown(image, 3, 0.012, {"engine": "quilt"}, False, method=method.name, crop=(40, 30, 20, 15))
+        )
         assert only_whole == "preview around the stroke in 12 ms — its 40x30 crop (rendered at 20x15): engine quilt"
     finally:
         registry.unregister(method.name)
@@ -1100,6 +1143,7 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
         def wrapper(*args, **kwargs):
             on_gui[name].append(threading.current_thread() is threading.main_thread())
             return real(*args, **kwargs)
+
         return wrapper
 
     monkeypatch.setattr(Mask, "to_image", recorded("to_image", Mask.to_image))
@@ -1165,8 +1209,9 @@ def _large_picture(studio, qtbot, tmp_path, w=480, h=360, at=(105, 102)):
     return view
 
 
-def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole_mask(studio, qtbot, tmp_path,
-                                                                                   monkeypatch):
+def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole_mask(
+    studio, qtbot, tmp_path, monkeypatch
+):
     """The job of a preview around a stroke is given the part of the stroke's mask its crop can reach
     (``around_region``), cut on the GUI thread, never the whole mask (at 4096² a 64 MB float image per
     preview); the whole mask is made into an image only for the full render on release."""
@@ -1209,8 +1254,9 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
     assert result.figures["hole_pixels"] == expected.area
 
 
-def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the_latest(studio, qtbot, tmp_path,
-                                                                                     monkeypatch):
+def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the_latest(
+    studio, qtbot, tmp_path, monkeypatch
+):
     """While a stroke's preview is computed, the dabs that follow wait in one box: when it is done, one
     preview of all of them follows (the latest dab wins), not one per mouse move."""
     import threading
@@ -1271,7 +1317,10 @@ def test_esc_restores_the_overlay_of_the_mask_a_stroke_began_on(studio, qtbot):
     tool.set_size(7)
     _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 20.5), (60.5, 20.5)]))
     start = _mask(studio)
-    for mode, points in (("brush", [(30.5, 10.5), (30.5, 40.5), (50.5, 40.5)]), ("eraser", [(20.5, 20.5), (40.5, 22.5)])):
+    for mode, points in (
+        ("brush", [(30.5, 10.5), (30.5, 40.5), (50.5, 40.5)]),
+        ("eraser", [(20.5, 20.5), (40.5, 22.5)]),
+    ):
         qtbot.mouseClick(bar.mode_buttons[mode], Qt.MouseButton.LeftButton)
         _stroke(view, points, release=False)
         drawn = _painted(tool.overlay)
@@ -1293,11 +1342,18 @@ class SpreadFillParams(MeanFillParams):
 
 
 SPREAD_FILL = Method(
-    name="spread-fill", summary="mean fill whose auto spread grows with the canvas's margins", params=SpreadFillParams,
-    inputs=MEAN_FILL.inputs, run=_mean_fill,
-    studio=Studio(title="Spread fill", canvas="picture", preview_around="hole",
-                  auto=lambda params, shapes: {"spread": 3 + (params.grow.right if params.grow else 0)},
-                  geometry=MEAN_FILL.studio.geometry),
+    name="spread-fill",
+    summary="mean fill whose auto spread grows with the canvas's margins",
+    params=SpreadFillParams,
+    inputs=MEAN_FILL.inputs,
+    run=_mean_fill,
+    studio=Studio(
+        title="Spread fill",
+        canvas="picture",
+        preview_around="hole",
+        auto=lambda params, shapes: {"spread": 3 + (params.grow.right if params.grow else 0)},
+        geometry=MEAN_FILL.studio.geometry,
+    ),
 )
 
 

@@ -12,7 +12,6 @@ import time
 
 import numpy as np
 import pytest
-
 from weft.app.gui.document import InputImage
 from weft.app.gui.main_window import MainWindow
 from weft.core import registry
@@ -54,8 +53,9 @@ def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest
     words = "preparing the fast method — first run only"
     seen = []
     window.renderer.preparing.connect(seen.append)
-    qtbot.waitUntil(lambda: window.result_view.notice.isVisible()
-                    and window.result_view.notice.text() == words, timeout=20000)
+    qtbot.waitUntil(
+        lambda: window.result_view.notice.isVisible() and window.result_view.notice.text() == words, timeout=20000
+    )
     held_from = time.perf_counter()
     assert seen == ["loading the fast method", words]  # words at once, then what it turned out to be
     qtbot.waitUntil(lambda: window.progress_bar.isVisible(), timeout=20000)

@@ -7,11 +7,10 @@ import threading
 
 import numpy as np
 import pytest
+import weft.app.gui.views as views
 from PySide6.QtCore import QRectF, Qt, QTimer
 from PySide6.QtGui import QColor, QPainter, QPixmap
 from PySide6.QtWidgets import QGraphicsPixmapItem, QGraphicsScene, QGraphicsView
-
-import weft.app.gui.views as views
 from weft.app.gui.convert import to_qimage
 from weft.app.gui.views import ImageView, ResultView
 from weft.core.image import save_image
@@ -159,8 +158,7 @@ def test_the_view_draws_the_same_pixels_as_a_pixmap_of_the_image(qtbot, channels
         assert ours.size() == ref.size() and ours == ref, (channels, side, zoom)
 
 
-def test_a_large_input_opened_in_the_window_reaches_both_views_off_the_gui_thread(window, qtbot, tmp_path,
-                                                                                  monkeypatch):
+def test_a_large_input_opened_in_the_window_reaches_both_views_off_the_gui_thread(window, qtbot, tmp_path, monkeypatch):
     """File > Open of a large picture (here as the current method's canvas input): decoded and
     converted off the GUI thread; the input view and the result view (the result's Compare "before")
     show it once converted."""
@@ -177,8 +175,9 @@ def test_a_large_input_opened_in_the_window_reaches_both_views_off_the_gui_threa
     held.release()
     qtbot.waitUntil(lambda: not view.converting, timeout=10000)
     assert view.image is window.doc.image(canvas) and view.image.shape[:2] == (BIG, BIG)
-    assert held.on_gui_thread and not any(held.on_gui_thread[i] for i, s in enumerate(held.sizes)
-                                          if s[0] * s[1] > views.ASYNC_PIXELS)
+    assert held.on_gui_thread and not any(
+        held.on_gui_thread[i] for i, s in enumerate(held.sizes) if s[0] * s[1] > views.ASYNC_PIXELS
+    )
 
 
 def test_the_compare_image_of_a_large_result_is_converted_off_the_gui_thread(qtbot, monkeypatch):
@@ -203,7 +202,6 @@ def test_display_pixels_are_qts_own_conversion_of_the_image(qtbot, channels):
     """``display_qimage`` (numpy, off the GUI thread) gives exactly the pixels Qt's conversion of
     ``to_qimage`` gives -- out-of-range values clipped, every alpha level premultiplied as Qt does."""
     from PySide6.QtGui import QImage
-
     from weft.app.gui.convert import display_qimage
 
     rng = np.random.default_rng(channels)
@@ -214,8 +212,9 @@ def test_display_pixels_are_qts_own_conversion_of_the_image(qtbot, channels):
     if channels in (2, 4):
         image[..., -1] = np.arange(256, dtype=np.float32)[None, :] / 255.0  # every alpha level
     qt = to_qimage(image)
-    qt = qt.convertToFormat(QImage.Format.Format_ARGB32_Premultiplied if qt.hasAlphaChannel()
-                            else QImage.Format.Format_RGB32)
+    qt = qt.convertToFormat(
+        QImage.Format.Format_ARGB32_Premultiplied if qt.hasAlphaChannel() else QImage.Format.Format_RGB32
+    )
     ours, _pixels = display_qimage(image)
     assert ours.format() == qt.format() and ours == qt
 

@@ -1,7 +1,6 @@
 """`weft` with no arguments opens the studio on the bundled examples, with a first result."""
 
 from PySide6.QtWidgets import QApplication
-
 from weft.app.cli import main
 from weft.app.gui.main_window import MainWindow
 

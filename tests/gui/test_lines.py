@@ -6,7 +6,6 @@ import pytest
 from PySide6.QtCore import QEvent, Qt
 from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import QApplication
-
 from weft.core.examples import RESOURCES
 from weft.core.geometry import Square
 
@@ -114,8 +113,10 @@ def test_affine_prototype_by_mouse_and_live_swap(window, qtbot):
     drag(view, (20.2, 24.2), (52.2, 40.2))
     assert doc.square == (20, 24, 32)
     assert doc.run_params().prototype == Square(20, 24, 32)
-    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.figures.get("prototype") == [20, 24, 32],
-                    timeout=30000)
+    qtbot.waitUntil(
+        lambda: window.renderer.last.final and window.renderer.last.figures.get("prototype") == [20, 24, 32],
+        timeout=30000,
+    )
     # With reuse_transforms, moving the square re-renders while the mouse moves (previews).
     doc.set_param("reuse_transforms", True)
     qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=30000)
@@ -137,12 +138,16 @@ def _at_global(view, kind, global_pos, buttons=Qt.MouseButton.LeftButton):
     from PySide6.QtGui import QMouseEvent
 
     local = QPointF(view.viewport().mapFromGlobal(global_pos))
-    etype = {"press": QEvent.Type.MouseButtonPress, "move": QEvent.Type.MouseMove,
-             "release": QEvent.Type.MouseButtonRelease}[kind]
+    etype = {
+        "press": QEvent.Type.MouseButtonPress,
+        "move": QEvent.Type.MouseMove,
+        "release": QEvent.Type.MouseButtonRelease,
+    }[kind]
     button = Qt.MouseButton.NoButton if kind == "move" else Qt.MouseButton.LeftButton
     held = buttons if kind != "release" else Qt.MouseButton.NoButton
-    QApplication.sendEvent(view.viewport(), QMouseEvent(etype, local, QPointF(global_pos), button, held,
-                                                        Qt.KeyboardModifier.NoModifier))
+    QApplication.sendEvent(
+        view.viewport(), QMouseEvent(etype, local, QPointF(global_pos), button, held, Qt.KeyboardModifier.NoModifier)
+    )
 
 
 def test_the_frontal_frame_does_not_move_under_a_drag(nfpt, qtbot):
@@ -243,6 +248,5 @@ def test_nfpt_without_lines_shows_the_photo_and_says_what_to_draw(window, qtbot)
     for x, y in [line[:2] for line in data["image_lines"][:4]]:
         mouse(window.canvas_view, "press", (x, y))
         mouse(window.canvas_view, "release", (x, y))
-    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.method == "nfpt",
-                    timeout=60000)
+    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.method == "nfpt", timeout=60000)
     assert not view.notice.isVisible() and window.nothing_to_export() is None

@@ -10,7 +10,6 @@ import pytest
 from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
 from PySide6.QtGui import QDragEnterEvent, QDropEvent, QWheelEvent
 from PySide6.QtWidgets import QApplication
-
 from weft.app.cli import main as cli_main
 from weft.core.errors import Cancelled, WeftError
 from weft.core.examples import example
@@ -55,8 +54,8 @@ def test_escape_cancels_a_prototype_drag(window):
     mouse(view, "press", (60, 60))
     mouse(view, "move", (90, 90))
     assert window.canvas_view.tool.live is not None
-    from PySide6.QtGui import QKeyEvent
     from PySide6.QtCore import QEvent
+    from PySide6.QtGui import QKeyEvent
 
     QApplication.sendEvent(view, QKeyEvent(QEvent.Type.KeyPress, Qt.Key.Key_Escape, Qt.KeyboardModifier.NoModifier))
     mouse(view, "release", (90, 90))
@@ -187,11 +186,13 @@ def test_dropping_a_file_on_the_target_view_opens_it(window, qtbot):
     path = str(example("camera"))
     data = QMimeData()
     data.setUrls([QUrl.fromLocalFile(path)])
-    enter = QDragEnterEvent(QPoint(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton,
-                            Qt.KeyboardModifier.NoModifier)
+    enter = QDragEnterEvent(
+        QPoint(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+    )
     assert QApplication.sendEvent(view.viewport(), enter) and enter.isAccepted()
-    drop = QDropEvent(QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton,
-                      Qt.KeyboardModifier.NoModifier)
+    drop = QDropEvent(
+        QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+    )
     QApplication.sendEvent(view.viewport(), drop)
     qtbot.waitUntil(lambda: window.doc.inputs["target"].path == path, timeout=5000)
     assert window.doc.image("target").shape == (256, 256)
@@ -219,7 +220,11 @@ def test_session_round_trip(window, qtbot, tmp_path):
     path = tmp_path / "s.weft.json"
     assert window.save_session(str(path))
     data = json.loads(path.read_text())
-    assert data["params"]["fast"]["p"] == 0.3 and data["seed"] == 42 and data["geometry"] == {"fast": {"region": [2, 4, 16]}}
+    assert (
+        data["params"]["fast"]["p"] == 0.3
+        and data["seed"] == 42
+        and data["geometry"] == {"fast": {"region": [2, 4, 16]}}
+    )
     doc.set_param("p", 0.9)
     doc.set_square(None)
     window.seed_box.setValue(1)
@@ -261,8 +266,16 @@ def test_compare_split_and_wheel_zoom_on_the_result(window):
     view.zoom_by(4.0)
     start = view.scale_factor()
     pos = view.mapFromScene(40.0, 30.0)
-    wheel = QWheelEvent(QPointF(pos), QPointF(view.viewport().mapToGlobal(pos)), QPoint(0, 0), QPoint(0, 120),
-                        Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+    wheel = QWheelEvent(
+        QPointF(pos),
+        QPointF(view.viewport().mapToGlobal(pos)),
+        QPoint(0, 0),
+        QPoint(0, 120),
+        Qt.MouseButton.NoButton,
+        Qt.KeyboardModifier.NoModifier,
+        Qt.ScrollPhase.NoScrollPhase,
+        False,
+    )
     QApplication.sendEvent(view.viewport(), wheel)
     assert view.scale_factor() == pytest.approx(start * 1.25)
     after = view.mapToScene(pos)
@@ -329,12 +342,14 @@ def test_result_figures_stay_while_a_menu_shows_status_tips(window, qtbot):
     """Hovering a menu entry shows its status tip and closing the menu clears the status message:
     the shown result's figures stay on the status line all along."""
     from PySide6.QtCore import Qt
-    from PySide6.QtWidgets import QLabel
     from PySide6.QtTest import QTest
+    from PySide6.QtWidgets import QLabel
 
     def figures_shown() -> bool:
-        return any(label.isVisible() and re.match(r"result \d+x\d+ in \d+ ms", label.text())
-                   for label in window.statusBar().findChildren(QLabel))
+        return any(
+            label.isVisible() and re.match(r"result \d+x\d+ in \d+ ms", label.text())
+            for label in window.statusBar().findChildren(QLabel)
+        )
 
     assert figures_shown()
     menu = window.view_menu

@@ -12,7 +12,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PySide6.QtCore import QSettings
-
 from weft.app.gui.main_window import MainWindow
 from weft.core.image import save_image
 
@@ -131,8 +130,9 @@ def test_recovery_declined_is_removed(qtbot, settings, private_recovery, monkeyp
     w.shutdown()
 
 
-def test_a_second_window_never_offers_or_removes_the_first_windows_work(window, qtbot, settings, private_recovery,
-                                                                          monkeypatch):
+def test_a_second_window_never_offers_or_removes_the_first_windows_work(
+    window, qtbot, settings, private_recovery, monkeypatch
+):
     """Two studios at once: the second does not offer the first one's recovery file (its window
     runs), so declining cannot remove it; each window autosaves to a file of its own."""
     window.doc.set_param("p", 0.25)
@@ -178,8 +178,14 @@ def test_the_restore_question_restores_on_enter(qtbot, settings, private_recover
     monkeypatch.setattr(MainWindow, "_ask_restore", REAL_ASK_RESTORE)
     target = tmp_path / "t.png"
     save_image(target, np.random.default_rng(1).random((40, 48, 3), dtype=np.float32))
-    session = {"weft_session": 1, "method": "fast", "params": {"fast": {"p": 0.31}}, "inputs": {"target": str(target)},
-               "geometry": {}, "seed": 5}
+    session = {
+        "weft_session": 1,
+        "method": "fast",
+        "params": {"fast": {"p": 0.31}},
+        "inputs": {"target": str(target)},
+        "geometry": {},
+        "seed": 5,
+    }
     orphan_recovery(private_recovery, settings, json.dumps(session))
     seen = []
 
@@ -199,8 +205,9 @@ def test_the_restore_question_restores_on_enter(qtbot, settings, private_recover
     w.shutdown()
 
 
-def test_ctrl_s_after_a_recovery_saves_to_the_sessions_file(window, qtbot, settings, private_recovery, tmp_path,
-                                                            monkeypatch):
+def test_ctrl_s_after_a_recovery_saves_to_the_sessions_file(
+    window, qtbot, settings, private_recovery, tmp_path, monkeypatch
+):
     from PySide6.QtCore import Qt
     from PySide6.QtWidgets import QFileDialog
 
@@ -241,9 +248,14 @@ def test_kill_9_then_restart_offers_to_restore(qtbot, tmp_path, private_recovery
     target = tmp_path / "my target ü.png"
     save_image(target, np.random.default_rng(1).random((48, 64, 3), dtype=np.float32))
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen", WEFT_RECOVERY_DIR=str(private_recovery))
-    proc = subprocess.Popen([sys.executable, str(ROOT / "tests" / "gui" / "recovery_helper.py"), str(target),
-                             str(tmp_path / "first.ini")], cwd=ROOT, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, str(ROOT / "tests" / "gui" / "recovery_helper.py"), str(target), str(tmp_path / "first.ini")],
+        cwd=ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     line = []
     reader = threading.Thread(target=lambda: line.append(proc.stdout.readline()), daemon=True)
     reader.start()

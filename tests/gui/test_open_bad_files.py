@@ -42,14 +42,16 @@ def test_gui_drop_keeps_document_and_says_which_file(corpus, window, qtbot, item
     window.message.connect(messages.append)
     data = QMimeData()
     data.setUrls([QUrl.fromLocalFile(str(path))])
-    enter = QDragEnterEvent(QPoint(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton,
-                            Qt.KeyboardModifier.NoModifier)
+    enter = QDragEnterEvent(
+        QPoint(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+    )
     QApplication.sendEvent(view.viewport(), enter)
     if item != "directory":  # a folder may be turned away at the door; a file named .png is let in
         assert enter.isAccepted()
     if enter.isAccepted():
-        drop = QDropEvent(QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton,
-                          Qt.KeyboardModifier.NoModifier)
+        drop = QDropEvent(
+            QPointF(10, 10), Qt.DropAction.CopyAction, data, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+        )
         QApplication.sendEvent(view.viewport(), drop)
         qtbot.waitUntil(lambda: bool(messages), timeout=10000)
         qtbot.wait(50)

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-
 from weft.app.cli import main as weft
 from weft.core import registry
 from weft.core.geometry import Square
@@ -32,16 +31,22 @@ def _invert(inputs, params, *, rng=None, progress=None, cancel=None):
     image = inputs["picture"].copy()
     if params.square is not None:
         x, y, s = params.square
-        part = image[y:y + s, x:x + s]
-        image[y:y + s, x:x + s] = part + params.amount * (1.0 - 2.0 * part)
-    return Result(image, {"inverted": 0 if params.square is None else params.square.side ** 2})
+        part = image[y : y + s, x : x + s]
+        image[y : y + s, x : x + s] = part + params.amount * (1.0 - 2.0 * part)
+    return Result(image, {"inverted": 0 if params.square is None else params.square.side**2})
 
 
 INVERT = Method(
-    name="invert-square", summary="invert the pixels of a square", params=InvertParams,
-    inputs=(InputSpec("picture", "the picture"),), run=_invert,
-    studio=Studio(title="Invert a square", canvas="picture",
-                  geometry=(Geometry(SQUARE, on=("picture",), param="square", help="drag the square to invert"),)),
+    name="invert-square",
+    summary="invert the pixels of a square",
+    params=InvertParams,
+    inputs=(InputSpec("picture", "the picture"),),
+    run=_invert,
+    studio=Studio(
+        title="Invert a square",
+        canvas="picture",
+        geometry=(Geometry(SQUARE, on=("picture",), param="square", help="drag the square to invert"),),
+    ),
 )
 
 
@@ -81,8 +86,9 @@ def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qt
         drag(view, (10.2, 12.2), (30.2, 28.2))
         assert window.doc.square == (10, 12, 20)
         assert window.doc.run_params().square == Square(10, 12, 20)
-        qtbot.waitUntil(lambda: window.renderer.last.final
-                        and window.renderer.last.figures.get("inverted") == 400, timeout=10000)
+        qtbot.waitUntil(
+            lambda: window.renderer.last.final and window.renderer.last.figures.get("inverted") == 400, timeout=10000
+        )
         shown = window.renderer.last.image
         source = load_image(picture).image
         assert np.allclose(shown[12:32, 10:30], 1.0 - source[12:32, 10:30], atol=1e-6)

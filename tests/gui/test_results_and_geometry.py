@@ -5,7 +5,6 @@ import json
 import threading
 
 import numpy as np
-
 from weft.core.image import load_image, read_recipe
 
 
@@ -24,8 +23,9 @@ def _cancelled_render(window, qtbot, monkeypatch):
     pixels on screen are 0.3's. Returns the shown result."""
     doc = window.doc
     doc.set_param("p", 0.3)
-    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.params["p"] == 0.3,
-                    timeout=20000)
+    qtbot.waitUntil(
+        lambda: window.renderer.last.final and window.renderer.last.recipe.params["p"] == 0.3, timeout=20000
+    )
     shown = window.renderer.last
     started = threading.Event()
     monkeypatch.setitem(doc.methods, "fast", _slow(doc.methods["fast"], started))
@@ -122,8 +122,10 @@ def test_the_affine_square_is_drawn_on_the_prototype_image_once_one_is_open(wind
     view.centerOn(30, 30)
     drag(view, (10.2, 10.2), (42.2, 42.2))
     assert doc.square == (10, 10, 32)
-    qtbot.waitUntil(lambda: window.renderer.last.final
-                    and window.renderer.last.figures.get("prototype") == [10, 10, 32], timeout=30000)
+    qtbot.waitUntil(
+        lambda: window.renderer.last.final and window.renderer.last.figures.get("prototype") == [10, 10, 32],
+        timeout=30000,
+    )
 
 
 def test_apply_to_folder_takes_the_recipe_of_the_shown_pixels(window, qtbot, monkeypatch):

@@ -12,7 +12,6 @@ from contextlib import contextmanager
 import numpy as np
 import pytest
 from PySide6.QtCore import QSettings, Qt
-
 from weft.app.cli import main as weft
 from weft.core.geometry import Mask
 from weft.core.image import load_image, read_recipe, save_image
@@ -28,9 +27,9 @@ BOTTOM_RIGHT = [(62.5, 56.5), (86.5, 56.5)]  # with a 25 px brush: rows 44..68 o
 def _picture(path):
     rng = np.random.default_rng(5)
     pixels = np.empty((H, W, 3), np.float32)
-    pixels[:, :W // 2] = RED
-    pixels[:H // 2, W // 2:] = BLUE
-    pixels[H // 2:, W // 2:] = GREEN
+    pixels[:, : W // 2] = RED
+    pixels[: H // 2, W // 2 :] = BLUE
+    pixels[H // 2 :, W // 2 :] = GREEN
     pixels += rng.uniform(-0.05, 0.05, pixels.shape).astype(np.float32)
     save_image(path, pixels.clip(0, 1))
     return path
@@ -133,10 +132,14 @@ def test_a_sampling_stroke_sets_where_fill_copies_from_and_undo_restores_it(fill
     sample = tool.overlay.image().pixelColor(70, 56)
     hole = hole_tool.overlay.image().pixelColor(22, 34)
     assert sample.alpha() > 0 and tool.overlay.image().pixelColor(20, 10).alpha() == 0
-    assert (sample.red(), sample.green(), sample.blue()) == MASK_COLOURS[1][:3] != (hole.red(), hole.green(), hole.blue())
+    assert (
+        (sample.red(), sample.green(), sample.blue()) == MASK_COLOURS[1][:3] != (hole.red(), hole.green(), hole.blue())
+    )
     # Ctrl+Z: the sampling area is gone (everywhere again), the hole red again
     view.setFocus()
-    again = _final_after(window, qtbot, lambda: qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier))
+    again = _final_after(
+        window, qtbot, lambda: qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    )
     assert doc.value("source_mask") is None and doc.value("mask") is not None
     assert tool.overlay.image().isNull()
     assert _near(_colour_of(again.image, inside), RED)
@@ -196,7 +199,8 @@ def test_esc_cancels_a_sampling_stroke_and_the_result_comes_back(fill, qtbot):
 
 
 def test_the_sampling_area_round_trips_through_a_session_and_an_export_reproduced_by_weft_run(
-        fill, qtbot, settings, tmp_path, capsys):
+    fill, qtbot, settings, tmp_path, capsys
+):
     window, doc, view = fill, fill.doc, fill.canvas_view
     bar, tool = _sampling(window, qtbot)
     tool.set_size(25)
@@ -225,8 +229,23 @@ def test_the_sampling_area_round_trips_through_a_session_and_an_export_reproduce
     assert np.array_equal(load_image(out).image, load_image(again).image)
     # and the command line's --source-mask with the same files gives those pixels too
     cli = tmp_path / "cli.png"
-    assert weft(["fill", str(tmp_path / "three.png"), "--mask", str(tmp_path / "out.mask.png"), "--source-mask",
-                 str(tmp_path / "out.source_mask.png"), "--seed", str(doc.seed), "-o", str(cli)]) == 0
+    assert (
+        weft(
+            [
+                "fill",
+                str(tmp_path / "three.png"),
+                "--mask",
+                str(tmp_path / "out.mask.png"),
+                "--source-mask",
+                str(tmp_path / "out.source_mask.png"),
+                "--seed",
+                str(doc.seed),
+                "-o",
+                str(cli),
+            ]
+        )
+        == 0
+    )
     assert np.array_equal(load_image(out).image, load_image(cli).image)
 
 
@@ -263,8 +282,16 @@ def test_every_button_over_the_picture_shows_and_the_picture_is_the_large_view(q
     with _fill_window(qtbot, settings, _picture(tmp_path / "three.png"), size=size) as window:
         bar = window.inputs_pane.bar()
         qtbot.waitUntil(lambda: bar.width() > 0, timeout=5000)
-        buttons = [bar.target_button(0), bar.target_button(1), *bar.mode_buttons.values(), bar.size_box,
-                   bar.clear_button, bar.invert_button, bar.transparent_button, bar.extend_button]
+        buttons = [
+            bar.target_button(0),
+            bar.target_button(1),
+            *bar.mode_buttons.values(),
+            bar.size_box,
+            bar.clear_button,
+            bar.invert_button,
+            bar.transparent_button,
+            bar.extend_button,
+        ]
         for button in buttons:
             assert button.isVisible(), (size, button)
             row = button.parentWidget()

@@ -9,7 +9,6 @@ import shutil
 
 import numpy as np
 import pytest
-
 from weft.core.image import load_image, save_image
 
 
@@ -21,10 +20,19 @@ def _image(path, seed, side=24):
 
 def _state(doc):
     """What must not change when a session is refused (images by identity: not even re-read)."""
-    return ({name: (item.path, id(item.image)) for name, item in doc.inputs.items()}, doc.method,
-            dict(doc.params), doc.square, doc.seed, [list(x) for x in doc.image_lines],
-            [list(x) for x in doc.frontal_lines], doc.frontal_size,
-            doc.undo_stack.count(), doc.undo_stack.index(), doc.undo_stack.isClean())
+    return (
+        {name: (item.path, id(item.image)) for name, item in doc.inputs.items()},
+        doc.method,
+        dict(doc.params),
+        doc.square,
+        doc.seed,
+        [list(x) for x in doc.image_lines],
+        [list(x) for x in doc.frontal_lines],
+        doc.frontal_size,
+        doc.undo_stack.count(),
+        doc.undo_stack.index(),
+        doc.undo_stack.isClean(),
+    )
 
 
 class _Exploit:
@@ -50,8 +58,12 @@ def edited(window):
 def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_moves(window, qtbot, tmp_path):
     doc = window.doc
     project = tmp_path / "project"
-    files = {"texture": project / "tex.png", "target": project / "img" / "target.png", "photo": project / "photo.png",
-             "image": project / "img" / "hole.png"}  # (every input the studio has open: fill's image too)
+    files = {
+        "texture": project / "tex.png",
+        "target": project / "img" / "target.png",
+        "photo": project / "photo.png",
+        "image": project / "img" / "hole.png",
+    }  # (every input the studio has open: fill's image too)
     for i, (name, path) in enumerate(files.items()):
         doc.set_input(name, str(_image(path, i)), load_image(path).image)
     doc.set_param("p", 0.3)
@@ -59,8 +71,12 @@ def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_mov
     assert window.save_session(str(session))
 
     data = json.loads(session.read_text(encoding="utf-8"))  # plain JSON, nothing else
-    assert data["inputs"] == {"texture": "tex.png", "target": os.path.join("img", "target.png"), "photo": "photo.png",
-                              "image": os.path.join("img", "hole.png")}
+    assert data["inputs"] == {
+        "texture": "tex.png",
+        "target": os.path.join("img", "target.png"),
+        "photo": "photo.png",
+        "image": os.path.join("img", "hole.png"),
+    }
     assert data["weft_session"] == 1 and data["method"] == "fast" and data["params"]["fast"]["p"] == 0.3
     assert doc.undo_stack.isClean()
 
@@ -75,8 +91,9 @@ def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_mov
         assert doc.inputs[name].path == str(new)
         assert np.array_equal(doc.inputs[name].image, load_image(new).image)
     assert doc.current_params.p == 0.3 and doc.undo_stack.count() == 0
-    qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.image.shape == (24, 24, 3),
-                    timeout=20000)
+    qtbot.waitUntil(
+        lambda: window.renderer.last.final and window.renderer.last.image.shape == (24, 24, 3), timeout=20000
+    )
 
 
 def test_a_session_naming_a_missing_image_says_which_and_keeps_the_document(edited, qtbot, tmp_path):
@@ -122,8 +139,10 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
         "list": (b"[]", "not a weft session file"),
         "inputs_list": (field(inputs=["tex.png"]), "inputs must be an object"),
         "prototype_outside": (field(prototype=[100, 100, 16]), "leaves the texture (24x24)"),
-        "bad_lines": (field(lines={"image_lines": [[1]], "frontal_lines": [], "frontal_size": [64, 64]}),
-                      "image_lines[0] = [1] must be [x1, y1, x2, y2]"),
+        "bad_lines": (
+            field(lines={"image_lines": [[1]], "frontal_lines": [], "frontal_size": [64, 64]}),
+            "image_lines[0] = [1] must be [x1, y1, x2, y2]",
+        ),
         "huge_seed": (field(seed=2**40), "seed = 1099511627776 must be an integer"),
         "not_a_studio_method": (field(method="blend"), "the studio does not offer method 'blend'"),
     }
@@ -144,7 +163,6 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
     path = tmp_path / "good.weft.json"
     path.write_text(json.dumps(good))
     assert window.open_session(str(path))  # and a good one still opens
-
 
 
 def _runs_off_gui_thread(monkeypatch, module, name, action):

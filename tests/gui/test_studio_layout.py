@@ -6,11 +6,10 @@ import re
 
 import pytest
 from PySide6.QtCore import QRect, Qt
-
+from weft.app.gui.main_window import MainWindow
 from weft.core import registry
 from weft.core.examples import RESOURCES
 from weft.core.geometry import MASK, Mask
-from weft.app.gui.main_window import MainWindow
 
 from .helpers import drag, mouse
 
@@ -131,8 +130,13 @@ def _widgets_over_the_examples_title(w):
     assert title.height() > 0
     over = []
     for child in w.findChildren(QWidget):
-        if (not child.isVisible() or child.isWindow() or child is dock or child.isAncestorOf(dock)
-                or dock.isAncestorOf(child)):
+        if (
+            not child.isVisible()
+            or child.isWindow()
+            or child is dock
+            or child.isAncestorOf(dock)
+            or dock.isAncestorOf(child)
+        ):
             continue
         if QRect(child.mapTo(w, QPoint(0, 0)), child.size()).intersects(title):
             over.append(child)
@@ -183,7 +187,9 @@ def test_the_square_can_be_typed_and_the_edit_undone(window, qtbot):
     qtbot.keyClicks(x_box.lineEdit(), str(w - 4))
     qtbot.keyClick(x_box.lineEdit(), Qt.Key.Key_Return)
     assert window.doc.square == before
-    assert messages and messages[-1].startswith(f"parameter 'region' = {w - 4},{before[1]},{before[2]} leaves the texture")
+    assert messages and messages[-1].startswith(
+        f"parameter 'region' = {w - 4},{before[1]},{before[2]} leaves the texture"
+    )
     assert x_box.value() == before[0]
 
 
@@ -210,11 +216,13 @@ def test_quads_prompt_is_not_cut_off_in_a_narrow_pane(qtbot, settings):
     qtbot.mouseClick(panel.quad_button, Qt.MouseButton.LeftButton)
     status = panel.rectify_status
     qtbot.waitUntil(lambda: status.isVisible() and "top-left corner" in status.text(), timeout=5000)
+
     # every word is inside the label (it wraps) and the label inside the panel
     def fits():
         room = status.contentsRect()
-        need = status.fontMetrics().boundingRect(QRect(0, 0, room.width(), 10**4), Qt.TextFlag.TextWordWrap,
-                                                 status.text())
+        need = status.fontMetrics().boundingRect(
+            QRect(0, 0, room.width(), 10**4), Qt.TextFlag.TextWordWrap, status.text()
+        )
         return need.width() <= room.width() and need.height() <= room.height()
 
     qtbot.waitUntil(fits, timeout=5000)

@@ -6,7 +6,6 @@ import json
 import numpy as np
 import pytest
 from PySide6.QtCore import Qt
-
 from weft.core.examples import RESOURCES
 from weft.core.rectify.homography import apply_homography
 
@@ -33,6 +32,7 @@ def test_suggest_lines_button_proposes_editable_pairs_and_one_undo_removes_them(
     wall = np.array([[0, 0], [511, 0], [511, 383], [0, 383]], float)
     quad = apply_homography(truth, wall)
     import cv2
+
     for x1, y1, x2, y2 in photo_lines:
         for p in ((x1, y1), (x2, y2)):
             assert cv2.pointPolygonTest(quad.astype(np.float32), p, True) > -3
@@ -70,8 +70,11 @@ from weft.core.params import Params, param  # noqa: E402
 from weft.core.registry import InputSpec, Method, Result  # noqa: E402
 from weft.core.studio import LINES, Geometry, Studio  # noqa: E402
 
-_PROPOSED = FeatureLines([[5, 5, 50, 6], [6, 40, 52, 41], [5, 5, 6, 40], [50, 6, 52, 41]],
-                         [[0, 0, 63, 0], [0, 47, 63, 47], [0, 0, 0, 47], [63, 0, 63, 47]], (64, 48))
+_PROPOSED = FeatureLines(
+    [[5, 5, 50, 6], [6, 40, 52, 41], [5, 5, 6, 40], [50, 6, 52, 41]],
+    [[0, 0, 63, 0], [0, 47, 63, 47], [0, 0, 0, 47], [63, 0, 63, 47]],
+    (64, 48),
+)
 
 
 @dataclass(frozen=True)
@@ -81,11 +84,17 @@ class _TraceParams(Params):
 
 def _method(suggest):
     return Method(
-        name="trace-lines", summary="returns its picture", params=_TraceParams,
+        name="trace-lines",
+        summary="returns its picture",
+        params=_TraceParams,
         inputs=(InputSpec("picture", "the picture"),),
         run=lambda inputs, params, **_: Result(inputs["picture"].copy(), {}),
-        studio=Studio(title="Trace lines", canvas="picture",
-                      geometry=(Geometry(LINES, on=("picture",), param="trace", help="draw lines", suggest=suggest),)))
+        studio=Studio(
+            title="Trace lines",
+            canvas="picture",
+            geometry=(Geometry(LINES, on=("picture",), param="trace", help="draw lines", suggest=suggest),),
+        ),
+    )
 
 
 @pytest.mark.parametrize("declared", [True, False])

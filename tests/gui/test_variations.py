@@ -4,11 +4,10 @@ import threading
 
 import numpy as np
 import pytest
-from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QApplication
-
 import weft.app.gui.render as render
 import weft.core.jobs as jobs_module
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QApplication
 from weft.app.gui.document import Document, DocumentState
 from weft.app.gui.variations import THUMB_SIDE
 from weft.core.errors import WeftError
@@ -231,7 +230,6 @@ def test_variations_offers_only_parameters_that_matter_and_labels_its_export(win
     parameters and every row's and column's value (the margins hold text)."""
     import json
 
-
     from weft.core.examples import RESOURCES
     from weft.core.image import load_image
 
@@ -273,8 +271,8 @@ def test_variations_offers_only_parameters_that_matter_and_labels_its_export(win
     cells = [im for im in dialog.images.values()]
     h, w = cells[0].shape[:2]
     assert grid.shape[0] > 3 * h + 8 and grid.shape[1] > 3 * w + 8  # room for the labels
-    margin_top = grid[: grid.shape[0] - (3 * h + 8), -(3 * w + 8):]
-    margin_left = grid[-(3 * h + 8):, : grid.shape[1] - (3 * w + 8)]
+    margin_top = grid[: grid.shape[0] - (3 * h + 8), -(3 * w + 8) :]
+    margin_left = grid[-(3 * h + 8) :, : grid.shape[1] - (3 * w + 8)]
     for margin in (margin_top, margin_left):
         assert (margin.max(axis=2) > 0.6).sum() > 30  # light text on the dark margin
     dialog.close()
@@ -290,8 +288,9 @@ def test_variations_ranges_stay_within_what_the_inputs_allow(window, qtbot, tmp_
     doc.set_method("quilt")
     doc.clear_input("target")
     window.open_input("texture", str(texture))
-    qtbot.waitUntil(lambda: doc.image("texture") is not None and doc.image("texture").shape[:2] == (128, 112),
-                    timeout=10000)
+    qtbot.waitUntil(
+        lambda: doc.image("texture") is not None and doc.image("texture").shape[:2] == (128, 112), timeout=10000
+    )
     doc.set_param("block", 112)
     window.open_variations()
     dialog = window._variations

@@ -48,9 +48,27 @@ evidence of vanishing directions).
 """
 
 from .segments import LSD_SCALE, WORK_SIDE
-from .suggest import (ASSUMED_FOCAL, MIN_CONFIDENCE, REFUSAL, Suggestion, suggest_for_studio, suggest_lines,
-                      suggestion_from_families)
+from .suggest import (
+    ASSUMED_FOCAL,
+    MIN_CONFIDENCE,
+    REFUSAL,
+    Suggestion,
+    suggest_for_studio,
+    suggest_lines,
+    suggestion_from_families,
+)
 from .vanishing import INLIER_DEG, MIN_FOCAL
 
-__all__ = ["Suggestion", "suggest_lines", "suggest_for_studio", "suggestion_from_families", "REFUSAL",
-           "WORK_SIDE", "LSD_SCALE", "INLIER_DEG", "ASSUMED_FOCAL", "MIN_CONFIDENCE", "MIN_FOCAL"]
+__all__ = [
+    "Suggestion",
+    "suggest_lines",
+    "suggest_for_studio",
+    "suggestion_from_families",
+    "REFUSAL",
+    "WORK_SIDE",
+    "LSD_SCALE",
+    "INLIER_DEG",
+    "ASSUMED_FOCAL",
+    "MIN_CONFIDENCE",
+    "MIN_FOCAL",
+]

@@ -59,8 +59,13 @@ def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     i, j = pairs[:, 0], pairs[:, 1]
     gap = np.hypot(*(pts[i] - pts[j]).T)
     turn = np.abs(np.angle(np.exp(1j * (ang[i] - ang[j]))))
-    keep = ((i < j) & (gap > 3 * np.maximum(size[i], size[j])) & (turn < math.radians(20))
-            & (np.abs(np.log(size[i] / size[j])) < 0.3) & (dists < np.quantile(dists, 0.3)))
+    keep = (
+        (i < j)
+        & (gap > 3 * np.maximum(size[i], size[j]))
+        & (turn < math.radians(20))
+        & (np.abs(np.log(size[i] / size[j])) < 0.3)
+        & (dists < np.quantile(dists, 0.3))
+    )
     return np.column_stack([pts[i[keep]], pts[j[keep]]])
 
 
@@ -98,8 +103,10 @@ def chains(seg: np.ndarray, px: float, tol: float = 1.2) -> tuple[np.ndarray, np
     i, j = i[near], j[near]
 
     def off(a, b):  # how far b's end points lie from a's line
-        return np.maximum(np.abs(np.einsum("ij,ij->i", lines[a, :2], p[b]) + lines[a, 2]),
-                          np.abs(np.einsum("ij,ij->i", lines[a, :2], q[b]) + lines[a, 2]))
+        return np.maximum(
+            np.abs(np.einsum("ij,ij->i", lines[a, :2], p[b]) + lines[a, 2]),
+            np.abs(np.einsum("ij,ij->i", lines[a, :2], q[b]) + lines[a, 2]),
+        )
 
     link = np.maximum(off(i, j), off(j, i)) <= tol * px
     linked = coo_matrix((np.ones(int(link.sum())), (i[link], j[link])), shape=(n, n))

@@ -16,8 +16,15 @@ from ..homography import apply_homography
 from .segments import WORK_SIDE, line_segments, repeat_segments, work_grey
 from .vanishing import MAX_FOCAL, MIN_FOCAL, MIN_SPREAD_DEG, Families, direction_at, focal_sq, two_families
 
-__all__ = ["Suggestion", "suggest_lines", "suggestion_from_families", "suggest_for_studio", "REFUSAL",
-           "ASSUMED_FOCAL", "MIN_CONFIDENCE"]
+__all__ = [
+    "Suggestion",
+    "suggest_lines",
+    "suggestion_from_families",
+    "suggest_for_studio",
+    "REFUSAL",
+    "ASSUMED_FOCAL",
+    "MIN_CONFIDENCE",
+]
 
 #: The one line said when the photo shows no two families of straight lines (nor of repeats).
 REFUSAL = "no two families of straight lines found: draw feature lines"
@@ -70,15 +77,22 @@ class Suggestion:
     def describe(self) -> str:
         """The suggestion in words, for a status line."""
         aspect = "" if self.aspect == "camera" else ", aspect from an assumed focal length"
-        return (f"suggested {len(self.lines)} line pairs from {self.source}: confidence {self.confidence:.2f}, "
-                f"directions {self.angle_deg:.0f}° apart{aspect}")
+        return (
+            f"suggested {len(self.lines)} line pairs from {self.source}: confidence {self.confidence:.2f}, "
+            f"directions {self.angle_deg:.0f}° apart{aspect}"
+        )
 
     def report(self) -> dict:
         """The figures ``--report`` prints (JSON-able)."""
-        return {"suggest_confidence": round(self.confidence, 3), "suggest_angle_deg": round(self.angle_deg, 2),
-                "suggest_source": self.source, "suggest_aspect": self.aspect,
-                "suggest_focal_px": round(self.focal_px, 1), "suggest_pairs": len(self.lines),
-                **{f"suggest_{k}": v for k, v in self.figures.items()}}
+        return {
+            "suggest_confidence": round(self.confidence, 3),
+            "suggest_angle_deg": round(self.angle_deg, 2),
+            "suggest_source": self.source,
+            "suggest_aspect": self.aspect,
+            "suggest_focal_px": round(self.focal_px, 1),
+            "suggest_pairs": len(self.lines),
+            **{f"suggest_{k}": v for k, v in self.figures.items()},
+        }
 
 
 def _plane_homography(v1: np.ndarray, v2: np.ndarray, focal: float, x0: np.ndarray) -> np.ndarray:
@@ -120,8 +134,13 @@ def _frame(h: np.ndarray, seg_px: np.ndarray, size: tuple[int, int]) -> tuple[np
         a, b = centre + (lo - centre) * scale, centre + (hi - centre) * scale
         corners = np.array([[a[0], a[1]], [b[0], a[1]], [b[0], b[1]], [a[0], b[1]]])
         img = apply_homography(h, corners)
-        if (_in_front(h, corners) and np.all(img[:, 0] >= 0) and np.all(img[:, 0] <= w - 1)
-                and np.all(img[:, 1] >= 0) and np.all(img[:, 1] <= hgt - 1)):
+        if (
+            _in_front(h, corners)
+            and np.all(img[:, 0] >= 0)
+            and np.all(img[:, 0] <= w - 1)
+            and np.all(img[:, 1] >= 0)
+            and np.all(img[:, 1] <= hgt - 1)
+        ):
             return np.array([a[0], a[1], b[0], b[1]]), apply_homography(inv, seg_px.reshape(-1, 2)).reshape(-1, 4)
         scale *= 0.93
     raise GeometryError(REFUSAL)
@@ -142,8 +161,7 @@ def _pick(positions: np.ndarray, weights: np.ndarray, lo: float, hi: float, k: i
     return out
 
 
-def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 0,
-                  repeats: bool = True) -> Suggestion:
+def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 0, repeats: bool = True) -> Suggestion:
     """Suggest feature lines for a photo of a planar texture seen at an angle.
 
     Parameters
@@ -198,8 +216,11 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
         found_work = line_segments(grey) if source == "lines" else repeat_segments(grey, rng)
         seg_px = (found_work + 0.5) / k - 0.5
         found = max(found, len(seg_px)) if source == "lines" else found
-        fam = (two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s), lattice=source == "repeats")
-               if len(seg_px) else None)
+        fam = (
+            two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s), lattice=source == "repeats")
+            if len(seg_px)
+            else None
+        )
         if fam is None:
             continue
         try:
@@ -211,9 +232,16 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
     raise GeometryError(REFUSAL)
 
 
-def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list, explained: float,
-                             size: tuple[int, int], *, source: str = "lines",
-                             min_confidence: float = MIN_CONFIDENCE) -> Suggestion:
+def suggestion_from_families(
+    seg_px: np.ndarray,
+    vps: np.ndarray,
+    members: list,
+    explained: float,
+    size: tuple[int, int],
+    *,
+    source: str = "lines",
+    min_confidence: float = MIN_CONFIDENCE,
+) -> Suggestion:
     """The rectification and feature lines of two families of segments (steps 3-4 of the module).
 
     Parameters
@@ -249,9 +277,9 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
         fam.members.reverse()
     members = np.concatenate(fam.members)
     f2 = focal_sq(v1, v2)
-    if f2 is not None and f2 <= MIN_FOCAL ** 2:
+    if f2 is not None and f2 <= MIN_FOCAL**2:
         raise GeometryError(REFUSAL)
-    if f2 is not None and f2 < MAX_FOCAL ** 2:
+    if f2 is not None and f2 < MAX_FOCAL**2:
         focal, aspect = math.sqrt(f2), "camera"
     else:
         focal, aspect = 2.0 * ASSUMED_FOCAL, "assumed focal"
@@ -261,8 +289,9 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
     rect, plane_seg = _frame(h_plane, seg_px[members], (w, hgt))
 
     # frontal pixels: the photo's pixel density over the region, at most MAX_FRONTAL_SIDE
-    quad = apply_homography(h_plane, np.array([[rect[0], rect[1]], [rect[2], rect[1]], [rect[2], rect[3]],
-                                               [rect[0], rect[3]]]))
+    quad = apply_homography(
+        h_plane, np.array([[rect[0], rect[1]], [rect[2], rect[1]], [rect[2], rect[3]], [rect[0], rect[3]]])
+    )
     area_px = 0.5 * abs(np.dot(quad[:, 0], np.roll(quad[:, 1], 1)) - np.dot(quad[:, 1], np.roll(quad[:, 0], 1)))
     pw, ph = rect[2] - rect[0], rect[3] - rect[1]
     scale = math.sqrt(area_px / (pw * ph))
@@ -299,8 +328,9 @@ def suggestion_from_families(seg_px: np.ndarray, vps: np.ndarray, members: list,
     if confidence < min_confidence:
         raise GeometryError(REFUSAL)
     vps_px = np.array([to_px_m @ v1, to_px_m @ v2])
-    vps_px = np.where(np.abs(vps_px[:, 2:3]) > 1e-12, vps_px / np.where(np.abs(vps_px[:, 2:3]) > 1e-12,
-                                                                        vps_px[:, 2:3], 1.0), vps_px)
+    vps_px = np.where(
+        np.abs(vps_px[:, 2:3]) > 1e-12, vps_px / np.where(np.abs(vps_px[:, 2:3]) > 1e-12, vps_px[:, 2:3], 1.0), vps_px
+    )
     figures = {"family_sizes": [len(m) for m in fam.members]}
     return Suggestion(lines, hom, float(confidence), angle, vps_px, focal * s, aspect, source, figures)
 

@@ -12,8 +12,17 @@ import numpy as np
 
 from .segments import chains, homogeneous
 
-__all__ = ["Families", "two_families", "refine_point", "focal_sq", "direction_at", "INLIER_DEG", "MIN_FAMILY",
-           "MIN_FOCAL", "MIN_SPREAD_DEG"]
+__all__ = [
+    "Families",
+    "two_families",
+    "refine_point",
+    "focal_sq",
+    "direction_at",
+    "INLIER_DEG",
+    "MIN_FAMILY",
+    "MIN_FOCAL",
+    "MIN_SPREAD_DEG",
+]
 
 INLIER_DEG = 1.5  # a segment supports a vanishing point when it points at it within this angle
 MIN_FAMILY = 5  # segments a family needs
@@ -35,14 +44,20 @@ def support(vps: np.ndarray, mids: np.ndarray, dirs: np.ndarray, sin_tol: np.nda
     return cross * cross <= (sin_tol * sin_tol).astype(np.float32)[None, :] * (qx * qx + qy * qy)
 
 
-def refine_point(lines: np.ndarray, weights: np.ndarray, mids: np.ndarray | None = None,
-            v: np.ndarray | None = None, iterations: int = 4) -> np.ndarray:
+def refine_point(
+    lines: np.ndarray,
+    weights: np.ndarray,
+    mids: np.ndarray | None = None,
+    v: np.ndarray | None = None,
+    iterations: int = 4,
+) -> np.ndarray:
     """The point the ``lines`` point at best: unit 3-vector. Without ``mids``, the algebraic least
     squares; with them (each line's centre) and a start ``v``, the sum of squared sines of the
     angles between each line and the direction from its centre to the point, by reweighting: the
     algebraic residual of a line is that sine times the distance (in ``v``'s scale) from its centre
     to the point, which would favour points near the long lines. A Cauchy weight (scale twice the
     robust spread of the sines, at least 0.3 degrees) keeps stray members from pulling."""
+
     def solve(w: np.ndarray) -> np.ndarray:
         m = (lines * w[:, None]).T @ lines
         return np.linalg.eigh(m)[1][:, 0]
@@ -122,7 +137,7 @@ def two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice: 
             if mem.sum() < 2:
                 break
             merged, span, centres = chains(seg[mem], px)
-            v = refine_point(merged, span ** 2, centres, v)
+            v = refine_point(merged, span**2, centres, v)
             mem = support(v[None], mids, dirs, sin_tol)[0] & free
         return v, mem
 
@@ -144,7 +159,7 @@ def two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice: 
         for a in range(len(found)):
             for b in range(a + 1, len(found)):
                 f2 = focal_sq(found[a][0], found[b][0])
-                if f2 is None or not MIN_FOCAL ** 2 < f2 < MAX_FOCAL ** 2:
+                if f2 is None or not MIN_FOCAL**2 < f2 < MAX_FOCAL**2:
                     continue
                 sc = min(found[a][1] @ length, found[b][1] @ length)
                 if sc > score:
@@ -152,8 +167,9 @@ def two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice: 
         if best is None:
             return None
         explained = float((best[0][1] | best[1][1]) @ length / length.sum())
-        return Families(np.array([best[0][0], best[1][0]]), [np.flatnonzero(best[0][1]), np.flatnonzero(best[1][1])],
-                         explained)
+        return Families(
+            np.array([best[0][0], best[1][0]]), [np.flatnonzero(best[0][1]), np.flatnonzero(best[1][1])], explained
+        )
     cand = hypotheses(lines, length, np.arange(n), rng)
     sup = support(cand, mids, dirs, sin_tol)
     v1, mem1 = refine(cand[np.argmax(sup @ length)], everything)
@@ -169,13 +185,13 @@ def two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice: 
         if sup[m].sum() < MIN_FAMILY:
             break
         f2 = focal_sq(v1, cand[m])
-        if f2 is not None and f2 <= MIN_FOCAL ** 2:  # no camera sees these two directions as perpendicular
+        if f2 is not None and f2 <= MIN_FOCAL**2:  # no camera sees these two directions as perpendicular
             continue
         v2, mem2 = refine(cand[m], ~mem1)
         if mem2.sum() < MIN_FAMILY:
             continue
         f2 = focal_sq(v1, v2)
-        if f2 is not None and f2 <= MIN_FOCAL ** 2:
+        if f2 is not None and f2 <= MIN_FOCAL**2:
             continue
         # two families of comparable strength and a third nearly as strong (the edges of hexagonal
         # cells) leave it open which two are the perpendicular ones: no guess
