@@ -1,10 +1,10 @@
 """The ``weft`` command.
 
-``weft`` with no arguments opens the desktop studio (``weft IMAGE [TARGET]``: on those images); ``weft METHOD INPUT... -o OUT [options]`` runs a
-method headless; ``weft run RECIPE -o OUT`` reproduces a recipe (a ``.json`` file, or a PNG exported
-by weft, which carries its recipe); ``weft batch RECIPE --over INPUT FILES -o PATTERN`` applies it to
-many files (:mod:`weft.app.batch_cli`). Method options are generated from the method's ``Params`` specs,
-so the CLI and the GUI share one definition of every parameter and its range.
+``weft`` with no arguments opens the desktop studio (``weft IMAGE [TARGET]``: on those images); ``weft METHOD
+INPUT... -o OUT [options]`` runs a method headless; ``weft run RECIPE -o OUT`` reproduces a recipe (a
+``.json`` file, or a PNG exported by weft, which carries its recipe); ``weft batch RECIPE --over INPUT FILES
+-o PATTERN`` applies it to many files (:mod:`weft.app.batch_cli`). Method options are generated from the
+method's ``Params`` specs, so the CLI and the GUI share one definition of every parameter and its range.
 
 Contract: any bad input (a file, a parameter, a geometry) prints exactly one line on stderr and exits
 with status 2, with no traceback and no output file. ``--report`` prints exactly one JSON line on
@@ -60,7 +60,7 @@ from weft.core.errors import Cancelled, WeftError  # noqa: E402
 from weft.core.params import Params, specs  # noqa: E402
 
 from .options import parse_bit_depth as _parse_bit_depth  # noqa: E402
-from .options import parse_int as _parse_int
+from .options import parse_int as _parse_int  # noqa: E402
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -114,7 +114,8 @@ class _TerminalProgress:
 class _PreparingLine:
     """Says on stderr that kernels are being compiled — the first run's long silent stretch (a cold
     quilting transfer compiled for 39 s before its first progress report) — and keeps the line alive
-    with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes over or the run ends.
+    with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes
+    over or the run ends.
 
     Called from numba's compile events (``registry.watch_compiles``), i.e. only when a kernel really
     compiles: a run that loads every kernel from numba's cache says nothing. Like the progress bar it
@@ -344,9 +345,11 @@ def _execute(
     read_too: Sequence[str] = (),
 ) -> int:
     from weft.core import registry
+    from weft.core.geometry import Square
     from weft.core.image import save_image
     from weft.core.image.temporaries import remove_stale_temporaries
-    from weft.core.run import output_recipe, render
+    from weft.core.request import RenderRequest
+    from weft.core.run import output_recipe
 
     method = registry.get(method_name)
     # typed parameters (a method's own command line) or their JSON form (a recipe's, read at its edge)
@@ -363,15 +366,20 @@ def _execute(
 
     bar = _TerminalProgress(not args.quiet)
     preparing = _PreparingLine(method.name, bar)
-    infos: dict = {}
     try:
         with registry.watch_compiles(on_start=preparing):  # a kernel compiling: say so on the terminal
             # Loading every kernel up front only keeps --report's "seconds" free of cache loads; without
             # --report a run loads (or, first time, compiles) just the kernels it uses: a cold
             # `weft affine` 3.8 -> 3.0 s, `weft nfpt` 4.7 -> 3.9 s.
-            result, seconds = render(
-                method, params, input_paths, seed, region, progress=bar, warm_up=args.report, infos=infos
+            request = RenderRequest(
+                method,
+                params,
+                input_paths,
+                seed,
+                None if region is None else Square(*region),
+                warm_up=args.report and method.warm_up_in_cli,
             )
+            rendered = request.run(progress=bar)
     finally:
         preparing.stop()
         bar.close()
@@ -381,22 +389,22 @@ def _execute(
     for repair in registry.kernel_cache_repairs() if not args.quiet else ():
         print(f"weft: {repair}", file=sys.stderr)
     if bit_depth is None:  # not asked for: 8, or the bit depth of the input the method names (fill: the image)
-        info = infos.get(method.depth_from) if method.depth_from else None
+        info = rendered.infos.get(method.depth_from) if method.depth_from else None
         jpeg = out.suffix.lower() in (".jpg", ".jpeg")
         bit_depth = info.bit_depth if info is not None and not jpeg else 8
     recipe = output_recipe(method, params, input_paths, seed, region, out)
     if args.bit_depth is not None:  # asked for (or a recipe's): recorded, so weft run writes it again
         recipe = dataclasses.replace(recipe, bit_depth=bit_depth)
     remove_stale_temporaries([out])  # a killed earlier run's half-written file beside it
-    save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
+    save_image(out, rendered.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if save_lines is not None:
         from weft.core.image import atomic_write_bytes
 
         atomic_write_bytes(save_lines[0], (save_lines[1].to_text() + "\n").encode("utf-8"))
     if args.report:
-        h, w = result.image.shape[:2]
-        line = {"method": method.name, "seconds": round(seconds, 6), "size": [w, h], "seed": seed}
-        line.update(result.figures)
+        h, w = rendered.image.shape[:2]
+        line = {"method": method.name, "seconds": round(rendered.seconds, 6), "size": [w, h], "seed": seed}
+        line.update(rendered.figures)
         line.update(extra or {})
         print(json.dumps(line), flush=True)
     return 0

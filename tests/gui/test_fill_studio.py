@@ -1135,7 +1135,7 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
     the render job on its worker: at 4096² they stalled the GUI thread 0.15-0.57 s per stroke preview."""
     import threading
 
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
 
     on_gui: dict[str, list[bool]] = {"to_image": [], "crop_around": [], "reduce_for_preview": []}
 
@@ -1147,8 +1147,9 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
         return wrapper
 
     monkeypatch.setattr(Mask, "to_image", recorded("to_image", Mask.to_image))
-    monkeypatch.setattr(render, "crop_around", recorded("crop_around", render.crop_around))
-    monkeypatch.setattr(render, "reduce_for_preview", recorded("reduce_for_preview", render.reduce_for_preview))
+    monkeypatch.setattr(core_request, "crop_around", recorded("crop_around", core_request.crop_around))
+    reduce = recorded("reduce_for_preview", core_request.reduce_for_preview)
+    monkeypatch.setattr(core_request, "reduce_for_preview", reduce)
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
@@ -1215,7 +1216,7 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
     """The job of a preview around a stroke is given the part of the stroke's mask its crop can reach
     (``around_region``), cut on the GUI thread, never the whole mask (at 4096² a 64 MB float image per
     preview); the whole mask is made into an image only for the full render on release."""
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
     from weft.core.studio import around_region
 
     w, h = 480, 360
@@ -1226,8 +1227,8 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
         calls.append((set(inputs), stroke, kwargs.get("mask_part")))
         return crop_around(studio_, inputs, params, stroke, **kwargs)
 
-    crop_around = render.crop_around
-    monkeypatch.setattr(render, "crop_around", recorded_crop)
+    crop_around = core_request.crop_around
+    monkeypatch.setattr(core_request, "crop_around", recorded_crop)
     to_image = Mask.to_image
     monkeypatch.setattr(Mask, "to_image", lambda self: images.append(self.shape) or to_image(self))
     studio.inputs_pane.mask_tool().set_size(9)  # radius 4
@@ -1261,12 +1262,12 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
     preview of all of them follows (the latest dab wins), not one per mouse move."""
     import threading
 
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
 
     w, h = 480, 360
     view = _large_picture(studio, qtbot, tmp_path, w, h, at=(130, 102))
     gate = threading.Event()
-    crop_around = render.crop_around
+    crop_around = core_request.crop_around
     entered = []
 
     def held(*args, **kwargs):
@@ -1274,7 +1275,7 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
         assert gate.wait(20)  # the first preview's job waits here until the moves are made
         return crop_around(*args, **kwargs)
 
-    monkeypatch.setattr(render, "crop_around", held)
+    monkeypatch.setattr(core_request, "crop_around", held)
     submitted = []
     studio.renderer.submitted.connect(lambda job, slot: submitted.append(job) if slot == "preview" else None)
     around = []
