@@ -93,11 +93,11 @@ class Around:
         fit together (another size or channel count)."""
         x0, y0, x1, y1 = self.box
         dx, dy = self.offset
-        part = self.fitted(part)
+        fitted = self.fitted(part)
         if (
-            part is None
-            or part.ndim != base.ndim
-            or (part.ndim == 3 and part.shape[2] != base.shape[2])
+            fitted is None
+            or fitted.ndim != base.ndim
+            or (fitted.ndim == 3 and fitted.shape[2] != base.shape[2])
             or y0 + dy < 0
             or x0 + dx < 0
             or y1 + dy > base.shape[0]
@@ -105,7 +105,7 @@ class Around:
         ):
             return None
         out = base.copy() if copy else base
-        out[y0 + dy : y1 + dy, x0 + dx : x1 + dx] = part
+        out[y0 + dy : y1 + dy, x0 + dx : x1 + dx] = fitted
         return out
 
 

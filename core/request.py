@@ -14,7 +14,7 @@ import os
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -253,17 +253,19 @@ class RenderRequest:
                 f"weft {method.name} takes no --region (it works on the whole {method.inputs[0].name}; "
                 f"crop the image first)"
             )
-        if _is_images(self.inputs):
-            return crop_region(method, dict(self.inputs), region)
         if callable(self.inputs):
             names = None
             if isinstance(self.mode, AroundStroke) and self.mode.mask_part is not None:
-                names = [i.name for i in method.inputs if i.name != method.studio.preview_around]
+                painted = None if method.studio is None else method.studio.preview_around
+                names = [i.name for i in method.inputs if i.name != painted]
             return crop_region(method, self.inputs(names), region)
+        if _is_images(self.inputs):
+            return crop_region(method, dict(cast(Mapping[str, np.ndarray], self.inputs)), region)
         from .image import load_image
 
+        paths = cast(Mapping[str, str | os.PathLike], self.inputs)
         keep_alpha = {spec.name for spec in method.inputs if spec.alpha}
-        loaded = {name: load_image(path, alpha=name in keep_alpha) for name, path in self.inputs.items()}
+        loaded = {name: load_image(path, alpha=name in keep_alpha) for name, path in paths.items()}
         infos.update({name: item.info for name, item in loaded.items()})
         images = crop_region(method, {name: item.image for name, item in loaded.items()}, region)
         shown = self._shown()

@@ -103,5 +103,5 @@ def output_recipe(
         params=params.to_dict(),
         inputs=rel_inputs,
         seed=seed,
-        region=None if region is None else Square(*region),
+        region=None if region is None else Square._make(region),
     )

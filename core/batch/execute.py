@@ -117,7 +117,7 @@ def run_item(item: Item) -> Outcome:
                 paths[name] = str(copy)
         cancel = CancelToken(_cancel_event) if _cancel_event is not None else None
         try:
-            region = None if item.region is None else Square(*item.region)
+            region = None if item.region is None else Square._make(item.region)
             request = RenderRequest(method, params, paths, item.seed, region, shown_paths=item.inputs)
             rendered = request.run(cancel=cancel)
             assert rendered is not None  # (a full render always gives a result)
