@@ -204,7 +204,7 @@ class Renderer(QObject):
         box = None
         if slot == "preview" and self._around_box is not None:
             # a stroke's preview: only the crop around it is built (not the whole-image reduced
-            # preview as well: 11.6 ms at 2048², 48.5 ms at 4096² per preview, thrown away)
+            # preview as well, which would be thrown away)
             if doc.missing_inputs():
                 return None
             box, self._around_box = self._around_box, None
@@ -233,7 +233,6 @@ class Renderer(QObject):
             masks=None if preview else doc.masks(),
             base=base,
         )
-
         if slot == "final":
             self.runner.cancel("preview")
             self._preview_running, self._preview_dirty = None, False
@@ -382,9 +381,9 @@ class Renderer(QObject):
         """Load (or compile) the other methods' kernels in the background — a moment
         (``WARM_UP_AFTER_RESULT_MS``) after the first full result is shown, or after ``delay_ms`` if no
         render is running then, and never while a stroke is previewed — so that they never make the
-        visible render wait: numba compiles under one process-wide lock, and a warm-up that went
-        first held the first result back behind every other method's compile. Nor do they stall
-        painting: loading them holds Python's GIL up to 40-66 ms at a time (imports, numba's typing
+        visible render wait: numba compiles under one process-wide lock, so a warm-up that went
+        first would hold the first result back behind every other method's compile. Nor do they stall
+        painting: loading them holds Python's GIL for several frames at a time (imports, numba's typing
         tables), and an artist often starts a stroke as soon as the picture is there."""
         self._warm_up_wanted = True
         self._warm_up_timer.start(delay_ms)
