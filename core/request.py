@@ -91,7 +91,7 @@ def crop_region(method: Method, images: dict[str, np.ndarray], region: Square | 
     Returns
     -------
     dict of str to ndarray
-        The inputs with the first one cropped. ``GeometryError`` if the square leaves that image.
+        The inputs with the first one cropped. ``InvalidParameter`` if the square leaves that image.
     """
     first = method.inputs[0].name
     if region is None or first not in images:
