@@ -41,7 +41,7 @@ class QtJobs(QObject):
         """Run ``fn(*args, progress=..., cancel=..., **kwargs)`` on a worker; a newer job of ``slot``
         cancels this one (see :meth:`JobRunner.submit <weft.core.jobs.JobRunner.submit>`)."""
         job = self.runner.submit(slot, fn, *args, **kwargs)
-        job.future.add_done_callback(lambda _f, jid=job.id, slot=slot: self._emit(self.finished, jid, slot))
+        job.future.add_done_callback(lambda _f, jid=job.id, slot=slot: self._emit("finished", jid, slot))
         return job
 
     def cancel(self, slot: str | None = None) -> None:
@@ -59,14 +59,13 @@ class QtJobs(QObject):
         self.runner.shutdown(wait=wait, cancel=cancel)
 
     def _emit_result(self, result) -> None:
-        self._emit(self.result, result)
+        self._emit("result", result)
 
     def _emit_progress(self, job_id: int, slot: str, progress) -> None:
-        self._emit(self.progressed, job_id, slot, progress)
+        self._emit("progressed", job_id, slot, progress)
 
-    @staticmethod
-    def _emit(signal, *args) -> None:
+    def _emit(self, name: str, *args) -> None:
         try:
-            signal.emit(*args)
-        except RuntimeError:  # the receiving window was deleted while the job ran: nobody to tell
+            getattr(self, name).emit(*args)
+        except RuntimeError:  # this object was deleted (its window closed) while the job ran: nobody to tell
             pass

@@ -49,3 +49,22 @@ def test_an_error_is_a_result_with_its_exception(qtbot):
         jobs.submit("x", failing)
     assert str(got.args[0].error) == "broken on purpose" and got.args[0].value is None
     jobs.shutdown()
+
+
+def test_a_job_that_ends_after_its_window_is_gone_tells_nobody_and_fails_nothing(qtbot, caplog):
+    import shiboken6
+
+    jobs = QtJobs()
+    runner = jobs.runner
+    release = threading.Event()
+
+    def held(*, progress=None, cancel=None):
+        assert release.wait(10)
+        return "late"
+
+    job = jobs.submit("x", held)
+    shiboken6.delete(jobs)  # the dialog that owned it was closed and deleted
+    release.set()
+    assert job.result(timeout=10).value == "late"
+    assert "callback failed" not in caplog.text
+    runner.shutdown()
