@@ -76,7 +76,7 @@ class BatchDialog(QDialog):
         self.recipe = recipe = recipe_source()
         self.method = registry.get(recipe.method)
         self._cancel: CancelToken | None = None
-        self.jobs = QtJobs(self)
+        self.jobs: QtJobs | None = None  # one per batch: its worker thread ends with the batch
 
         self.over = QComboBox()
         for spec in self.method.inputs:
@@ -146,7 +146,6 @@ class BatchDialog(QDialog):
         layout.addWidget(self.buttons)
         self.progressed.connect(self._on_progress)
         self.batch_finished.connect(self._on_finished)
-        self.jobs.finished.connect(self._job_ended)
         app = QApplication.instance()
         if app is not None:  # quitting stops the batch too (finished outputs stay; a re-run resumes)
             app.aboutToQuit.connect(self.cancel)
@@ -186,7 +185,7 @@ class BatchDialog(QDialog):
 
     @property
     def running(self) -> bool:
-        return self.jobs.busy("batch")
+        return self.jobs is not None and self.jobs.busy("batch")
 
     # --- running -------------------------------------------------------------------------------
     def start(self) -> None:
@@ -213,6 +212,8 @@ class BatchDialog(QDialog):
         self._set_running(True)
         self.status.setText("starting the worker processes…")
         self.progress.setRange(0, 0)  # busy until the first item is counted
+        self.jobs = jobs = QtJobs(self)
+        jobs.finished.connect(lambda _id, _slot: self._job_ended(jobs))
         self._cancel = self.jobs.submit("batch", self._work, over, pattern, options, workers).token
 
     def _emit(self, signal, *args) -> None:
@@ -289,9 +290,11 @@ class BatchDialog(QDialog):
             self.progress.setRange(0, 1)
         self.status.setText(line)
 
-    def _job_ended(self, job_id: int, slot: str) -> None:
-        """The batch's job resolved: if it said nothing (cancelled before it started), say so now."""
-        if not self.run_button.isEnabled():
+    def _job_ended(self, jobs: QtJobs) -> None:
+        """A batch's job resolved: its worker ends; if it is the current batch and said nothing
+        (cancelled before it started), say so now."""
+        jobs.shutdown(wait=False, cancel=False)
+        if jobs is self.jobs and not self.run_button.isEnabled():
             self.batch_finished.emit("cancelled before any item started", -1, True)
 
     def closeEvent(self, event):  # noqa: N802 - closing while running cancels (finished outputs stay)
