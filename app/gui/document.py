@@ -201,28 +201,27 @@ class Document(QObject):
 
     def method_inputs(self, *, live: bool = False) -> dict[str, np.ndarray]:
         """The current method's loaded inputs (its painted masks among them, as images; with
-        ``live`` the stroke being drawn); the canvas cropped to the source region if there is one."""
+        ``live`` the stroke being drawn), uncropped: a render request crops to the source region."""
         return self.deferred_inputs(live=live)()
 
     def deferred_inputs(self, *, live: bool = False) -> Callable[..., dict[str, np.ndarray]]:
         """:meth:`method_inputs` captured now and built when called, on any thread: the slow part
-        (a painted mask's float image, 64 MB for a 4096² mask, and a crop to the source region) is
-        left to the call, so a render job does it on its worker, not the GUI thread. The call
-        takes ``names`` (default all): only those inputs."""
-        arrays, masks, region, on = self._input_parts(live)
+        (a painted mask's float image, 64 MB for a 4096² mask) is left to the call, so a render job
+        does it on its worker, not the GUI thread. The call takes ``names`` (default all): only those
+        inputs."""
+        arrays, masks, _, _ = self._input_parts(live)
 
         def build(names=None) -> dict[str, np.ndarray]:
             out = {n: a for n, a in arrays.items() if names is None or n in names}
             out.update({n: m.to_image() for n, m in masks.items() if names is None or n in names})
-            if region is not None and on in out:
-                out[on] = region.crop(out[on], what=on.replace("_", " "))
             return out
 
         return build
 
     def input_shapes(self) -> dict[str, tuple[int, ...]]:
-        """The shapes of what :meth:`method_inputs` gives the current method (input name -> array
-        shape), without building it: what its "auto" parameters depend on (``Studio.resolved``)."""
+        """The shapes of what a render of the current method runs on (input name -> array shape: the
+        source region's crop included), without building it: what its "auto" parameters depend on
+        (``Studio.resolved``)."""
         arrays, masks, region, on = self._input_parts(False)
         out = {name: a.shape for name, a in arrays.items()}
         out.update({name: mask.shape for name, mask in masks.items()})

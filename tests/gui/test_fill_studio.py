@@ -584,7 +584,7 @@ def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
     _click_menu_item(qtbot, studio.geometry_menu, bar.extend_action)  # Edit > Mask and Canvas > Extend canvas…
     dialog = bar.dialog
     qtbot.waitUntil(dialog.isVisible, timeout=5000)
-    for side, value in zip(("left", "top", "right", "bottom"), (3, 5, 0, 12)):
+    for side, value in zip(("left", "top", "right", "bottom"), (3, 5, 0, 12), strict=True):
         box = dialog.boxes[side]
         box.selectAll()
         qtbot.keyClicks(box, str(value))
@@ -639,7 +639,7 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
 
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
-    around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
+    _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     text = studio.result_label.full_text()
     # (a count of pixels describes the crop, not the picture: only the full result states it)
     assert re.fullmatch(
@@ -725,7 +725,7 @@ def test_an_own_input_opened_for_another_method_stays_its_through_a_session(stud
     is still not mean-fill's (seen under Xvfb: after a recovery, the brick open for quilt filled a
     gravel hole in fill, because a restored session counted every own input as the current method's)."""
     doc, view = studio.doc, studio.canvas_view
-    swatch = _swatch_opened_for_another_method(studio, qtbot, tmp_path)
+    _swatch_opened_for_another_method(studio, qtbot, tmp_path)
     studio.inputs_pane.mask_tool().set_size(5)
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     session = tmp_path / "s.weft.json"
@@ -906,7 +906,7 @@ def test_esc_on_the_first_stroke_after_a_method_switch_shows_the_picture_again(s
     view.zoom_by(4.0)
     view.centerOn(W / 2, H / 2)
     studio.inputs_pane.mask_tool().set_size(9)
-    around = _previewed(studio, qtbot, view, [(20.5, 20.5), (30.5, 20.5)])
+    _previewed(studio, qtbot, view, [(20.5, 20.5), (30.5, 20.5)])
     assert not np.array_equal(studio.result_view.image, studio.doc.image("picture"))  # the stroke's preview
     view.setFocus()
     qtbot.keyClick(view, Qt.Key.Key_Escape)
@@ -923,7 +923,7 @@ def test_a_stroke_that_changes_nothing_ends_its_preview_with_no_undo_step(studio
     studio.inputs_pane.mask_tool().set_size(9)
     result = _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (40.5, 20.5)]))
     steps = doc.undo_stack.count()
-    around = _previewed(studio, qtbot, view, [(30.5, 20.5), (31.5, 20.5)])  # over what is painted already
+    _previewed(studio, qtbot, view, [(30.5, 20.5), (31.5, 20.5)])  # over what is painted already
     assert doc.live is not None
     assert not np.array_equal(studio.result_view.image, result.image)  # the crop's own mean: other pixels
     with qtbot.waitSignal(studio.renderer.shown, timeout=10000) as shown:  # the full result again
@@ -959,7 +959,7 @@ def test_a_parameter_change_does_not_redraw_the_masks_overlay(studio, qtbot):
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     drawn = tool.overlay.image().cacheKey()
     for amount in (0.9, 0.8):
-        _final_after(studio, qtbot, lambda: doc.set_param("amount", amount))
+        _final_after(studio, qtbot, lambda amount=amount: doc.set_param("amount", amount))
     assert tool.overlay.image().cacheKey() == drawn  # the same image: not rebuilt
     assert np.array_equal(_painted(tool.overlay), _mask(studio).bits)
     # another mask is drawn: undo brings back the picture with nothing painted, redo the stroke
@@ -1135,7 +1135,7 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
     the render job on its worker: at 4096² they stalled the GUI thread 0.15-0.57 s per stroke preview."""
     import threading
 
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
 
     on_gui: dict[str, list[bool]] = {"to_image": [], "crop_around": [], "reduce_for_preview": []}
 
@@ -1147,8 +1147,9 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
         return wrapper
 
     monkeypatch.setattr(Mask, "to_image", recorded("to_image", Mask.to_image))
-    monkeypatch.setattr(render, "crop_around", recorded("crop_around", render.crop_around))
-    monkeypatch.setattr(render, "reduce_for_preview", recorded("reduce_for_preview", render.reduce_for_preview))
+    monkeypatch.setattr(core_request, "crop_around", recorded("crop_around", core_request.crop_around))
+    reduce = recorded("reduce_for_preview", core_request.reduce_for_preview)
+    monkeypatch.setattr(core_request, "reduce_for_preview", reduce)
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
@@ -1215,7 +1216,7 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
     """The job of a preview around a stroke is given the part of the stroke's mask its crop can reach
     (``around_region``), cut on the GUI thread, never the whole mask (at 4096² a 64 MB float image per
     preview); the whole mask is made into an image only for the full render on release."""
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
     from weft.core.studio import around_region
 
     w, h = 480, 360
@@ -1226,8 +1227,8 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
         calls.append((set(inputs), stroke, kwargs.get("mask_part")))
         return crop_around(studio_, inputs, params, stroke, **kwargs)
 
-    crop_around = render.crop_around
-    monkeypatch.setattr(render, "crop_around", recorded_crop)
+    crop_around = core_request.crop_around
+    monkeypatch.setattr(core_request, "crop_around", recorded_crop)
     to_image = Mask.to_image
     monkeypatch.setattr(Mask, "to_image", lambda self: images.append(self.shape) or to_image(self))
     studio.inputs_pane.mask_tool().set_size(9)  # radius 4
@@ -1261,12 +1262,12 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
     preview of all of them follows (the latest dab wins), not one per mouse move."""
     import threading
 
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
 
     w, h = 480, 360
     view = _large_picture(studio, qtbot, tmp_path, w, h, at=(130, 102))
     gate = threading.Event()
-    crop_around = render.crop_around
+    crop_around = core_request.crop_around
     entered = []
 
     def held(*args, **kwargs):
@@ -1274,7 +1275,7 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
         assert gate.wait(20)  # the first preview's job waits here until the moves are made
         return crop_around(*args, **kwargs)
 
-    monkeypatch.setattr(render, "crop_around", held)
+    monkeypatch.setattr(core_request, "crop_around", held)
     submitted = []
     studio.renderer.submitted.connect(lambda job, slot: submitted.append(job) if slot == "preview" else None)
     around = []
@@ -1304,7 +1305,7 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
     assert np.array_equal(image[150:, :], picture[150:, :])  # nothing else changed
     _final_after(studio, qtbot, lambda: mouse(view, "release", points[-1]))
     expected = Mask.empty(w, h)
-    for p0, p1 in zip([points[0]] + points[:-1], points):
+    for p0, p1 in zip([points[0]] + points[:-1], points, strict=True):
         expected = expected.painted_line((p0[0] - 0.5, p0[1] - 0.5), (p1[0] - 0.5, p1[1] - 0.5), 3)
     assert _mask(studio) == expected and np.array_equal(_painted(studio.inputs_pane.mask_tool().overlay), expected.bits)
 
