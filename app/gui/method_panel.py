@@ -4,12 +4,11 @@ Contract
 --------
 * Built from ``weft.core.registry.studio_methods()`` and the current method's ``Params`` specs and studio
   description; it names no method, input or parameter.
-* It changes the document only through its setters (``set_method``, ``set_param``, ``set_seed``) and
-  shows the document after each ``changed`` through :meth:`show_method`, :meth:`show_params`,
+* It changes the document only through its setters (``set_method``, ``set_param``, ``set_seed``; a
+  slider held is ``drag_param``, let go ``set_param``: the renderer decides what to render) and
+  shows the document after each change through :meth:`show_method`, :meth:`show_params`,
   :meth:`show_seed`, :meth:`show_square`.
-* Signals: ``preview_requested()`` while a slider is held (the edit is already in the document),
-  ``final_requested()`` when it is let go;
-  ``render_requested()``; ``variations_requested()``; ``message(text)`` a one-line problem.
+* Signals: ``render_requested()``; ``variations_requested()``; ``message(text)`` a one-line problem.
   ``compare_button`` is checkable (the window connects it to the result view).
 """
 
@@ -43,8 +42,6 @@ THUMB = 96
 class MethodPanel(QWidget):
     """See the module docstring."""
 
-    preview_requested = Signal()
-    final_requested = Signal()
     render_requested = Signal()
     variations_requested = Signal()
     message = Signal(str)
@@ -52,7 +49,6 @@ class MethodPanel(QWidget):
     def __init__(self, doc, parent=None):
         super().__init__(parent)
         self.doc = doc
-        self.dragging = False  # a slider is held: the document's "params" change asks for no final render
         lay = QVBoxLayout(self)
         top = QHBoxLayout()
         top.addWidget(QLabel("Method"))
@@ -140,20 +136,15 @@ class MethodPanel(QWidget):
 
     def _param_edited(self, name: str, value, dragging: bool) -> None:
         try:
-            self.dragging = dragging
-            # a slider's moves are one undo step; a choice from a list, a switch or a typed size is its own
-            row = self.params_panel.rows.get(name)
-            self.doc.set_param(name, value, merge=row is not None and row.spec.kind in (INT, FLOAT))
+            if dragging:
+                self.doc.drag_param(name, value)
+            else:
+                # a slider's moves are one undo step; a choice from a list, a switch or a typed size is its own
+                row = self.params_panel.rows.get(name)
+                self.doc.set_param(name, value, merge=row is not None and row.spec.kind in (INT, FLOAT))
         except WeftError as e:
             self.message.emit(str(e))
             self.show_params()  # back to the valid value
-            return
-        finally:
-            self.dragging = False
-        if dragging:
-            self.preview_requested.emit()
-        else:
-            self.final_requested.emit()  # a release on an unchanged value still asks for the full size
 
     def _square_typed(self, _value=None) -> None:
         """X, Y or side typed: the square they give, checked as the CLI checks ``--region X,Y,S`` /
@@ -170,7 +161,8 @@ class MethodPanel(QWidget):
         values = [b.value() for b in self.square_boxes]
         if doc.value(g.key) is None:  # none drawn: the boxes left blank take the corner and a default side
             values = [
-                d if v == b.minimum() else v for v, b, d in zip(values, self.square_boxes, _default_square(image))
+                d if v == b.minimum() else v
+                for v, b, d in zip(values, self.square_boxes, _default_square(image), strict=True)
             ]
         try:
             square = Square.parse(values, g.key)
@@ -239,7 +231,7 @@ class MethodPanel(QWidget):
             return
         h, w = image.shape[:2]
         limits = ((0, max(w - Square.MIN_SIDE, 0)), (0, max(h - Square.MIN_SIDE, 0)), (Square.MIN_SIDE, min(w, h)))
-        for i, (box, (lo, hi)) in enumerate(zip(self.square_boxes, limits)):
+        for i, (box, (lo, hi)) in enumerate(zip(self.square_boxes, limits, strict=True)):
             box.blockSignals(True)
             if square is None:  # blank (the minimum shows "–") until a number is typed
                 box.setRange(lo - 1, max(lo, hi))

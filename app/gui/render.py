@@ -1,5 +1,12 @@
 """Rendering: turns the document into preview and final jobs on the worker pool, results into images.
 
+* The renderer alone decides what a change of the document renders: it listens to the document's
+  signals (:meth:`Renderer.listen`). A slider held (``Document.drag_param``) or a geometry dragged
+  whose studio description asks for a live result (``Geometry.live``) previews; a mask stroke of the
+  mask its method previews around (``Studio.preview_around``) previews around the stroke; any edit
+  renders in full; an edit in progress dropped (``live_changed(None)``) shows what was there before
+  (``withdrawn``), or renders in full when a slider was let go.
+
 * While a slider is held down, ``preview()`` submits a reduced-size job (slot ``"preview"``). At most
   one preview is computed at a time: changes that arrive meanwhile are coalesced into the next one,
   started as soon as the running one is done (cancelling a running preview at every slider step
@@ -12,7 +19,8 @@
 * Jobs carry ids; a result older than the one shown is dropped, so what is shown is always the last
   completed job. A result carries the recipe of its pixels (method, parameters, inputs, seed, region)
   and its "before" image, captured when the job was made: export and Compare use those, never the
-  panel's state at the time of the export. Workers never touch widgets: results and progress arrive through queued signals.
+  panel's state at the time of the export. Workers never touch widgets: results and progress arrive
+  through queued signals.
 * While a mask stroke is painted, ``preview_around(box)`` submits (in the same coalesced preview slot)
   a render of the region around the stroke only, when the method's studio description asks for it
   (``Studio.preview_around``; ``weft.core.studio.crop_around`` crops the inputs to at most
@@ -40,6 +48,7 @@ import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from enum import Enum, auto
 
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
@@ -62,6 +71,25 @@ WARM_UP_AFTER_RESULT_MS = 1000  # the first result is in: warm the others up thi
 #: 51.7 ms (``python -m benchmarks.gui_latency --paint --side 4096``); a long C call holding the GIL
 #: (an import, numba loading its typing tables) is not cut short by it.
 GIL_SWITCH_INTERVAL = 0.001
+
+
+class FailureKind(Enum):
+    """What failed: a render of the document (the result shown is out of date), or a job in the
+    background (the kernels' warm-up: the result shown is not affected)."""
+
+    RENDER = auto()
+    BACKGROUND = auto()
+
+
+@dataclass(frozen=True)
+class RenderFailure:
+    """A failure the renderer reports (``Renderer.failed``): its kind and one line of words."""
+
+    kind: FailureKind
+    message: str
+
+    def __str__(self) -> str:
+        return self.message
 
 
 class _Partial:
@@ -142,14 +170,14 @@ def stroke_part(doc, box) -> tuple[np.ndarray, tuple[int, int]] | None:
     then reads the document's live masks whole)."""
     g = doc.mask_geometry(doc.studio.preview_around) if doc.studio.preview_around else None
     live = doc.live
-    if g is None or live is None or live[0] != g.key or not isinstance(live[1], MaskStroke):
+    if g is None or live is None or live.param or live.key != g.key or not isinstance(live.value, MaskStroke):
         return None
     on = doc.image(g.input_for(doc.inputs))
-    h, w = live[1].shape
+    h, w = live.value.shape
     if on is None or on.shape[:2] != (h, w):
         return None
     x0, y0, x1, y1 = around_region(box, w, h)
-    return live[1].cut(x0, y0, x1, y1), (x0, y0)
+    return live.value.cut(x0, y0, x1, y1), (x0, y0)
 
 
 def preparation(doc, *, side: int | None = None, around_box=None) -> tuple[Callable[[], tuple | None], Params] | None:
@@ -188,7 +216,9 @@ class Renderer(QObject):
 
     Signals: ``shown(Shown)`` a new result to display; ``partial(image)`` a partial image of a
     running job; ``progress(fraction, stage)``; ``busy(bool)`` a job over the progress delay is
-    running (show the bar); ``failed(message)``; ``needs(words)`` nothing rendered: the method needs
+    running (show the bar); ``failed(RenderFailure)``; ``withdrawn()`` an edit in progress was
+    dropped: show again what was shown before its previews (``shown`` has the last result again
+    when it was on screen); ``needs(words)`` nothing rendered: the method needs
     something drawn first (``Geometry.needed``); ``cancelled()``; ``preparing(words)`` the running
     final render is waiting for its method's kernels to compile (a first run), in words for the
     result view (then ``progress`` takes over again); ``submitted(job_id, slot)`` a job was handed
@@ -203,7 +233,8 @@ class Renderer(QObject):
     progress = Signal(float, str)
     preparing = Signal(str)
     busy = Signal(bool)
-    failed = Signal(str)
+    failed = Signal(object)  # a RenderFailure
+    withdrawn = Signal()
     needs = Signal(str)  # the method needs a geometry drawn before it renders: what to draw (no job runs)
     cancelled = Signal()
     _delivered = Signal(object)
@@ -247,6 +278,46 @@ class Renderer(QObject):
         self._warm_up_timer.timeout.connect(self._warm_up_due)
         self._warm_up_started = False
         self._warm_up_wanted = False
+        self._live_seen = None  # the document's edit in progress, as last heard
+        self.listen()
+
+    # --- what a change of the document renders -------------------------------------------------
+    def listen(self) -> None:
+        """Render on the document's changes (see the module docstring)."""
+        doc = self.doc
+        for signal in (doc.input_changed, doc.method_changed, doc.restored, doc.geometry_changed, doc.seed_changed):
+            signal.connect(self._on_edit)
+        doc.params_changed.connect(self._on_params)
+        doc.live_changed.connect(self._on_live)
+
+    def _on_edit(self, *_args) -> None:
+        self._live_seen = self.doc.live
+        self.final()
+
+    def _on_params(self) -> None:
+        live = self.doc.live
+        self._live_seen = live
+        if live is not None and live.param:
+            self.preview()  # a slider held: its release renders in full
+        else:
+            self.final()
+
+    def _on_live(self, edit) -> None:
+        ended, self._live_seen = self._live_seen, edit
+        doc = self.doc
+        if edit is None:
+            if ended is not None and ended.param:
+                self.final()  # a slider let go (changed or not): the full size
+            elif ended is not None and not self.stroke_cancelled():
+                self.withdrawn.emit()
+            return
+        around = doc.mask_geometry(doc.studio.preview_around) if doc.studio.preview_around else None
+        if around is not None and edit.key == around.key and edit.box is not None:
+            self.preview_around(edit.box)
+            return
+        g = next((g for g in doc.studio.geometry if g.key == edit.key), None)
+        if g is not None and g.live is not None and g.live(doc.current_params):
+            self.preview()  # the method asks for a live result while this geometry moves
 
     # --- requests ------------------------------------------------------------------------------
     def preview(self) -> None:
@@ -435,7 +506,7 @@ class Renderer(QObject):
     def _on_result(self, result: JobResult) -> None:
         if result.slot not in ("preview", "final"):  # e.g. the kernels' warm-up
             if result.error is not None:
-                self.failed.emit(f"{result.slot} failed: {result.error}")
+                self.failed.emit(RenderFailure(FailureKind.BACKGROUND, f"{result.slot} failed: {result.error}"))
             return
         if result.slot == "final" and result.job_id == self.latest_final:
             self._final_running = False
@@ -447,7 +518,7 @@ class Renderer(QObject):
         base = self._around_bases.pop(result.job_id, None)
         if result.error is not None:
             if not around and (self.last is None or result.job_id > self.last.job_id):
-                self.failed.emit(f"render failed: {result.error}")
+                self.failed.emit(RenderFailure(FailureKind.RENDER, f"render failed: {result.error}"))
             return
         if result.value is None:
             return  # a stroke's preview with nothing painted near it

@@ -169,7 +169,7 @@ def test_a_large_input_opened_in_the_window_reaches_both_views_off_the_gui_threa
     held = _Held(monkeypatch)
     with qtbot.waitSignal(window.doc.changed, timeout=20000):
         window.open_input(canvas, str(path))
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     qtbot.waitUntil(held.started.is_set, timeout=10000)
     assert view.converting and (view.image is None or view.image.shape[:2] != (BIG, BIG))
     held.release()
