@@ -229,19 +229,19 @@ def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) 
             elif g.kind == LINES and (lines.image_lines or lines.frontal_lines):
                 geometry.setdefault(name, {})[g.key] = lines
     for name, values in _get(data, "geometry", dict, "an object of method name -> geometry", {}).items():
-        method = methods.get(name)
-        if method is None or method.studio is None:
+        found = methods.get(name)
+        if found is None or found.studio is None:
             continue  # a method this version lacks is skipped, as its parameters are
         if not isinstance(values, dict):
             raise WeftError(f"geometry of {name} must be an object of geometry name -> value")
-        known = {g.key: g for g in method.studio.geometry}
+        known = {g.key: g for g in found.studio.geometry}
         geometry[name] = {}
         for key, value in values.items():
-            g = known.get(key)
-            if g is None:
+            spec = known.get(key)
+            if spec is None:
                 raise WeftError(f"{name}: unknown geometry {key!r} (known: {', '.join(known) or 'none'})")
             try:
-                geometry[name][key] = _geometry_from_json(g, value, base)
+                geometry[name][key] = _geometry_from_json(spec, value, base)
             except _UnreadableMask as e:
                 if dropped is None:
                     raise WeftError(f"{name}: {e}") from None

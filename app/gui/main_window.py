@@ -39,9 +39,10 @@ from .menus import Menus
 from .method_panel import MethodPanel
 from .questions import Questions
 from .render import Renderer
+from .result_view import ResultView
 from .results import ResultState
 from .status import StatusParts
-from .views import ImageView, ResultView, is_image_path
+from .views import ImageView, is_image_path
 
 OPEN_FILTER = "Images (*.png *.jpg *.jpeg *.tif *.tiff *.bmp *.webp);;All files (*)"
 

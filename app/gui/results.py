@@ -17,8 +17,8 @@ from weft.core.studio import MARGINS, MASK
 
 from .convert import to_qimage
 from .render import FailureKind, RenderFailure, describe
+from .result_view import ResultView
 from .status import ElidedLabel
-from .views import ResultView
 
 
 class ResultState(QObject):
