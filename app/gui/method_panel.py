@@ -50,6 +50,19 @@ class MethodPanel(QWidget):
         super().__init__(parent)
         self.doc = doc
         lay = QVBoxLayout(self)
+        lay.addLayout(self._method_row())
+        self.params_panel = ParamsPanel()
+        self.params_panel.edited.connect(self._param_edited)
+        scroll = QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(self.params_panel)
+        lay.addWidget(scroll, 1)
+        lay.addLayout(self._seed_row())
+        lay.addWidget(self._square_row())
+        lay.addLayout(self._buttons())
+
+    def _method_row(self) -> QHBoxLayout:
+        doc = self.doc
         top = QHBoxLayout()
         top.addWidget(QLabel("Method"))
         self.method_box = QComboBox()
@@ -60,13 +73,10 @@ class MethodPanel(QWidget):
             )
         self.method_box.currentIndexChanged.connect(self._method_chosen)
         top.addWidget(self.method_box, 1)
-        lay.addLayout(top)
-        self.params_panel = ParamsPanel()
-        self.params_panel.edited.connect(self._param_edited)
-        scroll = QScrollArea()
-        scroll.setWidgetResizable(True)
-        scroll.setWidget(self.params_panel)
-        lay.addWidget(scroll, 1)
+        return top
+
+    def _seed_row(self) -> QHBoxLayout:
+        """The seed, New, and the thumbnail of the method's square with its caption."""
         self.square_label = QLabel()
         self.square_label.setFixedSize(THUMB, THUMB)
         self.square_label.setToolTip("the square drawn on the input (drag one on its view)")
@@ -75,7 +85,7 @@ class MethodPanel(QWidget):
         seed_row.addWidget(QLabel("seed"))
         self.seed_box = QSpinBox()
         self.seed_box.setRange(0, 2**31 - 1)
-        self.seed_box.setValue(doc.seed)
+        self.seed_box.setValue(self.doc.seed)
         self.seed_box.setKeyboardTracking(False)
         self.seed_box.valueChanged.connect(lambda value: self.doc.set_seed(int(value)))
         seed_row.addWidget(self.seed_box, 1)
@@ -93,8 +103,10 @@ class MethodPanel(QWidget):
         self.square_caption.setWordWrap(True)
         square_box.addWidget(self.square_caption)
         seed_row.addLayout(square_box)
-        lay.addLayout(seed_row)
-        # the square typed: its corner and side (the same undoable edit as a drag on its view)
+        return seed_row
+
+    def _square_row(self) -> QWidget:
+        """The square typed: its corner and side (the same undoable edit as a drag on its view)."""
         self.square_row = QWidget()
         sq = QHBoxLayout(self.square_row)
         sq.setContentsMargins(0, 0, 0, 0)
@@ -113,7 +125,9 @@ class MethodPanel(QWidget):
             sq.addWidget(label)
             sq.addWidget(box, 1)
             self.square_boxes.append(box)
-        lay.addWidget(self.square_row)
+        return self.square_row
+
+    def _buttons(self) -> QHBoxLayout:
         buttons = QHBoxLayout()
         self.render_button = QPushButton("Render")
         self.render_button.setToolTip("render the full-size result (F5)")
@@ -126,7 +140,7 @@ class MethodPanel(QWidget):
         self.variations_button.clicked.connect(self.variations_requested)
         for b in (self.render_button, self.compare_button, self.variations_button):
             buttons.addWidget(b)
-        lay.addLayout(buttons)
+        return buttons
 
     # --- user edits ----------------------------------------------------------------------------
     def _method_chosen(self, index: int) -> None:
