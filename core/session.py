@@ -104,7 +104,18 @@ class Session:
         return session
 
     def mask_files(self, path: str | Path) -> dict[Path, Mask]:
-        """The mask PNGs a session at ``path`` keeps beside it: file -> mask (:func:`mask_file`)."""
+        """The mask PNGs a session at ``path`` keeps beside it.
+
+        Parameters
+        ----------
+        path : str or Path
+            The session file.
+
+        Returns
+        -------
+        dict of Path to Mask
+            File (:func:`mask_file`) -> mask, for each mask of each method.
+        """
         return {
             mask_file(path, method, key): value
             for method, values in self.geometry.items()
@@ -113,9 +124,22 @@ class Session:
         }
 
     def to_data(self, path: str | Path | None = None, *, relative: bool = True) -> dict:
-        """The session's JSON object. With ``path`` (the file it goes to) each mask is named as its
-        PNG beside it and, with ``relative``, file names are relative to its folder; without
-        ``path`` masks are left out and paths are as held."""
+        """The session's JSON object.
+
+        Parameters
+        ----------
+        path : str or Path, optional
+            The file it goes to: each mask is named as its PNG beside it (:func:`mask_file`).
+            Without it masks are left out (null) and file names are as held.
+        relative : bool, default True
+            File names relative to ``path``'s folder; False: absolute (a recovery file).
+
+        Returns
+        -------
+        dict
+            ``{"weft_session": 1, "method", "params", "inputs", "opened_for", "geometry", "seed"}``,
+            and ``"saved_as"`` when set.
+        """
         folder = None if path is None else Path(path).resolve().parent
 
         def name(p: str) -> str:
@@ -146,8 +170,20 @@ class Session:
         return data
 
     def files(self, path: str | Path, *, relative: bool = True) -> dict[Path, bytes]:
-        """What :meth:`save` writes for a session at ``path``, encoded (the slow part: a large mask's
-        PNG): its masks' 1-bit PNGs, then the JSON last (file -> bytes, in writing order)."""
+        """What :meth:`save` writes for a session at ``path``, encoded (the slow part: a large mask's PNG).
+
+        Parameters
+        ----------
+        path : str or Path
+            The session file.
+        relative : bool, default True
+            As :meth:`to_data`.
+
+        Returns
+        -------
+        dict of Path to bytes
+            Its masks' 1-bit PNGs, then the JSON last (in writing order: what names a file comes after it).
+        """
         path = Path(path)
         out = {file: mask.to_png() for file, mask in self.mask_files(path).items()}
         out[path] = (json.dumps(self.to_data(path, relative=relative), indent=1) + "\n").encode("utf-8")
@@ -155,12 +191,30 @@ class Session:
 
     def save(self, path: str | Path, *, relative: bool = True) -> None:
         """Write the session at ``path``: its masks as 1-bit PNGs beside it, then the JSON, each file
-        atomically (on any thread: the value is immutable). ``WeftError`` naming a file not written."""
+        atomically (on any thread: the value is immutable).
+
+        Parameters
+        ----------
+        path : str or Path
+            The session file.
+        relative : bool, default True
+            As :meth:`to_data`.
+
+        Raises
+        ------
+        WeftError
+            Naming the first file not written.
+        """
         write_files(self.files(path, relative=relative))
 
 
 def write_files(files: Mapping[Path, bytes]) -> None:
-    """Write each file of ``files`` (path -> bytes) atomically, in order (masks before what names them).
+    """Write each file of ``files`` atomically, in order (masks before what names them).
+
+    Parameters
+    ----------
+    files : mapping of Path to bytes
+        File -> its bytes.
 
     Raises
     ------
@@ -174,12 +228,23 @@ def write_files(files: Mapping[Path, bytes]) -> None:
 
 
 def write_masks(masks: Mapping[Path, Mask]) -> None:
-    """Write each mask of ``masks`` (path -> mask) as a 1-bit PNG, atomically (export and sessions)."""
+    """Write each mask of ``masks`` as a 1-bit PNG, atomically (an export's masks beside it).
+
+    Parameters
+    ----------
+    masks : mapping of Path to Mask
+        File -> mask.
+
+    Raises
+    ------
+    WeftError
+        ``{file}: cannot write (reason)`` for the first file not written.
+    """
     write_files({file: mask.to_png() for file, mask in masks.items()})
 
 
 def read_session(path: str | Path, *, dropped: list[str] | None = None) -> Session:
-    """:meth:`Session.read` (the same arguments)."""
+    """Read a session file: :meth:`Session.read` (the same parameters, the same value returned)."""
     return Session.read(path, dropped=dropped)
 
 

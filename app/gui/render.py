@@ -1,12 +1,8 @@
 """Rendering: turns the document into preview and final jobs on the worker pool, results into images.
 
-* The renderer alone decides what a change of the document renders: it listens to the document's
-  signals (:meth:`Renderer.listen`). A slider held (``Document.drag_param``) or a geometry dragged
-  whose studio description asks for a live result (``Geometry.live``) previews; a mask stroke of the
-  mask its method previews around (``Studio.preview_around``) previews around the stroke; any edit
-  renders in full; an edit in progress dropped (``live_changed(None)``) shows what was there before
-  (``withdrawn``), or renders in full when a slider was let go.
-
+* The renderer alone decides what a change of the document renders: its ``policy``
+  (:class:`~weft.app.gui.render_policy.RenderPolicy`) listens to the document and asks for a
+  preview, a preview around a stroke, or the full size.
 * While a slider is held down, ``preview()`` submits a reduced-size job (slot ``"preview"``). At most
   one preview is computed at a time: changes that arrive meanwhile are coalesced into the next one,
   started as soon as the running one is done (cancelling a running preview at every slider step
@@ -58,6 +54,8 @@ from weft.core.geometry import MaskStroke
 from weft.core.jobs import JobResult, JobRunner, Progress
 from weft.core.params import Params, Recipe
 from weft.core.studio import around_region, crop_around, describe_figures, reduce_for_preview
+
+from .render_policy import RenderPolicy
 
 PREVIEW_SIDE = 400
 PROGRESS_DELAY_MS = 300
@@ -278,46 +276,7 @@ class Renderer(QObject):
         self._warm_up_timer.timeout.connect(self._warm_up_due)
         self._warm_up_started = False
         self._warm_up_wanted = False
-        self._live_seen = None  # the document's edit in progress, as last heard
-        self.listen()
-
-    # --- what a change of the document renders -------------------------------------------------
-    def listen(self) -> None:
-        """Render on the document's changes (see the module docstring)."""
-        doc = self.doc
-        for signal in (doc.input_changed, doc.method_changed, doc.restored, doc.geometry_changed, doc.seed_changed):
-            signal.connect(self._on_edit)
-        doc.params_changed.connect(self._on_params)
-        doc.live_changed.connect(self._on_live)
-
-    def _on_edit(self, *_args) -> None:
-        self._live_seen = self.doc.live
-        self.final()
-
-    def _on_params(self) -> None:
-        live = self.doc.live
-        self._live_seen = live
-        if live is not None and live.param:
-            self.preview()  # a slider held: its release renders in full
-        else:
-            self.final()
-
-    def _on_live(self, edit) -> None:
-        ended, self._live_seen = self._live_seen, edit
-        doc = self.doc
-        if edit is None:
-            if ended is not None and ended.param:
-                self.final()  # a slider let go (changed or not): the full size
-            elif ended is not None and not self.stroke_cancelled():
-                self.withdrawn.emit()
-            return
-        around = doc.mask_geometry(doc.studio.preview_around) if doc.studio.preview_around else None
-        if around is not None and edit.key == around.key and edit.box is not None:
-            self.preview_around(edit.box)
-            return
-        g = next((g for g in doc.studio.geometry if g.key == edit.key), None)
-        if g is not None and g.live is not None and g.live(doc.current_params):
-            self.preview()  # the method asks for a live result while this geometry moves
+        self.policy = RenderPolicy(doc, self)  # what a change of the document renders
 
     # --- requests ------------------------------------------------------------------------------
     def preview(self) -> None:
