@@ -1,5 +1,9 @@
-"""Rendering: turns the document into preview and final render requests on the worker pool, results into images.
+"""Rendering: turns the document into preview and final render requests on the worker pool, and
+their results into images.
 
+* The renderer alone decides what a change of the document renders: its ``policy``
+  (:class:`~weft.app.gui.render_policy.RenderPolicy`) listens to the document and asks for a
+  preview, a preview around a stroke, or the full size.
 * While a slider is held down, ``preview()`` submits a reduced-size job (slot ``"preview"``,
   :class:`~weft.core.request.Preview` at ``PREVIEW_SIDE``, reduced as the method's studio description
   says). At most one preview is computed at a time: changes that arrive meanwhile are coalesced into
@@ -28,6 +32,8 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
+from enum import Enum, auto
 
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
@@ -37,6 +43,7 @@ from weft.core.request import FULL, AroundStroke, Preview
 
 from .qjobs import QtJobs
 from .render_job import Rendered, StudioJob, render_request
+from .render_policy import RenderPolicy
 from .shown import Shown, describe
 
 __all__ = ["Renderer", "Shown", "describe", "PREVIEW_SIDE", "PROGRESS_DELAY_MS"]
@@ -53,12 +60,33 @@ WARM_UP_AFTER_RESULT_MS = 1000  # the first result is in: warm the others up thi
 GIL_SWITCH_INTERVAL = 0.001
 
 
+class FailureKind(Enum):
+    """What failed: a render of the document (the result shown is out of date), or a job in the
+    background (the kernels' warm-up: the result shown is not affected)."""
+
+    RENDER = auto()
+    BACKGROUND = auto()
+
+
+@dataclass(frozen=True)
+class RenderFailure:
+    """A failure the renderer reports (``Renderer.failed``): its kind and one line of words."""
+
+    kind: FailureKind
+    message: str
+
+    def __str__(self) -> str:
+        return self.message
+
+
 class Renderer(QObject):
     """Preview/final job logic for one document (see the module docstring).
 
     Signals: ``shown(Shown)`` a new result to display; ``partial(image)`` a partial image of a
     running job; ``progress(fraction, stage)``; ``busy(bool)`` a job over the progress delay is
-    running (show the bar); ``failed(message)``; ``needs(words)`` nothing rendered: the method needs
+    running (show the bar); ``failed(RenderFailure)``; ``withdrawn()`` an edit in progress was
+    dropped: show again what was shown before its previews (``shown`` has the last result again
+    when it was on screen); ``needs(words)`` nothing rendered: the method needs
     something drawn first (``Geometry.needed``); ``cancelled()``; ``preparing(words)`` the running
     final render is waiting for its method's kernels to compile (a first run), in words for the
     result view (then ``progress`` takes over again); ``submitted(job_id, slot)`` a job was handed
@@ -73,7 +101,8 @@ class Renderer(QObject):
     progress = Signal(float, str)
     preparing = Signal(str)
     busy = Signal(bool)
-    failed = Signal(str)
+    failed = Signal(object)  # a RenderFailure
+    withdrawn = Signal()
     needs = Signal(str)  # the method needs a geometry drawn before it renders: what to draw (no job runs)
     cancelled = Signal()
 
@@ -110,6 +139,7 @@ class Renderer(QObject):
         self._warm_up_timer.timeout.connect(self._warm_up_due)
         self._warm_up_started = False
         self._warm_up_wanted = False
+        self.policy = RenderPolicy(doc, self)  # what a change of the document renders
 
     # --- requests ------------------------------------------------------------------------------
     def preview(self) -> None:
@@ -273,7 +303,7 @@ class Renderer(QObject):
     def _on_result(self, result: JobResult) -> None:
         if result.slot not in ("preview", "final"):  # e.g. the kernels' warm-up
             if result.error is not None:
-                self.failed.emit(f"{result.slot} failed: {result.error}")
+                self.failed.emit(RenderFailure(FailureKind.BACKGROUND, f"{result.slot} failed: {result.error}"))
             return
         if result.slot == "final" and result.job_id == self.latest_final:
             self._final_running = False
@@ -285,7 +315,7 @@ class Renderer(QObject):
         base = self._around_bases.pop(result.job_id, None)
         if result.error is not None:
             if not around and (self.last is None or result.job_id > self.last.job_id):
-                self.failed.emit(f"render failed: {result.error}")
+                self.failed.emit(RenderFailure(FailureKind.RENDER, f"render failed: {result.error}"))
             return
         if result.value is None:
             return  # a stroke's preview with nothing painted near it

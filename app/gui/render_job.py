@@ -41,14 +41,14 @@ def stroke_part(doc, box) -> tuple[np.ndarray, tuple[int, int]] | None:
     then reads the document's live masks whole)."""
     g = doc.mask_geometry(doc.studio.preview_around) if doc.studio.preview_around else None
     live = doc.live
-    if g is None or live is None or live[0] != g.key or not isinstance(live[1], MaskStroke):
+    if g is None or live is None or live.param or live.key != g.key or not isinstance(live.value, MaskStroke):
         return None
     on = doc.image(g.input_for(doc.inputs))
-    h, w = live[1].shape
+    h, w = live.value.shape
     if on is None or on.shape[:2] != (h, w):
         return None
     x0, y0, x1, y1 = around_region(box, w, h)
-    return live[1].cut(x0, y0, x1, y1), (x0, y0)
+    return live.value.cut(x0, y0, x1, y1), (x0, y0)
 
 
 def render_request(doc, mode: Mode = FULL) -> RenderRequest | None:

@@ -44,7 +44,7 @@ def test_apply_to_folder_writes_what_weft_run_writes(window, qtbot, tmp_path):
     with qtbot.waitSignal(dialog.batch_finished, timeout=120000) as done:
         qtbot.mouseClick(dialog.run_button, Qt.MouseButton.LeftButton)
         assert dialog.running and dialog.cancel_button.isEnabled() and not dialog.run_button.isEnabled()
-        window.new_seed()  # the studio stays usable; the running batch keeps the recipe it started with
+        window.method_panel.new_seed()  # the studio stays usable; the running batch keeps the recipe it started with
     assert done.args == ["4 written", 0, False]
     assert dialog.status.text() == "4 written" and dialog.progress.value() == 4
     assert dialog.run_button.isEnabled() and not dialog.cancel_button.isEnabled()

@@ -18,7 +18,7 @@ from .helpers import no_job_threads
 
 def _dialog(window, p=(0.0, 0.5), w=(0.0, 4.0)):
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     dialog.combo[0].setCurrentText("p")
     dialog.combo[1].setCurrentText("target_weight")
     _ranges(dialog, p, w)
@@ -240,13 +240,13 @@ def test_variations_offers_only_parameters_that_matter_and_labels_its_export(win
     doc.set_method("nfpt")
     assert doc.current_params.warp == "homography"
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     offered = [dialog.combo[0].itemText(k) for k in range(dialog.combo[0].count())]
     assert offered and not {"a", "b", "p"} & set(offered)
     dialog.close()
     doc.set_param("warp", "morph")
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     offered = [dialog.combo[0].itemText(k) for k in range(dialog.combo[0].count())]
     assert {"a", "b", "p"} <= set(offered)
     dialog.close()
@@ -254,12 +254,12 @@ def test_variations_offers_only_parameters_that_matter_and_labels_its_export(win
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     doc.set_param("warp", "homography")
     doc.set_param("size", (96, 64))
-    window.lines_panel.quad_button.setChecked(True)
+    window.inputs_pane.lines_panel.quad_button.setChecked(True)
     for x, y in [line[:2] for line in data["image_lines"][:4]]:
-        mouse(window.canvas_view, "press", (x, y))
-        mouse(window.canvas_view, "release", (x, y))
+        mouse(window.inputs_pane.canvas_view, "press", (x, y))
+        mouse(window.inputs_pane.canvas_view, "release", (x, y))
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     dialog.combo[0].setCurrentText("tol")
     dialog.combo[1].setCurrentText("sigma_s")
     done = set()
@@ -294,7 +294,7 @@ def test_variations_ranges_stay_within_what_the_inputs_allow(window, qtbot, tmp_
     )
     doc.set_param("block", 112)
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     dialog.combo[0].setCurrentText("block")
     assert dialog.hi[0].maximum() == 112 and dialog.hi[0].value() <= 112
     dialog.close()
