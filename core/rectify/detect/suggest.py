@@ -7,13 +7,14 @@ import math
 import time
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from ...errors import GeometryError
 from ...geometry import FeatureLines
 from ...image import validate_image
 from ..homography import apply_homography
-from .segments import WORK_SIDE, line_segments, repeat_segments, work_grey
+from .segments import WORK_SIDE, line_segments, refine_segments, repeat_segments, work_grey
 from .vanishing import MAX_FOCAL, MIN_FOCAL, MIN_SPREAD_DEG, Families, direction_at, focal_sq, two_families
 
 __all__ = [
@@ -30,10 +31,12 @@ __all__ = [
 REFUSAL = "no two families of straight lines found: draw feature lines"
 FINE_SIDE = 1600  # a second look at up to this size when the reduced photo shows no two families
 FINE_BELOW = 300  # ... and fewer segments than this (fine structure lost in the reduction)
-REPEAT_SIDE = 560  # longer side of the photo the repeats are looked for on
+REPEAT_SIDE = 400  # longer side of the photo the repeats are looked for on (SIFT doubles it inside)
 ASSUMED_FOCAL = 1.2  # focal length (in photo longer sides) when the vanishing points leave it open
 MIN_CONFIDENCE = 0.3  # a weaker suggestion is refused
 MAX_FRONTAL_SIDE = 4096
+REFINE = True
+REFINE_REACH = 1.5
 
 
 @dataclass(frozen=True)
@@ -204,17 +207,21 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
     if repeats:
         attempts.append((REPEAT_SIDE, "repeats"))
     found = 0
+    full = photo if photo.ndim == 2 else cv2.cvtColor(photo, cv2.COLOR_RGB2GRAY)  # once for every look
     greys: dict = {}
+    full_f = full.astype(np.float32)
     for side, source in attempts:
         if source == "fine lines":  # fine structure (a weave) may need every pixel: when few segments showed
             if max(w, hgt) <= WORK_SIDE or found >= FINE_BELOW:
                 continue
             source = "lines"
         if side not in greys:
-            greys[side] = work_grey(photo, side)
+            greys[side] = work_grey(full, side)
         grey, k = greys[side]
         found_work = line_segments(grey) if source == "lines" else repeat_segments(grey, rng)
         seg_px = (found_work + 0.5) / k - 0.5
+        if source == "lines" and REFINE:
+            seg_px = refine_segments(full_f, seg_px, REFINE_REACH / k)
         found = max(found, len(seg_px)) if source == "lines" else found
         fam = (
             two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s), lattice=source == "repeats")
