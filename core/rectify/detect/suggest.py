@@ -35,8 +35,7 @@ REPEAT_SIDE = 400  # longer side of the photo the repeats are looked for on (SIF
 ASSUMED_FOCAL = 1.2  # focal length (in photo longer sides) when the vanishing points leave it open
 MIN_CONFIDENCE = 0.3  # a weaker suggestion is refused
 MAX_FRONTAL_SIDE = 4096
-REFINE = True
-REFINE_REACH = 1.5
+REFINE_REACH = 1.5  # work pixels either side of a segment its full-resolution refit looks
 
 
 @dataclass(frozen=True)
@@ -209,7 +208,6 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
     found = 0
     full = photo if photo.ndim == 2 else cv2.cvtColor(photo, cv2.COLOR_RGB2GRAY)  # once for every look
     greys: dict = {}
-    full_f = full.astype(np.float32)
     for side, source in attempts:
         if source == "fine lines":  # fine structure (a weave) may need every pixel: when few segments showed
             if max(w, hgt) <= WORK_SIDE or found >= FINE_BELOW:
@@ -220,8 +218,8 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
         grey, k = greys[side]
         found_work = line_segments(grey) if source == "lines" else repeat_segments(grey, rng)
         seg_px = (found_work + 0.5) / k - 0.5
-        if source == "lines" and REFINE:
-            seg_px = refine_segments(full_f, seg_px, REFINE_REACH / k)
+        if source == "lines":
+            seg_px = refine_segments(full, seg_px, REFINE_REACH / k)
         found = max(found, len(seg_px)) if source == "lines" else found
         fam = (
             two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s), lattice=source == "repeats")
