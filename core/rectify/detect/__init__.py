@@ -28,9 +28,10 @@ them and turns them into feature-line pairs the user can edit like drawn ones:
    fit would outvote one moved line).
 
 Where segments give no two families, segments joining the texture's own repeats (SIFT features on
-the photo reduced to 400 pixels, matched within the photo) take their place: the line through a feature and its repeat points at the
-vanishing point of the repeat's direction on the plane; every translation of the lattice has its
-point on the horizon, and the best supported pair a camera sees as perpendicular is taken.
+the photo reduced to 400 pixels, matched within the photo) take their place: the line through a
+feature and its repeat points at the vanishing point of the repeat's direction on the plane; every
+translation of the lattice has its point on the horizon, and the best supported pair a camera sees
+as perpendicular is taken.
 
 When nothing gives two families it raises :class:`~weft.core.errors.GeometryError` with one line
 (:data:`REFUSAL`); it never returns a guess it has no support for. A photo cropped off-centre breaks

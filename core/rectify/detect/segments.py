@@ -12,6 +12,7 @@ __all__ = ["work_grey", "line_segments", "repeat_segments", "homogeneous", "chai
 
 WORK_SIDE = 720  # longer side (px) of the reduced photo the segments are found on
 LSD_SCALE = 0.8  # LSD's own Gaussian reduction of the work image (its default)
+MIN_LENGTH = 1 / 120  # the shortest segment kept, as a fraction of the work image's longer side
 
 
 def work_grey(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, float]:
@@ -26,14 +27,14 @@ def work_grey(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, f
 
 
 def line_segments(grey: np.ndarray) -> np.ndarray:
-    """(N, 4) segments found by LSD, at least 1/90 of the longer side long."""
+    """(N, 4) segments found by LSD, at least :data:`MIN_LENGTH` of the longer side (and 6 pixels) long."""
     lsd = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD, LSD_SCALE)
     found = lsd.detect(grey)[0]
     if found is None:
         return np.zeros((0, 4))
     seg = found.reshape(-1, 4).astype(np.float64)
     length = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1])
-    return seg[length >= max(6.0, max(grey.shape) / 90.0)]
+    return seg[length >= max(6.0, max(grey.shape) * MIN_LENGTH)]
 
 
 def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
