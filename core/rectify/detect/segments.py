@@ -12,6 +12,7 @@ __all__ = ["work_grey", "line_segments", "repeat_segments", "homogeneous", "chai
 
 WORK_SIDE = 720  # longer side (px) of the reduced photo the segments are found on
 LSD_SCALE = 0.8  # LSD's own Gaussian reduction of the work image (its default)
+REPEAT_FEATURES = 500  # SIFT features the repeats are matched among
 MIN_LENGTH = 1 / 120  # the shortest segment kept, as a fraction of the work image's longer side
 
 
@@ -40,7 +41,7 @@ def line_segments(grey: np.ndarray) -> np.ndarray:
 def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Segments joining SIFT features to their repeats elsewhere in the photo (similar descriptor,
     scale and orientation), at least three feature sizes apart."""
-    sift = cv2.SIFT_create(nfeatures=1000)
+    sift = cv2.SIFT_create(nfeatures=REPEAT_FEATURES)
     kps, desc = sift.detectAndCompute(grey, None)
     if desc is None or len(kps) < 20:
         return np.zeros((0, 4))
