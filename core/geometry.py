@@ -57,16 +57,21 @@ SQUARE, LINES, MASK, MARGINS = "square", "lines", "mask", "margins"
 KINDS = (SQUARE, LINES, MASK, MARGINS)
 
 
-class Square(NamedTuple):
+class _SquareFields(NamedTuple):
+    x: int
+    y: int
+    side: int
+
+
+class Square(_SquareFields):
     """A square of an image: top-left corner ``(x, y)`` and ``side``, in pixels.
 
     It is a tuple, so ``x, y, s = square`` works; ``Square.parse("32,16,64")`` is the one parser of
     the text form ``X,Y,S`` (``--region``, ``--prototype``), ``from_json([x, y, s])`` of the JSON form.
+    (The fields live on a base class so that the constants below are class attributes, not fields.)
     """
 
-    x: int
-    y: int
-    side: int
+    __slots__ = ()
 
     MIN_SIDE = 2
     METAVAR = "X,Y,S"
@@ -274,6 +279,9 @@ class FeatureLines:
 
     __slots__ = ("image_lines", "frontal_lines", "frontal_size")
     METAVAR = "LINES"
+    image_lines: np.ndarray
+    frontal_lines: np.ndarray
+    frontal_size: tuple[int, int]
 
     def __init__(self, image_lines, frontal_lines, frontal_size) -> None:
         img = as_lines(image_lines, "image_lines")
@@ -430,6 +438,7 @@ class Mask:
     """
 
     __slots__ = ("bits",)
+    bits: np.ndarray
 
     def __init__(self, bits) -> None:
         arr = np.asarray(bits)
@@ -666,17 +675,21 @@ class MaskStroke:
 # --- margins --------------------------------------------------------------------------------------
 
 
-class Margins(NamedTuple):
+class _MarginsFields(NamedTuple):
+    left: int
+    top: int
+    right: int
+    bottom: int
+
+
+class Margins(_MarginsFields):
     """Pixels added on each side of an image: ``left, top, right, bottom`` (an uncrop's new border).
 
     Text form ``L,T,R,B`` (``--extend``); JSON ``[l, t, r, b]``. Each is a whole number from 0 to
     :data:`MAX_SIDE`; whether the grown canvas is allowed is the pixel limit's business.
     """
 
-    left: int
-    top: int
-    right: int
-    bottom: int
+    __slots__ = ()
 
     METAVAR = "L,T,R,B"
 

@@ -35,7 +35,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
@@ -292,7 +292,7 @@ class Params:
     def check(self) -> None:
         """Cross-parameter rules; raise ``InvalidParameter`` (see :func:`out_of_range`)."""
 
-    def replace(self, **changes: Any) -> Params:
+    def replace(self, **changes: Any) -> Self:
         unknown = set(changes) - {s.name for s in specs(type(self))}
         if unknown:
             raise InvalidParameter(_unknown_message(type(self), unknown))
@@ -309,7 +309,7 @@ class Params:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], *, base: str | os.PathLike | None = None) -> Params:
+    def from_dict(cls, data: Mapping[str, Any], *, base: str | os.PathLike | None = None) -> Self:
         """Parameters from their JSON form; a geometry value is read by its type's ``from_json``
         (a file it names is found relative to ``base``, the recipe's folder)."""
         if not isinstance(data, Mapping):
@@ -344,7 +344,7 @@ def specs(cls: type) -> tuple[Spec, ...]:
             continue
         out.append(Spec(name=f.name, default=f.default, **meta))
     result = tuple(out)
-    cls._weft_specs = result
+    cls._weft_specs = result  # type: ignore[attr-defined]  # a per-class cache, read back through cls.__dict__
     return result
 
 

@@ -93,7 +93,8 @@ class Method:
     #: ``memory(shapes, params) -> bytes``: the estimated peak memory of one run on inputs of these
     #: shapes (input name -> array shape), the figure the run checks against the memory available;
     #: a batch multiplies it by its workers to refuse up front (:mod:`weft.core.batch`). None: no estimate.
-    memory: Callable[[Mapping[str, tuple[int, ...]], Params], float] | None = None
+    #: It is called with this method's own ``params`` class, hence ``Any`` (Callable is contravariant).
+    memory: Callable[[Mapping[str, tuple[int, ...]], Any], float] | None = None
     studio: Studio | None = None
     #: The input whose bit depth (8 or 16) the command line's output keeps when ``--bit-depth`` is not
     #: given (``fill``: a 16-bit photo stays 16-bit; its known pixels come back unchanged). None: 8.
@@ -125,7 +126,7 @@ def unregister(name: str) -> None:
 def studio_methods() -> dict[str, Method]:
     """The methods the studio offers, in its order (``Studio.rank``, then registration)."""
     offered = [m for m in methods().values() if m.studio is not None]
-    return {m.name: m for m in sorted(offered, key=lambda m: m.studio.rank)}
+    return {m.name: m for m in sorted(offered, key=lambda m: m.studio.rank if m.studio else 0)}
 
 
 def names() -> tuple[str, ...]:

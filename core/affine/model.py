@@ -117,6 +117,7 @@ def _recombine(dec: Decomposition, grey: np.ndarray) -> np.ndarray:
     if dec.colour == "yuv":
         return yiq_to_rgb(np.concatenate([grey[..., None], dec.chroma_low], axis=2))
     comps = np.concatenate([(grey - dec.offset)[..., None], dec.chroma_low], axis=2)
+    assert dec.basis is not None  # a pca decomposition with chroma carries its basis
     return from_pca(comps, dec.basis)
 
 
@@ -155,7 +156,7 @@ class Prototype:
 
 def make_prototype(
     image: np.ndarray,
-    rect: Rect | str | None = None,
+    rect: Rect | tuple[int, int, int] | str | None = None,
     *,
     block: int = 32,
     colour: str = "pca",

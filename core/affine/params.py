@@ -63,14 +63,14 @@ def default_rect(shape: tuple[int, ...], block: int, what: str = "image") -> Rec
     s = min(2 * block, (min(h, w) // 2) * 2)
     if s < MIN_SIDE:
         raise GeometryError(f"the {what} is {w}x{h}; a prototype needs at least {MIN_SIDE}x{MIN_SIDE} pixels")
-    return (w - s) // 2, (h - s) // 2, s
+    return Square((w - s) // 2, (h - s) // 2, s)
 
 
 @dataclass(frozen=True)
 class AffineParams(Params):
     """Parameters of the affine prototype model (Smith & Bhalerao)."""
 
-    prototype: Square = param(
+    prototype: Square | None = param(
         None,
         kind="geometry",
         type=Square,
@@ -128,7 +128,7 @@ class AffineParams(Params):
         " them with --prototype (a prototype swap, §4): the layout stays, the look "
         "changes",
     )
-    analysis_prototype: Square = param(
+    analysis_prototype: Square | None = param(
         None,
         kind="geometry",
         type=Square,
@@ -168,7 +168,7 @@ class AffineParams(Params):
     field_strength: float = param(
         1.0, lo=0.0, hi=2.0, step=0.05, help="how strongly the field turns or zooms the prototype"
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=16,
