@@ -76,7 +76,7 @@ class FastParams(Params):
         help="side of the neighbourhood compared (odd): small copies fine "
         "grain, large carries larger structures of the texture",
     )
-    p: float = param(
+    p: float | None = param(
         None,
         kind="float",
         lo=0.0,
@@ -87,7 +87,7 @@ class FastParams(Params):
         help="chance of a random candidate: 0 gives long coherent pieces of the texture, higher values"
         " follow the picture in smaller pieces; default 0.05 (super-resolution 0)",
     )
-    p_l: float = param(
+    p_l: float | None = param(
         None,
         kind="float",
         lo=0.0,
@@ -138,7 +138,7 @@ class FastParams(Params):
         help="colour of the result: target keeps the picture's colours (YIQ chroma); source copies "
         "the texture's colours",
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=8,
@@ -179,14 +179,17 @@ class FastParams(Params):
 def _offsets(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(causal L, square without centre, complementary half with centre) offsets as (k, 2) int32."""
     h = n // 2
-    causal, square, rest = [], [], []
+    causal: list[tuple[int, int]] = []
+    square: list[tuple[int, int]] = []
+    rest: list[tuple[int, int]] = []
     for dy in range(-h, h + 1):
         for dx in range(-h, h + 1):
             is_causal = dy < 0 or (dy == 0 and dx < 0)
             (causal if is_causal else rest).append((dy, dx))
             if (dy, dx) != (0, 0):
                 square.append((dy, dx))
-    return tuple(np.array(o, dtype=np.int32).reshape(-1, 2) for o in (causal, square, rest))
+    c, s, r = (np.array(o, dtype=np.int32).reshape(-1, 2) for o in (causal, square, rest))
+    return c, s, r
 
 
 def _valid_region(source_shape: tuple[int, int], n: int, mask: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
@@ -334,6 +337,7 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
     else:
         tgt_pad = np.zeros((1, 1), np.float32)
     if params.metric == "artistic":
+        assert tgt_y is not None  # FastParams refuses the artistic metric without a target
         ksize = (params.n, params.n)
         src_mean = cv2.blur(match_y, ksize, borderType=cv2.BORDER_REFLECT)
         tgt_mean = cv2.blur(tgt_y, ksize, borderType=cv2.BORDER_REFLECT)

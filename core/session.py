@@ -46,7 +46,7 @@ def read_session(path: str | Path, *, dropped: list[str] | None = None) -> dict:
         session = _session_from_data(data, path.resolve().parent, said)
     except WeftError as e:
         raise WeftError(f"{path}: {e}") from None
-    if dropped is not None:
+    if dropped is not None and said is not None:
         dropped.extend(f"{path}: {line}" for line in said)
     return session
 
@@ -97,19 +97,19 @@ def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) 
             elif g.kind == LINES and (lines.image_lines or lines.frontal_lines):
                 geometry.setdefault(name, {})[g.key] = lines
     for name, values in _get(data, "geometry", dict, "an object of method name -> geometry", {}).items():
-        method = methods.get(name)
-        if method is None or method.studio is None:
+        owner = methods.get(name)
+        if owner is None or owner.studio is None:
             continue  # a method this version lacks is skipped, as its parameters are
         if not isinstance(values, dict):
             raise WeftError(f"geometry of {name} must be an object of geometry name -> value")
-        known = {g.key: g for g in method.studio.geometry}
+        known = {g.key: g for g in owner.studio.geometry}
         geometry[name] = {}
         for key, value in values.items():
-            g = known.get(key)
-            if g is None:
+            spec = known.get(key)
+            if spec is None:
                 raise WeftError(f"{name}: unknown geometry {key!r} (known: {', '.join(known) or 'none'})")
             try:
-                geometry[name][key] = _geometry_from_json(g, value, base)
+                geometry[name][key] = _geometry_from_json(spec, value, base)
             except _UnreadableMask as e:
                 if dropped is None:
                     raise WeftError(f"{name}: {e}") from None

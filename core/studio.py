@@ -368,11 +368,11 @@ class Around:
         fit together (another size or channel count)."""
         x0, y0, x1, y1 = self.box
         dx, dy = self.offset
-        part = self.fitted(part)
+        fit = self.fitted(part)
         if (
-            part is None
-            or part.ndim != base.ndim
-            or (part.ndim == 3 and part.shape[2] != base.shape[2])
+            fit is None
+            or fit.ndim != base.ndim
+            or (fit.ndim == 3 and fit.shape[2] != base.shape[2])
             or y0 + dy < 0
             or x0 + dx < 0
             or y1 + dy > base.shape[0]
@@ -380,7 +380,7 @@ class Around:
         ):
             return None
         out = base.copy() if copy else base
-        out[y0 + dy : y1 + dy, x0 + dx : x1 + dx] = part
+        out[y0 + dy : y1 + dy, x0 + dx : x1 + dx] = fit
         return out
 
 
@@ -444,7 +444,7 @@ def crop_around(
 
     name = studio.preview_around
     g = next((g for g in studio.geometry if g.kind == MASK and g.input == name), None)
-    if g is None or (name not in inputs and mask_part is None):
+    if g is None or name is None or (name not in inputs and mask_part is None):
         return None
     on = g.input_for(inputs)
     if on not in inputs:

@@ -149,7 +149,7 @@ def _enable_caching_or_not(self):
 
 def _install_no_cache_fallback() -> None:
     if _dispatcher.Dispatcher.enable_caching is not _enable_caching_or_not:
-        _dispatcher.Dispatcher.enable_caching = _enable_caching_or_not
+        _dispatcher.Dispatcher.enable_caching = _enable_caching_or_not  # type: ignore[method-assign]  # a patch of numba
 
 
 _original_save = _caching.IndexDataCacheFile.save
@@ -173,7 +173,7 @@ def _save_locked(self, key, data):
 
 def _install_save_lock() -> None:
     if _caching.IndexDataCacheFile.save is not _save_locked:
-        _caching.IndexDataCacheFile.save = _save_locked
+        _caching.IndexDataCacheFile.save = _save_locked  # type: ignore[method-assign]  # a patch of numba
 
 
 _DAMAGED_NOTICE = "numba's cache of {what} could not be read (damaged: {why}); it was dropped and compiled again"
@@ -243,9 +243,10 @@ def _load_overload_or_drop(self, sig, target_context):
 
 def _install_cache_repair() -> None:
     if _caching.IndexDataCacheFile._load_index is not _load_index_or_drop:
-        _caching.IndexDataCacheFile._load_index = _load_index_or_drop
-        _caching.IndexDataCacheFile._load_data = _load_data_or_drop
-        _caching.Cache.load_overload = _load_overload_or_drop
+        # patches of numba's cache classes
+        _caching.IndexDataCacheFile._load_index = _load_index_or_drop  # type: ignore[method-assign]
+        _caching.IndexDataCacheFile._load_data = _load_data_or_drop  # type: ignore[method-assign]
+        _caching.Cache.load_overload = _load_overload_or_drop  # type: ignore[method-assign]
 
 
 class _CompileListener(_event.Listener):
@@ -272,4 +273,4 @@ _install_save_lock()
 _install_cache_repair()
 if not getattr(_registry, "_compile_listener_installed", False):
     _event.register("numba:compile", _CompileListener())
-    _registry._compile_listener_installed = True
+    _registry._compile_listener_installed = True  # type: ignore[attr-defined]  # set once per process

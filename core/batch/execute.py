@@ -128,7 +128,6 @@ def run_item(item: Item) -> Outcome:
         if item.write:
             os.makedirs(os.path.dirname(item.output), exist_ok=True)
             atomic_write_bytes(Path(item.output), data)
-            data = None
         return Outcome(
             item.index,
             item.label,
@@ -137,7 +136,7 @@ def run_item(item: Item) -> Outcome:
             seconds=seconds,
             figures=dict(result.figures),
             worker=worker,
-            data=data,
+            data=None if item.write else data,  # a written item's bytes stay in the worker
             elapsed=time.perf_counter() - t0,
             cpu=time.process_time() - c0,
         )
@@ -226,7 +225,7 @@ class LocalPool:
         self.ctx = multiprocessing.get_context("spawn")
         with _interrupts_held():  # (the first semaphore starts multiprocessing's resource tracker)
             self.cancel_event = self.ctx.Event()
-        self.executor = None
+        self.executor: cf.ProcessPoolExecutor  # started by _start()
         self.restarts = 0  # times a dead worker took the pool down and it was started again
         self.threads = max(1, default_workers() // workers)
         self._start()
@@ -556,12 +555,12 @@ def run(
                         )
                         continue
                 inflight[pool.submit(item)] = item
-            reason = pool.gone() if isinstance(pool, DaskPool) else None
-            if reason:  # every item not done fails
+            lost = pool.gone() if isinstance(pool, DaskPool) else None
+            if lost:  # every item not done fails
                 pool.cancel(inflight)
                 for item in [*inflight.values(), *todo]:
                     _finish(
-                        Outcome(item.index, item.label, item.output, "failed", error=reason),
+                        Outcome(item.index, item.label, item.output, "failed", error=lost),
                         item,
                         summary,
                         state,

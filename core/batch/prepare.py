@@ -154,6 +154,7 @@ class BatchProgress:
     """Progress of a running batch, handed to :func:`run`'s ``progress`` after each item."""
 
     __slots__ = ("total", "done", "failed", "started", "_timed", "_first")
+    _first: float | None
 
     def __init__(self, total: int, skipped: int):
         self.total, self.done, self.failed = total, skipped, 0
@@ -172,7 +173,7 @@ class BatchProgress:
     def seconds_left(self) -> float | None:
         """Time left at the rate items have completed since the first one (so the workers' start-up
         does not count); None before two are done."""
-        if self._timed < 2:
+        if self._timed < 2 or self._first is None:
             return None
         rate = (self._timed - 1) / max(1e-9, time.monotonic() - self._first)
         return (self.total - self.done) / rate
@@ -476,8 +477,9 @@ def item_memory(items: Iterable[Item]) -> tuple[float, str]:
         return best, label
     params = method.params.from_dict(items[0].params)
     for item in items:
-        shapes = {name: _header_shape(path) for name, path in item.inputs.items()}
-        if any(s is None for s in shapes.values()):
+        found = {name: _header_shape(path) for name, path in item.inputs.items()}
+        shapes = {name: s for name, s in found.items() if s is not None}
+        if len(shapes) < len(found):
             continue
         if item.region is not None:
             first = method.inputs[0].name
@@ -520,13 +522,14 @@ def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> l
                 )
             )
             continue
-        if params is None or available is None or any(s is None for s in shapes.values()):
+        known = {name: s for name, s in shapes.items() if s is not None}
+        if method.memory is None or params is None or available is None or len(known) < len(shapes):
             continue
         if item.region is not None:
             first = method.inputs[0].name
-            shapes[first] = (item.region[2], item.region[2]) + tuple(shapes[first][2:])
+            known[first] = (item.region[2], item.region[2]) + tuple(known[first][2:])
         try:
-            need = float(method.memory(shapes, params))
+            need = float(method.memory(known, params))
         except (WeftError, KeyError, TypeError, ValueError):
             continue
         if need > available:

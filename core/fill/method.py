@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import cv2
 import numpy as np
@@ -200,6 +201,7 @@ def fill_image(
         # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
         # large picture (a colour corner far from a hole in a grey region does not make it a photo)
         known = ~hole & ~transparent
+        near: tuple[slice, slice] | None  # (None later: no neighbourhood, the engine fills the whole)
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
         on_border = touches_border(hole)
@@ -312,7 +314,7 @@ def fill_image(
     # a small hole in a large picture: the engine fills the hole's neighbourhood alone
     near = neighbourhood(work_hole, work_src, patch) if texture is None else None
     part = (slice(None), slice(None)) if near is None else near
-    engine_kw = {k: v[part] for k, v in extra.items()}
+    engine_kw: dict[str, Any] = {k: v[part] for k, v in extra.items()}
     if structure:  # the edges entering the hole, continued across it (None: none pair up)
         if pending is not None and pending[0] == part and work is colour:
             engine_kw["guide"], continued = pending[1], pending[2]

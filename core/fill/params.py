@@ -48,7 +48,7 @@ class FillParams(Params):
         "colour picture (always with --structure yes), else hybrid; "
         + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()),
     )
-    patch: int = param(
+    patch: int | None = param(
         None,
         kind="int",
         lo=3,
@@ -59,14 +59,14 @@ class FillParams(Params):
         + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items())
         + f" ({BORDER_BLOCK} for an uncrop more than 24 px deep)",
     )
-    extend: Margins = param(
+    extend: Margins | None = param(
         None,
         kind="geometry",
         type=Margins,
         optional=True,
         help="uncrop: pixels added on the left, top, right and bottom, filled like the hole",
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=1,

@@ -152,7 +152,7 @@ def _ccorr(planes: list[np.ndarray], crop: tuple[slice, slice], template: np.nda
     are ``planes``, as the sum of one single-channel correlation per channel: OpenCV's multi-channel
     correlation took 1.5-2.5x as long as three single-channel ones on the 216 px crops and 24 px
     blocks of a fill (equal to float32 rounding)."""
-    out = cv2.matchTemplate(planes[0][crop], np.ascontiguousarray(template[..., 0]), cv2.TM_CCORR)
+    out: np.ndarray = cv2.matchTemplate(planes[0][crop], np.ascontiguousarray(template[..., 0]), cv2.TM_CCORR)
     for k in range(1, len(planes)):
         out += cv2.matchTemplate(planes[k][crop], np.ascontiguousarray(template[..., k]), cv2.TM_CCORR)
     return out
@@ -365,7 +365,7 @@ def fill_quilt(
     while left > 0:
         py, px = front.first_max()
         if score[py, px] < 0:  # an unknown region touching nothing valued (cannot happen, kept safe)
-            py, px = np.unravel_index(int(np.argmax(~have)), have.shape)
+            py, px = np.unravel_index(int(np.argmax(~have)), have.shape)  # type: ignore[assignment]  # numpy ints
         # the window centred there, moved away from its known pixels so that they fill about an
         # overlap's width of it (a straight front: B/2 known -> B/3) and the block fills more
         y0 = int(min(max(py - b // 2, 0), h - b))

@@ -116,7 +116,7 @@ class Flat:
         touches = box_sum(hole, p) > 0.5
         ty, tx = np.nonzero(touches)
         self.ty, self.tx = ty.astype(np.int64), tx.astype(np.int64)
-        self.tmap = np.full(touches.shape, -1, np.int64)
+        self.tmap: np.ndarray = np.full(touches.shape, -1, np.int64)
         self.tmap[ty, tx] = np.arange(len(ty))
         self.weights = None  # (N, P * C) float32: the target patches' confidences, a pixel's repeated per channel
         self.mean_conf = None  # (N,) float64: their means over the patch
@@ -421,7 +421,7 @@ def em(
     bias: float,
     worst: float,
     cancel: CancelToken | None,
-    on_iteration: Callable[[int], None],
+    on_iteration: Callable[[int], object],
     last_stride: int | None = None,
     fixed: slice | None = None,
 ) -> None:

@@ -221,7 +221,7 @@ def _side_colours(rgb8: np.ndarray | None, lum: np.ndarray, p: np.ndarray, t: np
     nrm = np.array([-t[1], t[0]])
     back = np.arange(2, 10, dtype=float)
     aside = np.arange(2, 6, dtype=float)
-    out = []
+    out: list[np.ndarray | None] = []
     for sgn in (1.0, -1.0):
         pts = (
             p[None, None, :] - t[None, None, :] * back[:, None, None] + sgn * nrm[None, None, :] * aside[None, :, None]
@@ -308,7 +308,7 @@ def _orient(struct: np.ndarray, nx_: np.ndarray, ny_: np.ndarray, seeds) -> np.n
     Returns the pixels reached (a piece of edge the curves do not reach is dropped)."""
     h, w = struct.shape
     done = np.zeros((h, w), bool)
-    queue = deque()
+    queue: deque[tuple[int, int]] = deque()
     for y, x in seeds:
         if not done[y, x]:
             done[y, x] = True

@@ -389,6 +389,7 @@ def load_image(
             raise ImageError(f"{shown(name)}: truncated or corrupt JPEG data ({damage})", path=name)
         if kept is not None:
             return _loaded_alpha(kept, name, fmt, orientation, src_mode, animated, mode)
+        assert arr is not None  # decoded by OpenCV or Pillow, or raised
         if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] == 3)):
             raise ValueError(f"unexpected decoder output of shape {arr.shape}")
         if arr.dtype not in (np.uint8, np.uint16):
@@ -401,7 +402,7 @@ def load_image(
         # so for PNG the IHDR colour type (0 grey, 4 grey+alpha) decides.
         if arr.ndim == 3 and (src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] in (0, 4))):
             arr = arr[..., 0]
-        image = arr.astype(np.float32, order="C") / np.float32(np.iinfo(arr.dtype).max)
+        image = arr.astype(np.float32, order="C") / np.float32(65535 if arr.dtype == np.uint16 else 255)
     except MemoryError:
         raise ImageError(f"{shown(name)}: not enough memory to decode {width}x{height} pixels", path=name) from None
     except ImageError:

@@ -31,7 +31,7 @@ class NfptParams(WarpParams):
     """Parameters of ``weft nfpt`` (Yan, Lee & Lin): rectification (the fields of ``WarpParams``),
     synthesis, repair, re-projection."""
 
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=8,
@@ -55,7 +55,7 @@ class NfptParams(WarpParams):
         help="how much each patch overlaps those already placed (the L-shaped neighbourhood): more"
         " matches and hides seams better; at most block/2",
     )
-    sigma_d: float = param(
+    sigma_d: float | None = param(
         None,
         kind="float",
         lo=0.1,
@@ -102,7 +102,7 @@ class NfptParams(WarpParams):
     smooth: bool = param(
         False, help="step 7: blur the re-made pixels slightly (Gaussian) to hide what the repair leaves"
     )
-    view: View = param(
+    view: View | None = param(
         None,
         kind="geometry",
         type=View,
@@ -363,6 +363,7 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
     if cancel is not None:
         cancel.raise_if_cancelled()
     homography = None
+    mask: np.ndarray | None  # where the synthesis may sample; None: everywhere
     if lines is not None:
         rep = ProgressReporter(progress, "rectify", 1)
         rect = rf.Rectifier(photo).rectify(
@@ -400,6 +401,7 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
             out, cover = plan.apply(syn.image, supersample=rv.SUPERSAMPLE, alpha=True)
             figures["view_coverage"] = round(float(cover.mean()), 4)
         else:
+            assert rect is not None and lines is not None  # into_photo without lines was refused above
             plan = rv.into_photo_plan(
                 rect.plan,
                 lines.image_lines,

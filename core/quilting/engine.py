@@ -11,7 +11,9 @@ checks it).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -171,6 +173,9 @@ def _record(sources: np.ndarray, y0: int, x0: int, sy: int, sx: int, b: int, mas
 class _Source:
     """The source texture prepared for one block size: centred, spectra, squared sums."""
 
+    spectrum_c: np.ndarray | None  # the correspondence map's, when there is one
+    sq_c: np.ndarray | None
+
     def __init__(self, tex: np.ndarray, corr_src: np.ndarray | None, block: int):
         import cv2
 
@@ -286,7 +291,7 @@ def _quilt_pass(
                     sources[y0 : y0 + bh, x0 : x0 + bw, 1] = (sx[i, j] + np.arange(bw))[None, :]
             if report is not None:
                 report.update(i + 1, preview=preview)
-        if record is not None:
+        if record is not None and sources is not None:
             record["sources"] = sources[:out_h, :out_w].copy()
         return canvas[:out_h, :out_w], rows * cols
 
@@ -303,6 +308,13 @@ def _quilt_pass(
         and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS
         and "weft.core._kernels.quilting" not in sys.modules
     )
+    # the numba kernels or their numpy twins, called alike
+    error: Callable[..., Any]
+    by_best: Callable[..., int]
+    by_tol: Callable[..., int]
+    by_eps: Callable[..., int]
+    by_sampled: Callable[..., int]
+    choose: Callable[..., int]
     if use_numpy:
         place, template, blend = _place_block_numpy, _make_template_numpy, None
         error, cut = _block_error_numpy, _cut_mask_into_numpy
@@ -431,7 +443,7 @@ def _quilt_pass(
             row_static = None
             if ahead is not None:
                 row_static = ahead.result()
-                ahead = static_rows.submit(static_row, i + 1) if i + 1 < rows else None
+                ahead = static_rows.submit(static_row, i + 1) if static_rows is not None and i + 1 < rows else None
             y0, top, bottom = ys[i], tops[i], bottoms[i]
             ip[_K.P_Y0], ip[_K.P_TOP], ip[_K.P_BOTTOM] = y0, top, bottom
             for j in range(cols):
@@ -468,7 +480,7 @@ def _quilt_pass(
                             else:
                                 cv2.mulSpectrums(spectra[c], fwd, 0, c=part, conjB=True)
                                 spec = np.add(spec, part, out=acc)
-                    cross = cv2.idft(spec, dst=cross_buf, flags=flags)
+                    cross = cv2.idft(spec, dst=cross_buf, flags=flags)  # type: ignore[arg-type]  # nc >= 1 set spec
                     if usage is not None and overlaps:
                         n_overlap = b * b - (b - top - bottom) * (b - left - right)
                         _penalise_usage(cross, usage, src.ph, src.pw, b, usage_weight * random_error * n_overlap)
@@ -510,8 +522,8 @@ def _quilt_pass(
                 place(canvas, filled, tex, ip, mask, win, label, old)
                 chosen[i, j] = ip[_K.P_SY], ip[_K.P_SX]
                 if usage is not None:
-                    sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
-                    usage[sy : sy + b, sx : sx + b] += mask if mincut and overlaps else np.float32(1.0)
+                    uy, ux = int(ip[_K.P_SY]), int(ip[_K.P_SX])
+                    usage[uy : uy + b, ux : ux + b] += mask if mincut and overlaps else np.float32(1.0)
                 if sources is not None:
                     _record(
                         sources, y0, x0, int(ip[_K.P_SY]), int(ip[_K.P_SX]), b, mask if mincut and overlaps else None
@@ -523,7 +535,7 @@ def _quilt_pass(
     finally:
         if static_rows is not None:
             static_rows.shutdown(wait=True, cancel_futures=True)
-    if record is not None:
+    if record is not None and sources is not None:
         record["sources"] = sources[:out_h, :out_w].copy()
     return canvas[:out_h, :out_w], rows * cols
 

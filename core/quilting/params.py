@@ -51,7 +51,7 @@ class QuiltParams(Params):
         help="how blocks join: random = side by side (seams show); overlap = matched where they "
         "overlap; mincut = also cut along the least visible path (smoothest)",
     )
-    block: int = param(
+    block: int | None = param(
         None,
         kind="int",
         lo=2,
@@ -62,7 +62,7 @@ class QuiltParams(Params):
         " its joints) but repeats more of the sample, smaller breaks them up (default 7/16 of "
         "the texture's shorter side, at most 56; transfer 9, iterative 31)",
     )
-    overlap: int = param(
+    overlap: int | None = param(
         None,
         kind="int",
         lo=1,
@@ -72,7 +72,7 @@ class QuiltParams(Params):
         "better and costs time; smaller than block (default block/6 rounded up; transfer "
         "block/3, iterative 2*block/3)",
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=1,
@@ -80,7 +80,7 @@ class QuiltParams(Params):
         optional=True,
         help="output size WIDTHxHEIGHT; default twice the texture's size (transfer: the target's)",
     )
-    tol: int = param(
+    tol: int | None = param(
         None,
         kind="int",
         lo=1,

@@ -211,7 +211,7 @@ def _transfer(
             bi,
             oi,
             params.rule,
-            params.tol,
+            params.tol or 1,
             params.epsilon,
             params.tile,
             params.poisson,

@@ -23,7 +23,7 @@ INTERPOLATIONS = ("cubic", "linear", "lanczos")
 class WarpParams(Params):
     """The rectification parameters, shared by ``weft rectify`` and ``weft nfpt`` (which add theirs)."""
 
-    lines: FeatureLines = param(
+    lines: FeatureLines | None = param(
         None,
         kind="geometry",
         type=FeatureLines,
@@ -73,7 +73,7 @@ class WarpParams(Params):
 class RectifyParams(WarpParams):
     """Parameters of ``weft rectify`` (and the rectification step of ``weft nfpt``)."""
 
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=2,

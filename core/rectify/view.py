@@ -55,7 +55,7 @@ class View:
     texture_lines: np.ndarray | None = None
 
     def with_size(self, default: tuple[int, int]) -> tuple[int, int]:
-        return self.size if self.size is not None else tuple(default)
+        return self.size if self.size is not None else (default[0], default[1])
 
     # A typed geometry parameter (weft.core.geometry): parsed at the edges, written once.
     METAVAR = "VIEW"
@@ -216,6 +216,7 @@ def view_plan(
         return plan
     # the view lines must lie in the view; the texture lines may reach beyond the texture (the plane
     # goes on), they only must not be zero-length
+    assert view.view_lines is not None and view.texture_lines is not None  # a view is a quad or two line sets
     check_lines(view.view_lines, size, key="view line", frame="the view")
     check_lines(view.texture_lines, texture_size, key="texture line", frame="the texture", tolerance=math.inf)
     return plan_warp(

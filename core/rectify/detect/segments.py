@@ -39,7 +39,7 @@ def line_segments(grey: np.ndarray) -> np.ndarray:
 def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Segments joining SIFT features to their repeats elsewhere in the photo (similar descriptor,
     scale and orientation), at least three feature sizes apart."""
-    sift = cv2.SIFT_create(nfeatures=1000)
+    sift = cv2.SIFT_create(nfeatures=1000)  # type: ignore[attr-defined]  # the cv2 stubs lack SIFT_create
     kps, desc = sift.detectAndCompute(grey, None)
     if desc is None or len(kps) < 20:
         return np.zeros((0, 4))
@@ -55,8 +55,8 @@ def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
             dists.append(m.distance)
     if not pairs:
         return np.zeros((0, 4))
-    pairs, dists = np.array(pairs), np.array(dists)
-    i, j = pairs[:, 0], pairs[:, 1]
+    index, dist = np.array(pairs), np.array(dists)
+    i, j = index[:, 0], index[:, 1]
     gap = np.hypot(*(pts[i] - pts[j]).T)
     turn = np.abs(np.angle(np.exp(1j * (ang[i] - ang[j]))))
     keep = (
@@ -64,7 +64,7 @@ def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         & (gap > 3 * np.maximum(size[i], size[j]))
         & (turn < math.radians(20))
         & (np.abs(np.log(size[i] / size[j])) < 0.3)
-        & (dists < np.quantile(dists, 0.3))
+        & (dist < np.quantile(dist, 0.3))
     )
     return np.column_stack([pts[i[keep]], pts[j[keep]]])
 

@@ -64,6 +64,7 @@ def refine_point(
 
     if mids is None:
         return solve(weights)
+    assert v is not None  # the centres come with a start point
     for _ in range(iterations):
         q = v[None, :2] - v[2] * mids
         qq = np.maximum(np.einsum("ij,ij->i", q, q), 1e-12)
