@@ -112,8 +112,8 @@ class _TerminalProgress:
 
 
 class _PreparingLine:
-    """Says on stderr that kernels are being compiled — the first run's long silent stretch (a cold
-    quilting transfer compiled for 39 s before its first progress report) — and keeps the line alive
+    """Says on stderr that kernels are being compiled — the first run's long silent stretch before
+    its first progress report — and keeps the line alive
     with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes over or the run ends.
 
     Called from numba's compile events (``registry.watch_compiles``), i.e. only when a kernel really
@@ -367,8 +367,7 @@ def _execute(
     try:
         with registry.watch_compiles(on_start=preparing):  # a kernel compiling: say so on the terminal
             # Loading every kernel up front only keeps --report's "seconds" free of cache loads; without
-            # --report a run loads (or, first time, compiles) just the kernels it uses: a cold
-            # `weft affine` 3.8 -> 3.0 s, `weft nfpt` 4.7 -> 3.9 s.
+            # --report a run loads (or, first time, compiles) just the kernels it uses.
             result, seconds = render(
                 method, params, input_paths, seed, region, progress=bar, warm_up=args.report, infos=infos
             )
@@ -444,8 +443,8 @@ def _warm_up_all(args: argparse.Namespace) -> int:
         f"{min(jobs, len(names))} process{'es' if min(jobs, len(names)) != 1 else ''} at once"
     )
     # "spawn": fresh interpreters (no inherited numba state or threads). Each worker warms several
-    # methods in turn (quilting, the longest, first): a process per method paid Python's, numba's
-    # and LLVM's start-up six times, 19.7 s of CPU against 12.2 s in one process on this machine.
+    # methods in turn (quilting, the longest, first): a process per method would pay Python's,
+    # numba's and LLVM's start-up once per method.
     with ProcessPoolExecutor(
         max_workers=min(jobs, len(names)), mp_context=multiprocessing.get_context("spawn")
     ) as pool:
@@ -531,12 +530,10 @@ def _dispatch(args: argparse.Namespace) -> int:
 def _reuse_freed_memory() -> None:
     """glibc's allocator told to keep freed memory for the next allocation: blocks under 32 MiB come
     from the heap (``M_MMAP_THRESHOLD``), and the heap is given back only past 256 MiB free
-    (``M_TRIM_THRESHOLD``). A ``weft fill`` of a 320 px photo allocates and frees thousands of 0.1-2
-    MB numpy temporaries; by default each got fresh pages from the kernel, 50-90 ms of page faults
-    and trims (whole process 0.42-0.45 s -> 0.35-0.37 s, G'MIC's 0.36; a 40 px hole in a 4096x4096
-    photo 748 -> 790 MiB peak). Growing the heap 256 MiB at a time (``M_TOP_PAD``) was as quick but
-    886 MiB there; the trim threshold alone disables glibc's sliding mmap threshold and doubled the
-    time. Other C libraries: nothing is done."""
+    (``M_TRIM_THRESHOLD``). A ``weft fill`` allocates and frees thousands of small numpy
+    temporaries; by default each gets fresh pages from the kernel, paying page faults and trims.
+    (Setting the trim threshold alone would disable glibc's sliding mmap threshold.) Other C
+    libraries: nothing is done."""
     if not sys.platform.startswith("linux"):
         return
     try:

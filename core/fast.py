@@ -9,14 +9,13 @@ uniformly random source position is added, with probability ``p_l`` the location
 Choices where the paper is silent (all documented here and in :func:`transfer`):
 
 * Candidates whose n x n source neighbourhood would leave the source are **clamped** into the valid
-  region (measured: on camera in gravel, clamping gave fidelity 0.930 / coherence 0.398 against
-  0.917 / 0.409 for dropping them: a clamped candidate is one more nearby choice). Candidates outside
+  region (a clamped candidate is one more nearby choice, where dropping it leaves fewer). Candidates outside
   a user's source mask are dropped. A pixel left with no candidate (the first pixel, or all dropped)
   gets a random one. The location-specific candidate is clamped likewise.
 * ``remap`` (default on, not in the paper, which found equalisation unnecessary): matching uses the
   source luminance linearly mapped to the target's mean and standard deviation, as in Hertzmann et
-  al.'s image analogies; the output still copies the source's own pixels. Measured on camera in
-  gravel at p = 0.05: fidelity 0.941 with it, 0.930 without.
+  al.'s image analogies (a target brighter or darker than the source is still followed); the output
+  still copies the source's own pixels.
 * The target part of eq. 1 is the complementary half of the square, centre included (Fig. 1b: "the
   bottom half from the target image"); the ``target`` metric uses only that part.
 * ``n`` in the artistic metric is the number of L-shape pixels actually compared (fewer at borders).
@@ -387,8 +386,8 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
 
 
 #: Peak memory per output pixel besides the inputs (result, positions, padded target, luminance and
-#: colour copies, previews; measured with /usr/bin/time -v on `weft fast` transfers: 392 MB peak RSS
-#: for a 2048x2048 target, 972 MB for 4096x4096, i.e. 46 B per pixel over ~200 MB of libraries).
+#: colour copies, previews), fitted to the peak memory of ``weft fast`` transfers without the
+#: libraries' share.
 BYTES_PER_OUTPUT_PIXEL = 50
 
 
@@ -409,8 +408,8 @@ def _output_size(
 def _check_limits(texture: np.ndarray, target: np.ndarray | None, params: FastParams) -> None:
     """Refuse up front an output over the pixel limit or beyond the memory available.
 
-    No running-time limit: the method is linear in the output, ~0.2 µs per pixel and iteration, so
-    the pixel limit (50 Mpx) bounds a job to well under the ten minutes of :mod:`weft.core.limits`.
+    No running-time limit: the method is linear in the output, so the pixel limit bounds a job to
+    well under the ten minutes of :mod:`weft.core.limits`.
     """
     from .limits import check_memory, check_output_size
 

@@ -452,8 +452,7 @@ class Mask:
 
     @classmethod
     def _own(cls, bits: np.ndarray) -> Mask:
-        """A mask over ``bits``, a fresh bool array of this module's own making (no second copy: a
-        brush dab on an 8192² mask copied it twice)."""
+        """A mask over ``bits``, a fresh bool array of this module's own making (no second copy)."""
         mask = cls.__new__(cls)
         bits.flags.writeable = False
         object.__setattr__(mask, "bits", bits)
@@ -616,7 +615,7 @@ def paint_line(bits: np.ndarray, p0, p1, radius: float, value: bool = True) -> t
 class MaskStroke:
     """A mask being painted, dab by dab (the studio's brush and eraser): its bits change in place
     (:func:`paint_line`), so a dab costs the dab's pixels, where ``Mask.painted_line`` copies the
-    whole mask (16 MB per dab at 4096²). Not a :class:`Mask` (which is immutable): read it with
+    whole mask. Not a :class:`Mask` (which is immutable): read it with
     :meth:`cut` (a copy of a part, what a preview around the stroke needs), :attr:`bits` (a read-only
     view that changes as the stroke goes on) or :meth:`snapshot`; :meth:`mask` ends the stroke.
 

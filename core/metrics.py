@@ -47,8 +47,8 @@ __all__ = [
 ]
 
 MIN_SIDE = 7
-# Upper bound on the float32 distance block held at once by the nearest-neighbour search
-# (16 MiB measured faster than larger blocks: the add/argmin passes stay closer to cache).
+# Upper bound on the float32 distance block held at once by the nearest-neighbour search (small
+# enough that the add/argmin passes stay close to the cache).
 _BLOCK_BYTES = 16 * 1024 * 1024
 
 
@@ -372,8 +372,8 @@ def verbatim_region(sources) -> int:
     # The graph drawn at twice the resolution: pixel (y, x) at (2y, 2x), the edge to its right
     # neighbour at (2y, 2x + 1), to the one below at (2y + 1, 2x); an edge pixel is set where both
     # neighbours are copies with the same offset. The 4-connected components of that image are the
-    # graph's (a node meets another only through an edge pixel), found by cv2 (scipy.sparse's
-    # csgraph took ~0.1 s to import in every quilting process).
+    # graph's (a node meets another only through an edge pixel), found by cv2 (importing
+    # scipy.sparse's csgraph would slow every quilting process's start).
     grid = np.zeros((2 * h - 1, 2 * w - 1), dtype=np.uint8)
     grid[::2, ::2] = valid
     grid[::2, 1::2] = valid[:, :-1] & valid[:, 1:] & (dy[:, :-1] == dy[:, 1:]) & (dx[:, :-1] == dx[:, 1:])
@@ -432,7 +432,7 @@ def fill_coherence(out, hole, reference=None, *, patch: int = 7, stride: int = 2
     :func:`fill_detail`.)
 
     ``hole`` is a bool (H, W) array, True where the image was filled. ``db_stride`` thins the known
-    windows (1 = all; 2 is ~4x faster and slightly pessimistic).
+    windows (1 = all; 2 is quicker and slightly pessimistic).
 
     Raises ``ImageError`` if shapes disagree, the known region holds no whole window, or the hole is
     empty; ``InvalidParameter`` for a bad ``patch``/``stride``.

@@ -54,7 +54,7 @@ class InputSpec:
     min_side: int = 1
     #: Keep an alpha channel when the file has one (``load_image(..., alpha=True)``): the method then
     #: gets (H, W, 2) grey+alpha or (H, W, 4) RGBA. Off for every method but ``fill`` (a transparent
-    #: region is its hole); the others get alpha dropped, as before.
+    #: region is its hole); the others get alpha dropped.
     alpha: bool = False
 
     @property
@@ -161,7 +161,7 @@ def get(name: str) -> Method:
 
 #: What a front end shows while a method's kernels compile (``{name}`` is the method's name) ...
 PREPARING = "preparing the {name} method — first run only"
-#: ... and while they load, before it is known whether they compile (numba's import alone takes ~0.5 s).
+#: ... and while they load, before it is known whether they compile (numba's import alone takes a while).
 LOADING = "loading the {name} method"
 
 _warm: set[str] = set()

@@ -8,9 +8,8 @@ A session is the whole document as JSON::
 ``geometry`` holds each method's own geometry (its studio description's keys): a square ``[x, y, side]``,
 feature lines ``{...}``, margins ``[left, top, right, bottom]``, and a mask as the name of its 1-bit PNG
 written beside the session (relative to the session's folder), e.g. ``"mask": "s.weft.fill.mask.png"``.
-Files written before
-geometry was per method have one ``"prototype": [x, y, side]`` and one ``"lines": {...}`` instead;
-each is given to every method with a geometry of that kind.
+Files of the older format, without per-method geometry, have one ``"prototype": [x, y, side]`` and
+one ``"lines": {...}`` instead; each is given to every method with a geometry of that kind.
 """
 
 from __future__ import annotations
@@ -85,8 +84,8 @@ def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) 
     seed = data.get("seed", 1)
     if not _ints([seed], 0, MAX_SEED):
         raise WeftError(f"seed = {seed!r} must be an integer in 0..{MAX_SEED}")
-    # Geometry per method. Sessions written before it was per method have one "prototype" and one
-    # "lines" for all: each goes to every method with a geometry of that kind.
+    # Geometry per method. Sessions of the older format have one "prototype" and one "lines" for
+    # all: each goes to every method with a geometry of that kind.
     geometry: dict[str, dict[str, Any]] = {}
     for name, method in methods.items():
         if method.studio is None:

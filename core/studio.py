@@ -391,7 +391,7 @@ def around_region(
     reads for ``stroke`` (same ``context``): the stroke's box grown by ``context``, grown again by
     ``context`` and a quarter of that box's longer side (the crop never reaches farther), clipped to
     the mask. Cut that part and pass it as ``crop_around(..., mask_part=)``: a preview around a
-    stroke then never needs the whole mask (64 MB as a float image at 4096²)."""
+    stroke then never needs the whole mask."""
     wx0, wy0, wx1, wy1 = _stroke_window(stroke, context)
     grow = context + max(wx1 - wx0, wy1 - wy0) // 4 + 1
     return max(0, wx0 - grow), max(0, wy0 - grow), min(width, wx1 + grow), min(height, wy1 + grow)

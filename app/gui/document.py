@@ -206,7 +206,7 @@ class Document(QObject):
 
     def deferred_inputs(self, *, live: bool = False) -> Callable[..., dict[str, np.ndarray]]:
         """:meth:`method_inputs` captured now and built when called, on any thread: the slow part
-        (a painted mask's float image, 64 MB for a 4096² mask, and a crop to the source region) is
+        (a painted mask's float image and a crop to the source region) is
         left to the call, so a render job does it on its worker, not the GUI thread. The call
         takes ``names`` (default all): only those inputs."""
         arrays, masks, region, on = self._input_parts(live)

@@ -104,11 +104,11 @@ class MainWindow(QMainWindow):
         super().__init__(parent)
         # Register all of Pillow's format plugins here, on the GUI thread, before any worker runs:
         # Pillow imports them on the first file it cannot identify, and that import racing the
-        # kernels' compilation on another worker crashed the process (seen in the test suite).
+        # kernels' compilation on another worker can crash the process.
         PILImage.init()
         self.setWindowTitle("weft")
-        # 1280x800, within the screen with room for the window manager's frame (a 1280x800 window on
-        # a 1280x800 screen had its status bar below the screen's edge, seen under Xvfb)
+        # 1280x800, within the screen with room for the window manager's frame (so that on a 1280x800
+        # screen the status bar stays above the screen's edge)
         room = self.screen().availableGeometry() if self.screen() is not None else None
         self.resize(min(1280, room.width()) if room else 1280, min(800, room.height() - 48) if room else 800)
         self.settings = settings if settings is not None else QSettings("weft", "weft")

@@ -6,9 +6,8 @@
   would starve the display while the slider moves). Release, and any other edit, asks for
   ``final()`` (slot ``"final"``, full size), which cancels any preview.
   Previews are reduced as the method's studio description says (its ``preview_inputs``, else its
-  ``preview_params`` sizes, scaled so the longer side is ``PREVIEW_SIDE``); measured with
-  ``python -m benchmarks.gui_latency``, full-size previews of a 640x500 fast transfer (~40 ms each)
-  gave a median latency of ~100 ms, 400 px previews meet the 50 ms goal.
+  ``preview_params`` sizes, scaled so the longer side is ``PREVIEW_SIDE``), small enough that a
+  preview follows the slider (``python -m benchmarks.gui_latency`` measures it).
 * Jobs carry ids; a result older than the one shown is dropped, so what is shown is always the last
   completed job. A result carries the recipe of its pixels (method, parameters, inputs, seed, region)
   and its "before" image, captured when the job was made: export and Compare use those, never the
@@ -26,8 +25,8 @@
   the part of the stroke's mask its crop can reach (``weft.core.studio.around_region``, cut from the
   tool's ``MaskStroke`` on the GUI thread: a few hundred pixels, never the 4096² mask), its result
   comes back already scaled to the crop's box, and the stroke's first one also brings the copy of
-  the full result its crops are pasted into (200 MB at 4096² in colour: 110 ms on the GUI thread
-  before); later ones are pasted into that copy in place, and the result view redraws only the part.
+  the full result its crops are pasted into (too large to copy on the GUI thread); later ones are
+  pasted into that copy in place, and the result view redraws only the part.
   While a stroke is painted, no whole-image preview is made (a preview asked for with no stroke box
   left waits for the next box).
 * A job running longer than ``PROGRESS_DELAY_MS`` shows its progress (with partial previews where the
@@ -58,9 +57,8 @@ WARM_UP_AFTER_RESULT_MS = 1000  # the first result is in: warm the others up thi
 #: Python's GIL switch interval (s) in a process with a renderer: a worker running Python (a numpy fill,
 #: a stroke's crop) hands the GIL over to a waiting GUI thread after at most this long, not the default
 #: 5 ms, and a GUI event handler enters Python several times (the tool, the QGraphicsItems' paint and
-#: boundingRect). Painting a 4096² mask, median of 3: longest stall 50.4 -> 30.1 ms, latency 70.5 ->
-#: 51.7 ms (``python -m benchmarks.gui_latency --paint --side 4096``); a long C call holding the GIL
-#: (an import, numba loading its typing tables) is not cut short by it.
+#: boundingRect), so painting stalls less (``python -m benchmarks.gui_latency --paint`` measures it);
+#: a long C call holding the GIL (an import, numba loading its typing tables) is not cut short by it.
 GIL_SWITCH_INTERVAL = 0.001
 
 
@@ -155,15 +153,14 @@ def stroke_part(doc, box) -> tuple[np.ndarray, tuple[int, int]] | None:
 def preparation(doc, *, side: int | None = None, around_box=None) -> tuple[Callable[[], tuple | None], Params] | None:
     """What a job of the document's current method runs on, captured now on the GUI thread (the
     document's inputs and parameters: references to immutable values) and built by the returned
-    call, on the job's worker: its painted masks as float images, a crop to the source region, a
-    reduction to ``side`` px (``reduce_for_preview``: 48.5 ms at 4096² on the GUI thread before;
+    call, on the job's worker (each too slow for the GUI thread on a large image): its painted masks
+    as float images, a crop to the source region, a reduction to ``side`` px (``reduce_for_preview``:
     a preview's, a variations grid's thumbnails) or a stroke's crop around ``around_box``
-    (``crop_around``, with the whole image's mask: 0.15-0.57 s per preview at 4096² on the GUI
-    thread before). The call gives ``(inputs, params, around)`` (``around``: the stroke's
+    (``crop_around``). The call gives ``(inputs, params, around)`` (``around``: the stroke's
     :class:`~weft.core.studio.Around`, or None), or None when there is nothing painted near the
     stroke. Returns ``(that call, the document's run parameters)``, or None when inputs are missing.
     A stroke's crop gets only the part of the stroke's mask it can reach (:func:`stroke_part`, cut
-    here), never the whole mask as an image (64 MB at 4096², per preview)."""
+    here), never the whole mask as an image."""
     if doc.missing_inputs():
         return None
     studio = doc.studio
@@ -352,7 +349,7 @@ class Renderer(QObject):
         box = None
         if slot == "preview" and self._around_box is not None:
             # a stroke's preview: only the crop around it is built (not the whole-image reduced
-            # preview as well: 11.6 ms at 2048², 48.5 ms at 4096² per preview, thrown away)
+            # preview as well, which would be thrown away)
             if doc.missing_inputs():
                 return None
             box, self._around_box = self._around_box, None
@@ -540,9 +537,9 @@ class Renderer(QObject):
         """Load (or compile) the other methods' kernels in the background — a moment
         (``WARM_UP_AFTER_RESULT_MS``) after the first full result is shown, or after ``delay_ms`` if no
         render is running then, and never while a stroke is previewed — so that they never make the
-        visible render wait: numba compiles under one process-wide lock, and a warm-up that went
-        first held the first result back behind every other method's compile. Nor do they stall
-        painting: loading them holds Python's GIL up to 40-66 ms at a time (imports, numba's typing
+        visible render wait: numba compiles under one process-wide lock, and a warm-up that goes
+        first holds the first result back behind every other method's compile. Nor do they stall
+        painting: loading them holds Python's GIL for long stretches (imports, numba's typing
         tables), and an artist often starts a stroke as soon as the picture is there."""
         self._warm_up_wanted = True
         self._warm_up_timer.start(delay_ms)

@@ -130,7 +130,7 @@ def segment_sums(
         p = (p - p.mean(axis=(1, 2), keepdims=True, dtype=np.float64).astype(np.float32)) * cos2_window(n)
     lowcut = 1.0 / n if lowcut is None else float(lowcut)
     bins = _bins(n, segments, lowcut)
-    import scipy.fft as sfft  # here, not at import: 0.12 s that every weft process paid
+    import scipy.fft as sfft  # here, not at import: most weft processes never need it
 
     mag = np.abs(sfft.rfft2(p)).reshape(len(p), -1)[:, bins.flat]
     mag[flat] = 0.0

@@ -251,7 +251,7 @@ def correlate_indexed(
     R = radius
     g = np.zeros((n, L, L), np.float32)
     g[:, R : R + B, R : R + B] = targets
-    import scipy.fft as sfft  # here, not at import: 0.12 s that every weft process paid
+    import scipy.fft as sfft  # here, not at import: most weft processes never need it
 
     G = sfft.rfft2(g)[:, None]
     F = sfft.rfft2(frames)

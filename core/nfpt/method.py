@@ -217,8 +217,8 @@ def synthesize(
     return syn if return_details else syn.image
 
 
-#: Seconds per source position per patch besides the DFTs (tol choice, cut, repair); ~1 ns on the
-#: 2-core machine (fitted to ``python -m benchmarks.estimates``).
+#: Seconds per source position per patch besides the DFTs (tol choice, cut, repair), on the 2-core
+#: reference machine (fitted by ``python -m benchmarks.estimates``).
 SELECT_SECONDS_PER_POSITION = 1e-9
 
 
@@ -227,7 +227,7 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], 
 
     Every patch but the first costs three DFTs of the padded source luminance (eqs. 1-3 for all
     positions at once: two spectra of the weighted template and the inverse) and a choice over every
-    source position; within 0.4..1.6x of real runs (``python -m benchmarks.estimates``).
+    source position (fitted by ``python -m benchmarks.estimates``).
     """
     from ..grid import block_grid
     from ..limits import dft_seconds

@@ -42,7 +42,7 @@ class QuiltParams(Params):
     quarter of the sample; the cap keeps the output of a large sample from being a few large copies
     of it. With a block of 48 or more the min-cut seam rule weighs 24 candidates (tol 6) instead of
     8: the wider overlap has room for a cut along the texture's joints, and the extra candidates find
-    it; at smaller blocks they cost time and gain nothing (the quilting benchmark's figures).
+    it; at smaller blocks they cost time and gain nothing.
     """
 
     mode: str = param(

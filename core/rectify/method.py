@@ -133,8 +133,8 @@ class Rectifier:
     photo : float32 (H, W) or (H, W, 3) in [0, 1]
         Validated once here.
     interpolation : {"cubic", "linear", "lanczos"}, default "cubic"
-        Resampling of the photo. Cubic keeps a 0.5 px-accurate rectification at ~39 dB against the
-        ground truth on the synthetic benchmark case; linear is ~30% faster and blurs a little more.
+        Resampling of the photo. Cubic keeps a sub-pixel-accurate rectification sharp; linear is
+        faster and blurs a little more.
 
     Examples
     --------
@@ -369,6 +369,6 @@ METHOD = Method(
     run=_run,
     warm_up=warm_up,
     # The default homography warp is numpy + OpenCV: loading the numba kernel of the morphs before
-    # every command would triple `weft rectify`'s whole run (0.3 s -> 1 s); the studio still loads it.
+    # every command would cost more than the run itself; the studio still loads it.
     warm_up_in_cli=False,
 )

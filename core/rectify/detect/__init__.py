@@ -31,8 +31,7 @@ point on the horizon, and the best supported pair a camera sees as perpendicular
 
 When nothing gives two families it raises :class:`~weft.core.errors.GeometryError` with one line
 (:data:`REFUSAL`); it never returns a guess it has no support for. A photo cropped off-centre breaks
-the principal-point assumption: the aspect is then off by about the crop's offset (the bundled
-example, whose camera's principal point is not the photo's centre, comes out 4.5 % too wide).
+the principal-point assumption: the aspect is then off by about the crop's offset.
 
 References
 ----------
