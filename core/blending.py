@@ -175,7 +175,23 @@ def poisson_blend(
 
 
 def max_levels(height: int, width: int) -> int:
-    """Most pyramid levels an image of this size allows (the coarsest level at least 1 pixel)."""
+    """Most pyramid levels an image of this size allows (the coarsest level at least 1 pixel).
+
+    Parameters
+    ----------
+    height, width : int
+        The image's size in pixels.
+
+    Returns
+    -------
+    int
+        ``floor(log2(min(height, width))) + 1`` (1 for an image of one pixel).
+
+    References
+    ----------
+    Burt & Adelson, "A multiresolution spline with application to image mosaics" (1983), as used in
+    Ngo's quilting write-up ("Bells and Whistles": Laplacian blending).
+    """
     return int(np.floor(np.log2(max(1, min(height, width))))) + 1
 
 

@@ -56,8 +56,29 @@ def default_rect(shape: tuple[int, ...], block: int, what: str = "image") -> Rec
     """The default prototype: a square of side ``2B`` (64 for B = 32) in the middle of the image.
 
     Its side is reduced to the largest even number the image holds (at least 8), so a small image
-    still gets a prototype; the paper uses a 64x64 prototype with 32x32 patches (§5). ``what``
-    names the image in the error (``"texture"``, ``"prototype image"``).
+    still gets a prototype; the paper uses a 64x64 prototype with 32x32 patches (§5).
+
+    Parameters
+    ----------
+    shape : tuple of int
+        The image's shape (H, W[, C]).
+    block : int
+        The patch side B.
+    what : str, default "image"
+        The image, for the message (``"texture"``, ``"prototype image"``).
+
+    Returns
+    -------
+    Square
+
+    Raises
+    ------
+    GeometryError
+        The image is smaller than 8x8 pixels.
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary matching", §5.
     """
     h, w = shape[:2]
     s = min(2 * block, (min(h, w) // 2) * 2)

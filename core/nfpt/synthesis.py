@@ -82,10 +82,27 @@ class Synthesis:
 
 
 def distance_weights(block: int, top: int, left: int, sigma_d: float) -> np.ndarray:
-    """W_d of eq. 1 on the L-shape of a patch (0 outside it), float64 (block, block).
+    """W_d of eq. 1 on the L-shape of a patch (0 outside it).
 
-    ``top`` and ``left`` are the widths of the overlap strips; ``d`` is the distance from the pixel's
-    centre to the edge between the L and the patch's new part (see the module docstring).
+    ``d`` is the distance from the pixel's centre to the edge between the L and the patch's new part
+    (see the module docstring).
+
+    Parameters
+    ----------
+    block : int
+        The patch side.
+    top, left : int
+        The widths of the overlap strips (0: no strip on that side).
+    sigma_d : float
+        The Gaussian's sigma, pixels.
+
+    Returns
+    -------
+    ndarray, float64 (block, block)
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §2, eq. 1.
     """
     ys = np.arange(block, dtype=np.float64)[:, None]
     xs = np.arange(block, dtype=np.float64)[None, :]
@@ -195,7 +212,39 @@ def synthesize_patches(
     progress: Callable[[Progress], None] | None = None,
     cancel: CancelToken | None = None,
 ) -> Synthesis:
-    """The engine of :func:`weft.core.nfpt.synthesize` (parameters already validated; see there)."""
+    """The engine of :func:`weft.core.nfpt.synthesize`, its parameters already validated.
+
+    Parameters
+    ----------
+    texture : ndarray, float32 (H, W) or (H, W, 3)
+        The (frontal) source texture.
+    size : (int, int)
+        The output's width and height.
+    block, overlap, sigma_d, sigma_s, tol, repair, band, threshold, n, smooth
+        As in :func:`weft.core.nfpt.synthesize`.
+    shift : int, default 0
+        A shift of the block grid, pixels.
+    mask : ndarray, bool (H, W), optional
+        Where the source may be sampled (the rectified photo's valid part); default everywhere.
+    rng, progress, cancel
+        Seed or generator; progress callback; cancel token.
+
+    Returns
+    -------
+    Synthesis
+        The image and what it took (patches, repaired pixels, source positions).
+
+    Raises
+    ------
+    InvalidParameter
+        ``block`` does not fit in the texture.
+    ImageError
+        The mask's size is not the texture's, or it leaves no whole patch to sample.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §2, steps 1-7.
+    """
     import cv2
 
     from .. import seams

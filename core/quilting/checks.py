@@ -73,11 +73,26 @@ def estimate_seconds(
 ) -> float:
     """Estimated running time of quilting on the 2-core reference machine (see :mod:`weft.core.limits`).
 
-    Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel
-    and the inverse; a transfer adds its correspondence and previous-pass spectra, computed on a
-    second thread one row ahead, so they do not add up) plus a position choice over every source
-    position, plus a fixed cost per block (:data:`SECONDS_PER_BLOCK`). ``passes`` are the (block,
-    overlap) of each pass. Fitted to real runs (``python -m benchmarks.limits``).
+    Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel and the
+    inverse; a transfer adds its correspondence and previous-pass spectra, computed on a second thread
+    one row ahead, so they do not add up) plus a position choice over every source position, plus a
+    fixed cost per block (:data:`SECONDS_PER_BLOCK`). Fitted by ``python -m benchmarks.limits``.
+
+    Parameters
+    ----------
+    texture_shape : tuple of int
+        The sample's shape (H, W[, C]).
+    out_size : (int, int)
+        The output's width and height.
+    passes : list of (int, int)
+        The (block, overlap) of each pass.
+    tile : bool, default False
+        A tileable output (the canvas wraps).
+
+    Returns
+    -------
+    float
+        Seconds.
     """
     from ..limits import dft_seconds
 
@@ -127,8 +142,20 @@ def _transfer_passes(params: QuiltParams) -> list[tuple[int, int, float]]:
 
 
 def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: QuiltParams) -> float:
-    """Estimated peak bytes of one run on inputs of these shapes (what the run's own check uses);
-    0 for a random-mode synthesis, which has no such check."""
+    """Estimated peak bytes of one run on inputs of these shapes (what the run's own check uses).
+
+    Parameters
+    ----------
+    shapes : mapping of str to tuple of int
+        Input name -> array shape.
+    params : QuiltParams
+        The run's parameters.
+
+    Returns
+    -------
+    float
+        Bytes; 0 for a random-mode synthesis, which has no such check.
+    """
     tex = shapes["texture"]
     if shapes.get("target") is not None:
         out_h, out_w = shapes["target"][:2]

@@ -162,14 +162,39 @@ class QuiltParams(Params):
 
 
 def synth_block(texture_shape: tuple[int, ...]) -> int:
-    """The default block of a synthesis from a sample of this shape (``(H, W[, C])``): 7/16 of its
-    shorter side rounded half up, at most 56 and at least 2 (see :class:`QuiltParams`)."""
+    """The default block of a synthesis from a sample of this shape (see :class:`QuiltParams`).
+
+    Parameters
+    ----------
+    texture_shape : tuple of int
+        The sample's shape (H, W[, C]).
+
+    Returns
+    -------
+    int
+        7/16 of its shorter side rounded half up, at most 56 and at least 2.
+
+    References
+    ----------
+    Efros & Freeman (2001), §2.1 (the block must capture the texture's structures).
+    """
     side = min(texture_shape[:2])
     return max(2, min(SYNTH_BLOCK_MAX, _round_half_up(SYNTH_BLOCK_SHARE * side)))
 
 
 def synth_tol(block: int) -> int:
-    """The default tol of a synthesis with this block: 2, or 6 from block 48 up (see :class:`QuiltParams`)."""
+    """The default tol of a synthesis with this block (see :class:`QuiltParams`).
+
+    Parameters
+    ----------
+    block : int
+        The block side.
+
+    Returns
+    -------
+    int
+        2, or 6 from block 48 up.
+    """
     return SYNTH_TOL_LARGE if block >= SYNTH_LARGE_BLOCK else SYNTH_TOL
 
 

@@ -116,7 +116,19 @@ class Rectified:
 
 
 def scale_lines(lines: np.ndarray, from_size: tuple[int, int], to_size: tuple[int, int]) -> np.ndarray:
-    """Lines of a frame of ``from_size`` in a frame of ``to_size`` (pixel areas mapped onto each other)."""
+    """Lines of a frame of ``from_size`` in a frame of ``to_size`` (pixel areas mapped onto each other).
+
+    Parameters
+    ----------
+    lines : array_like, (N, 4)
+        Lines ``x1, y1, x2, y2`` in pixel coordinates of the first frame.
+    from_size, to_size : (int, int)
+        The frames' width and height.
+
+    Returns
+    -------
+    ndarray, float64 (N, 4)
+    """
     sx = to_size[0] / from_size[0]
     sy = to_size[1] / from_size[1]
     out = np.array(lines, dtype=np.float64).reshape(-1, 4).copy()
@@ -290,8 +302,30 @@ def rectify_feature_lines(
 ) -> Rectified:
     """:func:`rectify` with parsed feature lines (or a JSON file name / JSON text).
 
-    ``size`` (optional) rescales the frontal frame: the frontal lines are scaled from
-    ``lines.frontal_size`` to ``size`` and the output has that size.
+    Parameters
+    ----------
+    photo : ndarray, float32 (H, W) or (H, W, 3)
+        The photo of the texture.
+    lines : FeatureLines or str
+        The feature lines, or a JSON file name or JSON text (see :func:`load_feature_lines`).
+    size : (int, int), optional
+        Rescales the frontal frame: the frontal lines are scaled from ``lines.frontal_size`` to
+        ``size`` and the output has that size.
+    warp, a, b, p, interpolation
+        As in :func:`rectify`.
+
+    Returns
+    -------
+    Rectified
+
+    Raises
+    ------
+    GeometryError
+        Malformed or degenerate lines (see :func:`rectify`).
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §3.
     """
     if not isinstance(lines, FeatureLines):
         lines = load_feature_lines(lines)
@@ -344,7 +378,18 @@ FIGURES = {
 
 
 def homography_figure(h: np.ndarray) -> list[list[float]]:
-    """``h`` scaled to ``h[2][2] = 1`` (as in the bundled example's JSON), as nested lists for reports."""
+    """A homography as nested lists for reports.
+
+    Parameters
+    ----------
+    h : ndarray, (3, 3)
+        The homography.
+
+    Returns
+    -------
+    list of list of float
+        ``h`` scaled to ``h[2][2] = 1``, as in the bundled example's JSON.
+    """
     h = np.asarray(h, dtype=np.float64)
     if abs(h[2, 2]) > 1e-12:
         h = h / h[2, 2]

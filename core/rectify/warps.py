@@ -192,11 +192,24 @@ def _all_in_front(h: np.ndarray, size: tuple[int, int]) -> bool:
 
 
 def homography_maps(h: np.ndarray, size: tuple[int, int], *, scale: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """Backward maps of the homography ``h`` (destination -> source) over a frame of ``size``.
+    """Backward maps of a homography over a frame.
 
-    With ``scale`` s > 1 the frame is an s-times finer grid of the destination (sample centres).
     Points behind the horizon (third coordinate <= 0: ``h`` is scaled so that it is positive on the
     texture) get coordinates far outside any image.
+
+    Parameters
+    ----------
+    h : ndarray, (3, 3)
+        Destination -> source.
+    size : (int, int)
+        The destination frame's width and height (already ``scale`` times finer).
+    scale : int, default 1
+        With s > 1 the frame is an s-times finer grid of the destination (sample centres).
+
+    Returns
+    -------
+    map_x, map_y : ndarray, float32 (H, W)
+        The source coordinates of every destination pixel, for ``cv2.remap``.
     """
     w, hgt = size
     xs = (np.arange(w, dtype=np.float64) + 0.5) / scale - 0.5
@@ -229,10 +242,30 @@ def homography_plan(
     *,
     positive_at: tuple[float, float] | None = None,
 ) -> WarpPlan:
-    """A plan from a known homography ``h`` (destination -> source): the fast path when it is given.
+    """A plan from a known homography (the fast path when it is given).
 
     The sign of ``h`` matters (its third coordinate must be positive where the plane is in front of
     the camera); ``positive_at``, a destination point known to be on the texture, fixes it.
+
+    Parameters
+    ----------
+    h : ndarray, (3, 3)
+        Destination -> source.
+    dst_size, src_size : (int, int)
+        The frames' width and height.
+    fit : HomographyFit, optional
+        The fit it came from, for the plan's figures.
+    positive_at : (float, float), optional
+        A destination point on the texture.
+
+    Returns
+    -------
+    WarpPlan
+
+    Raises
+    ------
+    GeometryError
+        ``h`` is not an invertible 3x3 matrix of finite numbers.
     """
     h = np.asarray(h, dtype=np.float64)
     if h.shape != (3, 3) or not np.all(np.isfinite(h)) or abs(np.linalg.det(h)) < 1e-300:
