@@ -419,7 +419,20 @@ def _check_limits(texture: np.ndarray, target: np.ndarray | None, params: FastPa
 
 
 def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: FastParams) -> float:
-    """Estimated peak bytes of one run on inputs of these shapes (what :func:`_check_limits` checks)."""
+    """Estimated peak bytes of one run on inputs of these shapes (what :func:`_check_limits` checks).
+
+    Parameters
+    ----------
+    shapes : mapping of str to tuple of int
+        Input name -> array shape.
+    params : FastParams
+        The run's parameters.
+
+    Returns
+    -------
+    float
+        Bytes.
+    """
     target = shapes.get("target")
     width, height, _ = _output_size(shapes["texture"], target, params.resolved(target is not None))
     return BYTES_PER_OUTPUT_PIXEL * width * height

@@ -179,7 +179,24 @@ def _short(value: Any) -> str:
 
 
 def as_lines(value: Any, key: str) -> np.ndarray:
-    """``value`` as a float64 (N, 4) array, or a GeometryError naming the first bad entry."""
+    """Feature lines as a float64 (N, 4) array.
+
+    Parameters
+    ----------
+    value : object
+        A sequence of ``[x1, y1, x2, y2]`` of finite numbers.
+    key : str
+        The JSON key, for the message.
+
+    Returns
+    -------
+    ndarray, float64 (N, 4)
+
+    Raises
+    ------
+    GeometryError
+        Naming the first bad entry.
+    """
     if isinstance(value, np.ndarray):
         arr = value
         if arr.ndim != 2 or arr.shape[1] != 4 or not np.issubdtype(arr.dtype, np.number):
@@ -203,15 +220,48 @@ _WHOLE = re.compile(r"[+-]?[0-9]+")
 
 
 def whole_number(text: str) -> int:
-    """``text`` as a whole number written in ASCII digits (an optional sign): ``int`` alone would also
-    take ``1_000`` and other scripts' digits. ``ValueError`` otherwise."""
+    """``text`` as a whole number written in ASCII digits, with an optional sign.
+
+    ``int`` alone would also take ``1_000`` and other scripts' digits.
+
+    Parameters
+    ----------
+    text : str
+        The text.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ValueError
+        Anything else.
+    """
     if not _WHOLE.fullmatch(text):
         raise ValueError(f"not a whole number: {text!r}")
     return int(text)
 
 
 def as_size(value: Any, key: str) -> tuple[int, int]:
-    """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not)."""
+    """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not).
+
+    Parameters
+    ----------
+    value : object
+        A two-item list or tuple.
+    key : str
+        The JSON key, for the message.
+
+    Returns
+    -------
+    (int, int)
+
+    Raises
+    ------
+    GeometryError
+        Not two whole numbers, or a side outside 2..MAX_SIDE.
+    """
     if (
         not isinstance(value, (list, tuple))
         or len(value) != 2
@@ -227,7 +277,24 @@ def as_size(value: Any, key: str) -> tuple[int, int]:
 def read_json_or_file(text_or_path: str | os.PathLike, what: str) -> tuple[Any, str]:
     """The command-line rule: text starting with ``{`` is JSON, anything else a JSON file's name.
 
-    Returns ``(data, source)``; ``source`` names the file (or says "inline JSON") for messages.
+    Parameters
+    ----------
+    text_or_path : str or os.PathLike
+        The option's value.
+    what : str
+        What the JSON is, for messages (``"feature lines"``, ``"view"``).
+
+    Returns
+    -------
+    data : object
+        The parsed JSON.
+    source : str
+        The file's name, or "inline JSON", for messages.
+
+    Raises
+    ------
+    GeometryError
+        A missing or unreadable file, a folder, or invalid JSON.
     """
     text = os.fspath(text_or_path)
     if text.lstrip().startswith("{"):
@@ -588,9 +655,26 @@ class Mask:
 
 
 def paint_line(bits: np.ndarray, p0, p1, radius: float, value: bool = True) -> tuple[int, int, int, int] | None:
-    """Paint :meth:`Mask.painted_line`'s brush line into the bool array ``bits`` in place (only the
-    line's box is read and written: a dab on a 4096² mask costs the dab, not a copy of the mask).
-    Returns the box ``(x0, y0, x1, y1)`` (exclusive ends) whose pixels changed, None if none did."""
+    """Paint :meth:`Mask.painted_line`'s brush line into ``bits`` in place.
+
+    Only the line's box is read and written, so a dab costs the dab, not a copy of the mask.
+
+    Parameters
+    ----------
+    bits : ndarray, bool (H, W)
+        The mask's bits, changed in place.
+    p0, p1 : (float, float)
+        The line's ends, image pixels.
+    radius : float
+        The brush's radius, pixels.
+    value : bool, default True
+        Paint (True) or erase (False).
+
+    Returns
+    -------
+    (int, int, int, int) or None
+        The box ``(x0, y0, x1, y1)`` (exclusive ends) whose pixels changed, None if none did.
+    """
     h, w = bits.shape
     (x0, y0), (x1, y1) = (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))
     r = max(0.0, float(radius)) + 0.5  # a pixel is hit when its centre is within radius (+ half a pixel)

@@ -27,9 +27,24 @@ from .readfile import kind_of, open_regular, shown
 
 
 def load_recipe(path: str) -> Recipe:
-    """A recipe from a ``.json`` file or from the ``weft-recipe`` chunk of a PNG weft exported; its
-    relative input paths are resolved against the file's folder. One-line ``WeftError`` naming the
-    file; an image of another format is told that only PNG exports (and ``.json`` files) carry a recipe."""
+    """A recipe from a ``.json`` file or from the ``weft-recipe`` chunk of a PNG weft exported.
+
+    Parameters
+    ----------
+    path : str
+        The file.
+
+    Returns
+    -------
+    Recipe
+        With its relative input paths resolved against the file's folder.
+
+    Raises
+    ------
+    WeftError
+        One line naming the file; an image of another format is told that only PNG exports (and
+        ``.json`` files) carry a recipe.
+    """
     from .image import read_recipe
     from .image.files import _SIGNATURES
 
@@ -57,12 +72,29 @@ def load_recipe(path: str) -> Recipe:
 
 
 def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) -> dict:
-    """Validate ``recipe`` against its method before any image is read; returns its parameters in
-    their JSON form with every geometry inline (one that names a file is read relative to ``base``,
-    the recipe file's folder, never the current one).
+    """Validate ``recipe`` against its method before any image is read.
 
-    ``supplied`` names inputs given from elsewhere (a batch's ``--over``): they need not be in the
-    recipe, nor exist. Messages do not name the recipe file; the caller puts it in front.
+    Messages do not name the recipe file; the caller puts it in front.
+
+    Parameters
+    ----------
+    recipe : Recipe
+        The recipe.
+    base : pathlib.Path
+        The recipe file's folder: a geometry that names a file is read relative to it, never to the
+        current folder.
+    supplied : tuple of str, optional
+        Inputs given from elsewhere (a batch's ``--over``): they need not be in the recipe, nor exist.
+
+    Returns
+    -------
+    dict
+        Its parameters in their JSON form with every geometry inline.
+
+    Raises
+    ------
+    WeftError
+        A bad parameter, a missing input, an input that is not an image file.
     """
     from . import registry
 
@@ -94,9 +126,30 @@ def output_recipe(
     region: tuple[int, int, int] | None,
     out: str | os.PathLike,
 ) -> Recipe:
-    """The recipe a run's output at ``out`` carries: input paths relative to the output's folder
-    (``weft run OUT.png`` then finds them wherever the folder moves); geometry (feature lines, a view)
-    inline, so it needs no other file."""
+    """The recipe a run's output at ``out`` carries.
+
+    Input paths are relative to the output's folder (``weft run OUT.png`` then finds them wherever
+    the folder moves); geometry (feature lines, a view) is inline, so it needs no other file.
+
+    Parameters
+    ----------
+    method : Method
+        The method run.
+    params : Params
+        Its parameters.
+    input_paths : mapping of str to str
+        Input name -> file.
+    seed : int
+        The seed used.
+    region : (int, int, int) or None
+        The square of the first input the method ran on.
+    out : str or os.PathLike
+        The output file.
+
+    Returns
+    -------
+    Recipe
+    """
     out_dir = Path(out).resolve().parent
     rel_inputs = {name: relative_path(path, out_dir) for name, path in input_paths.items()}
     return Recipe(
@@ -121,15 +174,45 @@ def render(
     shown_paths: Mapping[str, str] | None = None,
     infos: dict | None = None,
 ):
-    """Load the inputs, run ``method`` and return ``(Result, seconds)`` (compute time only).
+    """Load the inputs, run ``method`` and time it.
 
     The first input is cropped to ``region`` when given; an input smaller than its ``min_side`` is
-    refused naming its file; a ``WeftError`` about one input gets its file name in front.
-    ``warm_up`` loads the method's kernels first (when the method asks for that on the command line),
-    so ``seconds`` is the compute alone; a kernel compiled during the run (this thread's numba
-    compiles) is left out of it too. ``shown_paths`` are the names to use in messages when the
-    files read are copies (a batch's shipped inputs). An input whose ``InputSpec.alpha`` is set keeps
-    its alpha channel. ``infos``, when given, receives each input's :class:`~weft.core.image.ImageInfo`.
+    refused naming its file; a ``WeftError`` about one input gets its file name in front. An input
+    whose ``InputSpec.alpha`` is set keeps its alpha channel.
+
+    Parameters
+    ----------
+    method : Method
+        The method.
+    params : Params
+        Its validated parameters.
+    input_paths : mapping of str to str
+        Input name -> image file.
+    seed : int
+        The seed.
+    region : (int, int, int), optional
+        ``(x, y, side)`` of the first input to run on.
+    progress, cancel
+        Progress callback; cancel token.
+    warm_up : bool, default True
+        Load the method's kernels first (when the method asks for that on the command line), so
+        ``seconds`` is the compute alone; a kernel compiled during the run (this thread's numba
+        compiles) is left out of it too.
+    shown_paths : mapping of str to str, optional
+        The names to use in messages when the files read are copies (a batch's shipped inputs).
+    infos : dict, optional
+        Receives each input's :class:`~weft.core.image.ImageInfo`.
+
+    Returns
+    -------
+    result : Result
+    seconds : float
+        The compute time.
+
+    Raises
+    ------
+    WeftError
+        A bad input or a parameter the inputs do not suit; one line naming the file when it is about one.
     """
     from .image import load_image
 

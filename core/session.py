@@ -32,12 +32,30 @@ MAX_SEED = 2**31 - 1  # the studio's seed box
 
 
 def read_session(path: str | Path, *, dropped: list[str] | None = None) -> dict:
-    """Parse and validate a session file (JSON only, at most ``weft.core.params.MAX_FILE_BYTES``); input
-    paths come back absolute, relative ones resolved against the session's folder. ``WeftError`` with
-    one line naming the file if anything is wrong, so a bad file never half-replaces a document.
+    """Parse and validate a session file (JSON only, at most ``weft.core.jsonio.MAX_FILE_BYTES``).
 
-    With a ``dropped`` list, a mask PNG that is missing or unreadable is left out of the geometry
-    instead (the rest opens) and a one-line message naming it is appended to the list."""
+    A bad file never half-replaces a document: anything wrong is one error.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The session file.
+    dropped : list of str, optional
+        With a list, a mask PNG that is missing or unreadable is left out of the geometry instead (the
+        rest opens) and a one-line message naming it is appended to the list.
+
+    Returns
+    -------
+    dict
+        ``method``, ``params`` (per method), ``inputs`` (absolute paths, relative ones resolved
+        against the session's folder), ``geometry`` (typed values per method), ``seed`` and
+        ``opened_for``.
+
+    Raises
+    ------
+    WeftError
+        One line naming the file and what is wrong with it.
+    """
     path = Path(path)
     data = read_json_file(path, "weft session")
     said: list[str] | None = None if dropped is None else []
@@ -133,8 +151,20 @@ class _UnreadableMask(WeftError):
 
 
 def mask_file(session: str | Path, method: str, key: str) -> Path:
-    """Where a session at ``session`` keeps the mask ``key`` of ``method``: a 1-bit PNG beside it
-    (``s.weft.json`` -> ``s.weft.fill.mask.png``)."""
+    """Where a session keeps a painted mask: a 1-bit PNG beside it.
+
+    Parameters
+    ----------
+    session : str or pathlib.Path
+        The session file (``s.weft.json``).
+    method, key : str
+        The method and its mask geometry's key.
+
+    Returns
+    -------
+    pathlib.Path
+        E.g. ``s.weft.fill.mask.png``.
+    """
     session = Path(session)
     stem = session.name[:-5] if session.name.lower().endswith(".json") else session.name
     return session.with_name(f"{stem}.{method}.{key}.png")

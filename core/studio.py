@@ -159,11 +159,26 @@ class Figure:
 
 
 def describe_figures(figures: Mapping[str, Any], known: Mapping[str, Figure], *, crop: bool = False) -> list[str]:
-    """``figures`` (a ``Result.figures``) in words: each scalar by its :class:`Figure` in ``known``,
-    in the order of ``figures``; lists, tables and missing values (``None``) are left to the report.
-    A key no table describes reads as its words (``"some_count"`` -> ``"some count"``). ``crop``: the
-    figures of a render of a crop (a preview around a stroke): only those ``known`` as
-    :attr:`Figure.whole` (the others, and unknown keys, would describe the crop, not the image)."""
+    """A result's figures in words.
+
+    Lists, tables and missing values (``None``) are left to the report. A key no table describes reads
+    as its words (``"some_count"`` -> ``"some count"``).
+
+    Parameters
+    ----------
+    figures : mapping
+        A ``Result.figures``.
+    known : mapping of str to Figure
+        How each figure reads.
+    crop : bool, default False
+        The figures of a render of a crop (a preview around a stroke): only those ``known`` as
+        :attr:`Figure.whole` (the others, and unknown keys, would describe the crop, not the image).
+
+    Returns
+    -------
+    list of str
+        One phrase per scalar, in the order of ``figures``.
+    """
     out = []
     for key, value in figures.items():
         if value is None or isinstance(value, (list, tuple, dict, np.ndarray)):
@@ -298,9 +313,28 @@ class Studio:
 def reduce_for_preview(
     studio: Studio, inputs: Mapping[str, np.ndarray], params, side: int
 ) -> tuple[dict[str, np.ndarray], Any]:
-    """Inputs and parameters of a reduced render: the studio's ``preview_inputs`` that are open
-    scaled so the longer side of the largest is ``side``; else its ``preview_params`` sizes scaled
-    so; unchanged when already that small (or when the method refuses the smaller size)."""
+    """Inputs and parameters of a reduced render.
+
+    The studio's ``preview_inputs`` that are open are scaled so the longer side of the largest is
+    ``side``; else its ``preview_params`` sizes are scaled so; unchanged when already that small (or
+    when the method refuses the smaller size).
+
+    Parameters
+    ----------
+    studio : Studio
+        The method's studio description.
+    inputs : mapping of str to ndarray
+        The full-size inputs.
+    params : Params
+        The full-size parameters.
+    side : int
+        The preview's longer side, pixels.
+
+    Returns
+    -------
+    inputs : dict of str to ndarray
+    params : Params
+    """
     from .image import resize
 
     scaled = [n for n in studio.preview_inputs if n in inputs]
@@ -387,11 +421,26 @@ class Around:
 def around_region(
     stroke: tuple[float, float, float, float], width: int, height: int, *, context: int = 16
 ) -> tuple[int, int, int, int]:
-    """The part ``(x0, y0, x1, y1)`` of a ``width`` x ``height`` painted mask that :func:`crop_around`
-    reads for ``stroke`` (same ``context``): the stroke's box grown by ``context``, grown again by
-    ``context`` and a quarter of that box's longer side (the crop never reaches farther), clipped to
-    the mask. Cut that part and pass it as ``crop_around(..., mask_part=)``: a preview around a
-    stroke then never needs the whole mask."""
+    """The part of a painted mask that :func:`crop_around` reads for a stroke.
+
+    The stroke's box grown by ``context``, grown again by ``context`` and a quarter of that box's
+    longer side (the crop never reaches farther), clipped to the mask. Cut that part and pass it as
+    ``crop_around(..., mask_part=)``: a preview around a stroke then never needs the whole mask.
+
+    Parameters
+    ----------
+    stroke : (float, float, float, float)
+        The stroke's ``(x0, y0, x1, y1)``.
+    width, height : int
+        The mask's size.
+    context : int, default 16
+        As in :func:`crop_around`.
+
+    Returns
+    -------
+    (int, int, int, int)
+        ``(x0, y0, x1, y1)``, exclusive ends.
+    """
     wx0, wy0, wx1, wy1 = _stroke_window(stroke, context)
     grow = context + max(wx1 - wx0, wy1 - wy0) // 4 + 1
     return max(0, wx0 - grow), max(0, wy0 - grow), min(width, wx1 + grow), min(height, wy1 + grow)
@@ -419,24 +468,47 @@ def crop_around(
     context: int = 16,
     mask_part: tuple[np.ndarray, tuple[int, int]] | None = None,
 ) -> Around | None:
-    """What to render while a stroke paints the mask input ``studio.preview_around``: the inputs
-    cropped around the painted region near the stroke, so the preview costs a fraction of a full
-    render.
+    """What to render while a stroke paints the mask input ``studio.preview_around``.
 
-    ``stroke`` is the stroke's ``(x0, y0, x1, y1)`` in the painted image's pixels (brush radius
-    included). The crop is the bounding box of the mask's pixels within the stroke's box grown by
-    ``context`` px, grown again by ``context`` px and by a quarter of its side (known pixels around
+    The inputs are cropped around the painted region near the stroke, so the preview costs a fraction
+    of a full render. The crop is the bounding box of the mask's pixels within the stroke's box grown
+    by ``context`` px, grown again by ``context`` px and by a quarter of its side (known pixels around
     the hole to copy from), clipped to the image. Only what belongs to the painted image is cropped
-    alike: the image, the masks painted on it, and the masks ``studio.masks_of`` gives to it (a
-    source mask opened as a file, unless its texture is open); every other input (a second texture
-    to copy from, even of the image's size) is kept whole. A crop longer than
-    ``side`` is scaled down to it (``area``, a mask thresholded back to 0/1). Parameters filled by a
-    margins geometry on that image are reset to their defaults (the crop is not uncropped) and their
-    left/top margins give :attr:`Around.offset`. None when the studio previews no mask that way,
-    the mask is not open, or there is nothing painted near the stroke (nothing to fill).
+    alike: the image, the masks painted on it, and the masks ``studio.masks_of`` gives to it (a source
+    mask opened as a file, unless its texture is open); every other input (a second texture to copy
+    from, even of the image's size) is kept whole. A crop longer than ``side`` is scaled down to it
+    (``area``, a mask thresholded back to 0/1). Parameters filled by a margins geometry on that image
+    are reset to their defaults (the crop is not uncropped) and their left/top margins give
+    :attr:`Around.offset`.
 
-    ``mask_part`` = ``(bits, (x, y))``: the painted mask is not in ``inputs``; ``bits`` (bool or
-    float) is its part at ``(x, y)``, covering at least :func:`around_region` of the stroke.
+    Parameters
+    ----------
+    studio : Studio
+        The method's studio description.
+    inputs : mapping of str to ndarray
+        The full-size inputs.
+    params : Params
+        The full-size parameters.
+    stroke : (float, float, float, float)
+        The stroke's ``(x0, y0, x1, y1)`` in the painted image's pixels (brush radius included).
+    side : int, default AROUND_SIDE
+        The crop's longest side.
+    context : int, default 16
+        Pixels of context around the stroke.
+    mask_part : (ndarray, (int, int)), optional
+        ``(bits, (x, y))``: the painted mask is not in ``inputs``; ``bits`` (bool or float) is its
+        part at ``(x, y)``, covering at least :func:`around_region` of the stroke.
+
+    Returns
+    -------
+    Around or None
+        None when the studio previews no mask that way, the mask is not open, or there is nothing
+        painted near the stroke (nothing to fill).
+
+    Raises
+    ------
+    ValueError
+        ``mask_part`` does not cover the stroke's region.
     """
     from .geometry import Margins
     from .image import resize

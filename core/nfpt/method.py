@@ -228,6 +228,24 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], 
     Every patch but the first costs three DFTs of the padded source luminance (eqs. 1-3 for all
     positions at once: two spectra of the weighted template and the inverse) and a choice over every
     source position (fitted by ``python -m benchmarks.estimates``).
+
+    Parameters
+    ----------
+    texture_shape : tuple of int
+        The source texture's shape (H, W[, C]).
+    out_size : (int, int)
+        The output's width and height.
+    block, overlap : int
+        The patch side and the overlap.
+
+    Returns
+    -------
+    float
+        Seconds.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §2.
     """
     from ..grid import block_grid
     from ..limits import dft_seconds

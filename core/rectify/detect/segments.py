@@ -15,8 +15,21 @@ LSD_SCALE = 0.8  # LSD's own Gaussian reduction of the work image (its default)
 
 
 def work_grey(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, float]:
-    """The photo as 8-bit grey, reduced so its longer side is at most ``side`` (default
-    :data:`WORK_SIDE`); the factor."""
+    """The photo as 8-bit grey, reduced for the detection.
+
+    Parameters
+    ----------
+    photo : ndarray, float32 (H, W) or (H, W, 3)
+        The photo.
+    side : int, optional
+        The longest side of the result (default :data:`WORK_SIDE`).
+
+    Returns
+    -------
+    grey : ndarray, uint8 (h, w)
+    scale : float
+        The reduction factor, at most 1 (work pixels per photo pixel).
+    """
     grey = photo if photo.ndim == 2 else cv2.cvtColor(photo, cv2.COLOR_RGB2GRAY)
     h, w = grey.shape
     k = min(1.0, (side or WORK_SIDE) / max(h, w))
@@ -26,7 +39,22 @@ def work_grey(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, f
 
 
 def line_segments(grey: np.ndarray) -> np.ndarray:
-    """(N, 4) segments found by LSD, at least 1/90 of the longer side long."""
+    """Straight segments found by LSD, at least 1/90 of the longer side long.
+
+    Parameters
+    ----------
+    grey : ndarray, uint8 (h, w)
+        The work image (:func:`work_grey`).
+
+    Returns
+    -------
+    ndarray, (N, 4)
+        Segments ``x1, y1, x2, y2`` in work pixels.
+
+    References
+    ----------
+    Grompone von Gioi et al., "LSD: a line segment detector" (2012).
+    """
     lsd = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD, LSD_SCALE)
     found = lsd.detect(grey)[0]
     if found is None:
@@ -37,8 +65,27 @@ def line_segments(grey: np.ndarray) -> np.ndarray:
 
 
 def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Segments joining SIFT features to their repeats elsewhere in the photo (similar descriptor,
-    scale and orientation), at least three feature sizes apart."""
+    """Segments joining SIFT features to their repeats elsewhere in the photo.
+
+    Repeats have a similar descriptor, scale and orientation, and lie at least three feature sizes
+    apart.
+
+    Parameters
+    ----------
+    grey : ndarray, uint8 (h, w)
+        The work image.
+    rng : numpy.random.Generator
+        Unused by the matching; kept for a common signature with the other sources.
+
+    Returns
+    -------
+    ndarray, (N, 4)
+        Segments in work pixels (none when the photo has too few features).
+
+    References
+    ----------
+    Bharadwaj, Collins & Liu (2024): vanishing points from a lattice's repeats.
+    """
     sift = cv2.SIFT_create(nfeatures=1000)  # type: ignore[attr-defined]  # the cv2 stubs lack SIFT_create
     kps, desc = sift.detectAndCompute(grey, None)
     if desc is None or len(kps) < 20:
@@ -70,6 +117,18 @@ def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def homogeneous(seg: np.ndarray) -> np.ndarray:
+    """Segments as unit homogeneous lines.
+
+    Parameters
+    ----------
+    seg : ndarray, (N, 4)
+        Segments ``x1, y1, x2, y2``.
+
+    Returns
+    -------
+    ndarray, (N, 3)
+        ``(a, b, c)`` with ``a x + b y + c = 0`` and ``a² + b² = 1``.
+    """
     p = np.column_stack([seg[:, :2], np.ones(len(seg))])
     q = np.column_stack([seg[:, 2:], np.ones(len(seg))])
     ln = np.cross(p, q)
@@ -77,12 +136,30 @@ def homogeneous(seg: np.ndarray) -> np.ndarray:
 
 
 def chains(seg: np.ndarray, px: float, tol: float = 1.2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The segments joined into whole lines: two segments are links of one line when each one's end
-    points lie within ``tol`` work pixels of the other's line and the gap between them is at most
-    twice the longer one (links chain along a line: a joint broken at every brick, a checkerboard's
-    edge); each line is fitted to its segments' end points. Returns (K, 3) lines, their lengths and
-    their centres. A long line's direction is known far better than its pieces' (short segments
-    cut at corners lean towards the corners)."""
+    """The segments joined into whole lines.
+
+    Two segments are links of one line when each one's end points lie within ``tol`` work pixels of the
+    other's line and the gap between them is at most twice the longer one (links chain along a line: a
+    joint broken at every brick, a checkerboard's edge); each line is fitted to its segments' end
+    points. A long line's direction is known far better than its pieces' (short segments cut at
+    corners lean towards the corners).
+
+    Parameters
+    ----------
+    seg : ndarray, (N, 4)
+        Segments.
+    px : float
+        The length of a work pixel in the segments' units.
+    tol : float, default 1.2
+        Work pixels.
+
+    Returns
+    -------
+    lines : ndarray, (K, 3)
+        Homogeneous lines.
+    lengths : ndarray, (K,)
+    centres : ndarray, (K, 2)
+    """
     n = len(seg)
     lines = homogeneous(seg)
     p, q = seg[:, :2], seg[:, 2:]

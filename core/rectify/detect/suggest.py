@@ -336,6 +336,27 @@ def suggestion_from_families(
 
 
 def suggest_for_studio(photo: np.ndarray) -> tuple[FeatureLines, str]:
-    """:func:`suggest_lines` as a studio geometry's ``suggest``: the lines and their description."""
+    """:func:`suggest_lines` as a studio geometry's ``suggest``.
+
+    Parameters
+    ----------
+    photo : ndarray, float32 (H, W) or (H, W, 3)
+        The photo.
+
+    Returns
+    -------
+    lines : FeatureLines
+    description : str
+        What the suggestion rests on, for the status line.
+
+    Raises
+    ------
+    GeometryError
+        :data:`REFUSAL`: no two families of lines to rectify by.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §3.
+    """
     s = suggest_lines(photo)
     return s.lines, s.describe()
