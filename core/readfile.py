@@ -222,5 +222,15 @@ def file_key(path: str | os.PathLike) -> tuple:
 
 
 def same_file(a: str | os.PathLike, b: str | os.PathLike) -> bool:
-    """Whether ``a`` and ``b`` name one file (or one file to be), by :func:`file_key`."""
+    """Whether ``a`` and ``b`` name one file (or one file to be), by :func:`file_key`.
+
+    Parameters
+    ----------
+    a, b : str or os.PathLike
+        Paths.
+
+    Returns
+    -------
+    bool
+    """
     return file_key(a) == file_key(b)

@@ -116,8 +116,20 @@ GAP_SIGMA = 1.5
 
 
 def is_colour(img: np.ndarray, known: np.ndarray) -> bool:
-    """Whether (H, W, C) ``img`` is a colour picture on its ``known`` pixels: three channels or more,
-    not all grey (a grey picture stored as RGB has no chroma). Steps 1, 4 and 7 run on colour only."""
+    """Whether ``img`` is a colour picture on its ``known`` pixels.
+
+    Three channels or more, not all grey (a grey picture stored as RGB has no chroma). Steps 1, 4 and
+    7 run on colour only.
+
+    Parameters
+    ----------
+    img : ndarray, (H, W, C)
+    known : ndarray, bool (H, W)
+
+    Returns
+    -------
+    bool
+    """
     if img.shape[2] < 3 or not known.any():
         return False
     rgb, sub, ksub = img[..., :3], img[::7, ::7, :3], known[::7, ::7]
@@ -127,9 +139,23 @@ def is_colour(img: np.ndarray, known: np.ndarray) -> bool:
 
 
 def refines(image, hole, refine: bool | None = None) -> bool:
-    """Whether :func:`fill_quilt` ends with its patch-search refine (step 7) on this image: ``refine``
-    when given, else on colour pictures when :data:`REFINE` > 0. The method then runs no Poisson
-    blend band (the refine re-synthesises the band)."""
+    """Whether :func:`fill_quilt` ends with its patch-search refine (step 7) on this image.
+
+    The method then runs no Poisson blend band (the refine re-synthesises the band).
+
+    Parameters
+    ----------
+    image : ndarray
+        The picture.
+    hole : ndarray, bool (H, W)
+        The hole.
+    refine : bool, optional
+        The caller's choice; default: on colour pictures when :data:`REFINE` > 0.
+
+    Returns
+    -------
+    bool
+    """
     if refine is not None:
         return bool(refine) and REFINE > 0
     img = np.asarray(image)

@@ -77,14 +77,27 @@ _MAX_EDGES = 4  # at most this many edges are continued (the best pairs), a guid
 def structure_guide(
     image: np.ndarray, hole: np.ndarray, known: np.ndarray | None = None, *, reach: int = REACH
 ) -> tuple[np.ndarray | None, int]:
-    """The guide of the module text for filling ``hole`` in ``image``, and the number of edges it
-    continues across the hole: ``(float32 (H, W, n) in [-1, 1], n)``, a channel per edge (at most
-    ``_MAX_EDGES``, the best pairs), or ``(None, 0)`` when no two edges entering the hole pair up
-    (nothing to continue).
+    """The guide of the module text for filling ``hole`` in ``image``, and the number of edges it continues.
 
-    ``image``: float (H, W) or (H, W, 3) in [0, 1] (an alpha channel is not passed; values in the
-    hole are ignored). ``hole``: bool (H, W). ``known``: the pixels whose edges count (default: all
-    outside the hole; a transparent region outside the hole is not known)."""
+    Parameters
+    ----------
+    image : ndarray, float (H, W) or (H, W, 3) in [0, 1]
+        The picture (an alpha channel is not passed; values in the hole are ignored).
+    hole : ndarray, bool (H, W)
+        The hole.
+    known : ndarray, bool (H, W), optional
+        The pixels whose edges count (default: all outside the hole; a transparent region outside the
+        hole is not known).
+    reach : int, default REACH
+        The guide's reach from the continued structure, pixels (beyond it the guide is 0).
+
+    Returns
+    -------
+    guide : ndarray, float32 (H, W, n) in [-1, 1], or None
+        A channel per edge (at most ``_MAX_EDGES``, the best pairs); None when no two edges entering
+        the hole pair up (nothing to continue).
+    n : int
+    """
     hole = np.asarray(hole, dtype=bool)
     known = ~hole if known is None else (np.asarray(known, dtype=bool) & ~hole)
     if not hole.any() or not known.any():

@@ -146,8 +146,23 @@ class Families:
 
 
 def hypotheses(lines: np.ndarray, length: np.ndarray, pool: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Candidate vanishing points (unit 3-vectors): intersections of random pairs of segments of
-    ``pool``, longer segments drawn more often."""
+    """Candidate vanishing points: intersections of random pairs of segments, longer segments drawn more often.
+
+    Parameters
+    ----------
+    lines : ndarray, (N, 3)
+        The segments' homogeneous lines.
+    length : ndarray, (N,)
+        Their lengths.
+    pool : ndarray, int
+        The segments to draw from.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    ndarray, (K, 3)
+        Unit 3-vectors.
+    """
     p = length[pool] / length[pool].sum()
     a = rng.choice(pool, _CANDIDATES, p=p)
     b = rng.choice(pool, _CANDIDATES, p=p)
