@@ -23,7 +23,7 @@
   on (painted masks as images, the preview's reduction, the stroke's crop) on its worker: the GUI
   thread only takes references (``Document.deferred_inputs``). A preview around a stroke gets only
   the part of the stroke's mask its crop can reach (``weft.core.studio.around_region``, cut from the
-  tool's ``MaskStroke`` on the GUI thread: a few hundred pixels, never the 4096² mask), its result
+  tool's ``MaskStroke`` on the GUI thread: a few hundred pixels, never the whole mask), its result
   comes back already scaled to the crop's box, and the stroke's first one also brings the copy of
   the full result its crops are pasted into (too large to copy on the GUI thread); later ones are
   pasted into that copy in place, and the result view redraws only the part.

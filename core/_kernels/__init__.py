@@ -6,8 +6,8 @@ reports compilations; it is the only place that knows about numba's caching mach
 * **A cache folder that always works.** numba looks for a writable cache folder in turn: the
   folder ``NUMBA_CACHE_DIR`` names, the package's own ``__pycache__``, then the user's cache folder
   (``~/.cache/numba``); when none is writable — a shared read-only install used with
-  ``HOME=/nonexistent``, as on some render nodes — decorating a kernel raised ``RuntimeError: cannot
-  cache function ...: no locator available`` and every numba method died. We add a last folder to
+  ``HOME=/nonexistent``, as on some render nodes — decorating a kernel raises ``RuntimeError: cannot
+  cache function ...: no locator available`` and every numba method fails. We add a last folder to
   that list: ``weft-numba-<uid>`` in the system's temporary folder, private to the user (created
   0700; one owned by someone else, or open to others, is refused: numba's cache files are pickles,
   loading a planted one would run its code). The user-wide and the temporary folder are seeded
@@ -19,7 +19,7 @@ reports compilations; it is the only place that knows about numba's caching mach
   and a numbered data file, without a lock; weft takes a file lock around each save (POSIX), so
   processes compiling at once (``weft warm-up``'s workers) cannot cross their files.
 * **Damaged cache files are repaired.** An index or data file that cannot be read back (cut short
-  by a power cut) made every run of its method fail with ``EOFError: Ran out of input``, and
+  by a power cut) would make every run of its method fail with ``EOFError: Ran out of input``, and
   ``weft warm-up`` too; such files are removed, the kernel is compiled again and saved, and
   :func:`weft.core.registry.kernel_cache_repairs` says so in one line.
 * **Compile events.** numba announces every real compilation (a cache miss, never a cache load) as

@@ -127,8 +127,7 @@ def render(
 
     Each patch k is the prototype sampled through ``T_k⁻¹`` and moved by its translation,
     multiplied by its intensity factor and the cos² window, and summed into the canvas, which is
-    cropped to the image (§3). Cheap enough for a live preview (a 256² texture with B = 32 renders
-    in a few milliseconds): only warping, windowing and summing.
+    cropped to the image (§3). Cheap enough for a live preview: only warping, windowing and summing.
 
     Parameters
     ----------

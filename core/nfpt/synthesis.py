@@ -168,8 +168,8 @@ class _Search:
         self.spec2 = cv2.dft(self._padded(yc * yc))
         self.w_buf = np.zeros((self.n_h, self.n_w), np.float32)
         self.tw_buf = np.zeros((self.n_h, self.n_w), np.float32)
-        # per-patch spectra and the cost map go into these: fresh arrays every patch made glibc trim
-        # and re-fault the heap (a third of the time in the kernel for a 512² source)
+        # per-patch spectra and the cost map go into these: fresh arrays every patch make glibc trim
+        # and re-fault the heap
         self._fwd, self._spec, self._cross, self._cmap = (np.empty((self.n_h, self.n_w), np.float32) for _ in range(4))
 
     def _padded(self, img: np.ndarray) -> np.ndarray:
