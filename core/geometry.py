@@ -24,7 +24,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Protocol, Self
 
 import numpy as np
 
@@ -35,6 +35,7 @@ from .readfile import read_regular, shown
 MAX_SIDE = 16384
 
 __all__ = [
+    "GeometryValue",
     "Square",
     "FeatureLines",
     "LineDraft",
@@ -55,6 +56,31 @@ __all__ = [
 #: and margins (the canvas's edges dragged outward: an uncrop).
 SQUARE, LINES, MASK, MARGINS = "square", "lines", "mask", "margins"
 KINDS = (SQUARE, LINES, MASK, MARGINS)
+
+
+class GeometryValue(Protocol):
+    """What the class of a geometry parameter provides (:class:`Square`, :class:`FeatureLines`,
+    :class:`Margins`, :class:`weft.core.rectify.View`): the ``type`` of a ``Params`` geometry field.
+
+    ``parse`` reads the command line's text, ``from_json`` a recipe's or session's JSON (a file it
+    names is found relative to ``base``, the recipe's folder), ``coerce`` a Python caller's value
+    (an instance passes through); ``to_json`` writes the JSON form that ``from_json`` reads back.
+    Each reader raises ``InvalidParameter`` or ``GeometryError`` naming ``name`` and the value.
+    ``METAVAR`` is the command line's placeholder for the value (``X,Y,S``).
+    """
+
+    METAVAR: str
+
+    @classmethod
+    def parse(cls, text: Any, name: str = ...) -> Self: ...
+
+    @classmethod
+    def coerce(cls, value: Any, name: str = ...) -> Self: ...
+
+    @classmethod
+    def from_json(cls, data: Any, name: str = ..., base: str | os.PathLike | None = None) -> Self: ...
+
+    def to_json(self) -> Any: ...
 
 
 class _SquareFields(NamedTuple):

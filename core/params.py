@@ -40,7 +40,7 @@ from typing import Any, Self
 import numpy as np
 
 from .errors import InvalidParameter, WeftError
-from .geometry import MAX_SIDE, Square, whole_number
+from .geometry import MAX_SIDE, GeometryValue, Square, whole_number
 from .jsonio import MAX_FILE_BYTES, parse_json, read_json_file  # noqa: F401 (re-exported)
 
 KINDS = ("int", "float", "bool", "choice", "size", "str", "geometry")
@@ -79,7 +79,7 @@ class Spec:
     symbol: str = ""
     help: str = ""
     step: float | None = None
-    type: Any = None
+    type: type[GeometryValue] | None = None
 
     @property
     def option(self) -> str:
@@ -138,7 +138,7 @@ class Spec:
                 raise InvalidParameter(
                     f"parameter '{name}' = {value[0]}x{value[1]} has a side outside {lo}..{hi}", name=name, value=value
                 )
-        elif self.kind == "geometry":
+        elif self.kind == "geometry" and self.type is not None:  # (param() gives every geometry its type)
             value = self.type.coerce(value, name)
         elif self.kind == "str":
             if not isinstance(value, str):
@@ -178,7 +178,7 @@ class Spec:
             value = low in ("1", "true", "yes", "on")
         elif self.kind == "size":
             value = parse_size(text, self.name)
-        elif self.kind == "geometry":
+        elif self.kind == "geometry" and self.type is not None:
             value = self.type.parse(text, self.name)
         else:
             value = text
@@ -269,7 +269,7 @@ def param(
     symbol: str = "",
     help: str = "",
     step: float | None = None,
-    type: Any = None,
+    type: type[GeometryValue] | None = None,
 ) -> Any:
     """Declare a parameter field of a :class:`Params` dataclass.
 
@@ -386,7 +386,7 @@ class Params:
         values = dict(data)
         for name, value in values.items():
             spec = by_name[name]
-            if spec.kind == "geometry" and value is not None and not isinstance(value, spec.type):
+            if spec.type is not None and value is not None and not isinstance(value, spec.type):
                 values[name] = spec.type.from_json(value, name, base)
         return cls(**values)
 
