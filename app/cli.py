@@ -271,8 +271,7 @@ def _execute(
     try:
         with registry.watch_compiles(on_start=preparing):  # a kernel compiling: say so on the terminal
             # Loading every kernel up front only keeps --report's "seconds" free of cache loads; without
-            # --report a run loads (or, first time, compiles) just the kernels it uses: a cold
-            # `weft affine` 3.8 -> 3.0 s, `weft nfpt` 4.7 -> 3.9 s.
+            # --report a run loads (or, first time, compiles) just the kernels it uses.
             request = RenderRequest(
                 method,
                 params,
@@ -389,12 +388,10 @@ def _dispatch(args: argparse.Namespace) -> int:
 def _reuse_freed_memory() -> None:
     """glibc's allocator told to keep freed memory for the next allocation: blocks under 32 MiB come
     from the heap (``M_MMAP_THRESHOLD``), and the heap is given back only past 256 MiB free
-    (``M_TRIM_THRESHOLD``). A ``weft fill`` of a 320 px photo allocates and frees thousands of 0.1-2
-    MB numpy temporaries; by default each got fresh pages from the kernel, 50-90 ms of page faults
-    and trims (whole process 0.42-0.45 s -> 0.35-0.37 s, G'MIC's 0.36; a 40 px hole in a 4096x4096
-    photo 748 -> 790 MiB peak). Growing the heap 256 MiB at a time (``M_TOP_PAD``) was as quick but
-    886 MiB there; the trim threshold alone disables glibc's sliding mmap threshold and doubled the
-    time. Other C libraries: nothing is done."""
+    (``M_TRIM_THRESHOLD``). A ``weft fill`` allocates and frees thousands of small numpy
+    temporaries; by default each gets fresh pages from the kernel, paying page faults and trims.
+    (Setting the trim threshold alone would disable glibc's sliding mmap threshold.) Other C
+    libraries: nothing is done."""
     if not sys.platform.startswith("linux"):
         return
     try:

@@ -46,8 +46,8 @@ class TerminalProgress:
 
 
 class PreparingLine:
-    """Says on stderr that kernels are being compiled — the first run's long silent stretch (a cold
-    quilting transfer compiled for 39 s before its first progress report) — and keeps the line alive
+    """Says on stderr that kernels are being compiled — the first run's long silent stretch before
+    its first progress report — and keeps the line alive
     with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes
     over or the run ends.
 

@@ -31,8 +31,8 @@ def warm_up_all(args: argparse.Namespace) -> int:
         f"{min(jobs, len(names))} process{'es' if min(jobs, len(names)) != 1 else ''} at once"
     )
     # "spawn": fresh interpreters (no inherited numba state or threads). Each worker warms several
-    # methods in turn (quilting, the longest, first): a process per method paid Python's, numba's
-    # and LLVM's start-up six times, 19.7 s of CPU against 12.2 s in one process on this machine.
+    # methods in turn (quilting, the longest, first): a process per method would pay Python's,
+    # numba's and LLVM's start-up once per method.
     with ProcessPoolExecutor(
         max_workers=min(jobs, len(names)), mp_context=multiprocessing.get_context("spawn")
     ) as pool:

@@ -175,7 +175,23 @@ def poisson_blend(
 
 
 def max_levels(height: int, width: int) -> int:
-    """Most pyramid levels an image of this size allows (the coarsest level at least 1 pixel)."""
+    """Most pyramid levels an image of this size allows (the coarsest level at least 1 pixel).
+
+    Parameters
+    ----------
+    height, width : int
+        The image's size in pixels.
+
+    Returns
+    -------
+    int
+        ``floor(log2(min(height, width))) + 1`` (1 for an image of one pixel).
+
+    References
+    ----------
+    Burt & Adelson, "A multiresolution spline with application to image mosaics" (1983), as used in
+    Ngo's quilting write-up ("Bells and Whistles": Laplacian blending).
+    """
     return int(np.floor(np.log2(max(1, min(height, width))))) + 1
 
 
@@ -222,13 +238,14 @@ def pyramid_blend(foreground: np.ndarray, background: np.ndarray, mask: np.ndarr
         )
     fg = fg.astype(np.float32)
     bg = bg.astype(np.float32)
-    gm = [m.astype(np.float32)]
-    gf, gb = [fg], [bg]
+    gm: list[np.ndarray] = [m.astype(np.float32)]
+    gf: list[np.ndarray] = [fg]
+    gb: list[np.ndarray] = [bg]
     for _ in range(levels - 1):
         gf.append(cv2.pyrDown(gf[-1]))
         gb.append(cv2.pyrDown(gb[-1]))
         gm.append(cv2.pyrDown(gm[-1]))
-    out = None
+    out: np.ndarray | None = None
     for lev in range(levels - 1, -1, -1):
         mk = gm[lev] if fg.ndim == 2 else gm[lev][..., None]
         if lev == levels - 1:
@@ -242,6 +259,7 @@ def pyramid_blend(foreground: np.ndarray, background: np.ndarray, mask: np.ndarr
             out = mixed
         else:
             out = mixed + cv2.pyrUp(out, dstsize=(mixed.shape[1], mixed.shape[0]))
+    assert out is not None  # levels >= 1, so the loop ran
     return np.clip(out, 0.0, 1.0).astype(np.float32)
 
 

@@ -18,7 +18,23 @@ def examples() -> list[Path]:
 
 
 def example(name: str) -> Path:
-    """The bundled example called ``name`` (with or without extension)."""
+    """The bundled example called ``name`` (with or without extension).
+
+    Parameters
+    ----------
+    name : str
+        The file name or its stem, e.g. ``"brick"`` or ``"brick.png"``.
+
+    Returns
+    -------
+    pathlib.Path
+        The example's file under ``resources/``.
+
+    Raises
+    ------
+    WeftError
+        No example has that name; the message lists the known ones.
+    """
     for p in examples():
         if p.name == name or p.stem == name:
             return p

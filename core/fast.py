@@ -9,14 +9,13 @@ uniformly random source position is added, with probability ``p_l`` the location
 Choices where the paper is silent (all documented here and in :func:`transfer`):
 
 * Candidates whose n x n source neighbourhood would leave the source are **clamped** into the valid
-  region (measured: on camera in gravel, clamping gave fidelity 0.930 / coherence 0.398 against
-  0.917 / 0.409 for dropping them: a clamped candidate is one more nearby choice). Candidates outside
+  region (a clamped candidate is one more nearby choice, where dropping it leaves fewer). Candidates outside
   a user's source mask are dropped. A pixel left with no candidate (the first pixel, or all dropped)
   gets a random one. The location-specific candidate is clamped likewise.
 * ``remap`` (default on, not in the paper, which found equalisation unnecessary): matching uses the
   source luminance linearly mapped to the target's mean and standard deviation, as in Hertzmann et
-  al.'s image analogies; the output still copies the source's own pixels. Measured on camera in
-  gravel at p = 0.05: fidelity 0.941 with it, 0.930 without.
+  al.'s image analogies (a target brighter or darker than the source is still followed); the output
+  still copies the source's own pixels.
 * The target part of eq. 1 is the complementary half of the square, centre included (Fig. 1b: "the
   bottom half from the target image"); the ``target`` metric uses only that part.
 * ``n`` in the artistic metric is the number of L-shape pixels actually compared (fewer at borders).
@@ -76,7 +75,7 @@ class FastParams(Params):
         help="side of the neighbourhood compared (odd): small copies fine "
         "grain, large carries larger structures of the texture",
     )
-    p: float = param(
+    p: float | None = param(
         None,
         kind="float",
         lo=0.0,
@@ -87,7 +86,7 @@ class FastParams(Params):
         help="chance of a random candidate: 0 gives long coherent pieces of the texture, higher values"
         " follow the picture in smaller pieces; default 0.05 (super-resolution 0)",
     )
-    p_l: float = param(
+    p_l: float | None = param(
         None,
         kind="float",
         lo=0.0,
@@ -138,7 +137,7 @@ class FastParams(Params):
         help="colour of the result: target keeps the picture's colours (YIQ chroma); source copies "
         "the texture's colours",
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=8,
@@ -179,14 +178,17 @@ class FastParams(Params):
 def _offsets(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(causal L, square without centre, complementary half with centre) offsets as (k, 2) int32."""
     h = n // 2
-    causal, square, rest = [], [], []
+    causal: list[tuple[int, int]] = []
+    square: list[tuple[int, int]] = []
+    rest: list[tuple[int, int]] = []
     for dy in range(-h, h + 1):
         for dx in range(-h, h + 1):
             is_causal = dy < 0 or (dy == 0 and dx < 0)
             (causal if is_causal else rest).append((dy, dx))
             if (dy, dx) != (0, 0):
                 square.append((dy, dx))
-    return tuple(np.array(o, dtype=np.int32).reshape(-1, 2) for o in (causal, square, rest))
+    c, s, r = (np.array(o, dtype=np.int32).reshape(-1, 2) for o in (causal, square, rest))
+    return c, s, r
 
 
 def _valid_region(source_shape: tuple[int, int], n: int, mask: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
@@ -334,6 +336,7 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
     else:
         tgt_pad = np.zeros((1, 1), np.float32)
     if params.metric == "artistic":
+        assert tgt_y is not None  # FastParams refuses the artistic metric without a target
         ksize = (params.n, params.n)
         src_mean = cv2.blur(match_y, ksize, borderType=cv2.BORDER_REFLECT)
         tgt_mean = cv2.blur(tgt_y, ksize, borderType=cv2.BORDER_REFLECT)
@@ -383,8 +386,8 @@ def _transfer(texture, target, params: FastParams, *, mask=None, rng=None, progr
 
 
 #: Peak memory per output pixel besides the inputs (result, positions, padded target, luminance and
-#: colour copies, previews; measured with /usr/bin/time -v on `weft fast` transfers: 392 MB peak RSS
-#: for a 2048x2048 target, 972 MB for 4096x4096, i.e. 46 B per pixel over ~200 MB of libraries).
+#: colour copies, previews), fitted to the peak memory of ``weft fast`` transfers without the
+#: libraries' share.
 BYTES_PER_OUTPUT_PIXEL = 50
 
 
@@ -405,8 +408,8 @@ def _output_size(
 def _check_limits(texture: np.ndarray, target: np.ndarray | None, params: FastParams) -> None:
     """Refuse up front an output over the pixel limit or beyond the memory available.
 
-    No running-time limit: the method is linear in the output, ~0.2 µs per pixel and iteration, so
-    the pixel limit (50 Mpx) bounds a job to well under the ten minutes of :mod:`weft.core.limits`.
+    No running-time limit: the method is linear in the output, so the pixel limit bounds a job to
+    well under the ten minutes of :mod:`weft.core.limits`.
     """
     from .limits import check_memory, check_output_size
 
@@ -416,7 +419,20 @@ def _check_limits(texture: np.ndarray, target: np.ndarray | None, params: FastPa
 
 
 def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: FastParams) -> float:
-    """Estimated peak bytes of one run on inputs of these shapes (what :func:`_check_limits` checks)."""
+    """Estimated peak bytes of one run on inputs of these shapes (what :func:`_check_limits` checks).
+
+    Parameters
+    ----------
+    shapes : mapping of str to tuple of int
+        Input name -> array shape.
+    params : FastParams
+        The run's parameters.
+
+    Returns
+    -------
+    float
+        Bytes.
+    """
     target = shapes.get("target")
     width, height, _ = _output_size(shapes["texture"], target, params.resolved(target is not None))
     return BYTES_PER_OUTPUT_PIXEL * width * height

@@ -24,7 +24,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, Protocol, Self
 
 import numpy as np
 
@@ -35,6 +35,7 @@ from .readfile import read_regular, shown
 MAX_SIDE = 16384
 
 __all__ = [
+    "GeometryValue",
     "Square",
     "FeatureLines",
     "LineDraft",
@@ -57,16 +58,46 @@ SQUARE, LINES, MASK, MARGINS = "square", "lines", "mask", "margins"
 KINDS = (SQUARE, LINES, MASK, MARGINS)
 
 
-class Square(NamedTuple):
+class GeometryValue(Protocol):
+    """What the class of a geometry parameter provides (:class:`Square`, :class:`FeatureLines`,
+    :class:`Margins`, :class:`weft.core.rectify.View`): the ``type`` of a ``Params`` geometry field.
+
+    ``parse`` reads the command line's text, ``from_json`` a recipe's or session's JSON (a file it
+    names is found relative to ``base``, the recipe's folder), ``coerce`` a Python caller's value
+    (an instance passes through); ``to_json`` writes the JSON form that ``from_json`` reads back.
+    Each reader raises ``InvalidParameter`` or ``GeometryError`` naming ``name`` and the value.
+    ``METAVAR`` is the command line's placeholder for the value (``X,Y,S``).
+    """
+
+    METAVAR: str
+
+    @classmethod
+    def parse(cls, text: Any, name: str = ...) -> Self: ...
+
+    @classmethod
+    def coerce(cls, value: Any, name: str = ...) -> Self: ...
+
+    @classmethod
+    def from_json(cls, data: Any, name: str = ..., base: str | os.PathLike | None = None) -> Self: ...
+
+    def to_json(self) -> Any: ...
+
+
+class _SquareFields(NamedTuple):
+    x: int
+    y: int
+    side: int
+
+
+class Square(_SquareFields):
     """A square of an image: top-left corner ``(x, y)`` and ``side``, in pixels.
 
     It is a tuple, so ``x, y, s = square`` works; ``Square.parse("32,16,64")`` is the one parser of
     the text form ``X,Y,S`` (``--region``, ``--prototype``), ``from_json([x, y, s])`` of the JSON form.
+    (The fields live on a base class so that the constants below are class attributes, not fields.)
     """
 
-    x: int
-    y: int
-    side: int
+    __slots__ = ()
 
     MIN_SIDE = 2
     METAVAR = "X,Y,S"
@@ -174,7 +205,24 @@ def _short(value: Any) -> str:
 
 
 def as_lines(value: Any, key: str) -> np.ndarray:
-    """``value`` as a float64 (N, 4) array, or a GeometryError naming the first bad entry."""
+    """Feature lines as a float64 (N, 4) array.
+
+    Parameters
+    ----------
+    value : object
+        A sequence of ``[x1, y1, x2, y2]`` of finite numbers.
+    key : str
+        The JSON key, for the message.
+
+    Returns
+    -------
+    ndarray, float64 (N, 4)
+
+    Raises
+    ------
+    GeometryError
+        Naming the first bad entry.
+    """
     if isinstance(value, np.ndarray):
         arr = value
         if arr.ndim != 2 or arr.shape[1] != 4 or not np.issubdtype(arr.dtype, np.number):
@@ -198,15 +246,48 @@ _WHOLE = re.compile(r"[+-]?[0-9]+")
 
 
 def whole_number(text: str) -> int:
-    """``text`` as a whole number written in ASCII digits (an optional sign): ``int`` alone would also
-    take ``1_000`` and other scripts' digits. ``ValueError`` otherwise."""
+    """``text`` as a whole number written in ASCII digits, with an optional sign.
+
+    ``int`` alone would also take ``1_000`` and other scripts' digits.
+
+    Parameters
+    ----------
+    text : str
+        The text.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ValueError
+        Anything else.
+    """
     if not _WHOLE.fullmatch(text):
         raise ValueError(f"not a whole number: {text!r}")
     return int(text)
 
 
 def as_size(value: Any, key: str) -> tuple[int, int]:
-    """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not)."""
+    """``[w, h]`` of whole pixels (``512.0`` is accepted as 512, ``512.5`` is not).
+
+    Parameters
+    ----------
+    value : object
+        A two-item list or tuple.
+    key : str
+        The JSON key, for the message.
+
+    Returns
+    -------
+    (int, int)
+
+    Raises
+    ------
+    GeometryError
+        Not two whole numbers, or a side outside 2..MAX_SIDE.
+    """
     if (
         not isinstance(value, (list, tuple))
         or len(value) != 2
@@ -222,7 +303,24 @@ def as_size(value: Any, key: str) -> tuple[int, int]:
 def read_json_or_file(text_or_path: str | os.PathLike, what: str) -> tuple[Any, str]:
     """The command-line rule: text starting with ``{`` is JSON, anything else a JSON file's name.
 
-    Returns ``(data, source)``; ``source`` names the file (or says "inline JSON") for messages.
+    Parameters
+    ----------
+    text_or_path : str or os.PathLike
+        The option's value.
+    what : str
+        What the JSON is, for messages (``"feature lines"``, ``"view"``).
+
+    Returns
+    -------
+    data : object
+        The parsed JSON.
+    source : str
+        The file's name, or "inline JSON", for messages.
+
+    Raises
+    ------
+    GeometryError
+        A missing or unreadable file, a folder, or invalid JSON.
     """
     text = os.fspath(text_or_path)
     if text.lstrip().startswith("{"):
@@ -274,6 +372,9 @@ class FeatureLines:
 
     __slots__ = ("image_lines", "frontal_lines", "frontal_size")
     METAVAR = "LINES"
+    image_lines: np.ndarray
+    frontal_lines: np.ndarray
+    frontal_size: tuple[int, int]
 
     def __init__(self, image_lines, frontal_lines, frontal_size) -> None:
         img = as_lines(image_lines, "image_lines")
@@ -430,6 +531,7 @@ class Mask:
     """
 
     __slots__ = ("bits",)
+    bits: np.ndarray
 
     def __init__(self, bits) -> None:
         arr = np.asarray(bits)
@@ -443,8 +545,7 @@ class Mask:
 
     @classmethod
     def _own(cls, bits: np.ndarray) -> Mask:
-        """A mask over ``bits``, a fresh bool array of this module's own making (no second copy: a
-        brush dab on an 8192² mask copied it twice)."""
+        """A mask over ``bits``, a fresh bool array of this module's own making (no second copy)."""
         mask = cls.__new__(cls)
         bits.flags.writeable = False
         object.__setattr__(mask, "bits", bits)
@@ -580,9 +681,26 @@ class Mask:
 
 
 def paint_line(bits: np.ndarray, p0, p1, radius: float, value: bool = True) -> tuple[int, int, int, int] | None:
-    """Paint :meth:`Mask.painted_line`'s brush line into the bool array ``bits`` in place (only the
-    line's box is read and written: a dab on a 4096² mask costs the dab, not a copy of the mask).
-    Returns the box ``(x0, y0, x1, y1)`` (exclusive ends) whose pixels changed, None if none did."""
+    """Paint :meth:`Mask.painted_line`'s brush line into ``bits`` in place.
+
+    Only the line's box is read and written, so a dab costs the dab, not a copy of the mask.
+
+    Parameters
+    ----------
+    bits : ndarray, bool (H, W)
+        The mask's bits, changed in place.
+    p0, p1 : (float, float)
+        The line's ends, image pixels.
+    radius : float
+        The brush's radius, pixels.
+    value : bool, default True
+        Paint (True) or erase (False).
+
+    Returns
+    -------
+    (int, int, int, int) or None
+        The box ``(x0, y0, x1, y1)`` (exclusive ends) whose pixels changed, None if none did.
+    """
     h, w = bits.shape
     (x0, y0), (x1, y1) = (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))
     r = max(0.0, float(radius)) + 0.5  # a pixel is hit when its centre is within radius (+ half a pixel)
@@ -607,7 +725,7 @@ def paint_line(bits: np.ndarray, p0, p1, radius: float, value: bool = True) -> t
 class MaskStroke:
     """A mask being painted, dab by dab (the studio's brush and eraser): its bits change in place
     (:func:`paint_line`), so a dab costs the dab's pixels, where ``Mask.painted_line`` copies the
-    whole mask (16 MB per dab at 4096²). Not a :class:`Mask` (which is immutable): read it with
+    whole mask. Not a :class:`Mask` (which is immutable): read it with
     :meth:`cut` (a copy of a part, what a preview around the stroke needs), :attr:`bits` (a read-only
     view that changes as the stroke goes on) or :meth:`snapshot`; :meth:`mask` ends the stroke.
 
@@ -666,17 +784,21 @@ class MaskStroke:
 # --- margins --------------------------------------------------------------------------------------
 
 
-class Margins(NamedTuple):
+class _MarginsFields(NamedTuple):
+    left: int
+    top: int
+    right: int
+    bottom: int
+
+
+class Margins(_MarginsFields):
     """Pixels added on each side of an image: ``left, top, right, bottom`` (an uncrop's new border).
 
     Text form ``L,T,R,B`` (``--extend``); JSON ``[l, t, r, b]``. Each is a whole number from 0 to
     :data:`MAX_SIDE`; whether the grown canvas is allowed is the pixel limit's business.
     """
 
-    left: int
-    top: int
-    right: int
-    bottom: int
+    __slots__ = ()
 
     METAVAR = "L,T,R,B"
 

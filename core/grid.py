@@ -11,6 +11,30 @@ def block_grid(n: int, block: int, overlap: int, tile: bool) -> tuple[list[int],
     afterwards. With ``tile`` the canvas is exactly ``n`` and wraps: ``k = ceil(n / step)`` blocks
     start at ``round(j n / k)``, so their overlaps are ``overlap`` or a pixel more, and the last
     block overlaps the first one by its ``after`` width.
+
+    Parameters
+    ----------
+    n : int
+        The output's length along this axis, pixels.
+    block : int
+        The block side, pixels.
+    overlap : int
+        The overlap between neighbouring blocks, 0..block-1.
+    tile : bool
+        Whether the output wraps around (a tileable result).
+
+    Returns
+    -------
+    starts, before, after : list of int
+        Each block's first pixel, its overlap with the previous block and (``tile`` only, else 0)
+        with the next one across the wrap.
+    length : int
+        The canvas length the blocks cover (``n`` with ``tile``, else at least ``n``).
+
+    References
+    ----------
+    Efros & Freeman, "Image quilting for texture synthesis and transfer" (2001), §2.1 (blocks
+    stepping by block - overlap in raster order).
     """
     step = block - overlap
     if tile:

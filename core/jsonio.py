@@ -19,6 +19,21 @@ def parse_json(text: str) -> Any:
     Stricter than :func:`json.loads`: ``NaN`` and ``Infinity`` (not JSON) are refused, and every
     failure (bad syntax, nesting too deep for the parser, a number with thousands of digits) is a
     :class:`~weft.core.errors.WeftError` saying so in one line. Nothing is evaluated.
+
+    Parameters
+    ----------
+    text : str
+        The JSON text, at most :data:`MAX_FILE_BYTES` long.
+
+    Returns
+    -------
+    object
+        The parsed value (dict, list, str, int, float, bool or None).
+
+    Raises
+    ------
+    WeftError
+        Not valid JSON, or too long; one line saying where.
     """
 
     def no_constant(name: str):
@@ -39,9 +54,26 @@ def parse_json(text: str) -> Any:
 
 
 def read_json_file(path: str | os.PathLike, what: str) -> Any:
-    """Read a weft JSON file (``what``: "recipe", "weft session"); one-line ``WeftError`` naming the
-    file if it is missing, a folder, a named pipe or a device (refused unread, without blocking),
-    larger than :data:`MAX_FILE_BYTES`, not UTF-8 text or not JSON."""
+    """Read and parse a weft JSON file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    what : str
+        What the file is, for messages: ``"recipe"``, ``"weft session"``.
+
+    Returns
+    -------
+    object
+        The parsed value (see :func:`parse_json`).
+
+    Raises
+    ------
+    WeftError
+        One line naming the file if it is missing, a folder, a named pipe or a device (refused unread,
+        without blocking), larger than :data:`MAX_FILE_BYTES`, not UTF-8 text or not JSON.
+    """
     name = os.fsdecode(path)
     try:
         raw = read_regular(name, MAX_FILE_BYTES, f"{what} file")

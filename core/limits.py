@@ -30,8 +30,7 @@ from .errors import WeftError
 DEFAULT_MAX_SECONDS = 600.0
 _max_seconds_override: float | None = None
 
-#: Seconds per (pixel x log2(pixels)) of one real 2-D DFT with OpenCV, float32 (measured on the
-#: 2-core machine: a 256x256 DFT ~0.09 ms, 1024x1024 ~2 ms, 2048x2048 ~13 ms).
+#: Seconds per (pixel x log2(pixels)) of one real 2-D DFT with OpenCV, float32, on a 2-core machine.
 DFT_SECONDS_PER_UNIT = 1.2e-10
 
 
@@ -60,8 +59,18 @@ def get_max_seconds() -> float:
 
 
 def set_max_seconds(seconds: float | None) -> None:
-    """Set the process-wide limit on estimated running time (seconds > 0, ``inf`` for none);
-    ``None`` restores the environment variable / default."""
+    """Set the process-wide limit on estimated running time.
+
+    Parameters
+    ----------
+    seconds : float or None
+        The limit, > 0 (``inf``: no limit); ``None`` restores ``WEFT_MAX_SECONDS`` or the default.
+
+    Raises
+    ------
+    WeftError
+        ``seconds`` is not a positive number.
+    """
     global _max_seconds_override
     _max_seconds_override = None if seconds is None else _positive(seconds, "max_seconds")
 
@@ -214,7 +223,20 @@ def _bytes(n: float) -> str:
 
 
 def check_output_size(width: int, height: int, source: str = "parameter 'size'") -> None:
-    """Refuse an output of more pixels than the pixel limit; ``source`` names what set its size."""
+    """Refuse an output of more pixels than the pixel limit (:func:`weft.core.image.get_max_pixels`).
+
+    Parameters
+    ----------
+    width, height : int
+        The output's size in pixels.
+    source : str, default "parameter 'size'"
+        What set the size, for the message.
+
+    Raises
+    ------
+    LimitError
+        ``width * height`` exceeds the limit; the message gives both and how to raise the limit.
+    """
     from .image import get_max_pixels
 
     limit = get_max_pixels()
@@ -226,7 +248,22 @@ def check_output_size(width: int, height: int, source: str = "parameter 'size'")
 
 
 def check_memory(nbytes: float, what: str, advice: str = "make the output smaller") -> None:
-    """Refuse a job whose estimated peak memory ``nbytes`` exceeds the memory available now."""
+    """Refuse a job whose estimated peak memory exceeds the memory available now (:func:`available_memory`).
+
+    Parameters
+    ----------
+    nbytes : float
+        The job's estimated peak memory, bytes.
+    what : str
+        The job, for the message.
+    advice : str, default "make the output smaller"
+        What to change, for the message.
+
+    Raises
+    ------
+    LimitError
+        ``nbytes`` exceeds the memory available (nothing is refused when it is unknown).
+    """
     available = available_memory()
     if available is not None and nbytes > available:
         raise LimitError(f"{what} needs about {_bytes(nbytes)} of memory, {_bytes(available)} is available: {advice}")
@@ -235,7 +272,19 @@ def check_memory(nbytes: float, what: str, advice: str = "make the output smalle
 def check_duration(seconds: float, what: str, advice: str) -> None:
     """Refuse a job whose estimated running time exceeds :func:`get_max_seconds`.
 
-    ``what`` describes the job (sizes, counts), ``advice`` says which parameters shorten it.
+    Parameters
+    ----------
+    seconds : float
+        The job's estimated running time on the reference machine.
+    what : str
+        The job (sizes, counts), for the message.
+    advice : str
+        Which parameters shorten it, for the message.
+
+    Raises
+    ------
+    LimitError
+        ``seconds`` exceeds the limit; the message gives both and how to raise the limit.
     """
     limit = get_max_seconds()
     if seconds > limit:
@@ -246,7 +295,18 @@ def check_duration(seconds: float, what: str, advice: str) -> None:
 
 
 def dft_seconds(h: int, w: int) -> float:
-    """Estimated seconds of one real DFT of an ``h`` x ``w`` float32 image padded to OpenCV's optimal size."""
+    """Estimated seconds of one real DFT of an ``h`` x ``w`` float32 image padded to OpenCV's optimal size.
+
+    Parameters
+    ----------
+    h, w : int
+        The image's height and width before padding.
+
+    Returns
+    -------
+    float
+        ``DFT_SECONDS_PER_UNIT * n * log2(n)`` with ``n`` the padded pixel count.
+    """
     import cv2
 
     n = cv2.getOptimalDFTSize(int(h)) * cv2.getOptimalDFTSize(int(w))

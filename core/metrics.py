@@ -47,8 +47,8 @@ __all__ = [
 ]
 
 MIN_SIDE = 7
-# Upper bound on the float32 distance block held at once by the nearest-neighbour search
-# (16 MiB measured faster than larger blocks: the add/argmin passes stay closer to cache).
+# Upper bound on the float32 distance block held at once by the nearest-neighbour search (small
+# enough that the add/argmin passes stay close to the cache).
 _BLOCK_BYTES = 16 * 1024 * 1024
 
 
@@ -330,8 +330,22 @@ def snr_db(orig, synth) -> float:
 def psnr_db(orig, synth) -> float:
     """Peak signal-to-noise ratio of ``synth`` against ``orig`` in decibels, peak 1.
 
-    ``10 log10(1 / mean((orig - synth)^2))`` over all pixels and channels, float64; ``inf`` when
-    the arrays are identical. Same inputs and errors as :func:`snr_db`.
+    ``10 log10(1 / mean((orig - synth)^2))`` over all pixels and channels, float64.
+
+    Parameters
+    ----------
+    orig, synth : array_like, (H, W) or (H, W, 3), at least 7x7
+        The reference and the result, in [0, 1], the same shape.
+
+    Returns
+    -------
+    float
+        The PSNR in dB; ``inf`` when the arrays are identical.
+
+    Raises
+    ------
+    ImageError
+        As :func:`snr_db`.
     """
     orig = _check_image(orig, "original image")
     synth = _check_image(synth, "synthesized image")
@@ -344,11 +358,19 @@ def psnr_db(orig, synth) -> float:
 def verbatim_region(sources) -> int:
     """Pixels of the largest region of an output copied verbatim from its sample.
 
-    ``sources`` (H, W, 2) integers give, for every output pixel (y, x), the sample pixel
-    (sy, sx) it was copied from, or a negative value where the pixel is not a copy (not made yet,
-    blended). A verbatim region is a 4-connected set of copied pixels sharing one offset
-    ``(sy - y, sx - x)``: a piece of the sample pasted as it is, whatever the blocks it was pasted
-    in. Returns its pixel count (0 when nothing is a copy).
+    A verbatim region is a 4-connected set of copied pixels sharing one offset ``(sy - y, sx - x)``:
+    a piece of the sample pasted as it is, whatever the blocks it was pasted in.
+
+    Parameters
+    ----------
+    sources : ndarray, integer (H, W, 2)
+        For every output pixel (y, x), the sample pixel (sy, sx) it was copied from, or a negative
+        value where the pixel is not a copy (not made yet, blended).
+
+    Returns
+    -------
+    int
+        The region's pixel count (0 when nothing is a copy).
 
     Raises
     ------
@@ -372,8 +394,8 @@ def verbatim_region(sources) -> int:
     # The graph drawn at twice the resolution: pixel (y, x) at (2y, 2x), the edge to its right
     # neighbour at (2y, 2x + 1), to the one below at (2y + 1, 2x); an edge pixel is set where both
     # neighbours are copies with the same offset. The 4-connected components of that image are the
-    # graph's (a node meets another only through an edge pixel), found by cv2 (scipy.sparse's
-    # csgraph took ~0.1 s to import in every quilting process).
+    # graph's (a node meets another only through an edge pixel), found by cv2 (importing
+    # scipy.sparse's csgraph would slow every quilting process's start).
     grid = np.zeros((2 * h - 1, 2 * w - 1), dtype=np.uint8)
     grid[::2, ::2] = valid
     grid[::2, 1::2] = valid[:, :-1] & valid[:, 1:] & (dy[:, :-1] == dy[:, 1:]) & (dx[:, :-1] == dx[:, 1:])
@@ -384,13 +406,24 @@ def verbatim_region(sources) -> int:
 
 
 def verbatim_fraction(sources, sample_shape) -> float:
-    """The largest verbatim region of an output (:func:`verbatim_region`) as a fraction of the
-    sample's area ``sample_shape[0] * sample_shape[1]`` (lower is better).
+    """The largest verbatim region of an output (:func:`verbatim_region`) as a fraction of the sample.
 
     Quilting copies blocks, so every output has verbatim regions of about a block; a fraction near
     the block's share of the sample is the floor. When a method keeps choosing the continuation of
     its neighbour's source position, one region grows across blocks into a strip of the sample
-    (1.0: as large as the whole sample).
+    (1.0: as large as the whole sample). Lower is better.
+
+    Parameters
+    ----------
+    sources : ndarray, integer (H, W, 2)
+        As in :func:`verbatim_region`.
+    sample_shape : tuple of int
+        The sample's shape (H, W[, C]).
+
+    Returns
+    -------
+    float
+        The region's pixels over ``sample_shape[0] * sample_shape[1]``.
 
     Raises
     ------
@@ -425,17 +458,42 @@ def fill_coherence(out, hole, reference=None, *, patch: int = 7, stride: int = 2
 
     The mean, over the ``patch`` x ``patch`` luminance windows of ``out`` that touch the hole (their
     top-left corners on a ``stride`` grid), of the distance to the nearest window lying wholly in the
-    known region of ``reference`` (default ``out``; pass the input image so that a fill which changes
-    known pixels is judged against what was there). The distance is the RMS difference per pixel in
-    8-bit levels (0..255): a fill made only of known patches scores ~0; blur between structures,
-    seams and invented colours raise it. (Diffusion fills score deceptively well on it: read it with
-    :func:`fill_detail`.)
+    known region of ``reference``. The distance is the RMS difference per pixel in 8-bit levels
+    (0..255): a fill made only of known patches scores about 0; blur between structures, seams and
+    invented colours raise it. Diffusion fills score deceptively well on it: read it with
+    :func:`fill_detail`.
 
-    ``hole`` is a bool (H, W) array, True where the image was filled. ``db_stride`` thins the known
-    windows (1 = all; 2 is ~4x faster and slightly pessimistic).
+    Parameters
+    ----------
+    out : array_like, (H, W) or (H, W, 3)
+        The filled image.
+    hole : array_like, bool (H, W)
+        True where the image was filled.
+    reference : array_like, optional
+        The image the known windows come from (default ``out``; pass the input image so that a fill
+        which changes known pixels is judged against what was there).
+    patch : int, default 7
+        The window side.
+    stride : int, default 2
+        The grid of the windows touching the hole.
+    db_stride : int, default 1
+        Thins the known windows (1 = all; 2 is quicker and slightly pessimistic).
 
-    Raises ``ImageError`` if shapes disagree, the known region holds no whole window, or the hole is
-    empty; ``InvalidParameter`` for a bad ``patch``/``stride``.
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ImageError
+        The shapes disagree, the known region holds no whole window, or the hole is empty.
+    InvalidParameter
+        A bad ``patch`` or ``stride``.
+
+    References
+    ----------
+    Simakov et al., "Summarizing visual data using bidirectional similarity" (CVPR 2008): the
+    coherence half, restricted to the hole's windows against the known region.
     """
     patch = _check_int("patch", patch, 1)
     stride = _check_int("stride", stride, 1)
@@ -478,11 +536,30 @@ def _known_gradient(grad: np.ndarray, mask: np.ndarray, margin: int) -> float:
 
 
 def fill_detail(out, hole) -> float:
-    """How detailed a fill is against its surroundings: the mean gradient magnitude (of luminance,
-    central differences) inside the hole, beyond 2 px from its edge, divided by that of the known
-    region beyond 2 px from the hole. About the ground truth's value is right; much lower is a
-    smeared fill (diffusion scores 0.1-0.5), much higher is noise. A hole thinner than 5 px is
-    measured whole. 0 when the known region is flat and the fill is too; ``inf`` when only it is flat."""
+    """How detailed a fill is against its surroundings.
+
+    The mean gradient magnitude (of luminance, central differences) inside the hole, beyond 2 px from
+    its edge, divided by that of the known region beyond 2 px from the hole. About the ground truth's
+    value is right; much lower is a smeared fill, much higher is noise. A hole thinner than 5 px is
+    measured whole.
+
+    Parameters
+    ----------
+    out : array_like, (H, W) or (H, W, 3)
+        The filled image.
+    hole : array_like, bool (H, W)
+        True where the image was filled.
+
+    Returns
+    -------
+    float
+        0 when the known region is flat and the fill is too; ``inf`` when only the known region is flat.
+
+    Raises
+    ------
+    ImageError
+        The shapes disagree or the hole is empty.
+    """
     from scipy.ndimage import binary_erosion
 
     img = _check_image(out, "output image", 1)
@@ -501,10 +578,29 @@ def fill_detail(out, hole) -> float:
 
 
 def fill_seam(out, hole) -> float:
-    """How visible a fill's edge is: the mean gradient magnitude on the 2-px ring around the hole's
-    edge (the pixels within 1 px of it on either side) divided by that of the known region beyond
-    2 px from the hole. About the ground truth's value is right; above it is a visible edge. The
-    image's own border is not an edge of the hole (an uncrop's ring lies where new meets old)."""
+    """How visible a fill's edge is.
+
+    The mean gradient magnitude on the 2-px ring around the hole's edge (the pixels within 1 px of it
+    on either side) divided by that of the known region beyond 2 px from the hole. About the ground
+    truth's value is right; above it is a visible edge. The image's own border is not an edge of the
+    hole (an uncrop's ring lies where new meets old).
+
+    Parameters
+    ----------
+    out : array_like, (H, W) or (H, W, 3)
+        The filled image.
+    hole : array_like, bool (H, W)
+        True where the image was filled.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ImageError
+        The shapes disagree or the hole is empty.
+    """
     from scipy.ndimage import binary_dilation, binary_erosion
 
     img = _check_image(out, "output image", 1)

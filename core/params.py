@@ -35,12 +35,12 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
 from .errors import InvalidParameter, WeftError
-from .geometry import MAX_SIDE, Square, whole_number
+from .geometry import MAX_SIDE, GeometryValue, Square, whole_number
 from .jsonio import MAX_FILE_BYTES, parse_json, read_json_file  # noqa: F401 (re-exported)
 
 KINDS = ("int", "float", "bool", "choice", "size", "str", "geometry")
@@ -79,7 +79,7 @@ class Spec:
     symbol: str = ""
     help: str = ""
     step: float | None = None
-    type: Any = None
+    type: type[GeometryValue] | None = None
 
     @property
     def option(self) -> str:
@@ -138,7 +138,7 @@ class Spec:
                 raise InvalidParameter(
                     f"parameter '{name}' = {value[0]}x{value[1]} has a side outside {lo}..{hi}", name=name, value=value
                 )
-        elif self.kind == "geometry":
+        elif self.kind == "geometry" and self.type is not None:  # (param() gives every geometry its type)
             value = self.type.coerce(value, name)
         elif self.kind == "str":
             if not isinstance(value, str):
@@ -178,7 +178,7 @@ class Spec:
             value = low in ("1", "true", "yes", "on")
         elif self.kind == "size":
             value = parse_size(text, self.name)
-        elif self.kind == "geometry":
+        elif self.kind == "geometry" and self.type is not None:
             value = self.type.parse(text, self.name)
         else:
             value = text
@@ -194,7 +194,23 @@ def out_of_range(
 ) -> InvalidParameter:
     """Build the standard message: ``parameter 'overlap' = 40 is outside 1..31 (why)``.
 
-    ``input`` names the method input whose size set the bound (see ``WeftError.input``).
+    Parameters
+    ----------
+    name : str
+        The parameter.
+    value : object
+        The value given.
+    lo, hi : float or None
+        The allowed range (None: unbounded on that side).
+    why : str, optional
+        Why the range is what it is, appended in parentheses.
+    input : str, optional
+        The method input whose size set the bound (see ``WeftError.input``).
+
+    Returns
+    -------
+    InvalidParameter
+        The error, for the caller to raise.
     """
     lo_t = "-inf" if lo is None else _fmt(lo)
     hi_t = "inf" if hi is None else _fmt(hi)
@@ -208,7 +224,25 @@ def out_of_range(
 
 
 def parse_size(text: str, name: str = "size") -> tuple[int, int]:
-    """Parse ``"512x384"`` (or ``"512"`` for a square) into ``(512, 384)``."""
+    """Parse ``"512x384"`` (or ``"512"`` for a square) into ``(512, 384)``.
+
+    Parameters
+    ----------
+    text : str
+        ``WIDTHxHEIGHT`` or ``SIDE`` in whole pixels (``×`` is read as ``x``).
+    name : str, default "size"
+        The parameter, for the message.
+
+    Returns
+    -------
+    (int, int)
+        Width and height.
+
+    Raises
+    ------
+    InvalidParameter
+        The text is not one or two whole numbers joined by ``x``.
+    """
     parts = text.lower().replace("×", "x").split("x")
     try:
         if len(parts) == 1:
@@ -235,12 +269,43 @@ def param(
     symbol: str = "",
     help: str = "",
     step: float | None = None,
-    type: Any = None,
+    type: type[GeometryValue] | None = None,
 ) -> Any:
     """Declare a parameter field of a :class:`Params` dataclass.
 
     The kind is inferred from ``default`` (``choices`` given -> ``choice``; a 2-tuple -> ``size``)
     unless ``kind`` says otherwise.
+
+    Parameters
+    ----------
+    default : object
+        The default value (None with ``optional``: "auto", resolved by the method).
+    lo, hi : float, optional
+        The allowed range of a number or of a size's sides.
+    choices : sequence, optional
+        The allowed values of a ``choice``.
+    kind : str, optional
+        One of :data:`KINDS`; inferred from ``default`` when omitted.
+    optional : bool, default False
+        Whether None is allowed.
+    symbol : str, optional
+        The paper's symbol (``"B"``, ``"p_l"``), shown beside the slider.
+    help : str, optional
+        One line for the CLI's help, the slider's tooltip and the docs.
+    step : float, optional
+        The slider's step for a float.
+    type : type, optional
+        The geometry type of a ``geometry`` parameter (and only of one).
+
+    Returns
+    -------
+    dataclasses.Field
+        The field, with its :class:`Spec` metadata.
+
+    Raises
+    ------
+    TypeError
+        The kind cannot be inferred or is unknown, or ``type`` and ``kind="geometry"`` do not go together.
     """
     if kind is None:
         if choices is not None:
@@ -292,7 +357,7 @@ class Params:
     def check(self) -> None:
         """Cross-parameter rules; raise ``InvalidParameter`` (see :func:`out_of_range`)."""
 
-    def replace(self, **changes: Any) -> Params:
+    def replace(self, **changes: Any) -> Self:
         unknown = set(changes) - {s.name for s in specs(type(self))}
         if unknown:
             raise InvalidParameter(_unknown_message(type(self), unknown))
@@ -309,7 +374,7 @@ class Params:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], *, base: str | os.PathLike | None = None) -> Params:
+    def from_dict(cls, data: Mapping[str, Any], *, base: str | os.PathLike | None = None) -> Self:
         """Parameters from their JSON form; a geometry value is read by its type's ``from_json``
         (a file it names is found relative to ``base``, the recipe's folder)."""
         if not isinstance(data, Mapping):
@@ -321,7 +386,7 @@ class Params:
         values = dict(data)
         for name, value in values.items():
             spec = by_name[name]
-            if spec.kind == "geometry" and value is not None and not isinstance(value, spec.type):
+            if spec.type is not None and value is not None and not isinstance(value, spec.type):
                 values[name] = spec.type.from_json(value, name, base)
         return cls(**values)
 
@@ -333,7 +398,18 @@ def _unknown_message(cls: type, unknown: set) -> str:
 
 
 def specs(cls: type) -> tuple[Spec, ...]:
-    """The :class:`Spec` of every declared parameter of a ``Params`` subclass, in field order."""
+    """The :class:`Spec` of every declared parameter of a ``Params`` subclass, in field order.
+
+    Parameters
+    ----------
+    cls : type
+        A ``Params`` subclass.
+
+    Returns
+    -------
+    tuple of Spec
+        Cached on the class after the first call.
+    """
     cached = cls.__dict__.get("_weft_specs")
     if cached is not None:
         return cached
@@ -344,12 +420,28 @@ def specs(cls: type) -> tuple[Spec, ...]:
             continue
         out.append(Spec(name=f.name, default=f.default, **meta))
     result = tuple(out)
-    cls._weft_specs = result
+    cls._weft_specs = result  # type: ignore[attr-defined]  # a per-class cache, read back through cls.__dict__
     return result
 
 
 def as_rng(rng: None | int | np.random.Generator) -> np.random.Generator:
-    """``None`` -> fresh entropy, ``int`` -> seeded PCG64, a ``Generator`` is used as it is."""
+    """A numpy Generator from the ``rng`` argument every method takes.
+
+    Parameters
+    ----------
+    rng : None, int or numpy.random.Generator
+        ``None``: fresh entropy; an integer: a seeded PCG64 (the same seed gives the same pixels); a
+        ``Generator`` is used as it is.
+
+    Returns
+    -------
+    numpy.random.Generator
+
+    Raises
+    ------
+    InvalidParameter
+        ``rng`` is none of these (a bool is not a seed).
+    """
     if rng is None or isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
         return np.random.default_rng(rng)
     if isinstance(rng, np.random.Generator):
@@ -467,8 +559,20 @@ class Recipe:
 
 
 def relative_path(path: str, folder: str | os.PathLike) -> str:
-    """``path`` relative to ``folder`` (recipes and sessions store paths relative to their own file);
-    absolute when there is no relative form (another drive on Windows)."""
+    """``path`` relative to ``folder``, as recipes and sessions store paths relative to their own file.
+
+    Parameters
+    ----------
+    path : str
+        An absolute path.
+    folder : str or os.PathLike
+        The folder of the file that will carry the path.
+
+    Returns
+    -------
+    str
+        The relative path, or ``path`` itself when there is no relative form (another drive on Windows).
+    """
     try:
         return os.path.relpath(Path(path).resolve(), Path(folder).resolve())
     except ValueError:

@@ -23,9 +23,28 @@ __all__ = ["reduce_for_preview", "crop_around", "around_region", "Around", "AROU
 def reduce_for_preview(
     studio: Any, inputs: Mapping[str, np.ndarray], params, side: int
 ) -> tuple[dict[str, np.ndarray], Any]:
-    """Inputs and parameters of a reduced render: the studio's ``preview_inputs`` that are open
-    scaled so the longer side of the largest is ``side``; else its ``preview_params`` sizes scaled
-    so; unchanged when already that small (or when the method refuses the smaller size)."""
+    """Inputs and parameters of a reduced render.
+
+    The studio's ``preview_inputs`` that are open are scaled so the longer side of the largest is
+    ``side``; else its ``preview_params`` sizes are scaled so; unchanged when already that small (or
+    when the method refuses the smaller size).
+
+    Parameters
+    ----------
+    studio : Studio
+        The method's studio description.
+    inputs : mapping of str to ndarray
+        The full-size inputs.
+    params : Params
+        The full-size parameters.
+    side : int
+        The preview's longer side, pixels.
+
+    Returns
+    -------
+    inputs : dict of str to ndarray
+    params : Params
+    """
     from .image import resize
 
     scaled = [n for n in studio.preview_inputs if n in inputs]
@@ -112,11 +131,26 @@ class Around:
 def around_region(
     stroke: tuple[float, float, float, float], width: int, height: int, *, context: int = 16
 ) -> tuple[int, int, int, int]:
-    """The part ``(x0, y0, x1, y1)`` of a ``width`` x ``height`` painted mask that :func:`crop_around`
-    reads for ``stroke`` (same ``context``): the stroke's box grown by ``context``, grown again by
-    ``context`` and a quarter of that box's longer side (the crop never reaches farther), clipped to
-    the mask. Cut that part and pass it as ``crop_around(..., mask_part=)``: a preview around a
-    stroke then never needs the whole mask (64 MB as a float image at 4096²)."""
+    """The part of a painted mask that :func:`crop_around` reads for a stroke.
+
+    The stroke's box grown by ``context``, grown again by ``context`` and a quarter of that box's
+    longer side (the crop never reaches farther), clipped to the mask. Cut that part and pass it as
+    ``crop_around(..., mask_part=)``: a preview around a stroke then never needs the whole mask.
+
+    Parameters
+    ----------
+    stroke : (float, float, float, float)
+        The stroke's ``(x0, y0, x1, y1)``.
+    width, height : int
+        The mask's size.
+    context : int, default 16
+        As in :func:`crop_around`.
+
+    Returns
+    -------
+    (int, int, int, int)
+        ``(x0, y0, x1, y1)``, exclusive ends.
+    """
     wx0, wy0, wx1, wy1 = _stroke_window(stroke, context)
     grow = context + max(wx1 - wx0, wy1 - wy0) // 4 + 1
     return max(0, wx0 - grow), max(0, wy0 - grow), min(width, wx1 + grow), min(height, wy1 + grow)
@@ -144,24 +178,47 @@ def crop_around(
     context: int = 16,
     mask_part: tuple[np.ndarray, tuple[int, int]] | None = None,
 ) -> Around | None:
-    """What to render while a stroke paints the mask input ``studio.preview_around``: the inputs
-    cropped around the painted region near the stroke, so the preview costs a fraction of a full
-    render.
+    """What to render while a stroke paints the mask input ``studio.preview_around``.
 
-    ``stroke`` is the stroke's ``(x0, y0, x1, y1)`` in the painted image's pixels (brush radius
-    included). The crop is the bounding box of the mask's pixels within the stroke's box grown by
-    ``context`` px, grown again by ``context`` px and by a quarter of its side (known pixels around
+    The inputs are cropped around the painted region near the stroke, so the preview costs a fraction
+    of a full render. The crop is the bounding box of the mask's pixels within the stroke's box grown
+    by ``context`` px, grown again by ``context`` px and by a quarter of its side (known pixels around
     the hole to copy from), clipped to the image. Only what belongs to the painted image is cropped
-    alike: the image, the masks painted on it, and the masks ``studio.masks_of`` gives to it (a
-    source mask opened as a file, unless its texture is open); every other input (a second texture
-    to copy from, even of the image's size) is kept whole. A crop longer than
-    ``side`` is scaled down to it (``area``, a mask thresholded back to 0/1). Parameters filled by a
-    margins geometry on that image are reset to their defaults (the crop is not uncropped) and their
-    left/top margins give :attr:`Around.offset`. None when the studio previews no mask that way,
-    the mask is not open, or there is nothing painted near the stroke (nothing to fill).
+    alike: the image, the masks painted on it, and the masks ``studio.masks_of`` gives to it (a source
+    mask opened as a file, unless its texture is open); every other input (a second texture to copy
+    from, even of the image's size) is kept whole. A crop longer than ``side`` is scaled down to it
+    (``area``, a mask thresholded back to 0/1). Parameters filled by a margins geometry on that image
+    are reset to their defaults (the crop is not uncropped) and their left/top margins give
+    :attr:`Around.offset`.
 
-    ``mask_part`` = ``(bits, (x, y))``: the painted mask is not in ``inputs``; ``bits`` (bool or
-    float) is its part at ``(x, y)``, covering at least :func:`around_region` of the stroke.
+    Parameters
+    ----------
+    studio : Studio
+        The method's studio description.
+    inputs : mapping of str to ndarray
+        The full-size inputs.
+    params : Params
+        The full-size parameters.
+    stroke : (float, float, float, float)
+        The stroke's ``(x0, y0, x1, y1)`` in the painted image's pixels (brush radius included).
+    side : int, default AROUND_SIDE
+        The crop's longest side.
+    context : int, default 16
+        Pixels of context around the stroke.
+    mask_part : (ndarray, (int, int)), optional
+        ``(bits, (x, y))``: the painted mask is not in ``inputs``; ``bits`` (bool or float) is its
+        part at ``(x, y)``, covering at least :func:`around_region` of the stroke.
+
+    Returns
+    -------
+    Around or None
+        None when the studio previews no mask that way, the mask is not open, or there is nothing
+        painted near the stroke (nothing to fill).
+
+    Raises
+    ------
+    ValueError
+        ``mask_part`` does not cover the stroke's region.
     """
     from .geometry import Margins
     from .image import resize
@@ -169,7 +226,7 @@ def crop_around(
 
     name = studio.preview_around
     g = next((g for g in studio.geometry if g.kind == MASK and g.input == name), None)
-    if g is None or (name not in inputs and mask_part is None):
+    if g is None or name is None or (name not in inputs and mask_part is None):
         return None
     on = g.input_for(inputs)
     if on not in inputs:

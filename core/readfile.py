@@ -27,22 +27,58 @@ _KINDS = (
 
 
 def shown(path: str | os.PathLike | bytes) -> str:
-    """``path`` as text for a one-line message: as it is when every character is printable, else
-    quoted the way Python writes a string (``'a\\nb.png'``, ``'\\x1b]0;x.png'``)."""
+    """``path`` as text for a one-line message.
+
+    Parameters
+    ----------
+    path : str, os.PathLike or bytes
+        A file name.
+
+    Returns
+    -------
+    str
+        The path as it is when every character is printable, else quoted the way Python writes a
+        string (``'a\\nb.png'``, ``'\\x1b]0;x.png'``).
+    """
     text = os.fsdecode(path) if isinstance(path, (bytes, os.PathLike)) else str(path)
     return text if text.isprintable() else repr(text)
 
 
 def one_line(text: str) -> str:
-    """``text`` with every character that is not printable escaped (a message's last line of defence:
-    a newline, a carriage return or an escape sequence never reaches the terminal)."""
+    """``text`` with every character that is not printable escaped.
+
+    A message's last line of defence: a newline, a carriage return or an escape sequence never reaches
+    the terminal.
+
+    Parameters
+    ----------
+    text : str
+        A message.
+
+    Returns
+    -------
+    str
+        The message on one line.
+    """
     if text.isprintable():
         return text
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def kind_of(mode: int) -> str | None:
-    """What a file of this ``st_mode`` is when it is not a regular file ("a named pipe (FIFO)", ...)."""
+    """What a file of this ``st_mode`` is when it is not a regular file.
+
+    Parameters
+    ----------
+    mode : int
+        An ``os.stat`` mode.
+
+    Returns
+    -------
+    str or None
+        Words such as ``"a named pipe (FIFO)"``, ``"a character device"``, ``"a directory"``; None for
+        a regular file.
+    """
     for test, name in _KINDS:
         if test(mode):
             return name
@@ -60,10 +96,25 @@ def open_regular(path: str | os.PathLike, what: str = "file", *, error: type[Wef
     (``O_NONBLOCK``: a named pipe without a writer cannot hold the open up), so nothing swapped in
     between is read.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    what : str, default "file"
+        What it should be, for the message (``"recipe"``, ``"image"``).
+    error : type of WeftError, default NotRegularFile
+        The error raised for a path that is not a regular file.
+
+    Returns
+    -------
+    file object
+        Open for binary reading.
+
     Raises
     ------
     OSError
-        The file is missing, unreadable, a symbolic link loop, ... (the caller words these).
+        The file is missing, unreadable, a symbolic link loop, ... (the caller words these);
+        ``IsADirectoryError`` for a folder.
     error
         ``{path}: is a named pipe (FIFO), not a {what}`` (and the like), one line.
     """
@@ -92,9 +143,31 @@ def open_regular(path: str | os.PathLike, what: str = "file", *, error: type[Wef
 def read_regular(
     path: str | os.PathLike, limit: int, what: str = "file", *, error: type[WeftError] = NotRegularFile
 ) -> bytes:
-    """The bytes of the regular file ``path`` (see :func:`open_regular`); a file larger than ``limit``
-    bytes is refused unread (``{path}: 12.0 MB is too large for a {what} (the limit is 10 MB); not read``),
-    and one that grows past it while being read is refused after ``limit + 1`` bytes."""
+    """The bytes of the regular file ``path`` (see :func:`open_regular`), at most ``limit`` of them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    limit : int
+        The largest size read, bytes.
+    what : str, default "file"
+        What it should be, for the message.
+    error : type of WeftError, default NotRegularFile
+        The error raised for a path that is not a regular file or is too large.
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    OSError
+        As :func:`open_regular`.
+    error
+        Not a regular file; or larger than ``limit`` (``{path}: 12.0 MB is too large for a {what}
+        (the limit is 10 MB); not read``), also when it grows past it while being read.
+    """
     name = os.fsdecode(path)
     with open_regular(name, what, error=error) as f:
         size = os.fstat(f.fileno()).st_size
@@ -123,6 +196,16 @@ def file_key(path: str | os.PathLike) -> tuple:
     :func:`os.path.samefile` compares. A file not yet there: its folder's device and inode and its
     name, so two spellings of one new output (through a bind mount, ``..``, a link to the folder)
     still compare equal. A path whose folder is not there either: its absolute, normalised text.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file that exists or is about to be written.
+
+    Returns
+    -------
+    tuple
+        Equal for two paths of the same file.
     """
     name = os.path.abspath(os.fsdecode(path))
     try:
@@ -139,5 +222,15 @@ def file_key(path: str | os.PathLike) -> tuple:
 
 
 def same_file(a: str | os.PathLike, b: str | os.PathLike) -> bool:
-    """Whether ``a`` and ``b`` name one file (or one file to be), by :func:`file_key`."""
+    """Whether ``a`` and ``b`` name one file (or one file to be), by :func:`file_key`.
+
+    Parameters
+    ----------
+    a, b : str or os.PathLike
+        Paths.
+
+    Returns
+    -------
+    bool
+    """
     return file_key(a) == file_key(b)

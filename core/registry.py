@@ -54,7 +54,7 @@ class InputSpec:
     min_side: int = 1
     #: Keep an alpha channel when the file has one (``load_image(..., alpha=True)``): the method then
     #: gets (H, W, 2) grey+alpha or (H, W, 4) RGBA. Off for every method but ``fill`` (a transparent
-    #: region is its hole); the others get alpha dropped, as before.
+    #: region is its hole); the others get alpha dropped.
     alpha: bool = False
 
     @property
@@ -93,7 +93,8 @@ class Method:
     #: ``memory(shapes, params) -> bytes``: the estimated peak memory of one run on inputs of these
     #: shapes (input name -> array shape), the figure the run checks against the memory available;
     #: a batch multiplies it by its workers to refuse up front (:mod:`weft.core.batch`). None: no estimate.
-    memory: Callable[[Mapping[str, tuple[int, ...]], Params], float] | None = None
+    #: It is called with this method's own ``params`` class, hence ``Any`` (Callable is contravariant).
+    memory: Callable[[Mapping[str, tuple[int, ...]], Any], float] | None = None
     studio: Studio | None = None
     #: The input whose bit depth (8 or 16) the command line's output keeps when ``--bit-depth`` is not
     #: given (``fill``: a 16-bit photo stays 16-bit; its known pixels come back unchanged). None: 8.
@@ -107,8 +108,20 @@ _loaded: dict[str, Method] = {}
 
 
 def register(method: Method) -> None:
-    """Add a method at run time (a plug-in, a test): the CLI, ``weft run`` and, with a ``studio``
-    description, the studio offer it like the built-in ones. A second method of one name is an error."""
+    """Add a method at run time (a plug-in, a test).
+
+    The CLI, ``weft run`` and, with a ``studio`` description, the studio offer it like the built-in ones.
+
+    Parameters
+    ----------
+    method : Method
+        The method; its ``name`` must be new.
+
+    Raises
+    ------
+    WeftError
+        A method of that name is registered already.
+    """
     if method.name in _MODULES:
         raise WeftError(f"a method called {method.name!r} is registered already")
     _MODULES[method.name] = ""
@@ -116,7 +129,13 @@ def register(method: Method) -> None:
 
 
 def unregister(name: str) -> None:
-    """Remove a method added by :func:`register`."""
+    """Remove a method added by :func:`register`.
+
+    Parameters
+    ----------
+    name : str
+        The method's name; a built-in method or an unknown name is left alone.
+    """
     if _MODULES.get(name) == "":
         del _MODULES[name]
         _loaded.pop(name, None)
@@ -125,7 +144,7 @@ def unregister(name: str) -> None:
 def studio_methods() -> dict[str, Method]:
     """The methods the studio offers, in its order (``Studio.rank``, then registration)."""
     offered = [m for m in methods().values() if m.studio is not None]
-    return {m.name: m for m in sorted(offered, key=lambda m: m.studio.rank)}
+    return {m.name: m for m in sorted(offered, key=lambda m: m.studio.rank if m.studio else 0)}
 
 
 def names() -> tuple[str, ...]:
@@ -139,7 +158,22 @@ def methods() -> dict[str, Method]:
 
 
 def get(name: str) -> Method:
-    """The method called ``name`` (importing its module only); ``WeftError`` listing the known ones."""
+    """The method called ``name``, importing its module only.
+
+    Parameters
+    ----------
+    name : str
+        A registered method's name (``weft`` + name on the command line).
+
+    Returns
+    -------
+    Method
+
+    Raises
+    ------
+    WeftError
+        No such method; the message lists the known ones.
+    """
     if name not in _MODULES:
         raise WeftError(f"unknown method {name!r} (known: {', '.join(_MODULES)})")
     if name not in _loaded:
@@ -160,7 +194,7 @@ def get(name: str) -> Method:
 
 #: What a front end shows while a method's kernels compile (``{name}`` is the method's name) ...
 PREPARING = "preparing the {name} method — first run only"
-#: ... and while they load, before it is known whether they compile (numba's import alone takes ~0.5 s).
+#: ... and while they load, before it is known whether they compile (numba's import alone takes a while).
 LOADING = "loading the {name} method"
 
 _warm: set[str] = set()
@@ -173,24 +207,66 @@ _cache_notes: list[str] = []
 
 
 def preparing_text(name: str) -> str:
-    """The words a front end shows while ``name``'s kernels compile."""
+    """The words a front end shows while ``name``'s kernels compile.
+
+    Parameters
+    ----------
+    name : str
+        The method's name.
+
+    Returns
+    -------
+    str
+    """
     return PREPARING.format(name=get(name).name)
 
 
 def loading_text(name: str) -> str:
-    """The words a front end shows while ``name``'s kernels load (cache or compile: not known yet)."""
+    """The words a front end shows while ``name``'s kernels load (from the cache or compiled: not known yet).
+
+    Parameters
+    ----------
+    name : str
+        The method's name.
+
+    Returns
+    -------
+    str
+    """
     return LOADING.format(name=get(name).name)
 
 
 def is_warm(name: str) -> bool:
-    """Whether ``name``'s kernels are loaded in this process (its ``warm_up`` has run, or it has none)."""
+    """Whether ``name``'s kernels are loaded in this process.
+
+    Parameters
+    ----------
+    name : str
+        The method's name.
+
+    Returns
+    -------
+    bool
+        True once its ``warm_up`` has run here, or when it has none.
+    """
     return name in _warm or get(name).warm_up is None
 
 
 def warm_up(name: str) -> bool:
-    """Run ``name``'s ``warm_up`` unless it already ran in this process; returns True if it ran here.
+    """Run ``name``'s ``warm_up`` unless it already ran in this process.
 
-    Thread-safe: a second caller waits for the first one to finish rather than warming up twice."""
+    Thread-safe: a second caller waits for the first one to finish rather than warming up twice.
+
+    Parameters
+    ----------
+    name : str
+        The method's name.
+
+    Returns
+    -------
+    bool
+        True if it ran here (in this call).
+    """
     method = get(name)
     if method.warm_up is None or name in _warm:
         return False
@@ -205,9 +281,20 @@ def warm_up(name: str) -> bool:
 
 
 def warm_up_all(first: str | None = None, cancel=None) -> list[str]:
-    """Warm up every method not yet warm (``first`` before the others, then registration order), for
-    a background thread in the studio; ``cancel`` (a ``CancelToken``) is checked between methods.
-    Returns the names warmed up here."""
+    """Warm up every method not yet warm, for a background thread in the studio.
+
+    Parameters
+    ----------
+    first : str, optional
+        The method warmed up before the others (the rest in registration order).
+    cancel : CancelToken, optional
+        Checked between methods.
+
+    Returns
+    -------
+    list of str
+        The names warmed up here.
+    """
     order = ([first] if first in _MODULES else []) + [n for n in _MODULES if n != first]
     done = []
     for name in order:
@@ -219,9 +306,19 @@ def warm_up_all(first: str | None = None, cancel=None) -> list[str]:
 
 
 def warm_up_report(name: str) -> dict[str, Any]:
-    """Warm ``name`` up in this process and say what happened: ``{"method", "seconds",
-    "compiled", "notice"}`` with ``compiled`` the number of kernels compiled (0: all loaded from the
-    cache). For ``weft warm-up``'s worker processes."""
+    """Warm ``name`` up in this process and say what happened, for ``weft warm-up``'s worker processes.
+
+    Parameters
+    ----------
+    name : str
+        The method's name.
+
+    Returns
+    -------
+    dict
+        ``{"method", "seconds", "compiled", "notice"}`` with ``compiled`` the number of kernels
+        compiled (0: all loaded from the cache) and ``notice`` what the kernel cache said, if anything.
+    """
     import time
 
     t0 = time.perf_counter()
@@ -263,9 +360,22 @@ class CompileWatch:
 
 @contextmanager
 def watch_compiles(*, this_thread: bool = False, on_start: Callable[[], None] | None = None):
-    """Count numba compilations (and their time) while the block runs, in any thread or, with
-    ``this_thread``, only the calling thread's; ``on_start()`` is called (on the compiling thread) as
-    each one starts. A cache load is no compilation: a warm run sees none."""
+    """Count numba compilations (and their time) while the block runs.
+
+    A cache load is no compilation: a warm run sees none.
+
+    Parameters
+    ----------
+    this_thread : bool, default False
+        Count only the calling thread's compilations (else any thread's).
+    on_start : callable, optional
+        Called with no arguments, on the compiling thread, as each one starts.
+
+    Yields
+    ------
+    object
+        A watcher with ``count`` and ``seconds``, updated as compilations end.
+    """
     watch = CompileWatch(threading.get_ident() if this_thread else None, on_start)
     with _watch_lock:
         _watchers.append(watch)
@@ -296,18 +406,35 @@ def _notify(started: bool, outermost: bool) -> None:
 
 
 def compile_started(outermost: bool = True) -> None:
-    """Called by ``weft.core._kernels`` when a thread starts compiling a function (a cache miss);
-    ``outermost``: not a function compiled inside another one's compile."""
+    """Called by ``weft.core._kernels`` when a thread starts compiling a function (a cache miss).
+
+    Parameters
+    ----------
+    outermost : bool, default True
+        Not a function compiled inside another one's compile.
+    """
     _notify(True, outermost)
 
 
 def compile_ended(outermost: bool = True) -> None:
-    """Called by ``weft.core._kernels`` when that compilation ends."""
+    """Called by ``weft.core._kernels`` when that compilation ends.
+
+    Parameters
+    ----------
+    outermost : bool, default True
+        As given to :func:`compile_started`.
+    """
     _notify(False, outermost)
 
 
 def note_kernel_cache(message: str) -> None:
-    """Called by ``weft.core._kernels`` when numba's cache cannot be used (kept once)."""
+    """Called by ``weft.core._kernels`` when numba's cache cannot be used (the first message is kept).
+
+    Parameters
+    ----------
+    message : str
+        One line for the front ends to show.
+    """
     if message not in _cache_notes:
         _cache_notes.append(message)
 
@@ -316,7 +443,13 @@ _cache_repairs: list[str] = []
 
 
 def note_kernel_cache_repair(message: str) -> None:
-    """Called by ``weft.core._kernels`` when it dropped a damaged cache entry (kept once)."""
+    """Called by ``weft.core._kernels`` when it dropped a damaged cache entry (the first message is kept).
+
+    Parameters
+    ----------
+    message : str
+        One line for the front ends to show.
+    """
     if message not in _cache_repairs:
         _cache_repairs.append(message)
 

@@ -26,9 +26,24 @@ from .readfile import kind_of, open_regular, shown
 
 
 def load_recipe(path: str) -> Recipe:
-    """A recipe from a ``.json`` file or from the ``weft-recipe`` chunk of a PNG weft exported; its
-    relative input paths are resolved against the file's folder. One-line ``WeftError`` naming the
-    file; an image of another format is told that only PNG exports (and ``.json`` files) carry a recipe."""
+    """A recipe from a ``.json`` file or from the ``weft-recipe`` chunk of a PNG weft exported.
+
+    Parameters
+    ----------
+    path : str
+        The file.
+
+    Returns
+    -------
+    Recipe
+        With its relative input paths resolved against the file's folder.
+
+    Raises
+    ------
+    WeftError
+        One line naming the file; an image of another format is told that only PNG exports (and
+        ``.json`` files) carry a recipe.
+    """
     from .image import read_recipe
     from .image.files import _SIGNATURES
 
@@ -56,12 +71,29 @@ def load_recipe(path: str) -> Recipe:
 
 
 def check_recipe(recipe: Recipe, base: Path, *, supplied: tuple[str, ...] = ()) -> dict:
-    """Validate ``recipe`` against its method before any image is read; returns its parameters in
-    their JSON form with every geometry inline (one that names a file is read relative to ``base``,
-    the recipe file's folder, never the current one).
+    """Validate ``recipe`` against its method before any image is read.
 
-    ``supplied`` names inputs given from elsewhere (a batch's ``--over``): they need not be in the
-    recipe, nor exist. Messages do not name the recipe file; the caller puts it in front.
+    Messages do not name the recipe file; the caller puts it in front.
+
+    Parameters
+    ----------
+    recipe : Recipe
+        The recipe.
+    base : pathlib.Path
+        The recipe file's folder: a geometry that names a file is read relative to it, never to the
+        current folder.
+    supplied : tuple of str, optional
+        Inputs given from elsewhere (a batch's ``--over``): they need not be in the recipe, nor exist.
+
+    Returns
+    -------
+    dict
+        Its parameters in their JSON form with every geometry inline.
+
+    Raises
+    ------
+    WeftError
+        A bad parameter, a missing input, an input that is not an image file.
     """
     from . import registry
 
@@ -93,9 +125,30 @@ def output_recipe(
     region: tuple[int, int, int] | None,
     out: str | os.PathLike,
 ) -> Recipe:
-    """The recipe a run's output at ``out`` carries: input paths relative to the output's folder
-    (``weft run OUT.png`` then finds them wherever the folder moves); geometry (feature lines, a view)
-    inline, so it needs no other file."""
+    """The recipe a run's output at ``out`` carries.
+
+    Input paths are relative to the output's folder (``weft run OUT.png`` then finds them wherever
+    the folder moves); geometry (feature lines, a view) is inline, so it needs no other file.
+
+    Parameters
+    ----------
+    method : Method
+        The method run.
+    params : Params
+        Its parameters.
+    input_paths : mapping of str to str
+        Input name -> file.
+    seed : int
+        The seed used.
+    region : (int, int, int) or None
+        The square of the first input the method ran on.
+    out : str or os.PathLike
+        The output file.
+
+    Returns
+    -------
+    Recipe
+    """
     out_dir = Path(out).resolve().parent
     rel_inputs = {name: relative_path(path, out_dir) for name, path in input_paths.items()}
     return Recipe(

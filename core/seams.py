@@ -140,7 +140,6 @@ def min_error_path(error: np.ndarray) -> np.ndarray:
 def accumulated_costs(error: np.ndarray) -> np.ndarray:
     """The dynamic program's accumulated costs of a stack of vertical strips, in numpy (no numba).
 
-    ``error`` (K, h, w): the error surfaces of K strips; returns float64 (K, h, w) with
     ``E[y, x] = e[y, x] + min(E[y+1, x-1], E[y+1, x], E[y+1, x+1])`` (the bottom row its error;
     neighbours beyond the strip's edges not used), the values of the numba kernel's (the same
     additions; min is exact). A backtrace from any row follows it down; the numpy quilting engine
@@ -149,6 +148,20 @@ def accumulated_costs(error: np.ndarray) -> np.ndarray:
     The rows are accumulated into a buffer padded with +inf columns, three ufunc calls a row written
     in place, for the whole stack at once (the run is ``h`` steps of calls on tiny arrays, so the
     number of calls is the cost).
+
+    Parameters
+    ----------
+    error : ndarray, (K, h, w)
+        The error surfaces of K strips.
+
+    Returns
+    -------
+    ndarray, float64 (K, h, w)
+        The accumulated costs ``E``.
+
+    References
+    ----------
+    Efros & Freeman (2001), §2.1: the minimum error boundary cut by dynamic programming.
     """
     k, h, w = error.shape
     accp = np.full((k, h, w + 2), np.inf)

@@ -9,9 +9,9 @@ A session is the whole document as JSON::
 feature lines ``{...}``, margins ``[left, top, right, bottom]``, and a mask as the name of its 1-bit PNG
 written beside the session (relative to the session's folder), e.g. ``"mask": "s.weft.fill.mask.png"``.
 A session's mask PNGs are written with it, by :meth:`Session.save` (or :meth:`Session.files` for a
-caller that writes them elsewhere, e.g. on a worker with a lock of its own). Files written before
-geometry was per method have one ``"prototype": [x, y, side]`` and one ``"lines": {...}`` instead;
-each is given to every method with a geometry of that kind.
+caller that writes them elsewhere, e.g. on a worker with a lock of its own). Files of the older format,
+without per-method geometry, have one ``"prototype": [x, y, side]`` and one ``"lines": {...}``
+instead; each is given to every method with a geometry of that kind.
 """
 
 from __future__ import annotations
@@ -99,7 +99,7 @@ class Session:
             session = _session_from_data(data, path.resolve().parent, None if dropped is None else said)
         except WeftError as e:
             raise WeftError(f"{path}: {e}") from None
-        if dropped is not None:
+        if dropped is not None and said is not None:
             dropped.extend(f"{path}: {line}" for line in said)
         return session
 
@@ -244,7 +244,26 @@ def write_masks(masks: Mapping[Path, Mask]) -> None:
 
 
 def read_session(path: str | Path, *, dropped: list[str] | None = None) -> Session:
-    """Read a session file: :meth:`Session.read` (the same parameters, the same value returned)."""
+    """Read a session file (:meth:`Session.read`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The session file.
+    dropped : list of str, optional
+        With a list, a mask PNG that is missing or unreadable is left out (the rest opens) and a
+        one-line message naming it is appended to the list.
+
+    Returns
+    -------
+    Session
+        The session, input paths absolute.
+
+    Raises
+    ------
+    WeftError
+        One line naming the file and what is wrong with it.
+    """
     return Session.read(path, dropped=dropped)
 
 
@@ -282,8 +301,8 @@ def _session_from_data(data: Any, base: Path, dropped: list[str] | None = None) 
     seed = data.get("seed", 1)
     if not _ints([seed], 0, MAX_SEED):
         raise WeftError(f"seed = {seed!r} must be an integer in 0..{MAX_SEED}")
-    # Geometry per method. Sessions written before it was per method have one "prototype" and one
-    # "lines" for all: each goes to every method with a geometry of that kind.
+    # Geometry per method. Sessions of the older format have one "prototype" and one "lines" for
+    # all: each goes to every method with a geometry of that kind.
     geometry: dict[str, dict[str, Any]] = {}
     for name, method in methods.items():
         if method.studio is None:
@@ -333,8 +352,20 @@ class _UnreadableMask(WeftError):
 
 
 def mask_file(session: str | Path, method: str, key: str) -> Path:
-    """Where a session at ``session`` keeps the mask ``key`` of ``method``: a 1-bit PNG beside it
-    (``s.weft.json`` -> ``s.weft.fill.mask.png``)."""
+    """Where a session keeps a painted mask: a 1-bit PNG beside it.
+
+    Parameters
+    ----------
+    session : str or pathlib.Path
+        The session file (``s.weft.json``).
+    method, key : str
+        The method and its mask geometry's key.
+
+    Returns
+    -------
+    pathlib.Path
+        E.g. ``s.weft.fill.mask.png``.
+    """
     session = Path(session)
     stem = session.name[:-5] if session.name.lower().endswith(".json") else session.name
     return session.with_name(f"{stem}.{method}.{key}.png")

@@ -162,11 +162,26 @@ class Figure:
 
 
 def describe_figures(figures: Mapping[str, Any], known: Mapping[str, Figure], *, crop: bool = False) -> list[str]:
-    """``figures`` (a ``Result.figures``) in words: each scalar by its :class:`Figure` in ``known``,
-    in the order of ``figures``; lists, tables and missing values (``None``) are left to the report.
-    A key no table describes reads as its words (``"some_count"`` -> ``"some count"``). ``crop``: the
-    figures of a render of a crop (a preview around a stroke): only those ``known`` as
-    :attr:`Figure.whole` (the others, and unknown keys, would describe the crop, not the image)."""
+    """A result's figures in words.
+
+    Lists, tables and missing values (``None``) are left to the report. A key no table describes reads
+    as its words (``"some_count"`` -> ``"some count"``).
+
+    Parameters
+    ----------
+    figures : mapping
+        A ``Result.figures``.
+    known : mapping of str to Figure
+        How each figure reads.
+    crop : bool, default False
+        The figures of a render of a crop (a preview around a stroke): only those ``known`` as
+        :attr:`Figure.whole` (the others, and unknown keys, would describe the crop, not the image).
+
+    Returns
+    -------
+    list of str
+        One phrase per scalar, in the order of ``figures``.
+    """
     out = []
     for key, value in figures.items():
         if value is None or isinstance(value, (list, tuple, dict, np.ndarray)):

@@ -4,7 +4,7 @@ The GUI thread never converts a large image: an image of more than ``ASYNC_PIXEL
 into the QImage the view draws (:func:`~weft.app.gui.convert.display_qimage`, numpy only, so the
 worker leaves Python's GIL to the GUI thread) on a worker thread, and the view keeps showing the
 previous image until it is ready (``image_shown`` then; ``image`` is always the image on screen). A
-view draws that QImage itself: no QPixmap (which only the GUI thread may make, 35 ms for a 4096²
+view draws that QImage itself: no QPixmap (which only the GUI thread may make, slowly for a large
 image) is made. Requests made while one is converted are coalesced: the newest is converted next,
 and a conversion older than what is on screen is dropped. ``set_image(image, changed=box)`` redraws
 only a part of the array on screen changed in place (a stroke's preview pasted into the result).
@@ -23,15 +23,14 @@ from PySide6.QtWidgets import QGraphicsItem
 
 from .convert import display_qimage
 
-#: Images of more pixels than this are converted for display on a worker thread (display_qimage:
-#: 0.4 ms for 512², 10 ms for 1024², 39 ms for 2048², 145 ms for 4096², median of 7, loaded machine).
+#: Images of more pixels than this are converted for display on a worker thread (display_qimage's
+#: time grows with the pixels; under this it is short enough for the GUI thread).
 ASYNC_PIXELS = 512 * 512
 #: A part of the image on screen changed in place of at most this many pixels is converted on the GUI
-#: thread (``set_image(changed=)``: a stroke's preview), not the whole image on a worker: 2048² in 9 ms
-#: grey, 14 ms RGB (1024² in 3 and 2.4 ms; medians of 5, a quiet machine). At 1024², the part a 4096²
-#: picture's preview changes (its crop, up to ~1100x1200 px once dabs coalesced) outgrew it; the whole
-#: picture then went to the worker (~150 ms), every later preview waited behind that conversion, and
-#: previews reached the screen in bursts: medians 86-130 ms instead of ~31 ms in such runs.
+#: thread (``set_image(changed=)``: a stroke's preview), not the whole image on a worker. It is large
+#: enough for the crop a large picture's stroke preview changes: a part that outgrows it sends the
+#: whole picture to the worker, every later preview waits behind that conversion, and previews reach
+#: the screen in bursts.
 PART_PIXELS = 2048 * 2048
 
 _converters = ThreadPoolExecutor(max_workers=2, thread_name_prefix="weft-display")

@@ -136,7 +136,7 @@ class FeatureLinesPanel(QWidget):
             row.addWidget(box_)
         row.addStretch(1)
         lay.addLayout(row)
-        # on a line of its own, wrapped: Quad…'s "click the top-left corner" was cut off beside the boxes
+        # on a line of its own, wrapped: beside the boxes Quad…'s "click the top-left corner" is cut off
         self.rectify_status = QLabel("")
         self.rectify_status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         self.rectify_status.setWordWrap(True)

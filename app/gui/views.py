@@ -114,8 +114,8 @@ class ImageView(QGraphicsView):
         conversion for the screen is on its way (the whole picture went to the worker: the first
         preview of a stroke came before the picture itself was on screen, or its part was too large):
         ``box`` is redrawn from it once that conversion is shown, instead of converting it all again.
-        Else every later preview of the stroke waited behind a whole-picture conversion (~150 ms at
-        4096²) and they reached the screen in bursts."""
+        Else every later preview of the stroke would wait behind a whole-picture conversion and they
+        would reach the screen in bursts."""
         if image is None or over is not image or not self.converting or self._converter.latest is not image:
             return False
         if self._late_of is not image:

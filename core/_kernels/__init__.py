@@ -6,8 +6,8 @@ reports compilations; it is the only place that knows about numba's caching mach
 * **A cache folder that always works.** numba looks for a writable cache folder in turn: the
   folder ``NUMBA_CACHE_DIR`` names, the package's own ``__pycache__``, then the user's cache folder
   (``~/.cache/numba``); when none is writable — a shared read-only install used with
-  ``HOME=/nonexistent``, as on some render nodes — decorating a kernel raised ``RuntimeError: cannot
-  cache function ...: no locator available`` and every numba method died. We add a last folder to
+  ``HOME=/nonexistent``, as on some render nodes — decorating a kernel raises ``RuntimeError: cannot
+  cache function ...: no locator available`` and every numba method fails. We add a last folder to
   that list: ``weft-numba-<uid>`` in the system's temporary folder, private to the user (created
   0700; one owned by someone else, or open to others, is refused: numba's cache files are pickles,
   loading a planted one would run its code). The user-wide and the temporary folder are seeded
@@ -19,7 +19,7 @@ reports compilations; it is the only place that knows about numba's caching mach
   and a numbered data file, without a lock; weft takes a file lock around each save (POSIX), so
   processes compiling at once (``weft warm-up``'s workers) cannot cross their files.
 * **Damaged cache files are repaired.** An index or data file that cannot be read back (cut short
-  by a power cut) made every run of its method fail with ``EOFError: Ran out of input``, and
+  by a power cut) would make every run of its method fail with ``EOFError: Ran out of input``, and
   ``weft warm-up`` too; such files are removed, the kernel is compiled again and saved, and
   :func:`weft.core.registry.kernel_cache_repairs` says so in one line.
 * **Compile events.** numba announces every real compilation (a cache miss, never a cache load) as
@@ -149,7 +149,7 @@ def _enable_caching_or_not(self):
 
 def _install_no_cache_fallback() -> None:
     if _dispatcher.Dispatcher.enable_caching is not _enable_caching_or_not:
-        _dispatcher.Dispatcher.enable_caching = _enable_caching_or_not
+        _dispatcher.Dispatcher.enable_caching = _enable_caching_or_not  # type: ignore[method-assign]  # a patch of numba
 
 
 _original_save = _caching.IndexDataCacheFile.save
@@ -173,7 +173,7 @@ def _save_locked(self, key, data):
 
 def _install_save_lock() -> None:
     if _caching.IndexDataCacheFile.save is not _save_locked:
-        _caching.IndexDataCacheFile.save = _save_locked
+        _caching.IndexDataCacheFile.save = _save_locked  # type: ignore[method-assign]  # a patch of numba
 
 
 _DAMAGED_NOTICE = "numba's cache of {what} could not be read (damaged: {why}); it was dropped and compiled again"
@@ -243,9 +243,10 @@ def _load_overload_or_drop(self, sig, target_context):
 
 def _install_cache_repair() -> None:
     if _caching.IndexDataCacheFile._load_index is not _load_index_or_drop:
-        _caching.IndexDataCacheFile._load_index = _load_index_or_drop
-        _caching.IndexDataCacheFile._load_data = _load_data_or_drop
-        _caching.Cache.load_overload = _load_overload_or_drop
+        # patches of numba's cache classes
+        _caching.IndexDataCacheFile._load_index = _load_index_or_drop  # type: ignore[method-assign]
+        _caching.IndexDataCacheFile._load_data = _load_data_or_drop  # type: ignore[method-assign]
+        _caching.Cache.load_overload = _load_overload_or_drop  # type: ignore[method-assign]
 
 
 class _CompileListener(_event.Listener):
@@ -272,4 +273,4 @@ _install_save_lock()
 _install_cache_repair()
 if not getattr(_registry, "_compile_listener_installed", False):
     _event.register("numba:compile", _CompileListener())
-    _registry._compile_listener_installed = True
+    _registry._compile_listener_installed = True  # type: ignore[attr-defined]  # set once per process

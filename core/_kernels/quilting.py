@@ -18,10 +18,10 @@ pixels on any thread.
 Integer parameters of :func:`place_block` travel in one int64 array (fewer arguments to dispatch
 per block; see the ``P_*`` indices in ``weft.core.quilting.codes``).
 
-Compile cost (numba compiles a kernel and everything it calls on first use, ~0.1-3 s a function
-when the cache is cold): the selection rules and the Poisson band are separate kernels so that a
-run compiles only what it uses; no ``np.partition``/``np.argsort`` (seconds each to compile; a
-hand-written selection instead); work buffers come from the caller instead of ``np.full``.
+Compile cost (numba compiles a kernel and everything it calls on first use, when the cache is
+cold): the selection rules and the Poisson band are separate kernels so that a run compiles only
+what it uses; no ``np.partition``/``np.argsort`` (slow to compile; a hand-written selection
+instead); work buffers come from the caller instead of ``np.full``.
 """
 
 from __future__ import annotations
@@ -75,8 +75,8 @@ def _kth_smallest(cost, k):
     """The k-th smallest value of ``cost`` (1-based), as ``np.partition(cost, k - 1)[k - 1]``.
 
     For the small k of the tol rule, one pass keeping the k smallest in order, without a copy of
-    the whole array (7 MB per block for a 1024² texture). Larger k (tol > 32, rare) select on a
-    copy by three-way quickselect: ``np.partition`` itself took 7 s of numba compile for it.
+    the whole array. Larger k (tol > 32, rare) select on a copy by three-way quickselect
+    (``np.partition`` is slow to compile in numba).
     """
     n = cost.size
     if k <= 32:
@@ -146,7 +146,7 @@ def _ranked(cost, k, pick):
 
     With ``pick == k - 1`` that is the element at ``pick`` of a stable sort (the k-th smallest
     value, the ties with it in index order), so the sampled rule uses it instead of a stable
-    ``np.argsort`` (a merge sort, 2 s of numba compile).
+    ``np.argsort`` (a merge sort, slow to compile).
     """
     n = cost.size
     kth = _kth_smallest(cost, k)
@@ -364,8 +364,7 @@ def block_error(canvas, filled, tex, iparams, err):
     source block at (P_SY, P_SX) on the block's overlap strips where the canvas is filled, else 0.
 
     The engine calls ``cut_mask`` itself between this and :func:`place_block`: linked into
-    place_block, the cut's code was optimised and compiled a second time (0.4 s of CPU when the
-    cache is cold).
+    place_block, the cut's code would be optimised and compiled a second time.
     """
     hc, wc, nc = canvas.shape
     y0 = iparams[P_Y0]

@@ -7,7 +7,7 @@
 Compile cost is part of the design: a horizontal cut is the vertical program run on a C-contiguous
 transposed copy (not on ``err.T``, whose F layout compiled every helper a second time), and the
 helpers are never called with a literal integer (numba compiles a specialisation per literal
-value: ``_trace_down(..., 0)`` and ``_trace_down(..., c0)`` were two). ``zero`` below is an int64
+value: ``_trace_down(..., 0)`` and ``_trace_down(..., c0)`` would be two). ``zero`` below is an int64
 that numba cannot see as the constant 0. So each helper compiles once.
 """
 

@@ -346,8 +346,34 @@ def levenberg_marquardt(
     (M00, M01, M10, M11, o_y, o_x, g) (n, 7), from the chosen candidate (``o = -M t``, gain
     ``g = 1``). A step that does not lower a patch's error is refused and its damping multiplied
     by 10 (accepted: divided by 3.3), so no patch gets worse; a patch stops when its error falls by
-    less than 1e-7 of itself or its damping passes 1e6. ``proto`` and ``grad`` = (∂y, ∂x) are
-    padded alike (see :func:`padded`).
+    less than 1e-7 of itself or its damping passes 1e6.
+
+    Parameters
+    ----------
+    proto : ndarray
+        The prototype's highpass grey, padded (see :func:`padded`).
+    grad : (ndarray, ndarray)
+        Its derivatives (∂y, ∂x), padded alike.
+    centre : float
+        The prototype's centre ``c`` in its padded coordinates.
+    params : ndarray, float64 (n, 7)
+        The start of each patch's map.
+    targets : ndarray, (n, B, B)
+        Each patch of the texture, ``s_t``.
+    weights : ndarray, (n, B, B)
+        Each patch's window ``w`` (the cosine-squared window of §3.1, 0 outside the image).
+    iterations : int
+        Most steps per patch.
+
+    Returns
+    -------
+    ndarray, float64 (n, 7)
+        The refined maps.
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary
+    matching", §2.4 (the minimum error transformation this polishes).
     """
     from .._kernels import affine as _k
 

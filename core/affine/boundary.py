@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -67,7 +68,7 @@ class BoundaryReport:
 
     def figures(self) -> dict:
         """Short, JSON-serialisable figures for ``--report``."""
-        out = {"boundary": self.mode}
+        out: dict[str, Any] = {"boundary": self.mode}
         if self.errors:
             out["boundary_error"] = [float(f"{e:.5g}") for e in self.errors]
         if self.mode == "shaker":

@@ -10,6 +10,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from ..errors import ImageError
+from ..geometry import Square
 from ..image import luminance, validate_image
 from ..jobs import CancelToken, Progress
 from ..limits import check_output_size
@@ -94,7 +95,7 @@ def synthesize(
     float32 (H, W) or (H, W, 3) in [0, 1]
     """
     params = AffineParams(
-        prototype=prototype,
+        prototype=None if prototype is None else Square.coerce(prototype, "prototype"),
         block=block,
         segments=segments,
         lowpass=lowpass,
@@ -102,7 +103,9 @@ def synthesize(
         propagate=propagate,
         refine=refine,
         reuse_transforms=reuse_transforms,
-        analysis_prototype=analysis_prototype,
+        analysis_prototype=(
+            None if analysis_prototype is None else Square.coerce(analysis_prototype, "analysis_prototype")
+        ),
         boundary=boundary,
         iterations=iterations,
         per_radius=per_radius,
@@ -157,12 +160,11 @@ def _pipeline(
         )
         info["analysis_prototype"] = list(arect)
     else:
-        rect = params.prototype
-        if rect is not None:
-            check_rect(rect, source.shape, source_name)
+        if params.prototype is not None:
+            check_rect(params.prototype, source.shape, source_name)
         model = analyse(
             texture,
-            prototype=rect,
+            prototype=params.prototype,
             prototype_image=other,
             block=B,
             segments=params.segments,

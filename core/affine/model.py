@@ -30,6 +30,21 @@ def lowpass(image: np.ndarray, block: int) -> np.ndarray:
     Ambiguity resolved here (the paper gives no cutoff): a Gaussian of σ = B/4 (variations slower
     than about one patch), kept at 1/(B/8) of the resolution (area-averaged, the "subsampled
     lowpass image") and enlarged again bilinearly. Mirrored at the borders.
+
+    Parameters
+    ----------
+    image : ndarray, float32 (H, W) or (H, W, C)
+        The image.
+    block : int
+        The patch side B.
+
+    Returns
+    -------
+    ndarray, float32, the shape of ``image``
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary matching", §3.3.
     """
     img = np.ascontiguousarray(image, dtype=np.float32)
     h, w = img.shape[:2]
@@ -117,6 +132,7 @@ def _recombine(dec: Decomposition, grey: np.ndarray) -> np.ndarray:
     if dec.colour == "yuv":
         return yiq_to_rgb(np.concatenate([grey[..., None], dec.chroma_low], axis=2))
     comps = np.concatenate([(grey - dec.offset)[..., None], dec.chroma_low], axis=2)
+    assert dec.basis is not None  # a pca decomposition with chroma carries its basis
     return from_pca(comps, dec.basis)
 
 
@@ -155,7 +171,7 @@ class Prototype:
 
 def make_prototype(
     image: np.ndarray,
-    rect: Rect | str | None = None,
+    rect: Rect | tuple[int, int, int] | str | None = None,
     *,
     block: int = 32,
     colour: str = "pca",

@@ -56,21 +56,42 @@ def default_rect(shape: tuple[int, ...], block: int, what: str = "image") -> Rec
     """The default prototype: a square of side ``2B`` (64 for B = 32) in the middle of the image.
 
     Its side is reduced to the largest even number the image holds (at least 8), so a small image
-    still gets a prototype; the paper uses a 64x64 prototype with 32x32 patches (§5). ``what``
-    names the image in the error (``"texture"``, ``"prototype image"``).
+    still gets a prototype; the paper uses a 64x64 prototype with 32x32 patches (§5).
+
+    Parameters
+    ----------
+    shape : tuple of int
+        The image's shape (H, W[, C]).
+    block : int
+        The patch side B.
+    what : str, default "image"
+        The image, for the message (``"texture"``, ``"prototype image"``).
+
+    Returns
+    -------
+    Square
+
+    Raises
+    ------
+    GeometryError
+        The image is smaller than 8x8 pixels.
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary matching", §5.
     """
     h, w = shape[:2]
     s = min(2 * block, (min(h, w) // 2) * 2)
     if s < MIN_SIDE:
         raise GeometryError(f"the {what} is {w}x{h}; a prototype needs at least {MIN_SIDE}x{MIN_SIDE} pixels")
-    return (w - s) // 2, (h - s) // 2, s
+    return Square((w - s) // 2, (h - s) // 2, s)
 
 
 @dataclass(frozen=True)
 class AffineParams(Params):
     """Parameters of the affine prototype model (Smith & Bhalerao)."""
 
-    prototype: Square = param(
+    prototype: Square | None = param(
         None,
         kind="geometry",
         type=Square,
@@ -128,7 +149,7 @@ class AffineParams(Params):
         " them with --prototype (a prototype swap, §4): the layout stays, the look "
         "changes",
     )
-    analysis_prototype: Square = param(
+    analysis_prototype: Square | None = param(
         None,
         kind="geometry",
         type=Square,
@@ -168,7 +189,7 @@ class AffineParams(Params):
     field_strength: float = param(
         1.0, lo=0.0, hi=2.0, step=0.05, help="how strongly the field turns or zooms the prototype"
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=16,

@@ -130,7 +130,7 @@ def segment_sums(
         p = (p - p.mean(axis=(1, 2), keepdims=True, dtype=np.float64).astype(np.float32)) * cos2_window(n)
     lowcut = 1.0 / n if lowcut is None else float(lowcut)
     bins = _bins(n, segments, lowcut)
-    import scipy.fft as sfft  # here, not at import: 0.12 s that every weft process paid
+    import scipy.fft as sfft  # here, not at import: most weft processes never need it
 
     mag = np.abs(sfft.rfft2(p)).reshape(len(p), -1)[:, bins.flat]
     mag[flat] = 0.0
@@ -230,15 +230,11 @@ def centroid_pairs(M: np.ndarray, f1: np.ndarray, f2: np.ndarray) -> Centroids:
             cM[:, l] = cM[:, N] + cM[:, base]
             c1[:, l] = c1[:, N] + c1[:, base]
             c2[:, l] = c2[:, N] + c2[:, base]
-    ks, ls = [], []
     # k and k + N/2 give the same two runs mirrored (same variances, negated centroids): the
     # first half-plane of starting segments is enough.
-    for k in range(half):
-        for l in range(k + 1, k + half):
-            ks.append(k)
-            ls.append(l)
-    ks = np.array(ks)
-    ls = np.array(ls)
+    pairs = [(k, end) for k in range(half) for end in range(k + 1, k + half)]
+    ks = np.array([k for k, _ in pairs])
+    ls = np.array([end for _, end in pairs])
     ends = ks + half
     mass = cM[:, half]
     tiny = 1e-9 * np.maximum(mass, 1e-300)[:, None]

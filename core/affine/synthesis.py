@@ -26,8 +26,26 @@ def _as_prototype(model: AffineModel, prototype) -> Prototype:
 
 
 def render_signal(model: AffineModel, proto: Prototype) -> np.ndarray:
-    """The prototype channel(s) a model renders: highpass grey (``add``), else the unfiltered
-    colour patch if there is one, else the unfiltered grey; float32 (S, S, C)."""
+    """The prototype channel(s) a model renders.
+
+    Parameters
+    ----------
+    model : AffineModel
+        The model (its ``lowpass`` mode).
+    proto : Prototype
+        The prototype.
+
+    Returns
+    -------
+    ndarray, float32 (S, S, C)
+        The highpass grey (``add``), else the unfiltered colour patch if there is one, else the
+        unfiltered grey.
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary
+    matching", §3.3-3.4.
+    """
     if model.lowpass == "add":
         sig = proto.highpass
     elif proto.colour is not None:
@@ -39,7 +57,26 @@ def render_signal(model: AffineModel, proto: Prototype) -> np.ndarray:
 
 
 def render_canvas(model: AffineModel, proto: Prototype, index: np.ndarray | None = None) -> np.ndarray:
-    """Sum of the windowed, normalised, warped prototypes on the padded canvas, (Hc, Wc, C) float32."""
+    """Sum of the windowed, normalised, warped prototypes on the padded canvas.
+
+    Parameters
+    ----------
+    model : AffineModel
+        The transforms and the grid.
+    proto : Prototype
+        The prototype drawn.
+    index : ndarray, optional
+        The patches to draw (default all).
+
+    Returns
+    -------
+    ndarray, float32 (Hc, Wc, C)
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary
+    matching", §3 (synthesis: §3.1 the cosine-squared window, §3.2 the intensity normalisation).
+    """
     from .._kernels import affine as _k
 
     sig, c = padded(render_signal(model, proto))
@@ -90,8 +127,7 @@ def render(
 
     Each patch k is the prototype sampled through ``T_k⁻¹`` and moved by its translation,
     multiplied by its intensity factor and the cos² window, and summed into the canvas, which is
-    cropped to the image (§3). Cheap enough for a live preview (a 256² texture with B = 32 renders
-    in a few milliseconds): only warping, windowing and summing.
+    cropped to the image (§3). Cheap enough for a live preview: only warping, windowing and summing.
 
     Parameters
     ----------

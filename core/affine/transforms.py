@@ -130,10 +130,9 @@ def candidate_transforms(mu_p: np.ndarray, mu_t: np.ndarray) -> np.ndarray:
     single = mu_t.ndim == 2
     ct = regularise_pairs(mu_t.reshape(-1, 2, 2))
     cp = regularise_pairs(np.asarray(mu_p, dtype=np.float64))
-    cps = []
-    for first, s1, s2 in PAIRINGS:
-        cps.append(np.stack([s1 * cp[:, first], s2 * cp[:, 1 - first]], axis=1))
-    cps = np.stack(cps)  # (8, 2, 2)
+    cps = np.stack(
+        [np.stack([s1 * cp[:, first], s2 * cp[:, 1 - first]], axis=1) for first, s1, s2 in PAIRINGS]
+    )  # (8, 2, 2)
     # A_j = C_t C_pj^-1 and T_j = (A_j^T)^-1 = (C_pj^-T C_t^T)^-1 = C_t^-T C_pj^T
     ct_inv_t = np.linalg.inv(ct).transpose(0, 2, 1)  # (K, 2, 2)
     T = ct_inv_t[:, None] @ cps.transpose(0, 2, 1)[None]  # (K, 8, 2, 2)
@@ -252,7 +251,7 @@ def correlate_indexed(
     R = radius
     g = np.zeros((n, L, L), np.float32)
     g[:, R : R + B, R : R + B] = targets
-    import scipy.fft as sfft  # here, not at import: 0.12 s that every weft process paid
+    import scipy.fft as sfft  # here, not at import: most weft processes never need it
 
     G = sfft.rfft2(g)[:, None]
     F = sfft.rfft2(frames)

@@ -63,7 +63,13 @@ _cancel_event = None  # set in local pool workers by _init_local_worker
 
 
 def set_threads(n: int | None) -> None:
-    """OpenCV's thread count in this process (a worker shares the cores with the others)."""
+    """Set OpenCV's thread count in this process (a worker shares the cores with the others).
+
+    Parameters
+    ----------
+    n : int or None
+        Threads; None leaves OpenCV's default.
+    """
     if n is not None:
         import cv2
 
@@ -78,7 +84,13 @@ def _dask_threads(totals: Mapping[str, int], dask_worker=None) -> None:
 
 
 def warm_up(method_name: str) -> None:
-    """Load the method's kernels once per process (every worker calls it before its first item)."""
+    """Load the method's kernels once per process (every worker calls it before its first item).
+
+    Parameters
+    ----------
+    method_name : str
+        The batch's method.
+    """
     from .. import registry
 
     registry.warm_up(method_name)
@@ -93,6 +105,16 @@ def run_item(item: Item) -> Outcome:
 
     Never raises for the item's own problems (a bad input, a parameter its image does not suit, a
     full disk): they become a failed :class:`Outcome` with a one-line reason. Both pools call this.
+
+    Parameters
+    ----------
+    item : Item
+        The item: its recipe, inputs, output path and seed.
+
+    Returns
+    -------
+    Outcome
+        ``written`` (with the encoded bytes when the item is not written here) or ``failed``.
     """
     from .. import registry
     from ..geometry import Square
@@ -130,7 +152,6 @@ def run_item(item: Item) -> Outcome:
         if item.write:
             os.makedirs(os.path.dirname(item.output), exist_ok=True)
             atomic_write_bytes(Path(item.output), data)
-            data = None
         return Outcome(
             item.index,
             item.label,
@@ -139,7 +160,7 @@ def run_item(item: Item) -> Outcome:
             seconds=rendered.seconds,
             figures=rendered.figures,
             worker=worker,
-            data=data,
+            data=None if item.write else data,  # a written item's bytes stay in the worker
             elapsed=time.perf_counter() - t0,
             cpu=time.process_time() - c0,
         )
@@ -228,7 +249,7 @@ class LocalPool:
         self.ctx = multiprocessing.get_context("spawn")
         with _interrupts_held():  # (the first semaphore starts multiprocessing's resource tracker)
             self.cancel_event = self.ctx.Event()
-        self.executor = None
+        self.executor: cf.ProcessPoolExecutor  # started by _start()
         self.restarts = 0  # times a dead worker took the pool down and it was started again
         self.threads = max(1, default_workers() // workers)
         self._start()
@@ -435,7 +456,18 @@ class DaskPool:
 
 
 def scheduler_address(given: str | None) -> str | None:
-    """The Dask scheduler to use: ``given``, else ``DASK_SCHEDULER_ADDRESS``, else None (local pool)."""
+    """The Dask scheduler to use.
+
+    Parameters
+    ----------
+    given : str or None
+        The address given on the command line.
+
+    Returns
+    -------
+    str or None
+        ``given``, else ``DASK_SCHEDULER_ADDRESS``, else None (the local pool).
+    """
     return given or os.environ.get(SCHEDULER_ENV) or None
 
 
@@ -558,12 +590,12 @@ def run(
                         )
                         continue
                 inflight[pool.submit(item)] = item
-            reason = pool.gone() if isinstance(pool, DaskPool) else None
-            if reason:  # every item not done fails
+            lost = pool.gone() if isinstance(pool, DaskPool) else None
+            if lost:  # every item not done fails
                 pool.cancel(inflight)
                 for item in [*inflight.values(), *todo]:
                     _finish(
-                        Outcome(item.index, item.label, item.output, "failed", error=reason),
+                        Outcome(item.index, item.label, item.output, "failed", error=lost),
                         item,
                         summary,
                         state,

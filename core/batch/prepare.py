@@ -154,6 +154,7 @@ class BatchProgress:
     """Progress of a running batch, handed to :func:`run`'s ``progress`` after each item."""
 
     __slots__ = ("total", "done", "failed", "started", "_timed", "_first")
+    _first: float | None
 
     def __init__(self, total: int, skipped: int):
         self.total, self.done, self.failed = total, skipped, 0
@@ -172,7 +173,7 @@ class BatchProgress:
     def seconds_left(self) -> float | None:
         """Time left at the rate items have completed since the first one (so the workers' start-up
         does not count); None before two are done."""
-        if self._timed < 2:
+        if self._timed < 2 or self._first is None:
             return None
         rate = (self._timed - 1) / max(1e-9, time.monotonic() - self._first)
         return (self.total - self.done) / rate
@@ -187,8 +188,24 @@ def _natural_key(path: str):
 
 
 def expand_over(name: str, where: str) -> list[str]:
-    """The files of one ``--over``: a folder's image files, a glob's matches or one file, in natural
-    order (``frame_2`` before ``frame_10``); ``WeftError`` if there are none."""
+    """The files of one ``--over``, in natural order (``frame_2`` before ``frame_10``).
+
+    Parameters
+    ----------
+    name : str
+        The recipe input it replaces, for messages.
+    where : str
+        A folder (its image files), a glob (its matches) or one file.
+
+    Returns
+    -------
+    list of str
+
+    Raises
+    ------
+    WeftError
+        Nothing matches.
+    """
     if os.path.isdir(where):
         files = [
             str(Path(where) / f)
@@ -463,8 +480,20 @@ def _header_shape(path: str) -> tuple[int, ...] | None:
 
 
 def item_memory(items: Iterable[Item]) -> tuple[float, str]:
-    """The largest estimated peak memory of one item (``Method.memory`` on the inputs' header sizes)
-    and that item's label; ``(0, "")`` when the method gives no estimate."""
+    """The largest estimated peak memory of one item (``Method.memory`` on the inputs' header sizes).
+
+    Parameters
+    ----------
+    items : iterable of Item
+        The batch's items (one method).
+
+    Returns
+    -------
+    bytes : float
+        The largest estimate; 0 when the method gives none.
+    label : str
+        That item's label ("" with no estimate).
+    """
     from .. import registry
 
     best, label = 0.0, ""
@@ -476,8 +505,9 @@ def item_memory(items: Iterable[Item]) -> tuple[float, str]:
         return best, label
     params = method.params.from_dict(items[0].params)
     for item in items:
-        shapes = {name: _header_shape(path) for name, path in item.inputs.items()}
-        if any(s is None for s in shapes.values()):
+        found = {name: _header_shape(path) for name, path in item.inputs.items()}
+        shapes = {name: s for name, s in found.items() if s is not None}
+        if len(shapes) < len(found):
             continue
         if item.region is not None:
             first = method.inputs[0].name
@@ -493,9 +523,22 @@ def item_memory(items: Iterable[Item]) -> tuple[float, str]:
 
 
 def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> list[tuple[Item, str]]:
-    """The items that cannot run even alone, each with its one-line reason: an input whose header
-    claims more pixels than the pixel limit, or an estimated peak memory above ``available`` (default:
-    what the system has available now). They fail by themselves; the rest of the batch runs."""
+    """The items that cannot run even alone, each with its one-line reason.
+
+    An input whose header claims more pixels than the pixel limit, or an estimated peak memory above
+    ``available``. They fail by themselves; the rest of the batch runs.
+
+    Parameters
+    ----------
+    items : iterable of Item
+        The batch's items.
+    available : int, optional
+        Bytes of memory; default what the system has available now.
+
+    Returns
+    -------
+    list of (Item, str)
+    """
     from .. import registry
     from ..image import get_max_pixels
 
@@ -520,13 +563,14 @@ def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> l
                 )
             )
             continue
-        if params is None or available is None or any(s is None for s in shapes.values()):
+        known = {name: s for name, s in shapes.items() if s is not None}
+        if method.memory is None or params is None or available is None or len(known) < len(shapes):
             continue
         if item.region is not None:
             first = method.inputs[0].name
-            shapes[first] = (item.region[2], item.region[2]) + tuple(shapes[first][2:])
+            known[first] = (item.region[2], item.region[2]) + tuple(known[first][2:])
         try:
-            need = float(method.memory(shapes, params))
+            need = float(method.memory(known, params))
         except (WeftError, KeyError, TypeError, ValueError):
             continue
         if need > available:
@@ -540,7 +584,22 @@ def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> l
 
 
 def workers_that_fit(items: Iterable[Item], workers: int, *, available: int | None = None) -> int:
-    """At most ``workers``, as many as fit in memory at once (at least 1) by the largest item's estimate."""
+    """How many workers fit in memory at once by the largest item's estimate.
+
+    Parameters
+    ----------
+    items : iterable of Item
+        The batch's items.
+    workers : int
+        The most workers wanted.
+    available : int, optional
+        Bytes of memory; default what the system has available now.
+
+    Returns
+    -------
+    int
+        At most ``workers``, at least 1.
+    """
     need, _ = item_memory(items)
     available = available_memory() if available is None else available
     if not need or available is None:
@@ -551,8 +610,24 @@ def workers_that_fit(items: Iterable[Item], workers: int, *, available: int | No
 def check_memory(
     items: Iterable[Item], workers: int, *, available: int | None = None, option: str = "--workers"
 ) -> None:
-    """Refuse up front a batch whose largest item's estimate times ``workers`` exceeds ``available``
-    memory (default: what the system has available now), saying how many workers would fit."""
+    """Refuse up front a batch whose largest item's estimate times ``workers`` exceeds the memory.
+
+    Parameters
+    ----------
+    items : iterable of Item
+        The batch's items.
+    workers : int
+        The workers that would run at once.
+    available : int, optional
+        Bytes of memory; default what the system has available now.
+    option : str, default "--workers"
+        The option to name in the advice.
+
+    Raises
+    ------
+    LimitError
+        Saying how many workers would fit.
+    """
     need, label = item_memory(items)
     available = available_memory() if available is None else available
     if not need or available is None or need * workers <= available:

@@ -27,7 +27,21 @@ STEP = 2.0
 
 
 def band_region(hole: np.ndarray, band: int, exclude: np.ndarray | None = None) -> np.ndarray:
-    """bool (H, W): the pixels the band may change (see the module docstring)."""
+    """The pixels the blend band may change (see the module docstring).
+
+    Parameters
+    ----------
+    hole : ndarray, bool (H, W)
+        The hole.
+    band : int
+        The band's width around the hole, pixels.
+    exclude : ndarray, bool (H, W), optional
+        Pixels never changed (transparent ones).
+
+    Returns
+    -------
+    ndarray, bool (H, W)
+    """
     if band <= 0 or not hole.any():
         return np.zeros(hole.shape, dtype=bool)
     k = np.ones((2 * band + 1, 2 * band + 1), np.uint8)
@@ -43,12 +57,35 @@ def band_region(hole: np.ndarray, band: int, exclude: np.ndarray | None = None) 
 def blend_band(
     image: np.ndarray, hole: np.ndarray, band: int, exclude: np.ndarray | None = None, written: np.ndarray | None = None
 ) -> np.ndarray:
-    """``image`` (H, W, C) float32 with its band around ``hole`` re-solved; every other pixel is
-    returned bit for bit. ``exclude``: pixels never changed (transparent ones). ``written``: the
-    pixels the engine wrote (default ``hole``): the hole and the band's known pixels its cut ran
-    through. The seam is where written meets unwritten pixels, so that is where the step is spread:
-    with the hole's edge alone, a cut that ran through the band left its step at the band's outer
-    rows, kept as the image's own gradient (a 4-5 level line along the uncrop's whole lower edge)."""
+    """``image`` with its band around ``hole`` re-solved; every other pixel is returned bit for bit.
+
+    The seam is where written meets unwritten pixels, so that is where the step is spread: with the
+    hole's edge alone, a cut that ran through the band would leave its step at the band's outer rows,
+    kept as the image's own gradient.
+
+    Parameters
+    ----------
+    image : ndarray, float32 (H, W, C)
+        The filled image.
+    hole : ndarray, bool (H, W)
+        The hole.
+    band : int
+        The band's width, pixels.
+    exclude : ndarray, bool (H, W), optional
+        Pixels never changed (transparent ones).
+    written : ndarray, bool (H, W), optional
+        The pixels the engine wrote (default ``hole``): the hole and the band's known pixels its cut
+        ran through.
+
+    Returns
+    -------
+    ndarray, float32 (H, W, C)
+
+    References
+    ----------
+    Pérez, Gangnet & Blake, "Poisson image editing" (2003), as in the quilting write-up's "Poisson
+    Blending".
+    """
     ring = band_region(hole, band, exclude)
     seam = hole if written is None else (np.asarray(written, dtype=bool) | hole)
     if not ring.any() or ring.all():

@@ -10,7 +10,21 @@ from ..errors import ImageError, InvalidParameter, WeftError
 
 
 def as_channels(image: np.ndarray) -> np.ndarray:
-    """float32 (H, W, C), C-contiguous, from (H, W) or (H, W, C)."""
+    """An image as float32 (H, W, C), C-contiguous.
+
+    Parameters
+    ----------
+    image : array_like, (H, W) or (H, W, C) with C = 1..4
+
+    Returns
+    -------
+    ndarray, float32 (H, W, C)
+
+    Raises
+    ------
+    ImageError
+        Another shape.
+    """
     img = np.asarray(image, dtype=np.float32)
     if img.ndim == 2:
         img = img[..., None]
@@ -20,10 +34,23 @@ def as_channels(image: np.ndarray) -> np.ndarray:
 
 
 def percentile(values: np.ndarray, q: float) -> float:
-    """``np.percentile(values, q)`` (linear interpolation) of a non-empty vector, in float64, by
-    ``np.partition``: np.percentile imports numpy.ma (~7 ms of a fill's process start) on first use.
-    Equal to np.percentile on float64 input; on float32 within a float32 rounding (numpy computes
-    in the input's precision)."""
+    """``np.percentile(values, q)`` (linear interpolation) of a non-empty vector, in float64.
+
+    Computed by ``np.partition``: ``np.percentile`` imports ``numpy.ma`` on first use, a cost at every
+    fill's process start. Equal to ``np.percentile`` on float64 input; on float32 within a float32
+    rounding (numpy computes in the input's precision).
+
+    Parameters
+    ----------
+    values : ndarray, (N,)
+        N >= 1.
+    q : float
+        The percentile, 0..100.
+
+    Returns
+    -------
+    float
+    """
     a = np.asarray(values, dtype=np.float64).ravel()
     virtual = q / 100.0 * (len(a) - 1)
     lo = int(np.floor(virtual))
@@ -36,7 +63,35 @@ def percentile(values: np.ndarray, q: float) -> float:
 
 
 def check_engine_args(image, hole, source, patch: int, name: str):
-    """``(image (H, W, C) float32, hole bool, source bool)`` or a one-line ``WeftError``."""
+    """Validate an engine's inputs.
+
+    Parameters
+    ----------
+    image : array_like, (H, W) or (H, W, C)
+        The picture, float in [0, 1].
+    hole : array_like, bool (H, W)
+        The pixels to fill.
+    source : array_like, bool (H, W) or None
+        The pixels to copy from (default all outside the hole).
+    patch : int
+        The engine's patch or block side, at least 3.
+    name : str
+        The engine, for messages.
+
+    Returns
+    -------
+    image : ndarray, float32 (H, W, C)
+    hole, source : ndarray, bool (H, W)
+
+    Raises
+    ------
+    ImageError
+        The masks' sizes are not the image's.
+    InvalidParameter
+        A bad ``patch``.
+    WeftError
+        No whole patch of the source to copy from.
+    """
     img = as_channels(image)
     h, w = img.shape[:2]
     hole = np.asarray(hole, dtype=bool)
@@ -64,17 +119,29 @@ NEAR = 128
 
 
 def neighbourhood(hole: np.ndarray, source: np.ndarray, patch: int) -> tuple[slice, slice] | None:
-    """The part of the picture a fill of ``hole`` reads when it copies from (at least 9/10 of) the
-    known pixels: the hole's bounding box grown by ``NEAR`` and two patches, or None when that is
-    more than a quarter of the picture or the source is a smaller region (a source mask, a second
-    texture), which may lie anywhere.
+    """The part of the picture a fill of ``hole`` reads when it copies from the known pixels.
 
-    The method fills that part alone (every engine): their steps over the whole picture (the refine's
-    candidate search, the colour guide, the fill order's edge scale, the pyramid) cost a 40 px hole in
-    a 4096² photo 4.8-11 s and 2-3.9 GiB, though the quilt's blocks come from within 96 px. Only a
-    hole wider than 2 x 96 px has windows whose neighbourhood holds no whole block; they search the
-    part, not the picture. A neighbourhood of more than a quarter of the picture keeps the picture
-    (the 256-384 px benchmark cases fill as before, bit for bit)."""
+    The hole's bounding box grown by ``NEAR`` and two patches. The method fills that part alone (every
+    engine): their steps over the whole picture (the refine's candidate search, the colour guide, the
+    fill order's edge scale, the pyramid) would cost a small hole in a large photo time and memory,
+    though the quilt's blocks come from nearby. Only a hole wider than twice ``NEAR`` has windows
+    whose neighbourhood holds no whole block; they search the part, not the picture.
+
+    Parameters
+    ----------
+    hole : ndarray, bool (H, W)
+        The hole.
+    source : ndarray, bool (H, W)
+        The pixels to copy from.
+    patch : int
+        The engine's patch side.
+
+    Returns
+    -------
+    (slice, slice) or None
+        None when the part is more than a quarter of the picture, or the source is a smaller region (a
+        source mask, a second texture), which may lie anywhere.
+    """
     if source.sum() < 0.9 * (hole.size - hole.sum()):
         return None
     ys, xs = np.nonzero(hole)
@@ -87,13 +154,34 @@ def neighbourhood(hole: np.ndarray, source: np.ndarray, patch: int) -> tuple[sli
 
 
 def touches_border(hole: np.ndarray) -> bool:
-    """Whether ``hole`` has a pixel in the picture's first or last row or column (an uncrop's, a
-    transparent border's)."""
+    """Whether ``hole`` has a pixel in the picture's first or last row or column.
+
+    Parameters
+    ----------
+    hole : ndarray, bool (H, W)
+
+    Returns
+    -------
+    bool
+        True for an uncrop's hole or a transparent border.
+    """
     return bool(hole[0].any() or hole[-1].any() or hole[:, 0].any() or hole[:, -1].any())
 
 
 def whole_patches(region: np.ndarray, patch: int) -> np.ndarray:
-    """bool (H - patch + 1, W - patch + 1): the patch with this top-left corner lies inside ``region``."""
+    """Where a patch lies wholly inside ``region``.
+
+    Parameters
+    ----------
+    region : ndarray, bool (H, W)
+    patch : int
+        The patch side.
+
+    Returns
+    -------
+    ndarray, bool (H - patch + 1, W - patch + 1)
+        True where the patch with this top-left corner lies inside ``region``.
+    """
     h, w = region.shape
     if patch > h or patch > w:
         return np.zeros((max(0, h - patch + 1), max(0, w - patch + 1)), dtype=bool)
@@ -103,8 +191,17 @@ def whole_patches(region: np.ndarray, patch: int) -> np.ndarray:
 
 
 def onion_order(hole: np.ndarray) -> np.ndarray:
-    """The hole's pixels from its edge inwards ((N, 2) int64 rows of (y, x)): by distance to the
-    nearest known pixel (the fill front), ties in scan order."""
+    """The hole's pixels from its edge inwards: by distance to the nearest known pixel, ties in scan order.
+
+    Parameters
+    ----------
+    hole : ndarray, bool (H, W)
+
+    Returns
+    -------
+    ndarray, int64 (N, 2)
+        Rows of (y, x).
+    """
     from scipy.ndimage import distance_transform_edt
 
     # exact and the same on every call (OpenCV's precise transform varies in its last bit between

@@ -47,8 +47,25 @@ def _vertical_path(err: np.ndarray) -> np.ndarray:
 
 
 def min_cut(err: np.ndarray, *, left: int = 0, top: int = 0, right: int = 0, bottom: int = 0) -> np.ndarray:
-    """bool (h, w): where the new block shows after the cut through the given overlap strips (the
-    strips of one shape -- all four on a square block with equal overlaps -- cut in one pass)."""
+    """Where the new block shows after the minimum error boundary cut through its overlap strips.
+
+    The strips of one shape (all four on a square block with equal overlaps) are cut in one pass.
+
+    Parameters
+    ----------
+    err : ndarray, (h, w)
+        The squared difference between the block and the canvas.
+    left, top, right, bottom : int, default 0
+        The widths of the overlap strips (0: none on that side).
+
+    Returns
+    -------
+    ndarray, bool (h, w)
+
+    References
+    ----------
+    Efros & Freeman, "Image quilting for texture synthesis and transfer" (2001), §2.1.
+    """
     h, w = err.shape
     new = np.ones((h, w), dtype=bool)
     cols = np.arange(w)[None, :]
@@ -81,8 +98,32 @@ def min_cut(err: np.ndarray, *, left: int = 0, top: int = 0, right: int = 0, bot
 def poisson_cg(
     nbr: np.ndarray, ndeg: np.ndarray, rhs: np.ndarray, x: np.ndarray, tol: float, max_iter: int
 ) -> np.ndarray:
-    """Solve ``ndeg_p x_p - sum_{q in nbr_p} x_q = rhs_p`` (``nbr`` (n, 4), -1: none) for every
-    channel of ``rhs`` (n, C), starting from ``x`` (overwritten); stops at ``||r|| <= tol ||rhs||``."""
+    """Solve the discrete Poisson equation ``ndeg_p x_p - sum_{q in nbr_p} x_q = rhs_p`` by conjugate gradients.
+
+    Parameters
+    ----------
+    nbr : ndarray, int (n, 4)
+        Each unknown's neighbours (-1: none).
+    ndeg : ndarray, (n,)
+        Each unknown's neighbour count.
+    rhs : ndarray, (n, C)
+        The right-hand side, per channel.
+    x : ndarray, (n, C)
+        The start, overwritten with the solution.
+    tol : float
+        Stop at ``||r|| <= tol ||rhs||``.
+    max_iter : int
+        Most iterations.
+
+    Returns
+    -------
+    ndarray, (n, C)
+        ``x``.
+
+    References
+    ----------
+    Pérez, Gangnet & Blake, "Poisson image editing" (2003).
+    """
     n, c = rhs.shape
     idx = np.where(nbr >= 0, nbr, n)  # row n is a zero row
 

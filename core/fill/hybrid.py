@@ -49,14 +49,52 @@ def fill_hybrid(
     refine_patch=REFINE_PATCH,
     iterations=REFINE_ITERATIONS,
 ) -> np.ndarray:
-    """Fill ``hole`` of ``image`` with :func:`~weft.core.fill.quilt.fill_quilt` (block side ``patch``;
-    ``band`` / ``cuttable``: the known pixels the cut, and then the refine, may change), then refine
-    the hole and those pixels with :func:`~weft.core.fill.patchmatch.refine_patchmatch`
-    (``refine_patch``, ``iterations``), copying only from source pixels outside them.
+    """Fill ``hole`` by quilting, then refine it by patch search.
 
-    ``progress`` (:class:`weft.core.jobs.Progress`) counts the quilting's filled pixels, then one
-    unit per refine iteration; ``cancel`` is checked by both. Every pixel outside the hole and the band equals the
-    input exactly. Raises as :func:`~weft.core.fill.quilt.fill_quilt` does.
+    :func:`~weft.core.fill.quilt.fill_quilt` fills the hole, then
+    :func:`~weft.core.fill.patchmatch.refine_patchmatch` refines the hole and the band's changed pixels,
+    copying only from source pixels outside them. Every pixel outside the hole and the band equals the
+    input exactly.
+
+    Parameters
+    ----------
+    image : array_like, (H, W) or (H, W, C), float in [0, 1]
+        The picture.
+    hole : array_like, bool (H, W)
+        The pixels to fill.
+    source : array_like, bool (H, W), optional
+        The pixels to copy from (default all outside the hole).
+    patch : int, default BLOCK
+        The quilting's block side.
+    rng : None, int or numpy.random.Generator, default 0
+        Seed.
+    progress : callable, optional
+        Receives :class:`weft.core.jobs.Progress`: the quilting's filled pixels, then one unit per
+        refine iteration.
+    cancel : CancelToken, optional
+        Checked by both steps.
+    band : int, default 0
+        Known pixels around the hole the cut, and then the refine, may change.
+    cuttable : ndarray, bool (H, W), optional
+        Those pixels, when the caller worked them out.
+    refine_patch : int, default REFINE_PATCH
+        The refine's patch side.
+    iterations : int, default REFINE_ITERATIONS
+        The refine's EM iterations.
+
+    Returns
+    -------
+    ndarray, float32
+
+    Raises
+    ------
+    WeftError
+        As :func:`~weft.core.fill.quilt.fill_quilt`.
+
+    References
+    ----------
+    Efros & Freeman, "Image quilting for texture synthesis and transfer" (2001), §2; Barnes et al.,
+    "PatchMatch" (2009); Wexler, Shechtman & Irani, "Space-time completion of video" (2007).
     """
     from .band import band_region
     from .patchmatch import refine_band

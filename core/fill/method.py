@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import cv2
 import numpy as np
@@ -155,7 +156,35 @@ def _as_like(image: np.ndarray, colour: bool) -> np.ndarray:
 def fill_image(
     image, mask=None, *, params: FillParams, source_mask=None, texture=None, rng=0, progress=None, cancel=None
 ) -> tuple[np.ndarray, dict]:
-    """The whole method: ``(filled image, figures)``. See :func:`weft.core.fill.fill`."""
+    """The whole fill method (see :func:`weft.core.fill.fill`).
+
+    Parameters
+    ----------
+    image : ndarray, float32 (H, W), (H, W, 3) or with alpha
+        The picture; a transparent region is a hole.
+    mask : ndarray, optional
+        White (> 0.5) = the hole.
+    params : FillParams
+        The method's parameters.
+    source_mask : ndarray, optional
+        Where to copy from.
+    texture : ndarray, optional
+        A second picture to copy from.
+    rng, progress, cancel
+        Seed; progress callback; cancel token.
+
+    Returns
+    -------
+    image : ndarray, float32
+        The filled picture; pixels outside the hole (and the band) unchanged.
+    figures : dict
+        What the run reports.
+
+    Raises
+    ------
+    WeftError
+        Nothing to fill, masks of the wrong size, no source to copy from, an output over the limits.
+    """
     colour, alpha = _split_alpha(image, "image")
     h, w = colour.shape[:2]
     hole = np.zeros((h, w), dtype=bool)
@@ -200,6 +229,7 @@ def fill_image(
         # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
         # large picture (a colour corner far from a hole in a grey region does not make it a photo)
         known = ~hole & ~transparent
+        near: tuple[slice, slice] | None  # (None later: no neighbourhood, the engine fills the whole)
         near = neighbourhood(hole, known, DEFAULT_PATCH["quilt"]) or (slice(None), slice(None))
         picture = colour.ndim == 3 and is_colour(colour[near], known[near])
         on_border = touches_border(hole)
@@ -312,7 +342,7 @@ def fill_image(
     # a small hole in a large picture: the engine fills the hole's neighbourhood alone
     near = neighbourhood(work_hole, work_src, patch) if texture is None else None
     part = (slice(None), slice(None)) if near is None else near
-    engine_kw = {k: v[part] for k, v in extra.items()}
+    engine_kw: dict[str, Any] = {k: v[part] for k, v in extra.items()}
     if structure:  # the edges entering the hole, continued across it (None: none pair up)
         if pending is not None and pending[0] == part and work is colour:
             engine_kw["guide"], continued = pending[1], pending[2]
@@ -439,6 +469,17 @@ def _scaled(progress, part: int, parts: int):
 
 
 def engine_text(params: FillParams) -> str:
+    """The words naming the engine a fill runs with.
+
+    Parameters
+    ----------
+    params : FillParams
+        The fill's parameters.
+
+    Returns
+    -------
+    str
+    """
     return f"{params.engine} engine"
 
 
@@ -514,8 +555,20 @@ def _seconds(shapes: Mapping[str, tuple[int, ...]], params: FillParams) -> float
 
 
 def check_limits(inputs: Mapping[str, np.ndarray], params: FillParams) -> None:
-    """Refuse up front a fill whose estimated memory exceeds what is available or whose estimated
-    time exceeds the limit (:mod:`weft.core.limits`), before any work."""
+    """Refuse up front, before any work, a fill over the limits (:mod:`weft.core.limits`).
+
+    Parameters
+    ----------
+    inputs : mapping of str to ndarray
+        The method's inputs.
+    params : FillParams
+        Its parameters.
+
+    Raises
+    ------
+    LimitError
+        The grown canvas is over the pixel limit, or the estimated memory or time is over its limit.
+    """
     from ..limits import check_duration, check_memory
 
     shapes = {name: np.shape(image) for name, image in inputs.items() if image is not None}

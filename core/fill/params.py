@@ -48,7 +48,7 @@ class FillParams(Params):
         "colour picture (always with --structure yes), else hybrid; "
         + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()),
     )
-    patch: int = param(
+    patch: int | None = param(
         None,
         kind="int",
         lo=3,
@@ -59,14 +59,14 @@ class FillParams(Params):
         + ", ".join(f"{k} {v}" for k, v in DEFAULT_PATCH.items())
         + f" ({BORDER_BLOCK} for an uncrop more than 24 px deep)",
     )
-    extend: Margins = param(
+    extend: Margins | None = param(
         None,
         kind="geometry",
         type=Margins,
         optional=True,
         help="uncrop: pixels added on the left, top, right and bottom, filled like the hole",
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=1,
@@ -137,9 +137,21 @@ class FillParams(Params):
 
 
 def structure_value(value):
-    """``structure`` as given, but ``True`` / ``False`` (the on/off switch of the round before
-    ``auto``, off by default) read as ``yes`` / ``no``: a ``False`` recipe reproduces its pixels, a
-    ``True`` one gets the guide as it is now (laying out the coarsest level only)."""
+    """``structure`` as given, but ``True`` / ``False`` read as ``yes`` / ``no``.
+
+    Older recipes stored an on/off switch: a ``False`` recipe reproduces its pixels, a ``True`` one
+    gets the guide as it is now (laying out the coarsest level only).
+
+    Parameters
+    ----------
+    value : object
+        The recipe's or the caller's value.
+
+    Returns
+    -------
+    object
+        ``"yes"``, ``"no"`` or ``value`` unchanged (validated by the parameter's spec).
+    """
     if isinstance(value, (bool, np.bool_)):
         return "yes" if value else "no"
     return value
@@ -148,15 +160,35 @@ def structure_value(value):
 def auto_engine(
     colour_picture: bool, hole_on_border: bool, patch: int | None, structure: str = "auto", edges: bool | None = None
 ) -> str:
-    """The engine ``auto`` runs: ``patchmatch`` with the edge guide where that guide has edges to
-    continue (``edges``: at least one pair of edges crossing the hole, as
-    :func:`weft.core.fill.structure.structure_guide` pairs them) in a colour picture's hole that
-    does not touch the border, with ``structure`` = auto and a ``patch`` that engine takes (none
-    given, or at most its largest); ``patchmatch`` with ``structure`` = yes;
-    else ``hybrid`` (quilting, then full-resolution patch search). Patch search guided along the
-    edges continues a rim or a horizon a removed object cut; the hybrid's blocks fill textures and
-    structureless holes more coherently (``python -m benchmarks.fill_suite``). ``edges`` = None
-    (not looked for, e.g. when only the inputs' shapes are known) counts as none."""
+    """The engine ``auto`` runs.
+
+    ``patchmatch`` with the edge guide where that guide has edges to continue, in a colour picture's
+    hole that does not touch the border, with ``structure`` = auto and a ``patch`` that engine takes
+    (none given, or at most its largest); ``patchmatch`` with ``structure`` = yes; else ``hybrid``
+    (quilting, then full-resolution patch search). Patch search guided along the edges continues a rim
+    or a horizon a removed object cut; the hybrid's blocks fill textures and structureless holes more
+    coherently (``python -m benchmarks.fill_suite``).
+
+    Parameters
+    ----------
+    colour_picture : bool
+        The picture is in colour on its known pixels.
+    hole_on_border : bool
+        The hole touches the picture's border.
+    patch : int or None
+        The patch given.
+    structure : {"auto", "yes", "no"}, default "auto"
+        The edge guide's switch.
+    edges : bool or None
+        At least one pair of edges crossing the hole, as
+        :func:`weft.core.fill.structure.structure_guide` pairs them; None (not looked for, e.g. when
+        only the inputs' shapes are known) counts as none.
+
+    Returns
+    -------
+    str
+        ``"patchmatch"`` or ``"hybrid"``.
+    """
     from .patchmatch import MAX_PATCH
 
     if structure == "yes":

@@ -68,7 +68,7 @@ _FINAL_REFINE, _FINAL_WORST = 3, 50
 _FINAL_REFINE_GUIDED = 4
 
 
-def _halve(img: np.ndarray, hole: np.ndarray, source: np.ndarray):
+def _halve(img: np.ndarray, hole: np.ndarray, source: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The next coarser level: 2x2 blocks (an odd last row/column is its own block)."""
     h, w = hole.shape
     ph, pw = h % 2, w % 2
@@ -83,7 +83,7 @@ def _halve(img: np.ndarray, hole: np.ndarray, source: np.ndarray):
     img2 = np.where(kb[..., None] > 0, vb / np.maximum(kb, 1.0)[..., None], 0.0).astype(np.float32)
     hole2 = hole.reshape(h2, 2, w2, 2).any(axis=(1, 3))
     source2 = source.reshape(h2, 2, w2, 2).all(axis=(1, 3)) & ~hole2
-    return np.ascontiguousarray(img2), hole2, source2
+    return np.ascontiguousarray(img2), hole2, source2  # type: ignore[return-value]  # numpy's stubs: any/all with an axis may be a bool
 
 
 class _Level:
@@ -239,7 +239,7 @@ def fill_patchmatch(
             fixed = None  # the guide steers the coarsest level's layout only
             _upsample_into(im, lv.hole, pyramid[li + 1].img[..., : im.shape[2]])
             coarse, fl = fl, Flat(im, lv.hole, lv.source, p, conf=lv.conf)
-            sy, sx = _upsample_matches(fl, coarse, sy, sx, gen)
+            sy, sx = _upsample_matches(fl, coarse, sy, sx, gen)  # type: ignore[arg-type]  # set on the coarsest level, the loop's first
             # the first estimate of this level: the coarse matches, doubled, voted (an upsampled
             # image would be blurred; matched against it, the flattest patches win)
             vote_mode(im, lv.hole, fl, sy, sx, np.ones(len(sy)))

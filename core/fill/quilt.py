@@ -116,8 +116,20 @@ GAP_SIGMA = 1.5
 
 
 def is_colour(img: np.ndarray, known: np.ndarray) -> bool:
-    """Whether (H, W, C) ``img`` is a colour picture on its ``known`` pixels: three channels or more,
-    not all grey (a grey picture stored as RGB has no chroma). Steps 1, 4 and 7 run on colour only."""
+    """Whether ``img`` is a colour picture on its ``known`` pixels.
+
+    Three channels or more, not all grey (a grey picture stored as RGB has no chroma). Steps 1, 4 and
+    7 run on colour only.
+
+    Parameters
+    ----------
+    img : ndarray, (H, W, C)
+    known : ndarray, bool (H, W)
+
+    Returns
+    -------
+    bool
+    """
     if img.shape[2] < 3 or not known.any():
         return False
     rgb, sub, ksub = img[..., :3], img[::7, ::7, :3], known[::7, ::7]
@@ -127,9 +139,23 @@ def is_colour(img: np.ndarray, known: np.ndarray) -> bool:
 
 
 def refines(image, hole, refine: bool | None = None) -> bool:
-    """Whether :func:`fill_quilt` ends with its patch-search refine (step 7) on this image: ``refine``
-    when given, else on colour pictures when :data:`REFINE` > 0. The method then runs no Poisson
-    blend band (the refine re-synthesises the band)."""
+    """Whether :func:`fill_quilt` ends with its patch-search refine (step 7) on this image.
+
+    The method then runs no Poisson blend band (the refine re-synthesises the band).
+
+    Parameters
+    ----------
+    image : ndarray
+        The picture.
+    hole : ndarray, bool (H, W)
+        The hole.
+    refine : bool, optional
+        The caller's choice; default: on colour pictures when :data:`REFINE` > 0.
+
+    Returns
+    -------
+    bool
+    """
     if refine is not None:
         return bool(refine) and REFINE > 0
     img = np.asarray(image)
@@ -152,7 +178,7 @@ def _ccorr(planes: list[np.ndarray], crop: tuple[slice, slice], template: np.nda
     are ``planes``, as the sum of one single-channel correlation per channel: OpenCV's multi-channel
     correlation took 1.5-2.5x as long as three single-channel ones on the 216 px crops and 24 px
     blocks of a fill (equal to float32 rounding)."""
-    out = cv2.matchTemplate(planes[0][crop], np.ascontiguousarray(template[..., 0]), cv2.TM_CCORR)
+    out: np.ndarray = cv2.matchTemplate(planes[0][crop], np.ascontiguousarray(template[..., 0]), cv2.TM_CCORR)
     for k in range(1, len(planes)):
         out += cv2.matchTemplate(planes[k][crop], np.ascontiguousarray(template[..., k]), cv2.TM_CCORR)
     return out
@@ -365,7 +391,7 @@ def fill_quilt(
     while left > 0:
         py, px = front.first_max()
         if score[py, px] < 0:  # an unknown region touching nothing valued (cannot happen, kept safe)
-            py, px = np.unravel_index(int(np.argmax(~have)), have.shape)
+            py, px = np.unravel_index(int(np.argmax(~have)), have.shape)  # type: ignore[assignment]  # numpy ints
         # the window centred there, moved away from its known pixels so that they fill about an
         # overlap's width of it (a straight front: B/2 known -> B/3) and the block fills more
         y0 = int(min(max(py - b // 2, 0), h - b))

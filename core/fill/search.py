@@ -37,8 +37,19 @@ VOTE_STRIDE = 3
 
 
 def box_sum(a: np.ndarray, p: int) -> np.ndarray:
-    """Sums of ``a`` over every p x p window, indexed by the window's top-left corner (a bool ``a``:
-    exact int32 counts from OpenCV's integral image, ~10x faster than two float64 cumsums)."""
+    """Sums of ``a`` over every p x p window, indexed by the window's top-left corner.
+
+    Parameters
+    ----------
+    a : ndarray, (H, W)
+        Values; a bool ``a`` gives exact int32 counts from OpenCV's integral image.
+    p : int
+        The window side.
+
+    Returns
+    -------
+    ndarray, (H - p + 1, W - p + 1)
+    """
     if a.dtype == bool:
         import cv2
 
@@ -50,6 +61,35 @@ def box_sum(a: np.ndarray, p: int) -> np.ndarray:
 
 
 def check_inputs(image, hole, source, patch, levels, iterations):
+    """Validate the inputs of a patch-search fill.
+
+    Parameters
+    ----------
+    image : array_like, (H, W) or (H, W, C) with C = 1..4
+        Float in [0, 1].
+    hole : array_like, bool (H, W)
+        The pixels to fill.
+    source : array_like, bool (H, W) or None
+        The pixels to copy from (default all outside the hole).
+    patch : int
+        The patch side, MIN_PATCH..MAX_PATCH, at most the image's shorter side.
+    levels, iterations : int or None
+        1..64, or None.
+
+    Returns
+    -------
+    image : ndarray
+    hole, source : ndarray, bool (H, W)
+        ``source`` never includes the hole.
+    patch : int
+
+    Raises
+    ------
+    ImageError
+        A bad shape or type, or masks of another size than the image.
+    InvalidParameter
+        A bad ``patch``, ``levels`` or ``iterations``.
+    """
     arr = np.asarray(image)
     if arr.ndim not in (2, 3) or (arr.ndim == 3 and not 1 <= arr.shape[2] <= 4):
         raise ImageError(f"image must be (H, W) or (H, W, C) with C = 1..4 channels, got shape {arr.shape}")
@@ -116,7 +156,7 @@ class Flat:
         touches = box_sum(hole, p) > 0.5
         ty, tx = np.nonzero(touches)
         self.ty, self.tx = ty.astype(np.int64), tx.astype(np.int64)
-        self.tmap = np.full(touches.shape, -1, np.int64)
+        self.tmap: np.ndarray = np.full(touches.shape, -1, np.int64)
         self.tmap[ty, tx] = np.arange(len(ty))
         self.weights = None  # (N, P * C) float32: the target patches' confidences, a pixel's repeated per channel
         self.mean_conf = None  # (N,) float64: their means over the patch
@@ -220,17 +260,41 @@ def _stable_argsort(values: np.ndarray) -> np.ndarray:
 def vote_mode(
     img: np.ndarray, hole: np.ndarray, fl: Flat, sy, sx, weight, stride: int = VOTE_STRIDE, fixed: slice | None = None
 ) -> np.ndarray:
-    """Every pixel of ``hole`` is copied through the offset (match minus target corner) that the
-    target patches covering it agree on most (those at every ``stride``-th row and column of
-    corners, and the last), each counted with its ``weight`` (0..1). numpy; writes ``img`` in place
-    (but its ``fixed`` channels, the guide's, the last ones) and returns the pixels whose value
-    changed (bool (H, W)).
+    """Copy every pixel of ``hole`` through the offset its covering target patches agree on most.
 
-    Each covering patch is one int64 key: its offset's code in the high bits, its weight as an
-    integer (``weight * 2**(bits - 6)``, at least 1: a pixel whose votes all weigh nearly nothing
-    takes its most frequent offset) in the low ones; a plain sort of each pixel's keys groups equal
-    offsets, and exact integer sums weigh them (quicker than a stable argsort of the codes and float
-    sums, with the same result)."""
+    The covering patches are those at every ``stride``-th row and column of corners, and the last,
+    each counted with its ``weight``. Each covering patch is one int64 key: its offset's code in the
+    high bits, its weight as an integer (``weight * 2**(bits - 6)``, at least 1: a pixel whose votes all
+    weigh nearly nothing takes its most frequent offset) in the low ones; a plain sort of each pixel's
+    keys groups equal offsets, and exact integer sums weigh them (the result of a stable argsort of
+    the codes and float sums, for less).
+
+    Parameters
+    ----------
+    img : ndarray, float32 (H, W, C)
+        Written in place, but for its ``fixed`` channels.
+    hole : ndarray, bool (H, W)
+    fl : Flat
+        The target patches and their geometry.
+    sy, sx : ndarray
+        Each target patch's match (top-left corner).
+    weight : ndarray
+        Each target patch's weight, 0..1.
+    stride : int, default VOTE_STRIDE
+        Which corners vote.
+    fixed : slice, optional
+        Channels left as they are (the guide's, the last ones).
+
+    Returns
+    -------
+    ndarray, bool (H, W)
+        The pixels whose value changed.
+
+    References
+    ----------
+    Wexler, Shechtman & Irani, "Space-time completion of video" (2007), §3 (the vote), with the mode
+    of the offsets in place of their mean.
+    """
     h, w, p = fl.h, fl.w, fl.p
     hy, hx = np.nonzero(hole)
     changed = np.zeros(hole.shape, bool)
@@ -287,11 +351,29 @@ def refine_band(
     worst: float = 0.0,
     last_vote_stride: int | None = None,
 ) -> np.ndarray:
-    """:func:`refine_patchmatch` of a finished fill over ``region`` (the hole and the blend band's
-    known pixels that may change), copying only from ``source`` pixels outside it, so the band
-    becomes a continuation of the copies; over the hole alone, from the whole source, when the band
-    took the last whole source patch; ``filled`` as it is when there is none either. What the
-    ``quilt`` (colour), ``hybrid`` and ``patchmatch`` engines end with."""
+    """:func:`refine_patchmatch` of a finished fill over ``region``, copying from ``source`` outside it.
+
+    The band becomes a continuation of the copies. Over the hole alone, from the whole source, when
+    the band took the last whole source patch; ``filled`` as it is when there is none either. What the
+    ``quilt`` (colour), ``hybrid`` and ``patchmatch`` engines end with.
+
+    Parameters
+    ----------
+    filled : ndarray, float32 (H, W, C)
+        The finished fill.
+    hole : ndarray, bool (H, W)
+        The hole.
+    region : ndarray, bool (H, W)
+        The hole and the blend band's known pixels that may change.
+    source : ndarray, bool (H, W)
+        The pixels to copy from.
+    patch, iterations, rng, progress, cancel, worst, last_vote_stride
+        As in :func:`refine_patchmatch`.
+
+    Returns
+    -------
+    ndarray, float32 (H, W, C)
+    """
     sources = source & ~region
     if not whole_patches(sources, patch).any():
         region, sources = hole, source
@@ -340,18 +422,53 @@ def refine_patchmatch(
        where the covering patches agree.
 
     A patch that is an exact copy of its match is not searched again, and a pixel only such patches
-    cover keeps its value (any of their offsets gives it). In numpy and OpenCV: a fill that uses
-    only this loads no numba.
+    cover keeps its value (any of their offsets gives it). In numpy and OpenCV: a fill that uses only
+    this loads no numba.
 
-    Parameters are as for :func:`fill_patchmatch`, plus ``init``: an array of the image's shape whose
-    hole pixels are the starting fill (default: the image itself). ``iterations``: EM iterations
-    (1..64, default 3). ``worst``: a percentage 0..100 (default 0): every iteration searches only the
-    patches that are not exact copies and whose distance is at least this percentile of theirs (the
-    hybrid engine searches the worse half: most of the gain at a fraction of the cost, since the
-    judge's mean distance is dominated by the worst windows). ``last_vote_stride``: the last
-    iteration's vote counts the covering patches at every this-th corner row and column (default:
-    every ``VOTE_STRIDE``-th, as the others; the ``patchmatch`` engine's final refine counts every
-    one). Returns float32, every pixel outside the hole equal to ``image``'s bit for bit.
+    Parameters
+    ----------
+    image : ndarray, float (H, W) or (H, W, C) in [0, 1]
+        The picture.
+    hole : ndarray, bool (H, W)
+        The pixels to fill.
+    source : ndarray, bool (H, W), optional
+        The pixels to copy from (default all outside the hole).
+    init : ndarray, optional
+        An array of the image's shape whose hole pixels are the starting fill (default: the image).
+    patch : int, default 7
+        The patch side.
+    iterations : int, default REFINE_ITERATIONS
+        EM iterations, 1..64.
+    rng : None, int or numpy.random.Generator, default 0
+        Seed.
+    progress : callable, optional
+        Receives :class:`weft.core.jobs.Progress`, one unit per iteration.
+    cancel : CancelToken, optional
+        Checked every iteration.
+    worst : float, default 0
+        A percentage 0..100: every iteration searches only the patches that are not exact copies and
+        whose distance is at least this percentile of theirs (the hybrid engine searches the worse
+        half, where most of the gain is).
+    last_vote_stride : int, optional
+        The last iteration's vote counts the covering patches at every this-th corner row and column
+        (default: every ``VOTE_STRIDE``-th, as the others; the ``patchmatch`` engine's final refine
+        counts every one).
+
+    Returns
+    -------
+    ndarray, float32
+        Every pixel outside the hole equal to ``image``'s bit for bit.
+
+    Raises
+    ------
+    ImageError
+        Bad shapes (see :func:`check_inputs`), or an ``init`` of another shape.
+    InvalidParameter
+        A bad ``patch``, ``iterations`` or ``worst``.
+
+    References
+    ----------
+    Barnes et al., "PatchMatch" (2009); Wexler, Shechtman & Irani, "Space-time completion of video" (2007).
     """
     if isinstance(worst, bool) or not isinstance(worst, (int, float, np.integer, np.floating)) or not 0 <= worst < 100:
         raise InvalidParameter(
@@ -421,21 +538,51 @@ def em(
     bias: float,
     worst: float,
     cancel: CancelToken | None,
-    on_iteration: Callable[[int], None],
+    on_iteration: Callable[[int], object],
     last_stride: int | None = None,
     fixed: slice | None = None,
 ) -> None:
-    """EM iterations on ``img`` (the array ``fl`` views), improving the matches (``sy``, ``sx``, their
-    ``dist``) of ``fl``'s target patches and writing the hole's pixels, in place. Each iteration:
-    (E) the inexact patches (a distance above 0; with ``worst``, at least that percentile of their
-    distances) try their neighbours' offsets (``steps_first`` px away on the first iteration, then
-    ``_STEPS_LATER``; taken within ``1 + bias`` of the current distance) and random candidates around
-    their match (radii from half the image down to 1, divided by ``shrink``); (M) every hole pixel
-    covered by an inexact patch is copied through the offset its covering patches agree on most
-    (:func:`vote_mode`, weights ``exp(-d / 2 sigma^2)``). A patch that is an exact copy of its
-    match is not searched again, and a pixel only such patches cover keeps its value (any of their
-    offsets gives it). The votes leave the ``fixed`` channels (the guide) as they are.
-    ``on_iteration(it)`` after each."""
+    """EM iterations on ``img``, improving the matches of ``fl``'s target patches and writing the hole, in place.
+
+    Each iteration: (E) the inexact patches (a distance above 0; with ``worst``, at least that
+    percentile of their distances) try their neighbours' offsets (``steps_first`` px away on the first
+    iteration, then ``_STEPS_LATER``; taken within ``1 + bias`` of the current distance) and random
+    candidates around their match (radii from half the image down to 1, divided by ``shrink``); (M)
+    every hole pixel covered by an inexact patch is copied through the offset its covering patches
+    agree on most (:func:`vote_mode`, weights ``exp(-d / 2 sigma^2)``). A patch that is an exact copy
+    of its match is not searched again, and a pixel only such patches cover keeps its value.
+
+    Parameters
+    ----------
+    fl : Flat
+        The patches of ``img``.
+    img : ndarray, float32 (H, W, C)
+        The array ``fl`` views, written in place.
+    hole : ndarray, bool (H, W)
+    sy, sx, dist : ndarray
+        The target patches' matches and distances, updated in place.
+    iterations : int
+    gen : numpy.random.Generator
+    steps_first : tuple of int
+        Propagation steps of the first iteration.
+    shrink : int
+        Divides the random search's radii.
+    bias : float
+        A neighbour's offset is taken within ``1 + bias`` of the current distance.
+    worst : float
+        As in :func:`refine_patchmatch`.
+    cancel : CancelToken or None
+    on_iteration : callable
+        Called with the iteration's index after each.
+    last_stride : int, optional
+        The last vote's stride.
+    fixed : slice, optional
+        Channels the votes leave as they are (the guide).
+
+    References
+    ----------
+    Barnes et al., "PatchMatch" (2009); Wexler, Shechtman & Irani, "Space-time completion of video" (2007).
+    """
     p = fl.p
     hv, wv = fl.valid.shape
     changed = None

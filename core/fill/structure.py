@@ -77,14 +77,27 @@ _MAX_EDGES = 4  # at most this many edges are continued (the best pairs), a guid
 def structure_guide(
     image: np.ndarray, hole: np.ndarray, known: np.ndarray | None = None, *, reach: int = REACH
 ) -> tuple[np.ndarray | None, int]:
-    """The guide of the module text for filling ``hole`` in ``image``, and the number of edges it
-    continues across the hole: ``(float32 (H, W, n) in [-1, 1], n)``, a channel per edge (at most
-    ``_MAX_EDGES``, the best pairs), or ``(None, 0)`` when no two edges entering the hole pair up
-    (nothing to continue).
+    """The guide of the module text for filling ``hole`` in ``image``, and the number of edges it continues.
 
-    ``image``: float (H, W) or (H, W, 3) in [0, 1] (an alpha channel is not passed; values in the
-    hole are ignored). ``hole``: bool (H, W). ``known``: the pixels whose edges count (default: all
-    outside the hole; a transparent region outside the hole is not known)."""
+    Parameters
+    ----------
+    image : ndarray, float (H, W) or (H, W, 3) in [0, 1]
+        The picture (an alpha channel is not passed; values in the hole are ignored).
+    hole : ndarray, bool (H, W)
+        The hole.
+    known : ndarray, bool (H, W), optional
+        The pixels whose edges count (default: all outside the hole; a transparent region outside the
+        hole is not known).
+    reach : int, default REACH
+        The guide's reach from the continued structure, pixels (beyond it the guide is 0).
+
+    Returns
+    -------
+    guide : ndarray, float32 (H, W, n) in [-1, 1], or None
+        A channel per edge (at most ``_MAX_EDGES``, the best pairs); None when no two edges entering
+        the hole pair up (nothing to continue).
+    n : int
+    """
     hole = np.asarray(hole, dtype=bool)
     known = ~hole if known is None else (np.asarray(known, dtype=bool) & ~hole)
     if not hole.any() or not known.any():
@@ -221,7 +234,7 @@ def _side_colours(rgb8: np.ndarray | None, lum: np.ndarray, p: np.ndarray, t: np
     nrm = np.array([-t[1], t[0]])
     back = np.arange(2, 10, dtype=float)
     aside = np.arange(2, 6, dtype=float)
-    out = []
+    out: list[np.ndarray | None] = []
     for sgn in (1.0, -1.0):
         pts = (
             p[None, None, :] - t[None, None, :] * back[:, None, None] + sgn * nrm[None, None, :] * aside[None, :, None]
@@ -308,7 +321,7 @@ def _orient(struct: np.ndarray, nx_: np.ndarray, ny_: np.ndarray, seeds) -> np.n
     Returns the pixels reached (a piece of edge the curves do not reach is dropped)."""
     h, w = struct.shape
     done = np.zeros((h, w), bool)
-    queue = deque()
+    queue: deque[tuple[int, int]] = deque()
     for y, x in seeds:
         if not done[y, x]:
             done[y, x] = True

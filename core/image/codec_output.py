@@ -62,7 +62,7 @@ def _codec_output(said: list[str]):
         finally:
             os.close(saved)
             sink.close()
-    other = []
+    other: list[str] = []
     for line in text.splitlines():
         (said if _CODEC_LINE.match(line) else other).append(line)
     if other:

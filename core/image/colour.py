@@ -28,7 +28,17 @@ def _check_float_image(image: np.ndarray, what: str = "image") -> np.ndarray:
 
 
 def luminance(image: np.ndarray) -> np.ndarray:
-    """Rec. 601 luminance ``0.299 R + 0.587 G + 0.114 B`` as float32 (H, W); grey passes through."""
+    """Rec. 601 luminance ``0.299 R + 0.587 G + 0.114 B``.
+
+    Parameters
+    ----------
+    image : ndarray, (H, W) or (H, W, 3)
+        RGB in [0, 1]; a grey image passes through.
+
+    Returns
+    -------
+    ndarray, float32 (H, W)
+    """
     image = _check_float_image(image)
     if image.ndim == 2:
         return image.astype(np.float32, copy=False)
@@ -36,7 +46,28 @@ def luminance(image: np.ndarray) -> np.ndarray:
 
 
 def rgb_to_yiq(rgb: np.ndarray) -> np.ndarray:
-    """RGB in [0, 1] -> YIQ (NTSC), float32 (H, W, 3). Y in [0, 1], I in ±0.596, Q in ±0.523."""
+    """RGB to YIQ (NTSC).
+
+    Parameters
+    ----------
+    rgb : ndarray, (H, W, 3)
+        RGB in [0, 1].
+
+    Returns
+    -------
+    ndarray, float32 (H, W, 3)
+        Y in [0, 1], I in ±0.596, Q in ±0.523.
+
+    Raises
+    ------
+    ImageError
+        ``rgb`` is not (H, W, 3).
+
+    References
+    ----------
+    Ashikhmin, "Fast texture transfer" (2003), "Basic technique": the synthesis runs on Y and the
+    target's chroma is kept.
+    """
     rgb = _check_float_image(rgb, "RGB image")
     if rgb.ndim != 3:
         raise ImageError(f"RGB image must have shape (H, W, 3), not {rgb.shape}")
@@ -44,7 +75,24 @@ def rgb_to_yiq(rgb: np.ndarray) -> np.ndarray:
 
 
 def yiq_to_rgb(yiq: np.ndarray, *, clip: bool = True) -> np.ndarray:
-    """YIQ -> RGB float32 (H, W, 3), clipped to [0, 1] unless ``clip=False``."""
+    """YIQ to RGB, the inverse of :func:`rgb_to_yiq`.
+
+    Parameters
+    ----------
+    yiq : ndarray, (H, W, 3)
+        Y, I, Q.
+    clip : bool, default True
+        Clip the result to [0, 1].
+
+    Returns
+    -------
+    ndarray, float32 (H, W, 3)
+
+    Raises
+    ------
+    ImageError
+        ``yiq`` is not (H, W, 3).
+    """
     yiq = np.asarray(yiq)
     if yiq.ndim != 3 or yiq.shape[2] != 3:
         raise ImageError(f"YIQ image must have shape (H, W, 3), not {yiq.shape}")
@@ -67,7 +115,28 @@ class PcaBasis:
 
 
 def pca_basis(rgb: np.ndarray) -> PcaBasis:
-    """The principal components of an RGB image's colours (Smith & Bhalerao §3.4, Jolliffe)."""
+    """The principal components of an RGB image's colours.
+
+    Parameters
+    ----------
+    rgb : ndarray, (H, W, 3)
+        RGB in [0, 1].
+
+    Returns
+    -------
+    PcaBasis
+        The colours' mean and the three axes, the direction of greatest variance first.
+
+    Raises
+    ------
+    ImageError
+        ``rgb`` is not (H, W, 3).
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary
+    matching", §3.4; Jolliffe, *Principal Component Analysis*.
+    """
     rgb = _check_float_image(rgb, "RGB image")
     if rgb.ndim != 3:
         raise ImageError(f"RGB image must have shape (H, W, 3), not {rgb.shape}")
@@ -91,7 +160,26 @@ def pca_basis(rgb: np.ndarray) -> PcaBasis:
 
 
 def to_pca(rgb: np.ndarray, basis: PcaBasis | None = None) -> tuple[np.ndarray, PcaBasis]:
-    """Project RGB onto a PCA colour basis; returns float32 (H, W, 3) components and the basis."""
+    """Project RGB onto a PCA colour basis.
+
+    Parameters
+    ----------
+    rgb : ndarray, (H, W, 3)
+        RGB in [0, 1].
+    basis : PcaBasis, optional
+        The basis; default the image's own (:func:`pca_basis`).
+
+    Returns
+    -------
+    components : ndarray, float32 (H, W, 3)
+        The coordinates along the basis's axes, about its mean.
+    basis : PcaBasis
+        The basis used.
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary matching", §3.4.
+    """
     if basis is None:
         basis = pca_basis(rgb)
     comps = (np.asarray(rgb, dtype=np.float32) - basis.mean) @ basis.axes.T
@@ -99,7 +187,22 @@ def to_pca(rgb: np.ndarray, basis: PcaBasis | None = None) -> tuple[np.ndarray, 
 
 
 def from_pca(components: np.ndarray, basis: PcaBasis, *, clip: bool = True) -> np.ndarray:
-    """Inverse of :func:`to_pca`: float32 RGB (H, W, 3), clipped to [0, 1] unless ``clip=False``."""
+    """Inverse of :func:`to_pca`.
+
+    Parameters
+    ----------
+    components : ndarray, (H, W, 3)
+        Coordinates along the basis's axes.
+    basis : PcaBasis
+        The basis they are in.
+    clip : bool, default True
+        Clip the result to [0, 1].
+
+    Returns
+    -------
+    ndarray, float32 (H, W, 3)
+        RGB.
+    """
     rgb = (np.asarray(components, dtype=np.float32) @ basis.axes + basis.mean).astype(np.float32, copy=False)
     return np.clip(rgb, 0.0, 1.0, out=rgb) if clip else rgb
 
@@ -107,10 +210,24 @@ def from_pca(components: np.ndarray, basis: PcaBasis, *, clip: bool = True) -> n
 def pca_grey(rgb: np.ndarray) -> tuple[np.ndarray, PcaBasis]:
     """The principal-component grey of §3.4: the colour direction of greatest variance.
 
-    Returns the first component offset by the mean's projection on that axis (so the values sit
-    around the image's mean brightness rather than around zero), float32 (H, W), and the basis.
     Reconstruct with ``from_pca(stack([grey - offset, c1, c2]), basis)`` where
     ``offset = basis.mean @ basis.axes[0]``.
+
+    Parameters
+    ----------
+    rgb : ndarray, (H, W, 3)
+        RGB in [0, 1].
+
+    Returns
+    -------
+    grey : ndarray, float32 (H, W)
+        The first component offset by the mean's projection on that axis (so the values sit around
+        the image's mean brightness rather than around zero).
+    basis : PcaBasis
+
+    References
+    ----------
+    Smith & Bhalerao, "Texture transfer using affine transformation groups and patch boundary matching", §3.4.
     """
     comps, basis = to_pca(rgb)
     offset = float(basis.mean @ basis.axes[0])

@@ -137,7 +137,18 @@ def get_max_pixels() -> int:
 
 
 def set_max_pixels(n: int | None) -> None:
-    """Set the process-wide pixel limit (a positive int); ``None`` restores env var / default."""
+    """Set the process-wide pixel limit of :func:`load_image` and the outputs.
+
+    Parameters
+    ----------
+    n : int or None
+        The limit, a positive integer; ``None`` restores ``WEFT_MAX_PIXELS`` or the default.
+
+    Raises
+    ------
+    InvalidParameter
+        ``n`` is not a positive integer.
+    """
     global _max_pixels_override
     _max_pixels_override = None if n is None else _check_limit(n)
 
@@ -389,6 +400,7 @@ def load_image(
             raise ImageError(f"{shown(name)}: truncated or corrupt JPEG data ({damage})", path=name)
         if kept is not None:
             return _loaded_alpha(kept, name, fmt, orientation, src_mode, animated, mode)
+        assert arr is not None  # decoded by OpenCV or Pillow, or raised
         if not (arr.ndim == 2 or (arr.ndim == 3 and arr.shape[2] == 3)):
             raise ValueError(f"unexpected decoder output of shape {arr.shape}")
         if arr.dtype not in (np.uint8, np.uint16):
@@ -401,7 +413,7 @@ def load_image(
         # so for PNG the IHDR colour type (0 grey, 4 grey+alpha) decides.
         if arr.ndim == 3 and (src_mode in _GREY_MODES or (fmt == "PNG" and len(data) > 25 and data[25] in (0, 4))):
             arr = arr[..., 0]
-        image = arr.astype(np.float32, order="C") / np.float32(np.iinfo(arr.dtype).max)
+        image = arr.astype(np.float32, order="C") / np.float32(65535 if arr.dtype == np.uint16 else 255)
     except MemoryError:
         raise ImageError(f"{shown(name)}: not enough memory to decode {width}x{height} pixels", path=name) from None
     except ImageError:
@@ -441,10 +453,22 @@ def load_image(
 
 
 def file_bit_depth(path: str | os.PathLike) -> int | None:
-    """The bits per sample :func:`load_image` gives for an image file, from its header alone: 16 for
-    a 16-bit PNG or TIFF, 8 for anything else it reads; None when the header cannot be read (loading
-    the file says why). What an output keeps when the method keeps its input's depth
-    (``Method.depth_from``) and no bit depth was asked for."""
+    """The bits per sample :func:`load_image` gives for an image file, from its header alone.
+
+    What an output keeps when the method keeps its input's depth (``Method.depth_from``) and no bit
+    depth was asked for.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The image file.
+
+    Returns
+    -------
+    int or None
+        16 for a 16-bit PNG or TIFF, 8 for anything else it reads; None when the header cannot be read
+        (loading the file says why).
+    """
     name = os.fsdecode(path)
     try:
         with open_regular(name, error=ImageError) as f:
@@ -546,6 +570,13 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     fsync'ed, then ``os.replace`` puts them over ``path``. A replaced file keeps its permission bits;
     a new one gets ``0o666 & ~umask`` (not mkstemp's 0o600).
 
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file to write.
+    data : bytes
+        Its new contents.
+
     Raises
     ------
     ImageError
@@ -592,7 +623,25 @@ def save_image(
 ) -> None:
     """Save an image atomically (see :func:`atomic_write_bytes`) in the format of its extension.
 
-    The bytes are :func:`encode_image`'s (same parameters); this only adds the atomic write.
+    The bytes are :func:`encode_image`'s; this only adds the atomic write.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file; its extension picks the format.
+    image : ndarray, float32 in [0, 1], (H, W), (H, W, 3) (or with alpha)
+        The image.
+    recipe : str, optional
+        A recipe's JSON, stored in the PNG's ``weft-recipe`` chunk.
+    bit_depth : {8, 16}, default 8
+        Bits per sample (16: PNG and TIFF only).
+    quality : int, default 95
+        JPEG and WebP quality.
+
+    Raises
+    ------
+    ImageError
+        Unknown extension, 16-bit JPEG, invalid image, missing folder, write failure.
     """
     atomic_write_bytes(Path(path), encode_image(path, image, recipe=recipe, bit_depth=bit_depth, quality=quality))
 
@@ -701,10 +750,24 @@ def _tiff_with_alpha(data: bytes) -> bytes:
 def read_recipe(path: str | os.PathLike) -> str | None:
     """The ``weft-recipe`` text (tEXt, zTXt or iTXt chunk) of a PNG file, parsed by hand.
 
-    Returns ``None`` when the file is not a PNG or has no such chunk (chunks with a bad CRC or
-    that cannot be decoded are skipped). Raises :class:`ImageError` when the file cannot be read, is
-    not a regular file (a named pipe, a device: refused unread), or its recipe is larger than
-    ``weft.core.jsonio.MAX_FILE_BYTES`` stored or inflated (a compressed chunk is inflated only that far).
+    Chunks with a bad CRC or that cannot be decoded are skipped; a compressed chunk is inflated only
+    up to the size limit.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    str or None
+        The recipe's JSON text; None when the file is not a PNG or has no such chunk.
+
+    Raises
+    ------
+    ImageError
+        The file cannot be read, is not a regular file (a named pipe, a device: refused unread), or
+        its recipe is larger than ``weft.core.jsonio.MAX_FILE_BYTES`` stored or inflated.
     """
     from ..jsonio import MAX_FILE_BYTES
 
@@ -745,9 +808,21 @@ def read_recipe(path: str | os.PathLike) -> str | None:
 
 
 def png_is_whole(path: str | os.PathLike) -> bool:
-    """Whether ``path`` is a whole PNG file: a regular file, the signature, every chunk with its
-    stated length and a matching CRC, up to the IEND chunk. A file cut short (an interrupted copy) or
-    with a flipped byte anywhere is not. Reads the file through once; never raises."""
+    """Whether ``path`` is a whole PNG file.
+
+    A regular file, the signature, every chunk with its stated length and a matching CRC, up to the
+    IEND chunk. A file cut short (an interrupted copy) or with a flipped byte anywhere is not. Reads
+    the file through once; never raises.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    bool
+    """
     try:
         with open_regular(path, "PNG file", error=ImageError) as f:
             if f.read(8) != _PNG_SIGNATURE:

@@ -21,11 +21,22 @@ def _writer_tag() -> str:
 
 
 def remove_stale_temporaries(paths) -> list[str]:
-    """Remove what a killed :func:`atomic_write_bytes` left beside the given output paths: their
-    ``.{name}.XXXXXXXX[.{host}-{pid}].tmp`` files whose writer is gone, that is written by a process
-    of this machine that no longer runs, or untouched for :data:`STALE_TEMPORARY_SECONDS` (a writer
-    elsewhere, or an older weft). Another writer's file in progress is left alone. Returns the
-    removed paths; never raises."""
+    """Remove what a killed :func:`atomic_write_bytes` left beside the given output paths.
+
+    Their ``.{name}.XXXXXXXX[.{host}-{pid}].tmp`` files whose writer is gone are removed: written by a
+    process of this machine that no longer runs, or untouched for :data:`STALE_TEMPORARY_SECONDS` (a
+    writer elsewhere, or an older weft). Another writer's file in progress is left alone. Never raises.
+
+    Parameters
+    ----------
+    paths : iterable of str or os.PathLike
+        The outputs whose folders are looked through.
+
+    Returns
+    -------
+    list of str
+        The removed paths.
+    """
     host = _writer_tag().split("-")[0]
     by_folder: dict[str, set[str]] = {}
     for p in paths:

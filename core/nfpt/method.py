@@ -31,7 +31,7 @@ class NfptParams(WarpParams):
     """Parameters of ``weft nfpt`` (Yan, Lee & Lin): rectification (the fields of ``WarpParams``),
     synthesis, repair, re-projection."""
 
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=8,
@@ -55,7 +55,7 @@ class NfptParams(WarpParams):
         help="how much each patch overlaps those already placed (the L-shaped neighbourhood): more"
         " matches and hides seams better; at most block/2",
     )
-    sigma_d: float = param(
+    sigma_d: float | None = param(
         None,
         kind="float",
         lo=0.1,
@@ -102,7 +102,7 @@ class NfptParams(WarpParams):
     smooth: bool = param(
         False, help="step 7: blur the re-made pixels slightly (Gaussian) to hide what the repair leaves"
     )
-    view: View = param(
+    view: View | None = param(
         None,
         kind="geometry",
         type=View,
@@ -217,8 +217,8 @@ def synthesize(
     return syn if return_details else syn.image
 
 
-#: Seconds per source position per patch besides the DFTs (tol choice, cut, repair); ~1 ns on the
-#: 2-core machine (fitted to ``python -m benchmarks.estimates``).
+#: Seconds per source position per patch besides the DFTs (tol choice, cut, repair), on the 2-core
+#: reference machine (fitted by ``python -m benchmarks.estimates``).
 SELECT_SECONDS_PER_POSITION = 1e-9
 
 
@@ -227,7 +227,25 @@ def estimate_seconds(texture_shape: tuple[int, ...], out_size: tuple[int, int], 
 
     Every patch but the first costs three DFTs of the padded source luminance (eqs. 1-3 for all
     positions at once: two spectra of the weighted template and the inverse) and a choice over every
-    source position; within 0.4..1.6x of real runs (``python -m benchmarks.estimates``).
+    source position (fitted by ``python -m benchmarks.estimates``).
+
+    Parameters
+    ----------
+    texture_shape : tuple of int
+        The source texture's shape (H, W[, C]).
+    out_size : (int, int)
+        The output's width and height.
+    block, overlap : int
+        The patch side and the overlap.
+
+    Returns
+    -------
+    float
+        Seconds.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §2.
     """
     from ..grid import block_grid
     from ..limits import dft_seconds
@@ -363,6 +381,7 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
     if cancel is not None:
         cancel.raise_if_cancelled()
     homography = None
+    mask: np.ndarray | None  # where the synthesis may sample; None: everywhere
     if lines is not None:
         rep = ProgressReporter(progress, "rectify", 1)
         rect = rf.Rectifier(photo).rectify(
@@ -400,6 +419,7 @@ def _nfpt(photo, lines, view, params: NfptParams, *, rng=None, progress=None, ca
             out, cover = plan.apply(syn.image, supersample=rv.SUPERSAMPLE, alpha=True)
             figures["view_coverage"] = round(float(cover.mean()), 4)
         else:
+            assert rect is not None and lines is not None  # into_photo without lines was refused above
             plan = rv.into_photo_plan(
                 rect.plan,
                 lines.image_lines,

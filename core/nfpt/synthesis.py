@@ -12,8 +12,7 @@
    re-synthesized pixel by pixel by neighbourhood matching against the source.
 7. Optionally, the re-synthesized pixels are replaced by a Gaussian filtering of the result.
 
-Choices where the paper is ambiguous (it gives no numbers; "more details can refer to [14]"), with
-what was measured where it mattered:
+Choices where the paper is ambiguous (it gives no numbers; "more details can refer to [14]"):
 
 * ``P_diff`` is the squared difference of **luminance** (Rec. 601). Squared, so that the weighted
   sum over every source position is two template DFTs and one inverse per patch; luminance, so that
@@ -23,10 +22,8 @@ what was measured where it mattered:
   new part (0.5 next to it; in the corner square, the Euclidean distance to the corner). Intensities
   are in [0, 1], so eq. 2's 255 is 1. Each W keeps the paper's ``1 / (sqrt(2 pi) sigma)`` with its
   own sigma: ``sigma_d`` in pixels (default overlap / 2), ``sigma_s`` in intensity (default 0.35,
-  where W_s ranges from ~0 on the background to 1.1 on a full-contrast feature, against W_d's
-  0.07 maximum for the default overlap, so features dominate as the paper intends). Measured with
-  ``weft.core.metrics.coherence`` on five textures x 8 seeds, the weighting is within 1-2% of a plain SSD
-  (neither better nor worse by that measure).
+  where W_s ranges from about 0 on the background to 1.1 on a full-contrast feature, against W_d's
+  0.07 maximum for the default overlap, so features dominate as the paper intends).
 * Eq. 2 reads ``(M - P) - 255``; that sign would count only pixels darker than the background as
   features, so the feature strength is ``|P - M|`` (the RMS over colour channels). ``M`` is the mean
   colour of the L-shape's pixels in the most populated cell of an 8-level-per-channel colour
@@ -40,10 +37,7 @@ what was measured where it mattered:
   "Neighbourhood matching against the source" is limited to Ashikhmin's coherent candidates: every
   known pixel of the ``n x n`` window proposes the source pixel continuing its own source; the one
   whose window best matches the known pixels (mean squared colour difference) is copied. A search of
-  the whole source per pixel would cost a patch search per pixel. Measured (7x7 coherence of the
-  patches on the repaired pixels; 192x192 from 32/8 patches): fur 0.239 -> 0.222, grass 0.393 ->
-  0.373, gravel 0.282 -> 0.282; processing from the known pixels inwards ("onion peel") or
-  widening the candidates by +-1..2 pixels measured no better. A pixel a later patch covers loses
+  the whole source per pixel would cost a patch search per pixel. A pixel a later patch covers loses
   its mark from the older seam.
 * ``smooth``: a Gaussian of sigma 0.8 px over the result, copied onto the repaired pixels only.
 """
@@ -88,10 +82,27 @@ class Synthesis:
 
 
 def distance_weights(block: int, top: int, left: int, sigma_d: float) -> np.ndarray:
-    """W_d of eq. 1 on the L-shape of a patch (0 outside it), float64 (block, block).
+    """W_d of eq. 1 on the L-shape of a patch (0 outside it).
 
-    ``top`` and ``left`` are the widths of the overlap strips; ``d`` is the distance from the pixel's
-    centre to the edge between the L and the patch's new part (see the module docstring).
+    ``d`` is the distance from the pixel's centre to the edge between the L and the patch's new part
+    (see the module docstring).
+
+    Parameters
+    ----------
+    block : int
+        The patch side.
+    top, left : int
+        The widths of the overlap strips (0: no strip on that side).
+    sigma_d : float
+        The Gaussian's sigma, pixels.
+
+    Returns
+    -------
+    ndarray, float64 (block, block)
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §2, eq. 1.
     """
     ys = np.arange(block, dtype=np.float64)[:, None]
     xs = np.arange(block, dtype=np.float64)[None, :]
@@ -157,8 +168,8 @@ class _Search:
         self.spec2 = cv2.dft(self._padded(yc * yc))
         self.w_buf = np.zeros((self.n_h, self.n_w), np.float32)
         self.tw_buf = np.zeros((self.n_h, self.n_w), np.float32)
-        # per-patch spectra and the cost map go into these: fresh arrays every patch made glibc trim
-        # and re-fault the heap (a third of the time in the kernel for a 512² source)
+        # per-patch spectra and the cost map go into these: fresh arrays every patch make glibc trim
+        # and re-fault the heap
         self._fwd, self._spec, self._cross, self._cmap = (np.empty((self.n_h, self.n_w), np.float32) for _ in range(4))
 
     def _padded(self, img: np.ndarray) -> np.ndarray:
@@ -201,7 +212,39 @@ def synthesize_patches(
     progress: Callable[[Progress], None] | None = None,
     cancel: CancelToken | None = None,
 ) -> Synthesis:
-    """The engine of :func:`weft.core.nfpt.synthesize` (parameters already validated; see there)."""
+    """The engine of :func:`weft.core.nfpt.synthesize`, its parameters already validated.
+
+    Parameters
+    ----------
+    texture : ndarray, float32 (H, W) or (H, W, 3)
+        The (frontal) source texture.
+    size : (int, int)
+        The output's width and height.
+    block, overlap, sigma_d, sigma_s, tol, repair, band, threshold, n, smooth
+        As in :func:`weft.core.nfpt.synthesize`.
+    shift : int, default 0
+        A shift of the block grid, pixels.
+    mask : ndarray, bool (H, W), optional
+        Where the source may be sampled (the rectified photo's valid part); default everywhere.
+    rng, progress, cancel
+        Seed or generator; progress callback; cancel token.
+
+    Returns
+    -------
+    Synthesis
+        The image and what it took (patches, repaired pixels, source positions).
+
+    Raises
+    ------
+    InvalidParameter
+        ``block`` does not fit in the texture.
+    ImageError
+        The mask's size is not the texture's, or it leaves no whole patch to sample.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §2, steps 1-7.
+    """
     import cv2
 
     from .. import seams

@@ -52,7 +52,7 @@ def _finish(img: np.ndarray, channels: int) -> np.ndarray:
 
 
 #: Seconds per source position per block for choosing a position and pasting (rule, cut), besides
-#: the DFTs: ~1 ns on the 2-core machine (fitted to ``python -m benchmarks.estimates``).
+#: the DFTs, on the 2-core reference machine (fitted by ``python -m benchmarks.estimates``).
 SELECT_SECONDS_PER_POSITION = 1e-9
 #: Seconds per block besides its DFTs and position choice (overlap costs, the cut, pasting, the
 #: Python around them), ``SECONDS_PER_BLOCK + SECONDS_PER_BLOCK_SIDE * block``: what dominates small
@@ -60,9 +60,8 @@ SELECT_SECONDS_PER_POSITION = 1e-9
 SECONDS_PER_BLOCK = 4e-4
 SECONDS_PER_BLOCK_SIDE = 1.4e-4
 #: Bytes per output pixel of a job's peak memory (canvas, previous pass, correspondence maps and
-#: preview copies, float32; measured with /usr/bin/time -v on `weft quilt` of a 256x256 texture: 2048x2048
-#: synthesis 245 MB peak RSS, transfer 477 MB, of which ~100 MB are Python, NumPy, OpenCV and numba
-#: and, for the transfer, 175 MB its two rows of spectra, counted separately in ``_check_limits``).
+#: preview copies, float32), fitted to the peak memory of ``weft quilt`` runs without the libraries'
+#: share and without a transfer's two rows of spectra, which ``_check_limits`` counts separately.
 BYTES_PER_OUTPUT_PIXEL = {"synthesis": 40, "transfer": 50}
 #: Bytes per texture pixel: its spectra (one per channel and the correspondence map) and the
 #: squared-sum maps cached per overlap shape (up to nine), float32.
@@ -74,11 +73,26 @@ def estimate_seconds(
 ) -> float:
     """Estimated running time of quilting on the 2-core reference machine (see :mod:`weft.core.limits`).
 
-    Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel
-    and the inverse; a transfer adds its correspondence and previous-pass spectra, computed on a
-    second thread one row ahead, so they do not add up) plus a position choice over every source
-    position, plus a fixed cost per block (:data:`SECONDS_PER_BLOCK`). ``passes`` are the (block,
-    overlap) of each pass. Fitted to real runs (``python -m benchmarks.limits``).
+    Each block but the first costs ``C + 1`` DFTs of the padded source (one per channel and the
+    inverse; a transfer adds its correspondence and previous-pass spectra, computed on a second thread
+    one row ahead, so they do not add up) plus a position choice over every source position, plus a
+    fixed cost per block (:data:`SECONDS_PER_BLOCK`). Fitted by ``python -m benchmarks.limits``.
+
+    Parameters
+    ----------
+    texture_shape : tuple of int
+        The sample's shape (H, W[, C]).
+    out_size : (int, int)
+        The output's width and height.
+    passes : list of (int, int)
+        The (block, overlap) of each pass.
+    tile : bool, default False
+        A tileable output (the canvas wraps).
+
+    Returns
+    -------
+    float
+        Seconds.
     """
     from ..limits import dft_seconds
 
@@ -128,8 +142,20 @@ def _transfer_passes(params: QuiltParams) -> list[tuple[int, int, float]]:
 
 
 def memory_estimate(shapes: Mapping[str, tuple[int, ...]], params: QuiltParams) -> float:
-    """Estimated peak bytes of one run on inputs of these shapes (what the run's own check uses);
-    0 for a random-mode synthesis, which has no such check."""
+    """Estimated peak bytes of one run on inputs of these shapes (what the run's own check uses).
+
+    Parameters
+    ----------
+    shapes : mapping of str to tuple of int
+        Input name -> array shape.
+    params : QuiltParams
+        The run's parameters.
+
+    Returns
+    -------
+    float
+        Bytes; 0 for a random-mode synthesis, which has no such check.
+    """
     tex = shapes["texture"]
     if shapes.get("target") is not None:
         out_h, out_w = shapes["target"][:2]

@@ -1,10 +1,9 @@
 """Indices and codes of the quilting kernel's parameter array, in a module without numba.
 
 ``weft.core._kernels.quilting`` (numba) and the numpy engine of ``weft.core.quilting.engine`` both read them
-from here, so a small synthesis can run without importing numba and the two cannot disagree. (It
-lived in ``weft.core._kernels`` until that package's ``__init__`` came to import numba for its
-cache set-up: importing the codes from there loaded numba into every ``weft quilt`` process, ~0.15 s
-of the 0.45 s G'MIC takes for the whole job.)
+from here, so a small synthesis can run without importing numba and the two cannot disagree.
+(``weft.core._kernels``'s ``__init__`` imports numba for its cache set-up, so the codes do not live
+there.)
 """
 
 # place_block integer parameters (one int64 array): the block, its overlaps, the pass's options and

@@ -11,7 +11,9 @@ checks it).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -24,9 +26,8 @@ RULES = ("tol", "epsilon", "sampled")
 
 
 # Below this many blocks a synthesis without Poisson runs the per-block step in numpy when numba
-# is not loaded yet: numba's one-time start-up (~0.6 s: import, registries, kernel cache) costs more
-# than the numpy step (~0.5 ms a block of 32 with the seam rule's 8 cuts, which run as one stacked
-# dynamic program: quilt-mincut-512, 400 blocks, ~0.2 s) there. Both engines give the same pixels.
+# is not loaded yet: numba's one-time start-up (import, registries, kernel cache) costs more than
+# the numpy steps of that many blocks. Both engines give the same pixels.
 NUMPY_ENGINE_MAX_BLOCKS = 1024
 #: Synthesis never takes a source position within this many pixels of the continuation of a
 #: neighbouring block's piece of the sample, across the seam (see ``_forbid_continuations``); -1: off.
@@ -171,6 +172,9 @@ def _record(sources: np.ndarray, y0: int, x0: int, sy: int, sx: int, b: int, mas
 class _Source:
     """The source texture prepared for one block size: centred, spectra, squared sums."""
 
+    spectrum_c: np.ndarray | None  # the correspondence map's, when there is one
+    sq_c: np.ndarray | None
+
     def __init__(self, tex: np.ndarray, corr_src: np.ndarray | None, block: int):
         import cv2
 
@@ -286,7 +290,7 @@ def _quilt_pass(
                     sources[y0 : y0 + bh, x0 : x0 + bw, 1] = (sx[i, j] + np.arange(bw))[None, :]
             if report is not None:
                 report.update(i + 1, preview=preview)
-        if record is not None:
+        if record is not None and sources is not None:
             record["sources"] = sources[:out_h, :out_w].copy()
         return canvas[:out_h, :out_w], rows * cols
 
@@ -303,6 +307,13 @@ def _quilt_pass(
         and rows * cols <= NUMPY_ENGINE_MAX_BLOCKS
         and "weft.core._kernels.quilting" not in sys.modules
     )
+    # the numba kernels or their numpy twins, called alike
+    error: Callable[..., Any]
+    by_best: Callable[..., int]
+    by_tol: Callable[..., int]
+    by_eps: Callable[..., int]
+    by_sampled: Callable[..., int]
+    choose: Callable[..., int]
     if use_numpy:
         place, template, blend = _place_block_numpy, _make_template_numpy, None
         error, cut = _block_error_numpy, _cut_mask_into_numpy
@@ -345,8 +356,7 @@ def _quilt_pass(
         corr_t = _pad_to(corr[1], hc, wc)
     tbuf = np.zeros((nc, src.n_h, src.n_w), dtype=np.float32)
     # Per-block spectra and correlation written into these, not into fresh arrays: freeing a few
-    # hundred kB per block made glibc trim and re-fault the heap (9.7 M page faults, 40 % of the time
-    # in the kernel, for 1024² from 256² with block 6).
+    # hundred kB per block makes glibc trim and re-fault the heap.
     fwd, part, acc, cross_buf = (np.empty((src.n_h, src.n_w), dtype=np.float32) for _ in range(4))
     cost_buf = np.empty(src.ph * src.pw, dtype=np.float64)
     tcorr = np.zeros((src.n_h, src.n_w), dtype=np.float32)
@@ -431,7 +441,7 @@ def _quilt_pass(
             row_static = None
             if ahead is not None:
                 row_static = ahead.result()
-                ahead = static_rows.submit(static_row, i + 1) if i + 1 < rows else None
+                ahead = static_rows.submit(static_row, i + 1) if static_rows is not None and i + 1 < rows else None
             y0, top, bottom = ys[i], tops[i], bottoms[i]
             ip[_K.P_Y0], ip[_K.P_TOP], ip[_K.P_BOTTOM] = y0, top, bottom
             for j in range(cols):
@@ -468,7 +478,7 @@ def _quilt_pass(
                             else:
                                 cv2.mulSpectrums(spectra[c], fwd, 0, c=part, conjB=True)
                                 spec = np.add(spec, part, out=acc)
-                    cross = cv2.idft(spec, dst=cross_buf, flags=flags)
+                    cross = cv2.idft(spec, dst=cross_buf, flags=flags)  # type: ignore[arg-type]  # nc >= 1 set spec
                     if usage is not None and overlaps:
                         n_overlap = b * b - (b - top - bottom) * (b - left - right)
                         _penalise_usage(cross, usage, src.ph, src.pw, b, usage_weight * random_error * n_overlap)
@@ -510,8 +520,8 @@ def _quilt_pass(
                 place(canvas, filled, tex, ip, mask, win, label, old)
                 chosen[i, j] = ip[_K.P_SY], ip[_K.P_SX]
                 if usage is not None:
-                    sy, sx = int(ip[_K.P_SY]), int(ip[_K.P_SX])
-                    usage[sy : sy + b, sx : sx + b] += mask if mincut and overlaps else np.float32(1.0)
+                    uy, ux = int(ip[_K.P_SY]), int(ip[_K.P_SX])
+                    usage[uy : uy + b, ux : ux + b] += mask if mincut and overlaps else np.float32(1.0)
                 if sources is not None:
                     _record(
                         sources, y0, x0, int(ip[_K.P_SY]), int(ip[_K.P_SX]), b, mask if mincut and overlaps else None
@@ -523,7 +533,7 @@ def _quilt_pass(
     finally:
         if static_rows is not None:
             static_rows.shutdown(wait=True, cancel_futures=True)
-    if record is not None:
+    if record is not None and sources is not None:
         record["sources"] = sources[:out_h, :out_w].copy()
     return canvas[:out_h, :out_w], rows * cols
 
@@ -550,9 +560,8 @@ def _by_seam(
     """The seam rule: of the ``pool`` lowest-cost positions (the tol rule's candidates), the one
     whose minimum-error cut runs through the least error (``seam_error``; ties: the earlier
     candidate). The overlap SSD ranks a block by its whole overlap, but what shows is the error
-    along the cut; on brick_128 (T1) cutting 8 candidates instead of drawing one of the best 2
-    lowers coherence (fewer broken mortar joints at the seams). The winner's cut is left in
-    ``mask`` (the caller pastes with it)."""
+    along the cut, so cutting several candidates breaks fewer structures (mortar joints) at the
+    seams. The winner's cut is left in ``mask`` (the caller pastes with it)."""
     n = int(best_k(cross, sq, const, cost_buf, pool, candidates))
     best, best_err = int(candidates[0]), np.inf
     best_mask = np.empty_like(mask)
@@ -652,8 +661,7 @@ def _vertical_accs_numpy(strips: list[np.ndarray]) -> list[np.ndarray]:
 
 
 def _trace_scalar(acc: np.ndarray, y_start, x_start) -> np.ndarray:
-    """:func:`_trace_numpy` by scalar steps on Python floats: cheaper for a small stack (a single
-    cut: ~6 against ~40 us)."""
+    """:func:`_trace_numpy` by scalar steps on Python floats: cheaper for a small stack."""
     k, h, w = acc.shape
     rows_k = acc.tolist()
     out = []
@@ -680,9 +688,9 @@ def _trace_numpy(acc: np.ndarray, y_start, x_start) -> np.ndarray:
 
     Each cell's step into it from the row above (-1, 0 or +1: the kernel's choice, the centre first,
     then the left if strictly less, then the right if strictly less than both) is found for the
-    whole stack at once; the walk then takes one gather a row for all K paths (a Python loop of
-    scalar steps per path cost twice as much with the seam rule's 24 candidates: 110 against 290 us
-    for 24 cuts of 56 x 10; :func:`_trace_scalar` is kept for small stacks, K x h <= 256)."""
+    whole stack at once; the walk then takes one gather a row for all K paths (cheaper than scalar
+    steps per path for the seam rule's many candidates; :func:`_trace_scalar` takes small stacks,
+    K x h <= 256)."""
     k, h, w = acc.shape
     if k * h <= 256:
         return _trace_scalar(acc, y_start, x_start)

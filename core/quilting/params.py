@@ -42,7 +42,7 @@ class QuiltParams(Params):
     quarter of the sample; the cap keeps the output of a large sample from being a few large copies
     of it. With a block of 48 or more the min-cut seam rule weighs 24 candidates (tol 6) instead of
     8: the wider overlap has room for a cut along the texture's joints, and the extra candidates find
-    it; at smaller blocks they cost time and gain nothing (the quilting benchmark's figures).
+    it; at smaller blocks they cost time and gain nothing.
     """
 
     mode: str = param(
@@ -51,7 +51,7 @@ class QuiltParams(Params):
         help="how blocks join: random = side by side (seams show); overlap = matched where they "
         "overlap; mincut = also cut along the least visible path (smoothest)",
     )
-    block: int = param(
+    block: int | None = param(
         None,
         kind="int",
         lo=2,
@@ -62,7 +62,7 @@ class QuiltParams(Params):
         " its joints) but repeats more of the sample, smaller breaks them up (default 7/16 of "
         "the texture's shorter side, at most 56; transfer 9, iterative 31)",
     )
-    overlap: int = param(
+    overlap: int | None = param(
         None,
         kind="int",
         lo=1,
@@ -72,7 +72,7 @@ class QuiltParams(Params):
         "better and costs time; smaller than block (default block/6 rounded up; transfer "
         "block/3, iterative 2*block/3)",
     )
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=1,
@@ -80,7 +80,7 @@ class QuiltParams(Params):
         optional=True,
         help="output size WIDTHxHEIGHT; default twice the texture's size (transfer: the target's)",
     )
-    tol: int = param(
+    tol: int | None = param(
         None,
         kind="int",
         lo=1,
@@ -162,14 +162,39 @@ class QuiltParams(Params):
 
 
 def synth_block(texture_shape: tuple[int, ...]) -> int:
-    """The default block of a synthesis from a sample of this shape (``(H, W[, C])``): 7/16 of its
-    shorter side rounded half up, at most 56 and at least 2 (see :class:`QuiltParams`)."""
+    """The default block of a synthesis from a sample of this shape (see :class:`QuiltParams`).
+
+    Parameters
+    ----------
+    texture_shape : tuple of int
+        The sample's shape (H, W[, C]).
+
+    Returns
+    -------
+    int
+        7/16 of its shorter side rounded half up, at most 56 and at least 2.
+
+    References
+    ----------
+    Efros & Freeman (2001), §2.1 (the block must capture the texture's structures).
+    """
     side = min(texture_shape[:2])
     return max(2, min(SYNTH_BLOCK_MAX, _round_half_up(SYNTH_BLOCK_SHARE * side)))
 
 
 def synth_tol(block: int) -> int:
-    """The default tol of a synthesis with this block: 2, or 6 from block 48 up (see :class:`QuiltParams`)."""
+    """The default tol of a synthesis with this block (see :class:`QuiltParams`).
+
+    Parameters
+    ----------
+    block : int
+        The block side.
+
+    Returns
+    -------
+    int
+        2, or 6 from block 48 up.
+    """
     return SYNTH_TOL_LARGE if block >= SYNTH_LARGE_BLOCK else SYNTH_TOL
 
 

@@ -123,11 +123,11 @@ def _synthesize(
 ) -> np.ndarray:
     """:func:`synthesize` with its options in ``params`` (``None`` block and tol: the synthesis defaults)."""
     tex = _check_texture(texture)
+    b = params.block or synth_block(tex.shape)
+    tol = params.tol or synth_tol(b)
     if params.block is None or params.tol is None:
-        block = params.block or synth_block(tex.shape)
-        params = params.replace(block=block, tol=params.tol or synth_tol(block))
+        params = params.replace(block=b, tol=tol)
     h, w = tex.shape[:2]
-    b = params.block
     _check_block_fits(b, tex)
     ov = params.overlap if params.overlap is not None else max(1, -(-b // 6))
     if params.mode != "random":
@@ -143,7 +143,7 @@ def _synthesize(
         from ..limits import check_output_size
 
         check_output_size(out_w, out_h)
-    p = _Pass(params.mode, b, ov, params.rule, params.tol, params.epsilon, params.tile, params.poisson, params.band)
+    p = _Pass(params.mode, b, ov, params.rule, tol, params.epsilon, params.tile, params.poisson, params.band)
     rng = as_rng(rng)
     rows = len(block_grid(out_h, b, ov if params.mode != "random" else 0, params.tile and params.mode != "random")[0])
     report = ProgressReporter(progress, "quilting", rows)

@@ -120,9 +120,8 @@ def transfer(
         Map the target's correspondence map linearly to the texture map's mean and standard
         deviation first (Hertzmann et al. 2001's luminance remapping; not in E&F). Without it a
         target brighter or darker than most of the texture is rendered from the texture's few
-        extreme spots, repeated (camera in gravel: the sky is one bright stone tiled; coherence
-        0.30 against 0.21 with remapping, fidelity 0.99 against 0.98). ``False`` is the papers'
-        behaviour.
+        extreme spots, repeated (a bright sky becomes one bright stone tiled). ``False`` is the
+        papers' behaviour.
     tol, rule, epsilon
         Position rule as in :func:`synthesize`; transfer takes the best (tol None means 1, Ngo), the
         first block being the best correspondence.
@@ -211,7 +210,7 @@ def _transfer(
             bi,
             oi,
             params.rule,
-            params.tol,
+            params.tol or 1,
             params.epsilon,
             params.tile,
             params.poisson,

@@ -69,7 +69,20 @@ class HomographyFit:
 
 
 def apply_homography(h: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    """``pts`` (K, 2) mapped by the 3x3 ``h`` (dehomogenised)."""
+    """Points mapped by a homography.
+
+    Parameters
+    ----------
+    h : ndarray, (3, 3)
+        The homography.
+    pts : ndarray, (K, 2)
+        Points (x, y).
+
+    Returns
+    -------
+    ndarray, float64 (K, 2)
+        ``h @ (x, y, 1)``, dehomogenised.
+    """
     pts = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
     p = pts @ h[:, :2].T + h[:, 2]
     return p[:, :2] / p[:, 2:3]
@@ -94,7 +107,23 @@ def _check_spread(pts: np.ndarray, what: str) -> None:
 
 
 def homography_from_points(dst: np.ndarray, src: np.ndarray) -> np.ndarray:
-    """Direct linear transform (Hartley-normalised least squares) for ``src ~ H dst``; K >= 4."""
+    """Direct linear transform (Hartley-normalised least squares) for ``src ~ H dst``.
+
+    Parameters
+    ----------
+    dst, src : ndarray, (K, 2)
+        Corresponding points, K >= 4.
+
+    Returns
+    -------
+    ndarray, float64 (3, 3)
+        H, destination -> source.
+
+    References
+    ----------
+    Hartley & Zisserman, *Multiple View Geometry*, 2nd ed., §4.1 and §4.4 (the normalised DLT);
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §3.
+    """
     td, ts = _normaliser(dst), _normaliser(src)
     d = apply_homography(td, dst)
     s = apply_homography(ts, src)

@@ -48,14 +48,44 @@ FAR_MARGIN = 0.5  # an intersection further than this many frame sizes outside t
 
 
 def parse_feature_lines(data: Mapping[str, Any], *, source: str = "") -> FeatureLines:
-    """:meth:`FeatureLines.from_mapping`: from the parsed JSON object of DESIGN.md (``source``, a file
-    name, goes in front of error messages)."""
+    """Feature lines from the parsed JSON object of DESIGN.md (:meth:`FeatureLines.from_mapping`).
+
+    Parameters
+    ----------
+    data : mapping
+        ``{"image_lines": [...], "frontal_lines": [...], "frontal_size": [w, h]}``.
+    source : str, optional
+        A file name, put in front of error messages.
+
+    Returns
+    -------
+    FeatureLines
+
+    Raises
+    ------
+    GeometryError
+        A malformed object; the message names the key and the value.
+    """
     return FeatureLines.from_mapping(data, source=source)
 
 
 def load_feature_lines(path_or_json: str | Path) -> FeatureLines:
-    """:meth:`FeatureLines.parse`: a JSON file's name, or the JSON object itself as text (anything
-    starting with ``{``); GeometryError naming the file."""
+    """Feature lines from a JSON file or from JSON text (:meth:`FeatureLines.parse`).
+
+    Parameters
+    ----------
+    path_or_json : str or pathlib.Path
+        A JSON file's name, or the JSON object itself as text (anything starting with ``{``).
+
+    Returns
+    -------
+    FeatureLines
+
+    Raises
+    ------
+    GeometryError
+        A missing or unreadable file, invalid JSON or malformed lines; the message names the file.
+    """
     return FeatureLines.parse(path_or_json)
 
 
@@ -227,7 +257,20 @@ def line_correspondences(
 
 
 def all_parallel(lines: Sequence[np.ndarray], min_angle: float = MIN_ANGLE_DEG) -> bool:
-    """True when every line of every given set is within ``min_angle`` of the first line's direction."""
+    """Whether every line of every given set is within ``min_angle`` of the first line's direction.
+
+    Parameters
+    ----------
+    lines : sequence of ndarray, each (N, 4)
+        Sets of lines ``x1, y1, x2, y2``.
+    min_angle : float, default MIN_ANGLE_DEG
+        Degrees.
+
+    Returns
+    -------
+    bool
+        True when they are all (nearly) parallel: they cannot fix a homography.
+    """
     sin_min = math.sin(math.radians(min_angle))
     for ls in lines:
         hl = _homogeneous_lines(ls)

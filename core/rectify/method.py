@@ -23,7 +23,7 @@ INTERPOLATIONS = ("cubic", "linear", "lanczos")
 class WarpParams(Params):
     """The rectification parameters, shared by ``weft rectify`` and ``weft nfpt`` (which add theirs)."""
 
-    lines: FeatureLines = param(
+    lines: FeatureLines | None = param(
         None,
         kind="geometry",
         type=FeatureLines,
@@ -73,7 +73,7 @@ class WarpParams(Params):
 class RectifyParams(WarpParams):
     """Parameters of ``weft rectify`` (and the rectification step of ``weft nfpt``)."""
 
-    size: tuple = param(
+    size: tuple[int, int] | None = param(
         None,
         kind="size",
         lo=2,
@@ -116,7 +116,19 @@ class Rectified:
 
 
 def scale_lines(lines: np.ndarray, from_size: tuple[int, int], to_size: tuple[int, int]) -> np.ndarray:
-    """Lines of a frame of ``from_size`` in a frame of ``to_size`` (pixel areas mapped onto each other)."""
+    """Lines of a frame of ``from_size`` in a frame of ``to_size`` (pixel areas mapped onto each other).
+
+    Parameters
+    ----------
+    lines : array_like, (N, 4)
+        Lines ``x1, y1, x2, y2`` in pixel coordinates of the first frame.
+    from_size, to_size : (int, int)
+        The frames' width and height.
+
+    Returns
+    -------
+    ndarray, float64 (N, 4)
+    """
     sx = to_size[0] / from_size[0]
     sy = to_size[1] / from_size[1]
     out = np.array(lines, dtype=np.float64).reshape(-1, 4).copy()
@@ -133,8 +145,8 @@ class Rectifier:
     photo : float32 (H, W) or (H, W, 3) in [0, 1]
         Validated once here.
     interpolation : {"cubic", "linear", "lanczos"}, default "cubic"
-        Resampling of the photo. Cubic keeps a 0.5 px-accurate rectification at ~39 dB against the
-        ground truth on the synthetic benchmark case; linear is ~30% faster and blurs a little more.
+        Resampling of the photo. Cubic keeps a sub-pixel-accurate rectification sharp; linear is
+        faster and blurs a little more.
 
     Examples
     --------
@@ -290,8 +302,30 @@ def rectify_feature_lines(
 ) -> Rectified:
     """:func:`rectify` with parsed feature lines (or a JSON file name / JSON text).
 
-    ``size`` (optional) rescales the frontal frame: the frontal lines are scaled from
-    ``lines.frontal_size`` to ``size`` and the output has that size.
+    Parameters
+    ----------
+    photo : ndarray, float32 (H, W) or (H, W, 3)
+        The photo of the texture.
+    lines : FeatureLines or str
+        The feature lines, or a JSON file name or JSON text (see :func:`load_feature_lines`).
+    size : (int, int), optional
+        Rescales the frontal frame: the frontal lines are scaled from ``lines.frontal_size`` to
+        ``size`` and the output has that size.
+    warp, a, b, p, interpolation
+        As in :func:`rectify`.
+
+    Returns
+    -------
+    Rectified
+
+    Raises
+    ------
+    GeometryError
+        Malformed or degenerate lines (see :func:`rectify`).
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §3.
     """
     if not isinstance(lines, FeatureLines):
         lines = load_feature_lines(lines)
@@ -344,7 +378,18 @@ FIGURES = {
 
 
 def homography_figure(h: np.ndarray) -> list[list[float]]:
-    """``h`` scaled to ``h[2][2] = 1`` (as in the bundled example's JSON), as nested lists for reports."""
+    """A homography as nested lists for reports.
+
+    Parameters
+    ----------
+    h : ndarray, (3, 3)
+        The homography.
+
+    Returns
+    -------
+    list of list of float
+        ``h`` scaled to ``h[2][2] = 1``, as in the bundled example's JSON.
+    """
     h = np.asarray(h, dtype=np.float64)
     if abs(h[2, 2]) > 1e-12:
         h = h / h[2, 2]
@@ -369,6 +414,6 @@ METHOD = Method(
     run=_run,
     warm_up=warm_up,
     # The default homography warp is numpy + OpenCV: loading the numba kernel of the morphs before
-    # every command would triple `weft rectify`'s whole run (0.3 s -> 1 s); the studio still loads it.
+    # every command would cost more than the run itself; the studio still loads it.
     warm_up_in_cli=False,
 )

@@ -55,7 +55,7 @@ class View:
     texture_lines: np.ndarray | None = None
 
     def with_size(self, default: tuple[int, int]) -> tuple[int, int]:
-        return self.size if self.size is not None else tuple(default)
+        return self.size if self.size is not None else (default[0], default[1])
 
     # A typed geometry parameter (weft.core.geometry): parsed at the edges, written once.
     METAVAR = "VIEW"
@@ -100,7 +100,25 @@ class View:
 
 
 def parse_view(data: Any, *, source: str = "") -> View:
-    """A :class:`View` from the parsed JSON (see the module docstring); GeometryError if malformed."""
+    """A :class:`View` from the parsed JSON (see the module docstring).
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON: ``{"quad": [...]}`` or ``{"image_lines": [...], "frontal_lines": [...]}``,
+        with an optional ``"size"``.
+    source : str, optional
+        A file name, put in front of error messages.
+
+    Returns
+    -------
+    View
+
+    Raises
+    ------
+    GeometryError
+        Not an object, a malformed quad or lines, or lines that do not pair up.
+    """
     prefix = f"{source}: " if source else ""
     try:
         if not isinstance(data, dict):
@@ -146,6 +164,15 @@ def parse_view(data: Any, *, source: str = "") -> View:
 def load_view(path_or_json: str | Path) -> View:
     """Read a view from a JSON file or inline JSON text (see the module docstring).
 
+    Parameters
+    ----------
+    path_or_json : str or pathlib.Path
+        A JSON file's name, or the JSON object itself as text.
+
+    Returns
+    -------
+    View
+
     Raises
     ------
     GeometryError
@@ -159,7 +186,27 @@ def quad_homography(quad: np.ndarray, texture_size: tuple[int, int]) -> np.ndarr
     """The homography view -> texture that sends the quad's corners to the texture's corners.
 
     The corners are those of the texture's pixel area, ``(-0.5, -0.5)`` to ``(w - 0.5, h - 0.5)``.
-    GeometryError if the quad is degenerate (three corners on a line) or not convex.
+
+    Parameters
+    ----------
+    quad : ndarray, (4, 2)
+        Where the texture's corners land in the view: top-left, top-right, bottom-right, bottom-left.
+    texture_size : (int, int)
+        The texture's width and height.
+
+    Returns
+    -------
+    ndarray, float64 (3, 3)
+
+    Raises
+    ------
+    GeometryError
+        The quad is degenerate (three corners on a line) or not convex.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §3 (putting the
+    synthesized texture back into a view).
     """
     q = np.asarray(quad, dtype=np.float64).reshape(4, 2)
     for i in range(4):
@@ -216,6 +263,7 @@ def view_plan(
         return plan
     # the view lines must lie in the view; the texture lines may reach beyond the texture (the plane
     # goes on), they only must not be zero-length
+    assert view.view_lines is not None and view.texture_lines is not None  # a view is a quad or two line sets
     check_lines(view.view_lines, size, key="view line", frame="the view")
     check_lines(view.texture_lines, texture_size, key="texture line", frame="the texture", tolerance=math.inf)
     return plan_warp(
@@ -255,6 +303,26 @@ def into_photo_plan(
     larger texture extends the plane equally on every side. A homography rectification is simply
     inverted (the same fit, photo -> frontal, shifted by o); the other warps are fitted again with
     the photo as the destination.
+
+    Parameters
+    ----------
+    rect_plan : WarpPlan
+        The rectification's plan (photo -> frontal frame).
+    image_lines, frontal_lines : ndarray, (N, 4)
+        The feature lines in the photo and in the frontal frame.
+    frontal_size, photo_size, texture_size : (int, int)
+        Width and height of each frame.
+    warp, a, b, p
+        As in :func:`weft.core.rectify.rectify`.
+
+    Returns
+    -------
+    WarpPlan
+        Texture -> photo.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §3.
     """
     fw, fh = frontal_size
     tw, th = texture_size

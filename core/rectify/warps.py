@@ -104,7 +104,12 @@ class WarpPlan:
         # Samples that land inside are interpolated from the image continued by its edge (a black
         # frame would ring into them: a cubic kernel's negative lobes over the step to 0); samples
         # outside are 0, so a supersampled pixel is its colour premultiplied by its coverage.
-        if self.kind == "homography" and s == 1 and _all_in_front(self.homography, self.dst_size):
+        if (
+            self.kind == "homography"
+            and self.homography is not None
+            and s == 1
+            and _all_in_front(self.homography, self.dst_size)
+        ):
             out = cv2.warpPerspective(
                 image, self.homography, (dw, dh), flags=flags | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE
             )
@@ -143,7 +148,9 @@ class WarpPlan:
         if s == 1 and self.maps is not None:
             return self.maps
         if self.kind == "homography":
+            assert self.homography is not None  # a homography plan carries its matrix
             return homography_maps(self.homography, (dw * s, dh * s), scale=s)
+        assert self.maps is not None  # morph and lines plans carry their maps
         mx, my = self.maps
         if s == 1:
             return mx, my
@@ -170,6 +177,12 @@ def _clip(out: np.ndarray, flags: int) -> np.ndarray:
     return out
 
 
+def _pair(size) -> tuple[int, int]:
+    """``(width, height)`` of a size given as any pair."""
+    w, h = size
+    return w, h
+
+
 def _all_in_front(h: np.ndarray, size: tuple[int, int]) -> bool:
     """Whether the third coordinate of ``h`` is positive over the whole frame (checked at its corners:
     it is affine in x and y)."""
@@ -179,11 +192,24 @@ def _all_in_front(h: np.ndarray, size: tuple[int, int]) -> bool:
 
 
 def homography_maps(h: np.ndarray, size: tuple[int, int], *, scale: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """Backward maps of the homography ``h`` (destination -> source) over a frame of ``size``.
+    """Backward maps of a homography over a frame.
 
-    With ``scale`` s > 1 the frame is an s-times finer grid of the destination (sample centres).
     Points behind the horizon (third coordinate <= 0: ``h`` is scaled so that it is positive on the
     texture) get coordinates far outside any image.
+
+    Parameters
+    ----------
+    h : ndarray, (3, 3)
+        Destination -> source.
+    size : (int, int)
+        The destination frame's width and height (already ``scale`` times finer).
+    scale : int, default 1
+        With s > 1 the frame is an s-times finer grid of the destination (sample centres).
+
+    Returns
+    -------
+    map_x, map_y : ndarray, float32 (H, W)
+        The source coordinates of every destination pixel, for ``cv2.remap``.
     """
     w, hgt = size
     xs = (np.arange(w, dtype=np.float64) + 0.5) / scale - 0.5
@@ -216,10 +242,30 @@ def homography_plan(
     *,
     positive_at: tuple[float, float] | None = None,
 ) -> WarpPlan:
-    """A plan from a known homography ``h`` (destination -> source): the fast path when it is given.
+    """A plan from a known homography (the fast path when it is given).
 
     The sign of ``h`` matters (its third coordinate must be positive where the plane is in front of
     the camera); ``positive_at``, a destination point known to be on the texture, fixes it.
+
+    Parameters
+    ----------
+    h : ndarray, (3, 3)
+        Destination -> source.
+    dst_size, src_size : (int, int)
+        The frames' width and height.
+    fit : HomographyFit, optional
+        The fit it came from, for the plan's figures.
+    positive_at : (float, float), optional
+        A destination point on the texture.
+
+    Returns
+    -------
+    WarpPlan
+
+    Raises
+    ------
+    GeometryError
+        ``h`` is not an invertible 3x3 matrix of finite numbers.
     """
     h = np.asarray(h, dtype=np.float64)
     if h.shape != (3, 3) or not np.all(np.isfinite(h)) or abs(np.linalg.det(h)) < 1e-300:
@@ -227,7 +273,7 @@ def homography_plan(
     if positive_at is not None and float(h[2] @ np.array([positive_at[0], positive_at[1], 1.0])) < 0:
         h = -h
     figures = fit.figures() if fit is not None else {}
-    return WarpPlan("homography", tuple(dst_size), tuple(src_size), homography=h, fit=fit, figures=figures)
+    return WarpPlan("homography", _pair(dst_size), _pair(src_size), homography=h, fit=fit, figures=figures)
 
 
 def plan_warp(
@@ -310,7 +356,7 @@ def plan_warp(
     if warp == "lines":
         eye = np.eye(3)
         _k.field_map(dst_lines, src_lines, float(a), float(b), float(p), eye, eye, mx, my)
-        return WarpPlan("lines", tuple(dst_size), tuple(src_size), maps=(mx, my), figures={"lines": len(dst_lines)})
+        return WarpPlan("lines", _pair(dst_size), _pair(src_size), maps=(mx, my), figures={"lines": len(dst_lines)})
     return _morph_plan(dst_lines, src_lines, dst_size, src_size, a, b, p, planar_tol, mx, my, dst_name, src_name)
 
 
@@ -386,7 +432,7 @@ def _morph_plan(
         post = -post
     _k.field_map(dst_pre, src_pre, float(a), float(b), float(p), h_dst, post, mx, my)
     figures = {"points": k, "plane_rms_px": round(rms, 3)}
-    return WarpPlan("morph", tuple(dst_size), tuple(src_size), maps=(mx, my), figures=figures)
+    return WarpPlan("morph", _pair(dst_size), _pair(src_size), maps=(mx, my), figures=figures)
 
 
 def _positive(h: np.ndarray, size: tuple[int, int]) -> np.ndarray:

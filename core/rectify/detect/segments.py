@@ -17,8 +17,21 @@ MIN_LENGTH = 1 / 120  # the shortest segment kept, as a fraction of the work ima
 
 
 def work_grey(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, float]:
-    """The photo as 8-bit grey, reduced so its longer side is at most ``side`` (default
-    :data:`WORK_SIDE`); the factor."""
+    """The photo as 8-bit grey, reduced for the detection.
+
+    Parameters
+    ----------
+    photo : ndarray, float32 (H, W) or (H, W, 3)
+        The photo.
+    side : int, optional
+        The longest side of the result (default :data:`WORK_SIDE`).
+
+    Returns
+    -------
+    grey : ndarray, uint8 (h, w)
+    scale : float
+        The reduction factor, at most 1 (work pixels per photo pixel).
+    """
     grey = photo if photo.ndim == 2 else cv2.cvtColor(photo, cv2.COLOR_RGB2GRAY)
     h, w = grey.shape
     k = min(1.0, (side or WORK_SIDE) / max(h, w))
@@ -28,7 +41,22 @@ def work_grey(photo: np.ndarray, side: int | None = None) -> tuple[np.ndarray, f
 
 
 def line_segments(grey: np.ndarray) -> np.ndarray:
-    """(N, 4) segments found by LSD, at least :data:`MIN_LENGTH` of the longer side (and 6 pixels) long."""
+    """Straight segments found by LSD, at least :data:`MIN_LENGTH` of the longer side (and 6 pixels) long.
+
+    Parameters
+    ----------
+    grey : ndarray, uint8 (h, w)
+        The work image (:func:`work_grey`).
+
+    Returns
+    -------
+    ndarray, (N, 4)
+        Segments ``x1, y1, x2, y2`` in work pixels.
+
+    References
+    ----------
+    Grompone von Gioi et al., "LSD: a line segment detector" (2012).
+    """
     lsd = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD, LSD_SCALE)
     found = lsd.detect(grey)[0]
     if found is None:
@@ -39,9 +67,28 @@ def line_segments(grey: np.ndarray) -> np.ndarray:
 
 
 def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Segments joining SIFT features to their repeats elsewhere in the photo (similar descriptor,
-    scale and orientation), at least three feature sizes apart."""
-    sift = cv2.SIFT_create(nfeatures=REPEAT_FEATURES)
+    """Segments joining SIFT features to their repeats elsewhere in the photo.
+
+    Repeats have a similar descriptor, scale and orientation, and lie at least three feature sizes
+    apart.
+
+    Parameters
+    ----------
+    grey : ndarray, uint8 (h, w)
+        The work image.
+    rng : numpy.random.Generator
+        Unused by the matching; kept for a common signature with the other sources.
+
+    Returns
+    -------
+    ndarray, (N, 4)
+        Segments in work pixels (none when the photo has too few features).
+
+    References
+    ----------
+    Bharadwaj, Collins & Liu (2024): vanishing points from a lattice's repeats.
+    """
+    sift = cv2.SIFT_create(nfeatures=REPEAT_FEATURES)  # type: ignore[attr-defined]  # the cv2 stubs lack SIFT_create
     kps, desc = sift.detectAndCompute(grey, None)
     if desc is None or len(kps) < 20:
         return np.zeros((0, 4))
@@ -57,8 +104,8 @@ def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
             dists.append(m.distance)
     if not pairs:
         return np.zeros((0, 4))
-    pairs, dists = np.array(pairs), np.array(dists)
-    i, j = pairs[:, 0], pairs[:, 1]
+    index, dist = np.array(pairs), np.array(dists)
+    i, j = index[:, 0], index[:, 1]
     gap = np.hypot(*(pts[i] - pts[j]).T)
     turn = np.abs(np.angle(np.exp(1j * (ang[i] - ang[j]))))
     keep = (
@@ -66,12 +113,24 @@ def repeat_segments(grey: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         & (gap > 3 * np.maximum(size[i], size[j]))
         & (turn < math.radians(20))
         & (np.abs(np.log(size[i] / size[j])) < 0.3)
-        & (dists < np.quantile(dists, 0.3))
+        & (dist < np.quantile(dist, 0.3))
     )
     return np.column_stack([pts[i[keep]], pts[j[keep]]])
 
 
 def homogeneous(seg: np.ndarray) -> np.ndarray:
+    """Segments as unit homogeneous lines.
+
+    Parameters
+    ----------
+    seg : ndarray, (N, 4)
+        Segments ``x1, y1, x2, y2``.
+
+    Returns
+    -------
+    ndarray, (N, 3)
+        ``(a, b, c)`` with ``a x + b y + c = 0`` and ``a² + b² = 1``.
+    """
     p = np.column_stack([seg[:, :2], np.ones(len(seg))])
     q = np.column_stack([seg[:, 2:], np.ones(len(seg))])
     ln = np.cross(p, q)
@@ -79,12 +138,30 @@ def homogeneous(seg: np.ndarray) -> np.ndarray:
 
 
 def chains(seg: np.ndarray, px: float, tol: float = 1.2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The segments joined into whole lines: two segments are links of one line when each one's end
-    points lie within ``tol`` work pixels of the other's line and the gap between them is at most
-    twice the longer one (links chain along a line: a joint broken at every brick, a checkerboard's
-    edge); each line is fitted to its segments' end points. Returns (K, 3) lines, their lengths and
-    their centres. A long line's direction is known far better than its pieces' (short segments
-    cut at corners lean towards the corners)."""
+    """The segments joined into whole lines.
+
+    Two segments are links of one line when each one's end points lie within ``tol`` work pixels of the
+    other's line and the gap between them is at most twice the longer one (links chain along a line: a
+    joint broken at every brick, a checkerboard's edge); each line is fitted to its segments' end
+    points. A long line's direction is known far better than its pieces' (short segments cut at
+    corners lean towards the corners).
+
+    Parameters
+    ----------
+    seg : ndarray, (N, 4)
+        Segments.
+    px : float
+        The length of a work pixel in the segments' units.
+    tol : float, default 1.2
+        Work pixels.
+
+    Returns
+    -------
+    lines : ndarray, (K, 3)
+        Homogeneous lines.
+    lengths : ndarray, (K,)
+    centres : ndarray, (K, 2)
+    """
     n = len(seg)
     lines = homogeneous(seg)
     p, q = seg[:, :2], seg[:, 2:]
@@ -139,13 +216,32 @@ def chains(seg: np.ndarray, px: float, tol: float = 1.2) -> tuple[np.ndarray, np
 def refine_segments(
     grey: np.ndarray, seg: np.ndarray, reach: float, samples: int = 24, trim: float = 0.15
 ) -> np.ndarray:
-    """The segments ``seg`` (photo pixels) refitted on the photo's own pixels: along each segment,
-    away from its ends (``trim`` of its length each side: where two edges meet at a corner the edge
-    bends), the sub-pixel peak of the gradient across it within ``reach`` pixels; a line fitted to
-    the peaks by total least squares, the end points projected onto it. A segment found on a
-    reduced photo knows its direction to about a reduced pixel over its length; at full resolution
-    the many peaks fix it better. A segment with fewer than half its peaks found is kept as it was.
-    ``grey`` is the photo in grey (float32, full resolution)."""
+    """Segments refitted on the photo's own pixels.
+
+    Along each segment, away from its ends (where two edges meet at a corner the edge bends), the
+    sub-pixel peak of the gradient across it is found; a line is fitted to the peaks by total least
+    squares and the end points are projected onto it. A segment found on a reduced photo knows its
+    direction to about a reduced pixel over its length; at full resolution the many peaks fix it
+    better. A segment with fewer than half its peaks found is kept as it was.
+
+    Parameters
+    ----------
+    grey : ndarray, float32 (h, w)
+        The photo in grey, full resolution.
+    seg : ndarray, (N, 4)
+        Segments ``x1, y1, x2, y2`` in photo pixels.
+    reach : float
+        How far across a segment (pixels) its edge's peak is looked for.
+    samples : int
+        Points sampled along each segment.
+    trim : float
+        The fraction of its length left out at each end.
+
+    Returns
+    -------
+    ndarray, (N, 4)
+        The refitted segments, in photo pixels.
+    """
     if len(seg) == 0:
         return seg
     gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)

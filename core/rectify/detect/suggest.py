@@ -280,7 +280,7 @@ def suggestion_from_families(
     if abs(d1[0]) < abs(d2[0]):  # the more horizontal family along x
         v1, v2 = v2, v1
         fam.members.reverse()
-    members = np.concatenate(fam.members)
+    both = np.concatenate(fam.members)
     f2 = focal_sq(v1, v2)
     if f2 is not None and f2 <= MIN_FOCAL**2:
         raise GeometryError(REFUSAL)
@@ -291,7 +291,7 @@ def suggestion_from_families(
     hn = _plane_homography(v1, v2, focal, x0)
     to_px_m = np.array([[s, 0, c[0]], [0, s, c[1]], [0, 0, 1.0]])
     h_plane = to_px_m @ hn  # plane -> photo pixels
-    rect, plane_seg = _frame(h_plane, seg_px[members], (w, hgt))
+    rect, plane_seg = _frame(h_plane, seg_px[both], (w, hgt))
 
     # frontal pixels: the photo's pixel density over the region, at most MAX_FRONTAL_SIDE
     quad = apply_homography(
@@ -322,11 +322,11 @@ def suggestion_from_families(
             picks = [0.0, float(span)]
         for p in sorted(picks):
             frontal.append([0.0, p, fw - 1.0, p] if axis == 1 else [p, 0.0, p, fh - 1.0])
-    frontal = np.array(frontal)
-    image = np.column_stack([apply_homography(hom, frontal[:, :2]), apply_homography(hom, frontal[:, 2:])])
+    ends = np.array(frontal)
+    image = np.column_stack([apply_homography(hom, ends[:, :2]), apply_homography(hom, ends[:, 2:])])
     image[:, 0::2] = np.clip(image[:, 0::2], 0, w - 1)
     image[:, 1::2] = np.clip(image[:, 1::2], 0, hgt - 1)
-    lines = FeatureLines(np.round(image, 3), np.round(frontal, 3), (fw, fh))
+    lines = FeatureLines(np.round(image, 3), np.round(ends, 3), (fw, fh))
 
     weaker = min(len(m) for m in fam.members)
     confidence = fam.explained * (1.0 - math.exp(-weaker / 8.0)) * (1.0 if aspect == "camera" else 0.5)
@@ -341,6 +341,27 @@ def suggestion_from_families(
 
 
 def suggest_for_studio(photo: np.ndarray) -> tuple[FeatureLines, str]:
-    """:func:`suggest_lines` as a studio geometry's ``suggest``: the lines and their description."""
+    """:func:`suggest_lines` as a studio geometry's ``suggest``.
+
+    Parameters
+    ----------
+    photo : ndarray, float32 (H, W) or (H, W, 3)
+        The photo.
+
+    Returns
+    -------
+    lines : FeatureLines
+    description : str
+        What the suggestion rests on, for the status line.
+
+    Raises
+    ------
+    GeometryError
+        :data:`REFUSAL`: no two families of lines to rectify by.
+
+    References
+    ----------
+    Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §3.
+    """
     s = suggest_lines(photo)
     return s.lines, s.describe()

@@ -35,7 +35,24 @@ _CANDIDATES = 400  # RANSAC hypotheses (pairs of segments)
 
 
 def support(vps: np.ndarray, mids: np.ndarray, dirs: np.ndarray, sin_tol: np.ndarray) -> np.ndarray:
-    """(M, N) bool: segment n points at vanishing point m within its tolerance (sine of the angle)."""
+    """Which segments point at which vanishing points.
+
+    Parameters
+    ----------
+    vps : ndarray, (M, 3)
+        Homogeneous points.
+    mids : ndarray, (N, 2)
+        The segments' centres.
+    dirs : ndarray, (N, 2)
+        Their unit directions.
+    sin_tol : ndarray, (N,)
+        Each segment's tolerance, the sine of an angle.
+
+    Returns
+    -------
+    ndarray, bool (M, N)
+        True where segment n points at point m within its tolerance.
+    """
     v = vps.astype(np.float32)
     m = mids.astype(np.float32)
     qx = v[:, None, 0] - v[:, None, 2] * m[None, :, 0]
@@ -51,12 +68,36 @@ def refine_point(
     v: np.ndarray | None = None,
     iterations: int = 4,
 ) -> np.ndarray:
-    """The point the ``lines`` point at best: unit 3-vector. Without ``mids``, the algebraic least
-    squares; with them (each line's centre) and a start ``v``, the sum of squared sines of the
-    angles between each line and the direction from its centre to the point, by reweighting: the
-    algebraic residual of a line is that sine times the distance (in ``v``'s scale) from its centre
-    to the point, which would favour points near the long lines. A Cauchy weight (scale twice the
-    robust spread of the sines, at least 0.3 degrees) keeps stray members from pulling."""
+    """The point the ``lines`` point at best, as a unit 3-vector.
+
+    Without ``mids``, the algebraic least squares; with them (each line's centre) and a start ``v``,
+    the sum of squared sines of the angles between each line and the direction from its centre to the
+    point, by reweighting: the algebraic residual of a line is that sine times the distance (in
+    ``v``'s scale) from its centre to the point, which would favour points near the long lines. A
+    Cauchy weight (scale twice the robust spread of the sines, at least 0.3 degrees) keeps stray
+    members from pulling.
+
+    Parameters
+    ----------
+    lines : ndarray, (N, 3)
+        Homogeneous lines.
+    weights : ndarray, (N,)
+        Their weights (lengths).
+    mids : ndarray, (N, 2), optional
+        Their centres.
+    v : ndarray, (3,), optional
+        The start point (with ``mids``).
+    iterations : int, default 4
+        Reweighting steps.
+
+    Returns
+    -------
+    ndarray, (3,)
+
+    References
+    ----------
+    Hartley & Zisserman, *Multiple View Geometry*, 2nd ed., §8.6 (vanishing points).
+    """
 
     def solve(w: np.ndarray) -> np.ndarray:
         m = (lines * w[:, None]).T @ lines
@@ -64,6 +105,7 @@ def refine_point(
 
     if mids is None:
         return solve(weights)
+    assert v is not None  # the centres come with a start point
     for _ in range(iterations):
         q = v[None, :2] - v[2] * mids
         qq = np.maximum(np.einsum("ij,ij->i", q, q), 1e-12)
@@ -75,8 +117,22 @@ def refine_point(
 
 
 def focal_sq(v1: np.ndarray, v2: np.ndarray) -> float | None:
-    """f² from two orthogonal vanishing points about the origin (the principal point), or None when
-    one of them is (near) infinity and f is left open."""
+    """f² from two orthogonal vanishing points about the origin (the principal point).
+
+    Parameters
+    ----------
+    v1, v2 : ndarray, (3,)
+        Homogeneous vanishing points in normalised coordinates.
+
+    Returns
+    -------
+    float or None
+        None when one of them is (near) infinity and f is left open.
+
+    References
+    ----------
+    Hartley & Zisserman, *Multiple View Geometry*, 2nd ed., §8.8 (the image of the absolute conic).
+    """
     if abs(v1[2]) < 1e-9 or abs(v2[2]) < 1e-9:
         return None
     return float(-(v1[:2] @ v2[:2]) / (v1[2] * v2[2]))
@@ -90,8 +146,23 @@ class Families:
 
 
 def hypotheses(lines: np.ndarray, length: np.ndarray, pool: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Candidate vanishing points (unit 3-vectors): intersections of random pairs of segments of
-    ``pool``, longer segments drawn more often."""
+    """Candidate vanishing points: intersections of random pairs of segments, longer segments drawn more often.
+
+    Parameters
+    ----------
+    lines : ndarray, (N, 3)
+        The segments' homogeneous lines.
+    length : ndarray, (N,)
+        Their lengths.
+    pool : ndarray, int
+        The segments to draw from.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    ndarray, (K, 3)
+        Unit 3-vectors.
+    """
     p = length[pool] / length[pool].sum()
     a = rng.choice(pool, _CANDIDATES, p=p)
     b = rng.choice(pool, _CANDIDATES, p=p)
@@ -101,21 +172,51 @@ def hypotheses(lines: np.ndarray, length: np.ndarray, pool: np.ndarray, rng: np.
 
 
 def near(points: np.ndarray, of: np.ndarray, margin: float) -> np.ndarray:
-    """Whether each of ``points`` lies within ``margin`` of the convex hull of ``of`` (all 2-D)."""
+    """Whether each of ``points`` lies within ``margin`` of the convex hull of ``of`` (all 2-D).
+
+    Parameters
+    ----------
+    points : ndarray, (K, 2)
+    of : ndarray, (N, 2)
+    margin : float
+
+    Returns
+    -------
+    ndarray, bool (K,)
+    """
     hull = cv2.convexHull(of.astype(np.float32))
     return np.array([cv2.pointPolygonTest(hull, (float(x), float(y)), True) >= -margin for x, y in points])
 
 
 def two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice: bool = False) -> Families | None:
-    """Two well-supported vanishing points of segments in normalised coordinates (the principal
-    point at the origin) that a camera can see as perpendicular directions: the best supported
-    first, then the best supported among the other segments on the region of the first (clutter
-    beside the surface counts a tenth). ``px`` is the length of a work pixel in these units: a
-    short segment's direction is known only to about a pixel over its length.
+    """Two well-supported vanishing points that a camera can see as perpendicular directions.
 
-    ``lattice``: the segments join repeats of a lattice, whose every translation has a vanishing
-    point on the horizon (the axes and the diagonals): the four best-supported points are found in
-    turn and the best-supported pair a camera can see as perpendicular is taken."""
+    The best supported first, then the best supported among the other segments on the region of the
+    first (clutter beside the surface counts a tenth).
+
+    Parameters
+    ----------
+    seg : ndarray, (N, 4)
+        Segments in normalised coordinates (the principal point at the origin).
+    rng : numpy.random.Generator
+        For the hypotheses.
+    px : float
+        The length of a work pixel in these units: a short segment's direction is known only to about
+        a pixel over its length.
+    lattice : bool, default False
+        The segments join repeats of a lattice, whose every translation has a vanishing point on the
+        horizon (the axes and the diagonals): the four best-supported points are found in turn and the
+        best-supported pair a camera can see as perpendicular is taken.
+
+    Returns
+    -------
+    Families or None
+        None when there are no two such families.
+
+    References
+    ----------
+    Hartley & Zisserman, *Multiple View Geometry*, 2nd ed., §8.6-8.8.
+    """
     n = len(seg)
     if n < 2 * MIN_FAMILY:
         return None
@@ -215,6 +316,16 @@ def two_families(seg: np.ndarray, rng: np.random.Generator, px: float, lattice: 
 
 
 def direction_at(v: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Unit direction from point ``x`` (2,) towards the homogeneous point ``v``."""
+    """Unit direction from point ``x`` towards the homogeneous point ``v``.
+
+    Parameters
+    ----------
+    v : ndarray, (3,)
+    x : ndarray, (2,)
+
+    Returns
+    -------
+    ndarray, (2,)
+    """
     q = v[:2] - v[2] * x
     return q / np.linalg.norm(q)
