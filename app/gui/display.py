@@ -33,6 +33,7 @@ ASYNC_PIXELS = 512 * 512
 #: the screen in bursts.
 PART_PIXELS = 2048 * 2048
 
+# shared by every view of every window, not a QtJobs per view: two conversions at once however many views convert
 _converters = ThreadPoolExecutor(max_workers=2, thread_name_prefix="weft-display")
 
 

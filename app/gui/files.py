@@ -27,18 +27,20 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
-from PySide6.QtCore import QEventLoop, QMetaObject, QObject, Qt, QTimer, Signal
+from PySide6.QtCore import QEventLoop, QMetaObject, QObject, Qt
 from PySide6.QtWidgets import QFileDialog
+from superqt.utils import QSignalThrottler
 from weft.core import registry
 from weft.core.errors import WeftError
 from weft.core.image import save_image
-from weft.core.jobs import JobResult, JobRunner
+from weft.core.jobs import JobResult
 from weft.core.readfile import file_key
 from weft.core.session import Session, write_files, write_masks
 from weft.core.studio import MASK, SQUARE
 
 from . import recovery
 from .document import DocumentState, InputImage, read_input
+from .qjobs import QtJobs
 
 T = TypeVar("T")
 
@@ -57,8 +59,11 @@ def _source_depth(shown) -> int:
     return 8
 
 
-def off_gui_thread(fn: Callable[[], T]) -> T:
-    """Run ``fn()`` on a worker thread and return its value (or raise its exception).
+_waiting = [0]  # how many off_gui_thread calls are waiting (GUI thread only)
+
+
+def off_gui_thread(jobs: QtJobs, fn: Callable[[], T]) -> T:
+    """Run ``fn()`` on a worker of ``jobs`` and return its value (or raise its exception).
 
     For work the caller must wait for (a session's images are decoded before the document is
     touched, an export is written before it is reported): meanwhile the GUI thread runs a local
@@ -66,54 +71,58 @@ def off_gui_thread(fn: Callable[[], T]) -> T:
     stays alive and nothing can be started twice.
     """
     loop = QEventLoop()
-    box: dict = {}
+    box: dict = {}  # (the value is handed over here, not kept in the job's result after it is used)
 
-    def work() -> None:
-        try:
-            box["value"] = fn()
-        except BaseException as e:  # handed to the GUI thread and raised there
-            box["error"] = e
-        finally:
-            QMetaObject.invokeMethod(loop, "quit", Qt.ConnectionType.QueuedConnection)
+    def work(**_) -> None:
+        box["value"] = fn()
 
-    thread = threading.Thread(target=work, name="weft-open", daemon=True)
-    thread.start()
-    loop.exec(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)
-    thread.join()
-    if "error" in box:
-        raise box["error"]
+    # a wait started inside this one's event loop (a close event) gets a slot of its own, never cancelling this one
+    job = jobs.submit(f"wait-{_waiting[0]}", work)
+    job.future.add_done_callback(lambda _f: QMetaObject.invokeMethod(loop, "quit", Qt.ConnectionType.QueuedConnection))
+    _waiting[0] += 1
+    try:
+        loop.exec(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)
+    finally:
+        _waiting[0] -= 1
+    result = job.result()
+    if result.error is not None:
+        raise result.error
+    if "value" not in box:  # cancelled before it ran: the window shut its workers down meanwhile
+        raise WeftError("not done: the window is closing")
     return box["value"]
 
 
 class FileActions(QObject):
     """Export, recipes, sessions, autosave and recovery (see the module docstring)."""
 
-    _autosaved = Signal(object)  # a background autosave's JobResult (queued to the GUI thread)
-
     def __init__(self, window, doc, renderer):
         super().__init__(window)
         self.window, self.doc, self.renderer = window, doc, renderer
         self.settings = window.settings
         # Crash recovery: while the document has unsaved edits, it is autosaved (atomically) at most
-        # every AUTOSAVE_MS; a clean document has no recovery file.
+        # AUTOSAVE_MS after each edit, also while edits go on; a clean document has no recovery file.
         # (one file per window, with a lock naming its owner: see recovery.py)
         self._me = recovery.Owner.me(recovery.settings_id(self.settings))
         self.recovery_file = recovery.new_recovery_file(recovery.recovery_folder())
         self.session_path: str | None = None  # the session file Ctrl+S saves to (saved, opened or restored)
-        self._autosave_timer = QTimer(window, singleShot=True, interval=AUTOSAVE_MS)
-        self._autosave_timer.timeout.connect(lambda: self.autosave(wait=False))
+        # a throttle, not a debounce: a stream of edits (painting) still reaches the recovery file
+        self.autosave_throttle = QSignalThrottler(QSignalThrottler.EmissionPolicy.Trailing, window)
+        self.autosave_throttle.setTimeout(AUTOSAVE_MS)
+        self.autosave_throttle.triggered.connect(lambda: self.autosave(wait=False))
         self._owns_recovery = False  # only a file this window wrote (or restored) is removed by it
         # the recovery file's writes: one worker; the lock and generation keep a write from putting
         # back a recovery file that was removed (discard_recovery) while it was being encoded
         self._recovery_lock = threading.Lock()
         self._recovery_generation = 0
-        self._autosaver = JobRunner(max_workers=1, on_result=self._autosaved.emit)
-        self._autosaved.connect(self._on_autosaved)
+        self._autosaver = QtJobs(self)
+        self._autosaver.result.connect(self._on_autosaved)
+        self._io = QtJobs(self)  # what the GUI thread waits for (off_gui_thread)
 
     def shutdown(self) -> None:
-        """Finish a background autosave that has started (a pending one is dropped) and stop its worker."""
-        self._autosave_timer.stop()
+        """Finish a background autosave that has started (a pending one is dropped) and stop the workers."""
+        self.autosave_throttle.cancel()
         self._autosaver.shutdown(wait=True, cancel=True)
+        self._io.shutdown(wait=True, cancel=True)
 
     def show_message(self, text: str) -> None:
         self.window.show_message(text)
@@ -183,7 +192,7 @@ class FileActions(QObject):
             save_image(p, shown.image, recipe=recipe, bit_depth=depth)
 
         try:  # encoding a large PNG (and its mask's) takes a second: off the GUI thread
-            off_gui_thread(write)
+            off_gui_thread(self._io, write)
         except WeftError as e:
             self.show_message(str(e))
             return False
@@ -210,7 +219,7 @@ class FileActions(QObject):
                 write_masks(masks)
                 recipe.save(path)
 
-            off_gui_thread(write)
+            off_gui_thread(self._io, write)
         except WeftError as e:
             self.show_message(str(e))
             return False
@@ -254,7 +263,7 @@ class FileActions(QObject):
     def save_session(self, path: str) -> bool:
         session = self.doc.session()  # (captured here; its masks' PNGs are encoded off the GUI thread)
         try:
-            off_gui_thread(lambda: session.save(path))
+            off_gui_thread(self._io, lambda: session.save(path))
         except WeftError as e:
             self.show_message(str(e))
             return False
@@ -311,7 +320,7 @@ class FileActions(QObject):
             return data, images
 
         self.statusBar().showMessage(f"opening {Path(path).name}…")
-        data, images = off_gui_thread(decode)
+        data, images = off_gui_thread(self._io, decode)
         for method, values in data.geometry.items():  # a square must lie inside its image
             for g in offered[method].studio.geometry:
                 value, on = values.get(g.key), g.input_for(images)
@@ -348,11 +357,11 @@ class FileActions(QObject):
         """The document changed (or was saved): autosave it soon if it has unsaved edits, else
         remove this window's recovery file."""
         if self.doc.undo_stack.isClean():
-            self._autosave_timer.stop()
+            self.autosave_throttle.cancel()
             if self._owns_recovery:
                 self.discard_recovery()
-        elif not self._autosave_timer.isActive():
-            self._autosave_timer.start()
+        else:
+            self.autosave_throttle.throttle()
 
     def autosave(self, *, wait: bool = True) -> bool:
         """Write the session (absolute paths) to :attr:`recovery_file`, atomically, its masks' PNGs
@@ -378,7 +387,7 @@ class FileActions(QObject):
             self._autosaver.submit("autosave", lambda **_: self._write_recovery(generation, session))
             return True
         try:
-            off_gui_thread(lambda: self._write_recovery(generation, session))
+            off_gui_thread(self._io, lambda: self._write_recovery(generation, session))
         except (OSError, WeftError) as e:
             self._autosave_failed(e)
             return False
@@ -422,7 +431,7 @@ class FileActions(QObject):
     def close(self) -> None:
         """The window closes with nothing unsaved (saved or discarded): no autosave any more, and this
         window's recovery file goes."""
-        self._autosave_timer.stop()
+        self.autosave_throttle.cancel()
         if self._owns_recovery:
             self.discard_recovery()
 

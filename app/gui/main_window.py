@@ -28,7 +28,6 @@ from PySide6.QtCore import QSettings, Qt, Signal
 from PySide6.QtWidgets import QDockWidget, QFileDialog, QMainWindow, QSplitter
 from weft.core.errors import WeftError
 from weft.core.examples import example
-from weft.core.jobs import JobRunner
 from weft.core.studio import SQUARE
 
 from .canvas import InputsPane, titled
@@ -37,6 +36,7 @@ from .document import Document, DocumentState, read_input
 from .files import FileActions
 from .menus import Menus
 from .method_panel import MethodPanel
+from .qjobs import QtJobs
 from .questions import Questions
 from .render import Renderer
 from .result_view import ResultView
@@ -54,7 +54,6 @@ class MainWindow(QMainWindow):
     """
 
     message = Signal(str)
-    _opened = Signal(object)
 
     def __init__(self, parent=None, *, settings: QSettings | None = None, load_defaults: bool = True):
         super().__init__(parent)
@@ -71,8 +70,8 @@ class MainWindow(QMainWindow):
         self.doc = Document(self)
         self.renderer = Renderer(self.doc, self)
         # Opened files are decoded off the GUI thread; the result comes back through a queued signal.
-        self.loader = JobRunner(max_workers=1, on_result=self._opened.emit)
-        self._opened.connect(self._on_opened)
+        self.loader = QtJobs(self)
+        self.loader.result.connect(self._on_opened)
         self._variations = None
         self._build_parts()
         self._wire()
@@ -244,8 +243,6 @@ class MainWindow(QMainWindow):
         self.loader.submit(f"open-{name}", _load_job, name, str(path))
 
     def _on_opened(self, result) -> None:
-        if result.cancelled:
-            return
         if result.error is not None:
             self.show_message(f"could not open: {result.error}")
             return

@@ -2,8 +2,9 @@
 results, progress and completions arrive on the GUI thread as queued signals.
 
 Workers never touch widgets: every part of the studio that runs work in the background (renders,
-Variations, rectification, line suggestions, opening files, autosave, a batch) submits it here and
-connects to the signals.
+Variations, rectification, line suggestions, opening files, reading and writing sessions and exports,
+autosave, a batch) submits it here and connects to the signals. Drawing an image in a view is not a
+job: the views share one small pool (``display.py``).
 """
 
 from __future__ import annotations

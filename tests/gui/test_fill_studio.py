@@ -420,7 +420,7 @@ def test_mask_pngs_are_encoded_and_decoded_off_the_gui_thread(
 
     monkeypatch.setattr(Mask, "to_png", encode)
     monkeypatch.setattr(Mask, "read", classmethod(decode))
-    studio.files._autosave_timer.setInterval(10**7)  # no autosave until asked for below
+    studio.files.autosave_throttle.setTimeout(10**7)  # no autosave until asked for below
     view, doc = studio.inputs_pane.canvas_view, studio.doc
     _final_after(studio, qtbot, lambda: _stroke(view, [(15.5, 15.5), (35.5, 40.5)]))
     painted = _mask(studio)
@@ -432,7 +432,7 @@ def test_mask_pngs_are_encoded_and_decoded_off_the_gui_thread(
     assert len(threads["encode"]) == 3 and not any(threads["encode"])
     # the autosave (its timer's): off the GUI thread, and nothing waits for it
     doc.set_margins("grow", Margins(0, 0, 2, 0))
-    studio.files._autosave_timer.setInterval(10)
+    studio.files.autosave_throttle.setTimeout(10)
     recovery = studio.files.recovery_file.with_name(studio.files.recovery_file.name[:-5] + ".mean-fill.hole.png")
     qtbot.waitUntil(lambda: studio.files.recovery_file.is_file() and recovery.is_file(), timeout=10000)
     assert len(threads["encode"]) == 4 and not any(threads["encode"])
@@ -1050,7 +1050,7 @@ def test_a_background_autosave_that_fails_says_so_in_one_line(studio, qtbot, pri
     taken by a file) still reaches the status bar, in one line, and the studio goes on."""
     private_recovery.parent.mkdir(parents=True, exist_ok=True)
     private_recovery.write_text("not a folder")
-    studio.files._autosave_timer.setInterval(10)
+    studio.files.autosave_throttle.setTimeout(10)
     with qtbot.waitSignal(
         studio.statusBar().messageChanged, timeout=10000, check_params_cb=lambda text: "autosave failed" in text
     ) as said:

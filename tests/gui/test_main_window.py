@@ -323,6 +323,39 @@ def test_no_worker_thread_left_after_close(qtbot, settings):
     assert no_job_threads()
 
 
+def test_a_file_still_opening_when_its_window_is_deleted_tells_nobody_and_logs_nothing(
+    qtbot, settings, tmp_path, monkeypatch, caplog
+):
+    """The decode of File > Open outlives the window it was for: its result reaches no deleted object,
+    and no error is logged."""
+    import shiboken6
+    import weft.app.gui.main_window as main_window
+    from weft.app.gui.main_window import MainWindow
+
+    started, release = threading.Event(), threading.Event()
+    real = main_window.read_input
+
+    def held(path):
+        started.set()
+        assert release.wait(10)
+        return real(path)
+
+    monkeypatch.setattr(main_window, "read_input", held)
+    w = MainWindow(settings=settings, load_defaults=False)
+    w.renderer.shutdown()
+    w.files.shutdown()
+    w.inputs_pane.shutdown()
+    loader = w.loader.runner
+    w.open_input("texture", str(example("wood-grain")))
+    assert started.wait(10)
+    shiboken6.delete(w)  # (the window and its parts are gone; the decode goes on)
+    release.set()
+    job = loader.latest("open-texture")
+    assert job is not None and job.result(timeout=10).value is not None
+    loader.shutdown()
+    assert "callback failed" not in caplog.text
+
+
 def test_slow_stand_in_is_cancellable_directly():
     """The stand-in used above really blocks until cancelled (so the cancel test means something)."""
     from weft.core.jobs import CancelToken

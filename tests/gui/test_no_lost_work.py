@@ -92,7 +92,7 @@ def test_open_session_with_unsaved_edits_asks(window, tmp_path, monkeypatch):
 
 
 def test_autosave_while_edited_and_removed_when_clean(window, qtbot, private_recovery):
-    window.files._autosave_timer.setInterval(20)
+    window.files.autosave_throttle.setTimeout(20)
     recovery = window.files.recovery_file
     assert recovery.parent == private_recovery
     assert not recovery.exists()
@@ -107,6 +107,56 @@ def test_autosave_while_edited_and_removed_when_clean(window, qtbot, private_rec
     qtbot.waitUntil(recovery.exists, timeout=5000)
     window.close()  # the conftest answers "discard" to the question
     assert not recovery.exists() and list(private_recovery.iterdir()) == []  # (its lock too)
+
+
+def _recorded_autosaves(window, monkeypatch) -> list[float]:
+    """The value of the fast method's ``p`` in each recovery file written from now on, in order."""
+    import weft.app.gui.files as files
+
+    written, real = [], files.write_files
+
+    def recording(to_write):
+        real(to_write)
+        written.append(json.loads(window.files.recovery_file.read_text(encoding="utf-8"))["params"]["fast"]["p"])
+
+    monkeypatch.setattr(files, "write_files", recording)
+    return written
+
+
+def test_a_burst_of_edits_is_autosaved_once_with_its_last_state(window, qtbot, monkeypatch):
+    written = _recorded_autosaves(window, monkeypatch)
+    window.files.autosave_throttle.setTimeout(1500)
+    for p in (0.1, 0.2, 0.3, 0.4, 0.5):  # (well within the interval)
+        window.doc.set_param("p", p)
+    qtbot.waitUntil(lambda: len(written) >= 1, timeout=10000)
+    window.doc.set_param("p", 0.9)  # a later edit: its own write, after the burst's
+    qtbot.waitUntil(lambda: 0.9 in written, timeout=10000)
+    assert written == [0.5, 0.9]
+
+
+def test_edits_that_go_on_are_autosaved_while_they_go_on(window, qtbot, monkeypatch):
+    """The autosave is a throttle, not a debounce: painting without a pause longer than the autosave
+    interval still reaches the recovery file."""
+    from PySide6.QtCore import QTimer
+
+    written = _recorded_autosaves(window, monkeypatch)
+    window.files.autosave_throttle.setTimeout(300)
+    edits = []
+
+    def edit():
+        edits.append(len(edits))
+        window.doc.set_param("p", 0.2 + 0.1 * (len(edits) % 2))
+        if len(edits) >= 300:
+            ticker.stop()
+
+    ticker = QTimer(interval=30)  # an edit every 30 ms, for 9 s or more
+    ticker.timeout.connect(edit)
+    ticker.start()
+    try:
+        qtbot.waitUntil(lambda: bool(written), timeout=10000)
+        assert ticker.isActive() and len(edits) < 300  # written while the edits go on
+    finally:
+        ticker.stop()
 
 
 def answer_restore(monkeypatch, reply: bool) -> list[str]:

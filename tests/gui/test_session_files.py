@@ -218,3 +218,27 @@ def test_export_is_encoded_off_the_gui_thread(window, qtbot, tmp_path, monkeypat
     written, shown = load_image(out).image, window.renderer.last.image
     assert written.shape == shown.shape
     assert float(np.abs(written - shown).max()) <= 0.5 / 255 + 1e-6  # the shown result, to 8 bits
+
+
+def test_a_wait_started_inside_another_wait_leaves_that_one_its_result(qtbot):
+    """off_gui_thread runs a local event loop; a second wait started from it (a close event) is queued
+    behind the first one's work and never cancels it: both return their own values."""
+    import threading
+
+    from PySide6.QtCore import QTimer
+    from weft.app.gui.files import off_gui_thread
+    from weft.app.gui.qjobs import QtJobs
+
+    jobs = QtJobs()
+    busy = threading.Event()
+    jobs.submit("other", lambda **_: busy.wait(10))  # (its worker is busy: the first wait's work is queued)
+    inner = []
+
+    def nested():
+        inner.append(off_gui_thread(jobs, lambda: "inner"))
+
+    QTimer.singleShot(0, nested)
+    QTimer.singleShot(0, busy.set)
+    assert off_gui_thread(jobs, lambda: "outer") == "outer"
+    assert inner == ["inner"]
+    jobs.shutdown()
