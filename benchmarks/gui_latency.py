@@ -116,7 +116,7 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
 
         heartbeat, beats = _heartbeat()
 
-        slider = window.params_panel.row("p").editor
+        slider = window.method_panel.params_panel.row("p").editor
         slider.setSliderDown(True)
         series = [round(0.02 + 0.5 * i / (values - 1), 3) for i in range(values)]
         step = 1.0 / hz
@@ -170,7 +170,7 @@ def measure_painting(
         doc.restore(DocumentState(inputs={studio.canvas: InputImage(None, picture)}, method=method))
         window.renderer.final(now=True)
         _wait(app, lambda: bool(answered), 120)
-        view = window.canvas_view
+        view = window.inputs_pane.canvas_view
         tool = window.inputs_pane.mask_tool()
         tool.set_size(max(8, side // 24))
 
@@ -281,7 +281,7 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
             doc, studio = window.doc, window.doc.methods[method].studio
             canvas = studio.canvas
             doc.restore(DocumentState(inputs={canvas: item}, method=method))
-            doc.save_session(session)
+            doc.session().save(session)
             doc.restore(DocumentState(inputs={}, method=method))
             _wait(app, lambda: not window.renderer.running(), 30)
             answered: list[float] = []
@@ -289,7 +289,7 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
             window.renderer.failed.connect(lambda _m: answered.append(time.perf_counter()))
 
             def views_show(image) -> bool:
-                views = (window.canvas_view, window.result_view)
+                views = (window.inputs_pane.canvas_view, window.result_view)
                 return all(
                     v.image is not None and v.image.shape[:2] == image.shape[:2] and not getattr(v, "converting", False)
                     for v in views
@@ -307,7 +307,7 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
             # a session of the picture (nothing drawn: the result view shows the picture)
             step(
                 "session",
-                lambda: window.open_session(session),
+                lambda: window.files.open_session(session),
                 lambda: answered and views_show(item.image) and window.result_view.image is doc.image(canvas),
             )
             # File > Open of the picture (decoded off the GUI thread, then shown)
@@ -349,7 +349,7 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
                 since=lambda: answered[0],
             )
             out = os.path.join(tmp, f"out{run}.png")
-            step("export", lambda: window.export_result(out), lambda: os.path.exists(out), settle=0.2)
+            step("export", lambda: window.files.export_result(out), lambda: os.path.exists(out), settle=0.2)
             doc.undo_stack.setClean()
             window.close()
             del window
@@ -392,7 +392,7 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
         _wait(app, lambda: not window.renderer.running(), 30)
         for _run in range(runs):
             window.open_variations()
-            dialog = window._variations
+            dialog = window.variations
             _wait(app, dialog.isVisible, 10)
             done: set = set()
             dialog.cell_done.connect(lambda i, j: done.add((i, j)))

@@ -7,13 +7,14 @@ import math
 import time
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from ...errors import GeometryError
 from ...geometry import FeatureLines
 from ...image import validate_image
 from ..homography import apply_homography
-from .segments import WORK_SIDE, line_segments, repeat_segments, work_grey
+from .segments import WORK_SIDE, line_segments, refine_segments, repeat_segments, work_grey
 from .vanishing import MAX_FOCAL, MIN_FOCAL, MIN_SPREAD_DEG, Families, direction_at, focal_sq, two_families
 
 __all__ = [
@@ -30,10 +31,11 @@ __all__ = [
 REFUSAL = "no two families of straight lines found: draw feature lines"
 FINE_SIDE = 1600  # a second look at up to this size when the reduced photo shows no two families
 FINE_BELOW = 300  # ... and fewer segments than this (fine structure lost in the reduction)
-REPEAT_SIDE = 560  # longer side of the photo the repeats are looked for on
+REPEAT_SIDE = 400  # longer side of the photo the repeats are looked for on (SIFT doubles it inside)
 ASSUMED_FOCAL = 1.2  # focal length (in photo longer sides) when the vanishing points leave it open
 MIN_CONFIDENCE = 0.3  # a weaker suggestion is refused
 MAX_FRONTAL_SIDE = 4096
+REFINE_REACH = 1.5  # work pixels either side of a segment its full-resolution refit looks
 
 
 @dataclass(frozen=True)
@@ -204,6 +206,7 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
     if repeats:
         attempts.append((REPEAT_SIDE, "repeats"))
     found = 0
+    full = photo if photo.ndim == 2 else cv2.cvtColor(photo, cv2.COLOR_RGB2GRAY)  # once for every look
     greys: dict = {}
     for side, source in attempts:
         if source == "fine lines":  # fine structure (a weave) may need every pixel: when few segments showed
@@ -211,10 +214,12 @@ def suggest_lines(photo: np.ndarray, *, rng: None | int | np.random.Generator = 
                 continue
             source = "lines"
         if side not in greys:
-            greys[side] = work_grey(photo, side)
+            greys[side] = work_grey(full, side)
         grey, k = greys[side]
         found_work = line_segments(grey) if source == "lines" else repeat_segments(grey, rng)
         seg_px = (found_work + 0.5) / k - 0.5
+        if source == "lines":
+            seg_px = refine_segments(full, seg_px, REFINE_REACH / k)
         found = max(found, len(seg_px)) if source == "lines" else found
         fam = (
             two_families((seg_px - np.tile(c, 2)) / s, rng, 1.0 / (k * s), lattice=source == "repeats")
