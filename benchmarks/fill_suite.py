@@ -12,8 +12,8 @@ in turn, so machine noise hits them alike; the time is the median of ``--repeats
   ``$WEFT_PEERS_PYTHON`` (``benchmarks/peers_env.sh`` makes such an environment); a peer that is not
   installed gets a row saying so.
 
-``--variants`` adds in-process rows of weft's engines (``engine[:structure]``, e.g.
-``patchmatch:no``), figures only, to compare designs on the same cases.
+``--variants`` adds in-process rows of weft's engines (``engine[:structure][@patch]``, e.g.
+``patchmatch:no`` or ``hybrid@32``), figures only, to compare designs on the same cases.
 
 Per case and tool: ``coherence`` (:func:`weft.core.metrics.fill_coherence` against the input),
 ``detail`` and ``seam`` (:func:`~weft.core.metrics.fill_detail`, :func:`~weft.core.metrics.fill_seam`)
@@ -89,7 +89,10 @@ def weft_command(files: dict[str, Path], out: Path, inputs: SuiteInputs, seed: i
 
 def peer_tools() -> list[tuple[str, Any, str | None]]:
     """``(name, command(files, out), why it cannot run or None)`` for each peer."""
-    gmic = lambda f, o: _gmic_command(f, o, None, None)
+
+    def gmic(f, o):
+        return _gmic_command(f, o, None, None)
+
     return [
         (PEERS[0], gmic, None if shutil.which("gmic") else "gmic is not on the PATH (Debian: apt-get install gmic)"),
         (PEERS[1], lambda f, o: _peer_command("shiftmap", lambda: sys.executable)(f, o, None, None), _cv2_missing()),
@@ -159,14 +162,18 @@ def judge(row: dict[str, Any], truth: dict[str, float], best_peer: float | None)
 
 
 def run_variant(inputs: SuiteInputs, variant: str, seed: int = 1) -> tuple[np.ndarray, float]:
-    """In-process weft fill with ``variant`` = ``engine[:structure]``: (uint8 canvas, seconds)."""
+    """In-process weft fill with ``variant`` = ``engine[:structure][@patch]``: (uint8 canvas, seconds)."""
     from weft.core.fill import FillParams
     from weft.core.fill.method import fill_image
     from weft.core.geometry import Margins
 
+    variant, _, patch = variant.partition("@")
     engine, _, structure = variant.partition(":")
     params = FillParams(
-        engine=engine, structure=structure or "auto", extend=None if inputs.extend is None else Margins(*inputs.extend)
+        engine=engine,
+        structure=structure or "auto",
+        patch=int(patch) if patch else None,
+        extend=None if inputs.extend is None else Margins(*inputs.extend),
     )
     image = inputs.part(inputs.image).astype(np.float32) / 255.0
     inner = inputs.part(inputs.hole)
@@ -324,7 +331,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("cases", nargs="*", metavar="CASE", help="case names or shell patterns (default: all)")
     ap.add_argument("--quick", action="store_true", help="one round, no contact sheets, JSON to a temporary file")
     ap.add_argument("--repeats", type=int, default=3, help="interleaved timed rounds per case (default 3)")
-    ap.add_argument("--variants", default="", help="in-process weft rows, comma-separated engine[:structure]")
+    ap.add_argument("--variants", default="", help="in-process weft rows, comma-separated engine[:structure][@patch]")
     ap.add_argument("--half", choices=("tuning", "check", "all"), default="all")
     ap.add_argument("--reuse-peers", action="store_true", help="take the peers' rows from the cache's last run")
     ap.add_argument("--cache", type=Path, default=Path(tempfile.gettempdir()) / "weft-fill-suite")

@@ -21,7 +21,7 @@ from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
 from .common import percentile, whole_patches
 
-__all__ = ["MIN_PATCH", "MAX_PATCH", "refine_patchmatch", "refine_band"]
+__all__ = ["MIN_PATCH", "MAX_PATCH", "coherence", "refine_patchmatch", "refine_band"]
 
 MIN_PATCH = 3
 MAX_PATCH = 63
@@ -523,6 +523,78 @@ def refine_patchmatch(
     return out
 
 
+def search_step(
+    fl: Flat,
+    act: np.ndarray,
+    sy: np.ndarray,
+    sx: np.ndarray,
+    dist: np.ndarray,
+    steps: tuple[int, ...],
+    gen: np.random.Generator,
+    shrink: int,
+    bias: float = 0.0,
+) -> None:
+    """One PatchMatch pass over the target patches ``act``, in place: each tries its neighbours'
+    offsets ``steps`` px away (taken within ``1 + bias`` of its current distance), then random
+    candidates around its match at radii from half the image down to 1 px, divided by ``shrink``."""
+    hv, wv = fl.valid.shape
+    aty, atx = fl.ty[act], fl.tx[act]
+    targets = fl.gather(aty, atx)
+    for s in steps:
+        for dy, dx in ((0, s), (0, -s), (s, 0), (-s, 0)):
+            ny, nx = aty + dy, atx + dx
+            inside = (ny >= 0) & (ny < hv) & (nx >= 0) & (nx < wv)
+            m = np.where(inside, fl.tmap[np.clip(ny, 0, hv - 1), np.clip(nx, 0, wv - 1)], -1)
+            mm = np.maximum(m, 0)
+            _try(fl, targets, act, sy, sx, dist, sy[mm] - dy, sx[mm] - dx, m >= 0, bias)
+    r = max(hv, wv) // 2
+    while r >= 1:
+        ry = sy[act] + gen.integers(-r, r + 1, len(act))
+        rx = sx[act] + gen.integers(-r, r + 1, len(act))
+        _try(fl, targets, act, sy, sx, dist, ry, rx, np.ones(len(act), bool))
+        r //= shrink
+
+
+def coherence(
+    image: np.ndarray,
+    hole: np.ndarray,
+    source: np.ndarray,
+    *,
+    patch: int = 7,
+    iterations: int = 4,
+    rng: None | int | np.random.Generator = 0,
+) -> float:
+    """How much a fill looks like its source: the mean, over the ``patch`` x ``patch`` patches of
+    ``image`` touching ``hole``, of the RMS difference per value (0..1) to the nearest patch lying
+    wholly in ``source``, found by PatchMatch (the principal-axis start of :func:`refine_patchmatch`,
+    then ``iterations`` passes of :func:`search_step`): Wexler et al.'s global coherence, the
+    objective their EM lowers, so fills of one hole can be compared. Lower is better; an
+    approximation from above of the exact nearest-patch distance. Raises ``ImageError`` when the
+    source holds no whole patch."""
+    arr, hole, source, p = check_inputs(image, hole, source, patch, None, iterations)
+    img = np.array(arr if arr.ndim == 3 else arr[..., None], dtype=np.float32, order="C")
+    fl = Flat(img, hole, source, p)
+    if not fl.valid.any():
+        raise ImageError(f"the source region holds no whole {p}x{p} patch to compare the fill with")
+    n = len(fl.ty)
+    if n == 0:
+        return 0.0
+    gen = as_rng(rng)
+    cy, cx = _principal_candidates(fl, img, gen, _REFINE_CANDIDATES)
+    targets = fl.gather(fl.ty, fl.tx)
+    sy, sx = cy[0].copy(), cx[0].copy()
+    everyone = np.arange(n)
+    dist = fl.dist(targets, everyone, sy, sx)
+    for c in range(1, len(cy)):
+        _try(fl, targets, everyone, sy, sx, dist, cy[c], cx[c], np.ones(n, bool))
+    for it in range(iterations):
+        act = np.nonzero(dist > 0.0)[0]
+        if len(act) == 0:
+            break
+        search_step(fl, act, sy, sx, dist, STEPS_FIRST if it == 0 else _STEPS_LATER, gen, _SEARCH_SHRINK)
+    return float(np.sqrt(np.maximum(dist, 0.0) / (p * p * fl.c)).mean())
+
+
 def em(
     fl: Flat,
     img: np.ndarray,
@@ -584,7 +656,6 @@ def em(
     Barnes et al., "PatchMatch" (2009); Wexler, Shechtman & Irani, "Space-time completion of video" (2007).
     """
     p = fl.p
-    hv, wv = fl.valid.shape
     changed = None
     for it in range(iterations):
         if cancel is not None:
@@ -597,21 +668,7 @@ def em(
         act = np.nonzero(dist > 0.0)[0] if floor <= 0.0 else np.nonzero(dist >= floor)[0]
         if len(act) == 0:
             break
-        aty, atx = fl.ty[act], fl.tx[act]
-        targets = fl.gather(aty, atx)
-        for s in steps_first if it == 0 else _STEPS_LATER:
-            for dy, dx in ((0, s), (0, -s), (s, 0), (-s, 0)):
-                ny, nx = aty + dy, atx + dx
-                inside = (ny >= 0) & (ny < hv) & (nx >= 0) & (nx < wv)
-                m = np.where(inside, fl.tmap[np.clip(ny, 0, hv - 1), np.clip(nx, 0, wv - 1)], -1)
-                mm = np.maximum(m, 0)
-                _try(fl, targets, act, sy, sx, dist, sy[mm] - dy, sx[mm] - dx, m >= 0, bias)
-        r = max(hv, wv) // 2
-        while r >= 1:
-            ry = sy[act] + gen.integers(-r, r + 1, len(act))
-            rx = sx[act] + gen.integers(-r, r + 1, len(act))
-            _try(fl, targets, act, sy, sx, dist, ry, rx, np.ones(len(act), bool))
-            r //= shrink
+        search_step(fl, act, sy, sx, dist, steps_first if it == 0 else _STEPS_LATER, gen, shrink, bias)
         dn = fl.normalized(dist)
         sigma2 = max(percentile(dn, _SIGMA_PERCENTILE), 1e-12)
         inexact = np.zeros((fl.h + p - 1, fl.w + p - 1), bool)  # pixels covered by a patch that is not an exact copy

@@ -240,35 +240,77 @@ def test_auto_runs_hybrid_where_no_edges_cross_and_patchmatch_for_the_edge_guide
             kw["extend"] = Margins.coerce(kw["extend"])
         out, figures = fill_image(image, mask, params=FillParams(**kw), rng=2)
         assert figures["engine"] == expected, (expected, kw)
-        assert np.array_equal(out, fill(image, mask, seed=2, **{"engine": expected, **kw}))
+        named = {"engine": expected, **kw, "patch": kw.get("patch", figures["patch"])}
+        assert np.array_equal(out, fill(image, mask, seed=2, **named))
 
 
-def test_studio_resolves_an_unset_patch_to_the_engine_the_picture_gets(gravel):
+def test_studio_shows_the_patch_the_run_takes_or_none(gravel):
     """The studio's "auto" patch (beside its box, and the centre of a variations range) is the patch
-    of the engine that runs: the hybrid's 64-px block (at most a third of a small canvas) for holes
-    and uncrops; a named engine its own; a patch given is not resolved."""
+    the run then reports, or nothing when the run decides it from the pixels: ``auto`` on a colour
+    picture with a hole (patchmatch's 7 where the edge guide pairs edges, else the hybrid's) and
+    wherever ``auto`` tries two hybrid blocks; a named engine its own; a patch given is not
+    resolved."""
     from weft.core.fill.method import STUDIO, fill_image
 
     colour = np.ascontiguousarray(load_image(example("chelsea")).image[:96, :120])
-    for image, params in (
-        (colour, FillParams()),
-        (gravel, FillParams()),
-        (colour, FillParams(engine="hybrid")),
-        (gravel, FillParams(extend=(0, 0, 30, 0))),
-        (gravel, FillParams(extend=(0, 0, 16, 0))),
+    small = np.ascontiguousarray(gravel[:60, :60])
+    for image, params, shown in (
+        (colour, FillParams(), False),
+        (colour, FillParams(structure="yes"), True),
+        (gravel, FillParams(), False),
+        (small, FillParams(), True),
+        (colour, FillParams(engine="hybrid"), True),
+        (gravel, FillParams(extend=(0, 0, 30, 0)), True),
+        (gravel, FillParams(engine="quilt", extend=(0, 0, 16, 0)), True),
     ):
-        resolved = STUDIO.resolved(params, {"image": image.shape})
-        mask = None if params.extend is not None else square_hole(image.shape)
+        shapes = {"image": image.shape}
+        mask = None
+        if params.extend is None:
+            mask = square_hole(image.shape)
+            shapes["mask"] = mask.shape
+        resolved = STUDIO.resolved(params, shapes)
         _, figures = fill_image(image, mask, params=params, rng=0)
-        assert resolved == {"patch": figures["patch"]}, (image.shape, params.engine)
-    assert STUDIO.resolved(FillParams(extend=(0, 0, 30, 0)), {"image": gravel.shape}) == {"patch": 32}
-    assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3)}) == {"patch": 64}
+        assert resolved == ({"patch": figures["patch"]} if shown else {}), (image.shape, params, figures)
+    assert STUDIO.resolved(FillParams(engine="hybrid", extend=(0, 0, 30, 0)), {"image": gravel.shape}) == {"patch": 32}
+    assert STUDIO.resolved(FillParams(), {"image": (300, 400, 3), "mask": (300, 400)}) == {}
     assert STUDIO.resolved(FillParams(engine="patchmatch"), {"image": (300, 400, 3)}) == {"patch": 7}
     assert STUDIO.resolved(FillParams(engine="quilt", extend=(0, 0, 16, 0)), {"image": (300, 400, 3)}) == {"patch": 24}
     assert STUDIO.resolved(FillParams(engine="quilt", extend=(0, 0, 40, 0)), {"image": (300, 400, 3)}) == {"patch": 48}
     assert STUDIO.resolved(FillParams(engine="hybrid"), {"image": (300, 400)}) == {"patch": 64}
     assert STUDIO.resolved(FillParams(patch=9), {"image": (96, 120, 3)}) == {}
     assert STUDIO.resolved(FillParams(), {}) == {}
+
+
+def test_auto_shows_no_hybrid_block_on_a_colour_hole_it_fills_with_patchmatch():
+    """A colour picture whose hole cuts a rim the edge guide pairs: ``auto`` runs patchmatch with its
+    7-px patch, and the studio does not show the hybrid's 64 beside the "auto" box."""
+    from weft.core.fill.method import STUDIO, fill_image
+
+    from .test_fill_structure import _hole_on, _picture
+
+    image, _ = _picture()
+    hole = _hole_on(80, 225, 16)
+    _, figures = fill_image(image, hole, params=FillParams(), rng=1)
+    assert figures["engine"] == "patchmatch" and figures["patch"] == 7
+    resolved = STUDIO.resolved(FillParams(), {"image": image.shape, "mask": hole.shape})
+    assert resolved in ({}, {"patch": 7}), resolved
+
+
+def test_auto_keeps_the_more_coherent_of_two_hybrid_blocks(gravel):
+    """``auto`` runs the hybrid engine with its 64-px block and with 24 px and keeps the fill whose
+    :func:`weft.core.fill.choose.score` is lower: its pixels are that block's fill, and its figures
+    name it."""
+    from weft.core.fill.choose import score
+    from weft.core.fill.method import fill_image
+
+    image = np.ascontiguousarray(load_image(example("chelsea")).image[:160, :200])
+    mask = square_hole(image.shape, 60, 100, 70, 120)
+    out, figures = fill_image(image, mask, params=FillParams(structure="no"), rng=3)
+    assert figures["engine"] == "hybrid" and figures["patch"] in (24, 53)
+    fills = {p: fill(image, mask, seed=3, engine="hybrid", patch=p, structure="no") for p in (53, 24)}
+    assert np.array_equal(out, fills[figures["patch"]])
+    scores = {p: score(f, mask, ~mask) for p, f in fills.items()}
+    assert scores[figures["patch"]] == min(scores.values()), scores
 
 
 @pytest.mark.parametrize("engine", sorted(ENGINE_FUNCS))
@@ -279,7 +321,7 @@ def test_progress_reaches_the_end_and_cancel_stops(engine, gravel):
     hole = square_hole(gravel.shape)
     seen = []
     fill(gravel, hole, engine=engine, seed=0, progress=seen.append)
-    assert seen and seen[-1].fraction == 1.0 and all(a.done <= b.done for a, b in zip(seen, seen[1:]))
+    assert seen and seen[-1].fraction == 1.0 and all(a.done <= b.done for a, b in zip(seen, seen[1:], strict=False))
     token = CancelToken()
     token.cancel()
     with pytest.raises(Cancelled):
@@ -449,7 +491,7 @@ def test_batched_cut_is_each_sides_own_cut():
     for _ in range(50):
         err = rng.integers(0, 3, (24, 24)).astype(np.float64)
         err[rng.random((24, 24)) < 0.3] = 1e6
-        sides = {k: int(v) for k, v in zip(("left", "top", "right", "bottom"), rng.integers(0, 9, 4))}
+        sides = {k: int(v) for k, v in zip(("left", "top", "right", "bottom"), rng.integers(0, 9, 4), strict=True)}
         alone = np.ones((24, 24), bool)
         for k, v in sides.items():
             if v:

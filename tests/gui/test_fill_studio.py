@@ -1385,3 +1385,28 @@ def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, 
         window.shutdown()
     finally:
         registry.unregister(SPREAD_FILL.name)
+
+
+def test_the_auto_patch_shows_the_patch_the_run_takes_or_none(qtbot, settings):
+    """The greyed "auto" value beside fill's patch box: once a hole is painted, ``auto`` picks its
+    engine and block from the pixels (two hybrid blocks tried, or patchmatch where the edge guide
+    pairs edges), so no number is shown, where it showed the hybrid's 64 whatever ran; with the
+    edge guide asked for (patchmatch) it shows 7, the patch the result reports."""
+    with _fill_in_the_studio(qtbot, settings) as window:
+        view, doc = window.inputs_pane.canvas_view, window.doc
+        h, w = doc.image("image").shape[:2]
+        view.actual_size()
+        view.centerOn(w / 2, h / 2)
+        window.inputs_pane.mask_tool().set_size(9)
+        y = h / 2 + 0.5
+        first = _final_after(window, qtbot, lambda: _stroke(view, [(w * 0.4, y), (w * 0.5, y)]))
+        row = window.method_panel.params_panel.row("patch")
+        assert row.auto.isChecked() and doc.current_params.patch is None
+        assert not row.editor.isVisible() and "(now" not in row.editor.toolTip(), (first.figures, row.editor.toolTip())
+        structure = window.method_panel.params_panel.row("structure")
+        result = _final_after(
+            window, qtbot, lambda: structure.editor.setCurrentIndex(structure.spec.choices.index("yes"))
+        )
+        assert result.figures["engine"] == "patchmatch" and result.figures["patch"] == 7
+        assert row.auto.isChecked() and row.editor.isVisible() and row.editor.value() == 7
+        assert "(now 7)" in row.editor.toolTip()
