@@ -10,10 +10,9 @@ patch and how the method runs it; every engine returns every pixel outside the h
 the blend band's, when it takes them). The shared patch search (PatchMatch and EM voting) is
 :mod:`weft.core.fill.search`. ``auto`` (the default, :func:`~weft.core.fill.params.auto_engine`)
 runs ``patchmatch`` with the edge guide where it pairs edges across a hole inside a colour picture
-(or when ``structure`` is yes), else ``hybrid``: on a hole (not an uncrop) with its 64-px and its
-24-px block, keeping the fill that looks more like the picture (:mod:`weft.core.fill.choose`, when
-no ``patch`` is given); the figures name the engine and the patch that ran. The suite that chose
-it is ``python -m benchmarks.fill_suite`` (its results in ``benchmarks/results/fill_suite.json``).
+(or when ``structure`` is yes), else ``hybrid``; the figures name the engine and the patch that
+ran. The suite that chose it is ``python -m benchmarks.fill_suite`` (its results in
+``benchmarks/results/fill_suite.json``).
 
 **Known pixels** are never changed except within the blend band (``--band``, default 2 px): the
 quilting engine's minimum-error cut may run through the known pixels within ``band`` px of the hole,
@@ -80,8 +79,7 @@ def fill(
     size, anchor : ``(width, height)`` of a larger canvas, and where the image sits on it
         (:data:`ANCHORS`); not with ``extend``.
     engine : ``"auto"`` (the default, :data:`DEFAULT_ENGINE`: ``patchmatch`` with the edge guide where
-        it finds edges crossing a hole inside a colour picture, else ``hybrid``, on a hole with two
-        block sides of which it keeps the better fill: :mod:`weft.core.fill.choose`; ``patchmatch``
+        it finds edges crossing a hole inside a colour picture, else ``hybrid``; ``patchmatch``
         with ``structure`` = yes), ``"hybrid"``, ``"quilt"`` or ``"patchmatch"``.
     patch : patch side (engine default :data:`DEFAULT_PATCH`). band : the blend band in px (0: none).
     structure : continue the strong edges that cross the hole along smooth curves

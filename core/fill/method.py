@@ -15,7 +15,6 @@ from ..limits import check_output_size
 from ..registry import InputSpec, Method, Result
 from ..studio import Figure, Geometry, Studio
 from .band import blend_band
-from .choose import SMALL_BLOCK, best_of
 from .common import neighbourhood, touches_border, whole_patches
 from .engines import TABLE
 from .params import ANCHORS, BORDER_BLOCK, DEFAULT_PATCH, FillParams, auto_engine
@@ -226,8 +225,7 @@ def fill_image(
             alpha = np.pad(alpha, pad, constant_values=1.0)
     ch, cw = hole.shape
     pending = None  # auto's edge guide: (part, guide, edges continued)
-    chosen = params.engine == "auto"
-    if chosen:  # the figures and messages name the engine that runs
+    if params.engine == "auto":  # the figures and messages name the engine that runs
         # decided on the hole's neighbourhood, the part the engine fills when the hole is small in a
         # large picture (a colour corner far from a hole in a grey region does not make it a photo)
         known = ~hole & ~transparent
@@ -354,23 +352,9 @@ def fill_image(
             engine_kw["guide"], continued = structure_guide(
                 work[part], work_hole[part], ~work_hole[part] & ~transparent[part]
             )
-    patches = [patch]
-    if chosen and params.engine == "hybrid" and params.patch is None and patch > SMALL_BLOCK and not margins:
-        patches.append(SMALL_BLOCK)  # auto tries the small block too (not on an uncrop) and keeps the better fill
-
-    def run(side: int, i: int) -> np.ndarray:
-        return engine.function()(
-            work[part],
-            work_hole[part],
-            work_src[part],
-            patch=side,
-            rng=rng,
-            progress=_scaled(progress, i, len(patches)) if len(patches) > 1 else progress,
-            cancel=cancel,
-            **engine_kw,
-        )
-
-    filled, patch = best_of(run, patches, work_hole[part], work_src[part])
+    filled = engine.function()(
+        work[part], work_hole[part], work_src[part], patch=patch, rng=rng, progress=progress, cancel=cancel, **engine_kw
+    )
     if near is not None:
         whole = np.array(work, dtype=np.float32)
         whole[near] = filled
@@ -602,8 +586,7 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
     default, fitted to a small canvas; the quilt's border block for margins over 24 px). Nothing when
     the run decides it from the pixels, which a shape does not tell: ``auto``'s engine on a colour
     picture with a painted hole (:func:`auto_engine`: patchmatch where the edge guide pairs edges
-    across it), and its hybrid block wherever it tries two on a hole (:func:`weft.core.fill.choose.best_of`);
-    the result's figures then say what ran. Nothing before an image is open."""
+    across it); the result's figures then say what ran. Nothing before an image is open."""
     shape = shapes.get("image")
     if params.patch is not None or shape is None:
         return {}
@@ -620,10 +603,6 @@ def _auto(params: FillParams, shapes: Mapping[str, tuple]) -> dict:
         if params.structure == "auto" and colour and painted:
             return {}  # patchmatch or hybrid, as the edge guide finds edges in the hole or not
         params = params.replace(engine=auto_engine(colour, margins is not None, None, params.structure))
-        patch = _run_patch(params, h, w, margins=margins)
-        if params.engine == "hybrid" and patch > SMALL_BLOCK and margins is None:
-            return {}  # two blocks are tried
-        return {"patch": patch}
     return {"patch": _run_patch(params, h, w, margins=margins)}
 
 

@@ -45,8 +45,7 @@ class FillParams(Params):
         DEFAULT_ENGINE,
         choices=ENGINES,
         help="auto: patchmatch with the edge guide where it finds edges crossing a hole inside a "
-        "colour picture (always with --structure yes), else hybrid, on a hole with 64- and 24-px "
-        "blocks, keeping the fill that looks more like the picture; "
+        "colour picture (always with --structure yes), else hybrid; "
         + "; ".join(f"{name}: {e.summary}" for name, e in TABLE.items()),
     )
     patch: int | None = param(

@@ -21,7 +21,7 @@ from ..jobs import CancelToken, Progress, ProgressReporter
 from ..params import as_rng
 from .common import percentile, whole_patches
 
-__all__ = ["MIN_PATCH", "MAX_PATCH", "coherence", "refine_patchmatch", "refine_band"]
+__all__ = ["MIN_PATCH", "MAX_PATCH", "refine_patchmatch", "refine_band"]
 
 MIN_PATCH = 3
 MAX_PATCH = 63
@@ -523,7 +523,7 @@ def refine_patchmatch(
     return out
 
 
-def search_step(
+def _search_step(
     fl: Flat,
     act: np.ndarray,
     sy: np.ndarray,
@@ -553,46 +553,6 @@ def search_step(
         rx = sx[act] + gen.integers(-r, r + 1, len(act))
         _try(fl, targets, act, sy, sx, dist, ry, rx, np.ones(len(act), bool))
         r //= shrink
-
-
-def coherence(
-    image: np.ndarray,
-    hole: np.ndarray,
-    source: np.ndarray,
-    *,
-    patch: int = 7,
-    iterations: int = 4,
-    rng: None | int | np.random.Generator = 0,
-) -> float:
-    """How much a fill looks like its source: the mean, over the ``patch`` x ``patch`` patches of
-    ``image`` touching ``hole``, of the RMS difference per value (0..1) to the nearest patch lying
-    wholly in ``source``, found by PatchMatch (the principal-axis start of :func:`refine_patchmatch`,
-    then ``iterations`` passes of :func:`search_step`): Wexler et al.'s global coherence, the
-    objective their EM lowers, so fills of one hole can be compared. Lower is better; an
-    approximation from above of the exact nearest-patch distance. Raises ``ImageError`` when the
-    source holds no whole patch."""
-    arr, hole, source, p = check_inputs(image, hole, source, patch, None, iterations)
-    img = np.array(arr if arr.ndim == 3 else arr[..., None], dtype=np.float32, order="C")
-    fl = Flat(img, hole, source, p)
-    if not fl.valid.any():
-        raise ImageError(f"the source region holds no whole {p}x{p} patch to compare the fill with")
-    n = len(fl.ty)
-    if n == 0:
-        return 0.0
-    gen = as_rng(rng)
-    cy, cx = _principal_candidates(fl, img, gen, _REFINE_CANDIDATES)
-    targets = fl.gather(fl.ty, fl.tx)
-    sy, sx = cy[0].copy(), cx[0].copy()
-    everyone = np.arange(n)
-    dist = fl.dist(targets, everyone, sy, sx)
-    for c in range(1, len(cy)):
-        _try(fl, targets, everyone, sy, sx, dist, cy[c], cx[c], np.ones(n, bool))
-    for it in range(iterations):
-        act = np.nonzero(dist > 0.0)[0]
-        if len(act) == 0:
-            break
-        search_step(fl, act, sy, sx, dist, STEPS_FIRST if it == 0 else _STEPS_LATER, gen, _SEARCH_SHRINK)
-    return float(np.sqrt(np.maximum(dist, 0.0) / (p * p * fl.c)).mean())
 
 
 def em(
@@ -668,7 +628,7 @@ def em(
         act = np.nonzero(dist > 0.0)[0] if floor <= 0.0 else np.nonzero(dist >= floor)[0]
         if len(act) == 0:
             break
-        search_step(fl, act, sy, sx, dist, steps_first if it == 0 else _STEPS_LATER, gen, shrink, bias)
+        _search_step(fl, act, sy, sx, dist, steps_first if it == 0 else _STEPS_LATER, gen, shrink, bias)
         dn = fl.normalized(dist)
         sigma2 = max(percentile(dn, _SIGMA_PERCENTILE), 1e-12)
         inexact = np.zeros((fl.h + p - 1, fl.w + p - 1), bool)  # pixels covered by a patch that is not an exact copy

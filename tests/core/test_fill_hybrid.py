@@ -227,22 +227,3 @@ def test_refine_searching_the_worst_patches_only():
     for bad in (-1, 100, True, "50"):
         with pytest.raises(InvalidParameter, match="parameter 'worst'"):
             refine_patchmatch(photo, hole, init=init, worst=bad)
-
-
-def test_coherence_ranks_the_truth_before_a_smear_and_noise_and_tracks_the_judge(brick):
-    """``search.coherence`` (what ``auto`` compares its fills by): the picture's own pixels in the
-    hole score lower than a flat fill of their mean or a noise fill, about as the judge
-    ``metrics.fill_coherence`` (exact nearest windows, in 8-bit levels) ranks them; a source without
-    a whole patch is refused in one line."""
-    from weft.core.fill.search import coherence
-
-    hole = square_hole(brick.shape)
-    flat = brick.copy()
-    flat[hole] = brick[hole].mean()
-    noise = brick.copy()
-    noise[hole] = np.random.default_rng(0).random(int(hole.sum()), dtype=np.float32)
-    ours = [coherence(img, hole, ~hole) for img in (brick, flat, noise)]
-    judge = [metrics.fill_coherence(img, hole, brick) for img in (brick, flat, noise)]
-    assert ours[0] < ours[1] < ours[2] and judge[0] < judge[1] < judge[2], (ours, judge)
-    with pytest.raises(ImageError, match="holds no whole 7x7 patch"):
-        coherence(brick, hole, np.zeros(brick.shape, bool))

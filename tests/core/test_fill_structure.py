@@ -242,11 +242,11 @@ def test_the_command_line_option(tmp_path, capsys):
 
 
 def test_the_studio_shows_the_patch_the_structure_run_takes():
-    """With ``structure`` = yes, ``auto`` runs patchmatch whatever the picture: its 7 px patch, not a
-    hybrid block (where ``auto`` tries two, 32 and 24 on a small canvas, it shows none)."""
+    """With ``structure`` = yes, ``auto`` runs patchmatch whatever the picture: its 7 px patch, not the
+    hybrid's block (64, at most a third of a small canvas)."""
     from weft.core.fill.method import STUDIO
 
-    assert STUDIO.auto(FillParams(), {"image": (96, 96)}) == {}
+    assert STUDIO.auto(FillParams(), {"image": (96, 96)}) == {"patch": 32}
     assert STUDIO.auto(FillParams(structure="yes"), {"image": (96, 96)}) == {"patch": 7}
 
 

@@ -1389,8 +1389,8 @@ def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, 
 
 def test_the_auto_patch_shows_the_patch_the_run_takes_or_none(qtbot, settings):
     """The greyed "auto" value beside fill's patch box: once a hole is painted, ``auto`` picks its
-    engine and block from the pixels (two hybrid blocks tried, or patchmatch where the edge guide
-    pairs edges), so no number is shown, where it showed the hybrid's 64 whatever ran; with the
+    engine from the pixels on a colour picture (patchmatch where the edge guide pairs edges, else the
+    hybrid), so no number is shown, where it showed the hybrid's 64 whatever ran; with the
     edge guide asked for (patchmatch) it shows 7, the patch the result reports."""
     with _fill_in_the_studio(qtbot, settings) as window:
         view, doc = window.inputs_pane.canvas_view, window.doc
