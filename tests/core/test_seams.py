@@ -83,7 +83,7 @@ def test_accumulated_costs_are_the_kernels_dynamic_program():
     """``accumulated_costs`` (numpy, a stack at once) is E[y, x] = e[y, x] + min of the three below,
     and a trace down it by the kernel's tie rule gives :func:`min_error_path`'s path (tie-heavy
     integer errors, so the tie rules are compared too)."""
-    from weft.core.quilting.engine import _trace_numpy
+    from weft.core.quilting.numpy_kernels import _trace_numpy
     from weft.core.seams import accumulated_costs, min_error_path
 
     rng = np.random.default_rng(11)
