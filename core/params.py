@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InvalidParameter, WeftError
-from .geometry import MAX_SIDE, Square, whole_number
+from .geometry import MAX_SIDE, GeometryValue, Square, whole_number
 from .jsonio import MAX_FILE_BYTES, parse_json, read_json_file  # noqa: F401 (re-exported)
 
 KINDS = ("int", "float", "bool", "choice", "size", "str", "geometry")
@@ -66,7 +66,7 @@ class Spec:
     symbol : the paper's symbol (shown in tooltips), e.g. ``"p_l"`` or ``"α"``.
     help : one sentence for tooltips and ``--help``.
     step : slider step for ``float`` parameters.
-    type : the class of a ``geometry`` parameter.
+    type : the class of a ``geometry`` parameter (a :class:`~weft.core.geometry.GeometryValue`).
     """
 
     name: str
@@ -261,6 +261,9 @@ def param(
         raise TypeError(f"unknown parameter kind {kind!r}")
     if (kind == "geometry") != (type is not None):
         raise TypeError("a geometry parameter needs its type (and only a geometry parameter has one)")
+    if type is not None and not issubclass(type, GeometryValue):
+        missing = [m for m in ("parse", "coerce", "from_json", "to_json") if not callable(getattr(type, m, None))]
+        raise TypeError(f"a geometry parameter's type {type.__name__} has no {', '.join(missing)} (GeometryValue)")
     meta = dict(
         kind=kind,
         lo=lo,
