@@ -175,9 +175,9 @@ def load_image(
     limit = get_max_pixels() if max_pixels is None else _check_limit(max_pixels)
     head = _read_header(name, limit)
     try:
-        kept, arr = _decode(name, head, alpha)
-        if kept is not None:
-            return _loaded_alpha(kept, name, head.fmt, head.orientation, head.src_mode, head.animated, mode)
+        with_alpha, arr = _decode(name, head, alpha)
+        if with_alpha:
+            return _loaded_alpha(arr, name, head.fmt, head.orientation, head.src_mode, head.animated, mode)
         image = _as_float(name, head, arr)
     except MemoryError:
         raise ImageError(
@@ -232,9 +232,9 @@ def _read_header(name: str, limit: int) -> _Header:
     return _Header(fmt, width, height, src_mode, had_alpha, orientation, animated, data)
 
 
-def _decode(name: str, head: _Header, alpha: bool) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """The decoded samples: ``(kept, None)`` with alpha kept (``alpha`` asked and the file has it),
-    else ``(None, arr)``, RGB or grey, uint8 or uint16 (OpenCV, or Pillow where OpenCV cannot)."""
+def _decode(name: str, head: _Header, alpha: bool) -> tuple[bool, np.ndarray]:
+    """The decoded samples, uint8 or uint16, and whether they keep alpha (``alpha`` asked and the
+    file has it: grey+alpha or RGBA); else RGB or grey (OpenCV, or Pillow where OpenCV cannot)."""
     said: list[str] = []
     kept = arr = None
     data, fmt = head.data, head.fmt
@@ -257,7 +257,11 @@ def _decode(name: str, head: _Header, alpha: bool) -> tuple[np.ndarray | None, n
     damage = _scan_damage(said) if fmt == "JPEG" else None
     if damage is not None:
         raise ImageError(f"{shown(name)}: truncated or corrupt JPEG data ({damage})", path=name)
-    return kept, arr
+    if kept is not None:
+        return True, kept
+    if arr is None:  # the Pillow fallback either decodes or raises
+        raise ValueError("no decoder output")
+    return False, arr
 
 
 def _as_float(name: str, head: _Header, arr: np.ndarray) -> np.ndarray:

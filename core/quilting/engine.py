@@ -365,7 +365,8 @@ class _StaticRows:
     def take(self, i: int) -> list:
         """Row i's (spectrum, constant) per block; the next row starts on the second thread."""
         row = self.ahead.result()
-        self.ahead = self.pool.submit(self._row, i + 1) if i + 1 < self.q.rows else None
+        if i + 1 < self.q.rows:
+            self.ahead = self.pool.submit(self._row, i + 1)
         return row
 
     def close(self) -> None:
