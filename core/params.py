@@ -42,6 +42,19 @@ from .geometry import MAX_SIDE, GeometryValue, whole_number
 from .jsonio import MAX_FILE_BYTES, parse_json, read_json_file  # noqa: F401 (re-exported)
 from .recipe import RECIPE_VERSION, Recipe, relative_path  # noqa: F401 (re-exported: callers import them from here)
 
+# The public names, those of weft.core.recipe included (documented here).
+__all__ = [
+    "Spec",
+    "out_of_range",
+    "parse_size",
+    "param",
+    "Params",
+    "specs",
+    "as_rng",
+    "Recipe",
+    "relative_path",
+]
+
 KINDS = ("int", "float", "bool", "choice", "size", "str", "geometry")
 INT, FLOAT, BOOL, CHOICE, SIZE, STR, GEOMETRY = KINDS  # for front ends that branch on the kind
 

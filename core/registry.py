@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from .compiles import (  # noqa: F401 (re-exported: front ends read compiles through the registry)
+from .compiles import (  # re-exported: front ends read compiles through the registry
     CompileWatch,
     compile_ended,
     compile_started,
@@ -32,6 +32,36 @@ from .compiles import (  # noqa: F401 (re-exported: front ends read compiles thr
 from .errors import WeftError
 from .params import Params
 from .studio import Studio
+
+# The public names, those of weft.core.compiles included (documented here).
+__all__ = [
+    "InputSpec",
+    "Result",
+    "Method",
+    "register",
+    "unregister",
+    "studio_methods",
+    "names",
+    "methods",
+    "get",
+    "PREPARING",
+    "LOADING",
+    "preparing_text",
+    "loading_text",
+    "is_warm",
+    "warm_up",
+    "warm_up_all",
+    "warm_up_report",
+    "CompileWatch",
+    "watch_compiles",
+    "compiling",
+    "compile_started",
+    "compile_ended",
+    "note_kernel_cache",
+    "note_kernel_cache_repair",
+    "kernel_cache_repairs",
+    "kernel_cache_notice",
+]
 
 # Method name -> the module that defines it as a module-level ``METHOD``; imported on first use, one
 # at a time where possible (``weft quilt`` need not import the affine model's FFT machinery).

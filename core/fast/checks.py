@@ -8,9 +8,7 @@ import numpy as np
 
 from .params import FastParams
 
-#: Peak memory per output pixel besides the inputs (result, positions, padded target, luminance and
-#: colour copies, previews; measured with /usr/bin/time -v on `weft fast` transfers: 392 MB peak RSS
-#: for a 2048x2048 target, 972 MB for 4096x4096, i.e. 46 B per pixel over ~200 MB of libraries).
+# Peak memory per output pixel besides the inputs (documented where weft.core.fast re-exports it).
 BYTES_PER_OUTPUT_PIXEL = 50
 
 

@@ -14,14 +14,26 @@ Command-line rule for lines and views (one rule, stated here and in ``--help``):
 ``{`` is the JSON object itself; anything else is the name of a JSON file.
 """
 
-from .interface import KINDS, LINES, MARGINS, MASK, SQUARE, GeometryValue
+from . import interface as _interface
+from .interface import KINDS, GeometryValue
 from .lines import FeatureLines, LineDraft
 from .margins import Margins
 from .mask import Mask
 from .raster import paint_line
-from .reading import MAX_SIDE, as_lines, as_size, read_json_or_file, whole_number
+from .reading import MAX_SIDE, as_lines, as_size, read_json_or_file, whole_number  # noqa: F401 (re-exported)
 from .square import Square
 from .stroke import MaskStroke
+
+#: The kinds of geometry the studio has a tool for (a method's studio description names them per input):
+#: a square (dragged), feature lines (drawn in pairs), a mask (painted with a brush, eraser or lasso)
+#: and margins (the canvas's edges dragged outward: an uncrop).
+SQUARE, LINES, MASK, MARGINS = _interface.SQUARE, _interface.LINES, _interface.MASK, _interface.MARGINS
+
+# The value types are documented, pickled and imported under the package's name, as they were
+# before the package was split into modules.
+for _cls in (GeometryValue, Square, FeatureLines, LineDraft, Mask, MaskStroke, Margins):
+    _cls.__module__ = __name__
+del _cls
 
 __all__ = [
     "GeometryValue",
@@ -38,8 +50,4 @@ __all__ = [
     "MASK",
     "MARGINS",
     "KINDS",
-    "MAX_SIDE",
-    "as_lines",
-    "as_size",
-    "whole_number",
 ]

@@ -6,9 +6,7 @@ from __future__ import annotations
 import os
 from typing import Any, Protocol, Self, runtime_checkable
 
-#: The kinds of geometry the studio has a tool for (a method's studio description names them per input):
-#: a square (dragged), feature lines (drawn in pairs), a mask (painted with a brush, eraser or lasso)
-#: and margins (the canvas's edges dragged outward: an uncrop).
+# The kinds of geometry the studio has a tool for (documented where weft.core.geometry re-exports them).
 SQUARE, LINES, MASK, MARGINS = "square", "lines", "mask", "margins"
 KINDS = (SQUARE, LINES, MASK, MARGINS)
 

@@ -315,7 +315,7 @@ class _Canvas:
         (sy, sx), (y0, x0) = source, at
         new = tex[sy : sy + block, sx : sx + block]
         foot = (slice(y0, y0 + block), slice(x0, x0 + block))
-        if top or left:
+        if in_l is not None:  # (None for the first patch, which overlaps nothing)
             old = self.image[foot]
             err = seams.overlap_error(old, new)
             err[~in_l] = 0.0
