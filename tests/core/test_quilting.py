@@ -181,7 +181,7 @@ def test_rules_and_schedule():
         sched = transfer_schedule(n)
         for i, (_, _, a) in enumerate(sched, start=1):
             assert a == pytest.approx(0.8 * (i - 1) / (n - 1) + 0.1)
-        for (b0, o0, _), (b1, o1, _) in zip(sched, sched[1:]):
+        for (b0, o0, _), (b1, o1, _) in zip(sched, sched[1:], strict=False):
             assert b1 == max(9, int(np.floor(b0 * 2 / 3 + 0.5))) and o1 < b1
             assert o1 == min(b1 - 1, max(3, int(np.floor(o0 * 2 / 3 + 0.5))))
     assert transfer_schedule(3, block=9, overlap=3) == [(9, 3, 0.1), (9, 3, 0.5), (9, 3, 0.9)]
@@ -364,7 +364,7 @@ def test_stacked_numpy_cuts_match_the_kernel(shape, sides, stack):
     errs = np.floor(rng.random((stack, *shape)) * 4)
     masks = nk._cut_mask_numpy(errs, *sides)
     scores = nk._seam_errors_numpy(errs, masks)
-    for e, m, score in zip(errs, masks, scores):
+    for e, m, score in zip(errs, masks, scores, strict=True):
         mk = np.empty(shape, np.uint8)
         seams.cut_mask(np.ascontiguousarray(e), *sides, mk)
         assert np.array_equal(m, mk.astype(bool))
@@ -444,7 +444,7 @@ def test_synthesis_spreads_its_use_of_the_sample(brick64, monkeypatch):
     monkeypatch.setattr(engine, "USAGE_WEIGHT", 0.0)
     without = [run(seed) for seed in range(3)]
     # measured: spread 0.58-0.62 against 0.65-0.69 without; completeness 0.0038-0.0069
-    for seed, ((s, comp), (s0, _)) in enumerate(zip(spread, without)):
+    for seed, ((s, comp), (s0, _)) in enumerate(zip(spread, without, strict=True)):
         assert s < s0 - 0.03, seed
         assert comp < 0.008, seed
 
