@@ -1,4 +1,4 @@
-"""Frozen, validated parameter dataclasses and the recipe that records a run.
+"""Frozen, validated parameter dataclasses (the recipe that records a run is :mod:`weft.core.recipe`).
 
 One source of truth for every method's parameters: a method declares its parameters once with
 :func:`param`, the dataclass validates itself when built, and the CLI (options) and the GUI
@@ -28,24 +28,35 @@ numpy scalars are accepted for ``int`` parameters and stored as ``int``; ``bool`
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import numbers
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Self
 
 import numpy as np
 
-from .errors import InvalidParameter, WeftError
-from .geometry import MAX_SIDE, GeometryValue, Square, whole_number
+from .errors import InvalidParameter
+from .geometry import MAX_SIDE, GeometryValue, whole_number
 from .jsonio import MAX_FILE_BYTES, parse_json, read_json_file  # noqa: F401 (re-exported)
+from .recipe import RECIPE_VERSION, Recipe, relative_path  # noqa: F401 (re-exported: callers import them from here)
+
+# The public names, those of weft.core.recipe included (documented here).
+__all__ = [
+    "Spec",
+    "out_of_range",
+    "parse_size",
+    "param",
+    "Params",
+    "specs",
+    "as_rng",
+    "Recipe",
+    "relative_path",
+]
 
 KINDS = ("int", "float", "bool", "choice", "size", "str", "geometry")
 INT, FLOAT, BOOL, CHOICE, SIZE, STR, GEOMETRY = KINDS  # for front ends that branch on the kind
-RECIPE_VERSION = 1
 
 
 @dataclass(frozen=True)
@@ -66,7 +77,7 @@ class Spec:
     symbol : the paper's symbol (shown in tooltips), e.g. ``"p_l"`` or ``"α"``.
     help : one sentence for tooltips and ``--help``.
     step : slider step for ``float`` parameters.
-    type : the class of a ``geometry`` parameter.
+    type : the class of a ``geometry`` parameter (a :class:`~weft.core.geometry.GeometryValue`).
     """
 
     name: str
@@ -326,6 +337,9 @@ def param(
         raise TypeError(f"unknown parameter kind {kind!r}")
     if (kind == "geometry") != (type is not None):
         raise TypeError("a geometry parameter needs its type (and only a geometry parameter has one)")
+    if type is not None and not issubclass(type, GeometryValue):
+        missing = [m for m in ("parse", "coerce", "from_json", "to_json") if not callable(getattr(type, m, None))]
+        raise TypeError(f"a geometry parameter's type {type.__name__} has no {', '.join(missing)} (GeometryValue)")
     meta = dict(
         kind=kind,
         lo=lo,
@@ -447,133 +461,3 @@ def as_rng(rng: None | int | np.random.Generator) -> np.random.Generator:
     if isinstance(rng, np.random.Generator):
         return rng
     raise InvalidParameter(f"parameter 'rng' = {rng!r} must be None, an integer seed or a numpy Generator", name="rng")
-
-
-@dataclass(frozen=True)
-class Recipe:
-    """Everything needed to reproduce a result: method, parameters, input paths and seed.
-
-    JSON form (DESIGN.md)::
-
-        {"weft": 1, "method": "fast", "params": {...},
-         "inputs": {"texture": "a.png", "target": "b.png"}, "seed": 7}
-
-    plus, when the user picked one, ``"region": [x, y, side]``: the square of the texture the method
-    used as its source (the studio's prototype rectangle; ``--region X,Y,S`` on the command line);
-    and, when it was chosen (a studio export, ``--bit-depth``), ``"bit_depth": 8`` or ``16``: the bits
-    per sample of the output, which ``weft run`` then writes (without it: 8, or the depth of the input
-    the method keeps, ``Method.depth_from``).
-
-    Input paths are stored as given; :meth:`load` resolves relative paths against the folder of the
-    recipe file, so a recipe next to its images keeps working when the folder moves.
-    """
-
-    method: str
-    params: Mapping[str, Any] = field(default_factory=dict)
-    inputs: Mapping[str, str] = field(default_factory=dict)
-    seed: int | None = None
-    region: Square | None = None
-    bit_depth: int | None = None
-
-    def to_json(self, relative_to: str | os.PathLike | None = None) -> str:
-        """The recipe's JSON text; with ``relative_to`` (the folder of the file that will carry it),
-        input paths are written relative to it."""
-        inputs = dict(self.inputs)
-        if relative_to is not None:
-            inputs = {k: relative_path(v, relative_to) if os.path.isabs(v) else v for k, v in inputs.items()}
-        data = {
-            "weft": RECIPE_VERSION,
-            "method": self.method,
-            "params": dict(self.params),
-            "inputs": inputs,
-            "seed": self.seed,
-        }
-        if self.region is not None:
-            data["region"] = Square(*self.region).to_json()
-        if self.bit_depth is not None:
-            data["bit_depth"] = self.bit_depth
-        return json.dumps(data, sort_keys=False)
-
-    @classmethod
-    def from_json(cls, text: str, *, base: str | os.PathLike | None = None) -> Recipe:
-        try:
-            data = parse_json(text)
-        except WeftError as e:
-            raise WeftError(f"recipe is {e}") from None
-        return cls.from_data(data, base=base)
-
-    @classmethod
-    def from_data(cls, data: Any, *, base: str | os.PathLike | None = None) -> Recipe:
-        """Validate a parsed recipe; relative input paths are joined to ``base`` when given."""
-        if not isinstance(data, dict):
-            raise WeftError("recipe must be a JSON object")
-        version = data.get("weft")
-        if version != RECIPE_VERSION:
-            raise WeftError(
-                f'recipe has "weft": {version!r}; this version of weft reads recipes of version {RECIPE_VERSION}'
-            )
-        method = data.get("method")
-        if not isinstance(method, str):
-            raise WeftError('recipe has no "method" (a string such as "quilt")')
-        params = data.get("params", {})
-        inputs = data.get("inputs", {})
-        seed = data.get("seed")
-        if not isinstance(params, dict):
-            raise WeftError('recipe "params" must be a JSON object')
-        if not isinstance(inputs, dict) or not all(isinstance(v, str) for v in inputs.values()):
-            raise WeftError('recipe "inputs" must map input names to file paths')
-        for name, value in inputs.items():
-            if not value or "\0" in value:
-                raise WeftError(f"recipe input {name!r} = {value!r} is not a file path")
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63):
-            raise WeftError(f'recipe "seed" = {seed!r} must be a non-negative integer below 2**63, or null')
-        region = data.get("region")
-        if region is not None:
-            try:
-                region = Square.from_json(region, "region")
-            except InvalidParameter:
-                raise WeftError(f'recipe "region" = {region!r} must be [x, y, side] in pixels') from None
-        bit_depth = data.get("bit_depth")
-        if bit_depth is not None and (isinstance(bit_depth, bool) or bit_depth not in (8, 16)):
-            raise WeftError(f'recipe "bit_depth" = {bit_depth!r} must be 8 or 16')
-        if base is not None:
-            inputs = {k: str(Path(base) / v) if not os.path.isabs(v) else v for k, v in inputs.items()}
-        return cls(method=method, params=params, inputs=inputs, seed=seed, region=region, bit_depth=bit_depth)
-
-    @classmethod
-    def load(cls, path: str | os.PathLike) -> Recipe:
-        """Read a recipe JSON file (at most :data:`MAX_FILE_BYTES`); messages start with its name."""
-        path = Path(path)
-        data = read_json_file(path, "recipe")
-        try:
-            return cls.from_data(data, base=path.resolve().parent)
-        except WeftError as e:
-            raise WeftError(f"{path}: {e}") from None
-
-    def save(self, path: str | os.PathLike) -> None:
-        """Write the recipe to ``path`` (atomically), input paths relative to its folder."""
-        from .image import atomic_write_bytes
-
-        path = Path(path)
-        atomic_write_bytes(path, (self.to_json(relative_to=path.resolve().parent) + "\n").encode("utf-8"))
-
-
-def relative_path(path: str, folder: str | os.PathLike) -> str:
-    """``path`` relative to ``folder``, as recipes and sessions store paths relative to their own file.
-
-    Parameters
-    ----------
-    path : str
-        An absolute path.
-    folder : str or os.PathLike
-        The folder of the file that will carry the path.
-
-    Returns
-    -------
-    str
-        The relative path, or ``path`` itself when there is no relative form (another drive on Windows).
-    """
-    try:
-        return os.path.relpath(Path(path).resolve(), Path(folder).resolve())
-    except ValueError:
-        return str(Path(path).resolve())

@@ -13,15 +13,55 @@ from __future__ import annotations
 import importlib
 import threading
 from collections.abc import Callable, Mapping
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from .compiles import (  # re-exported: front ends read compiles through the registry
+    CompileWatch,
+    compile_ended,
+    compile_started,
+    compiling,
+    kernel_cache_notice,
+    kernel_cache_repairs,
+    note_kernel_cache,
+    note_kernel_cache_repair,
+    watch_compiles,
+)
 from .errors import WeftError
 from .params import Params
 from .studio import Studio
+
+# The public names, those of weft.core.compiles included (documented here).
+__all__ = [
+    "InputSpec",
+    "Result",
+    "Method",
+    "register",
+    "unregister",
+    "studio_methods",
+    "names",
+    "methods",
+    "get",
+    "PREPARING",
+    "LOADING",
+    "preparing_text",
+    "loading_text",
+    "is_warm",
+    "warm_up",
+    "warm_up_all",
+    "warm_up_report",
+    "CompileWatch",
+    "watch_compiles",
+    "compiling",
+    "compile_started",
+    "compile_ended",
+    "note_kernel_cache",
+    "note_kernel_cache_repair",
+    "kernel_cache_repairs",
+    "kernel_cache_notice",
+]
 
 # Method name -> the module that defines it as a module-level ``METHOD``; imported on first use, one
 # at a time where possible (``weft quilt`` need not import the affine model's FFT machinery).
@@ -189,8 +229,7 @@ def get(name: str) -> Method:
 # ``warm_up(name)`` runs a method's ``warm_up`` at most once per process (concurrent callers wait for
 # the one running it); ``is_warm(name)`` then tells a front end that the method's kernels are loaded,
 # so a render can be timed without them. Whether a real compile is happening (a first run: numba's
-# cache is cold) is known from numba's compile events, which ``weft.core._kernels`` forwards here:
-# ``watch_compiles()`` counts them and their time, ``compiling()`` tells whether one is under way.
+# cache is cold) is known from numba's compile events (:mod:`weft.core.compiles`, re-exported here).
 
 #: What a front end shows while a method's kernels compile (``{name}`` is the method's name) ...
 PREPARING = "preparing the {name} method — first run only"
@@ -200,10 +239,6 @@ LOADING = "loading the {name} method"
 _warm: set[str] = set()
 _warm_locks: dict[str, threading.Lock] = {}
 _warm_lock = threading.Lock()
-_watchers: list[CompileWatch] = []
-_watch_lock = threading.Lock()
-_compiles_running = 0
-_cache_notes: list[str] = []
 
 
 def preparing_text(name: str) -> str:
@@ -331,134 +366,3 @@ def warm_up_report(name: str) -> dict[str, Any]:
         "notice": kernel_cache_notice(),
         "repairs": kernel_cache_repairs(),
     }
-
-
-class CompileWatch:
-    """numba compilations seen while a :func:`watch_compiles` block runs: ``count`` (every function
-    compiled, the kernels a kernel calls included) and ``seconds`` (wall time of the outermost
-    compiles, which contain the nested ones)."""
-
-    def __init__(self, thread: int | None, on_start: Callable[[], None] | None) -> None:
-        self.thread = thread
-        self.on_start = on_start
-        self.count = 0
-        self.seconds = 0.0
-        self._started: dict[int, float] = {}
-
-    def _start(self, thread: int, now: float, outermost: bool) -> None:
-        self.count += 1
-        if outermost:
-            self._started[thread] = now
-            if self.on_start is not None:
-                self.on_start()
-
-    def _end(self, thread: int, now: float, outermost: bool) -> None:
-        started = self._started.pop(thread, None) if outermost else None
-        if started is not None:
-            self.seconds += now - started
-
-
-@contextmanager
-def watch_compiles(*, this_thread: bool = False, on_start: Callable[[], None] | None = None):
-    """Count numba compilations (and their time) while the block runs.
-
-    A cache load is no compilation: a warm run sees none.
-
-    Parameters
-    ----------
-    this_thread : bool, default False
-        Count only the calling thread's compilations (else any thread's).
-    on_start : callable, optional
-        Called with no arguments, on the compiling thread, as each one starts.
-
-    Yields
-    ------
-    object
-        A watcher with ``count`` and ``seconds``, updated as compilations end.
-    """
-    watch = CompileWatch(threading.get_ident() if this_thread else None, on_start)
-    with _watch_lock:
-        _watchers.append(watch)
-    try:
-        yield watch
-    finally:
-        with _watch_lock:
-            _watchers.remove(watch)
-
-
-def compiling() -> bool:
-    """Whether a numba compilation is under way in some thread of this process."""
-    return _compiles_running > 0
-
-
-def _notify(started: bool, outermost: bool) -> None:
-    import time
-
-    global _compiles_running
-    now = time.perf_counter()
-    me = threading.get_ident()
-    with _watch_lock:
-        if outermost:
-            _compiles_running += 1 if started else -1
-        watchers = [w for w in _watchers if w.thread is None or w.thread == me]
-    for w in watchers:
-        (w._start if started else w._end)(me, now, outermost)
-
-
-def compile_started(outermost: bool = True) -> None:
-    """Called by ``weft.core._kernels`` when a thread starts compiling a function (a cache miss).
-
-    Parameters
-    ----------
-    outermost : bool, default True
-        Not a function compiled inside another one's compile.
-    """
-    _notify(True, outermost)
-
-
-def compile_ended(outermost: bool = True) -> None:
-    """Called by ``weft.core._kernels`` when that compilation ends.
-
-    Parameters
-    ----------
-    outermost : bool, default True
-        As given to :func:`compile_started`.
-    """
-    _notify(False, outermost)
-
-
-def note_kernel_cache(message: str) -> None:
-    """Called by ``weft.core._kernels`` when numba's cache cannot be used (the first message is kept).
-
-    Parameters
-    ----------
-    message : str
-        One line for the front ends to show.
-    """
-    if message not in _cache_notes:
-        _cache_notes.append(message)
-
-
-_cache_repairs: list[str] = []
-
-
-def note_kernel_cache_repair(message: str) -> None:
-    """Called by ``weft.core._kernels`` when it dropped a damaged cache entry (the first message is kept).
-
-    Parameters
-    ----------
-    message : str
-        One line for the front ends to show.
-    """
-    if message not in _cache_repairs:
-        _cache_repairs.append(message)
-
-
-def kernel_cache_repairs() -> list[str]:
-    """One-line notices of damaged kernel cache entries dropped (and compiled again) in this process."""
-    return list(_cache_repairs)
-
-
-def kernel_cache_notice() -> str | None:
-    """A one-line notice if the kernels run without numba's on-disk cache (no writable folder)."""
-    return _cache_notes[0] if _cache_notes else None

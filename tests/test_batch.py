@@ -87,7 +87,7 @@ def test_each_output_is_weft_run_on_its_recipe_byte_for_byte(scene, capsys):
     items = sorted(lines[:-1], key=lambda d: d["index"])
     assert [d["input"] for d in items] == [f"frame_{i}.png" for i in range(1, 6)]
     assert all(d["status"] == "written" and d["seconds"] >= 0 for d in items)
-    for i, frame in enumerate(frames):
+    for i, _frame in enumerate(frames):
         made = tmp / "out" / f"frame_{i + 1}_{i:02d}.png"
         recipe = json.loads(read_recipe(made))
         assert recipe["inputs"] == {"texture": "../gravel.png", "target": f"../frames/frame_{i + 1}.png"}
@@ -286,7 +286,7 @@ def test_a_bad_recipe_exits_2(scene, capsys):
 def test_memory_for_all_workers_is_checked_up_front(scene, capsys, monkeypatch):
     tmp, _ = scene
     # Each item (a 48x40 fast transfer) is estimated at 50 B per output pixel = 96000 B.
-    monkeypatch.setattr("weft.core.batch.prepare.available_memory", lambda: 150_000)
+    monkeypatch.setattr("weft.core.batch.memory.available_memory", lambda: 150_000)
     code, _, err = run(
         [
             "batch",
@@ -306,7 +306,7 @@ def test_memory_for_all_workers_is_checked_up_front(scene, capsys, monkeypatch):
         "weft: batch: one item (frame_1.png) needs about 0 MiB of memory, 2 workers at once "
         "0 MiB, 0 MiB is available: use --workers 1"
     )
-    monkeypatch.setattr("weft.core.batch.prepare.available_memory", lambda: 50_000)
+    monkeypatch.setattr("weft.core.batch.memory.available_memory", lambda: 50_000)
     code, _, err = run(
         [
             "batch",

@@ -34,7 +34,7 @@ def _full_disk(monkeypatch):
         os.close(fd)
         return open("/dev/full", mode, buffering=0)
 
-    monkeypatch.setattr("weft.core.image.files.os.fdopen", to_dev_full)
+    monkeypatch.setattr("weft.core.image.writing.os.fdopen", to_dev_full)
 
 
 def _read_only(folder, monkeypatch):
@@ -45,7 +45,7 @@ def _read_only(folder, monkeypatch):
     def denied(*_a, **_k):
         raise PermissionError(errno.EACCES, "Permission denied")
 
-    monkeypatch.setattr("weft.core.image.files.tempfile.mkstemp", denied)
+    monkeypatch.setattr("weft.core.image.writing.tempfile.mkstemp", denied)
 
 
 def _quilt(texture, out):

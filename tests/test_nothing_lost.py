@@ -224,7 +224,7 @@ def test_a_frame_too_large_for_memory_fails_alone(tmp_path, capsys, monkeypatch)
     argv = _fast_batch(tmp_path)
     save_image(tmp_path / "frames" / "f3.png", np.zeros((400, 400, 3), np.float32))
     # the good frames (40x48) fit in this much memory by the fast method's estimate; the 400x400 one does not
-    monkeypatch.setattr("weft.core.batch.prepare.available_memory", lambda: 1_000_000)
+    monkeypatch.setattr("weft.core.batch.memory.available_memory", lambda: 1_000_000)
     code, out, err = _run(argv[:-3] + ["-q"], capsys)  # default workers: as many as fit
     assert code == 1, err
     assert err.strip().splitlines()[-1].startswith("3 written, 1 failed: f3.png: needs about")

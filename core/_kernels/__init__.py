@@ -13,7 +13,7 @@ reports compilations; it is the only place that knows about numba's caching mach
   loading a planted one would run its code). The user-wide and the temporary folder are seeded
   from the package's own ``__pycache__`` (what ``weft warm-up`` wrote there at install time), so a
   read-only install that was warmed up stays warm for every user. If even that fails, the kernels are compiled without a
-  cache (every run pays the compile) and :func:`weft.core.registry.kernel_cache_notice` says so in one
+  cache (every run pays the compile) and :func:`weft.core.compiles.kernel_cache_notice` says so in one
   line for the front ends to show.
 * **Safe concurrent saves.** numba's cache saves a new signature by rewriting the function's index
   and a numbered data file, without a lock; weft takes a file lock around each save (POSIX), so
@@ -21,9 +21,9 @@ reports compilations; it is the only place that knows about numba's caching mach
 * **Damaged cache files are repaired.** An index or data file that cannot be read back (cut short
   by a power cut) would make every run of its method fail with ``EOFError: Ran out of input``, and
   ``weft warm-up`` too; such files are removed, the kernel is compiled again and saved, and
-  :func:`weft.core.registry.kernel_cache_repairs` says so in one line.
+  :func:`weft.core.compiles.kernel_cache_repairs` says so in one line.
 * **Compile events.** numba announces every real compilation (a cache miss, never a cache load) as
-  a ``numba:compile`` event; we forward their start and end to :mod:`weft.core.registry`, which lets a
+  a ``numba:compile`` event; we forward their start and end to :mod:`weft.core.compiles`, which lets a
   front end say "preparing ... — first run only" exactly while a compile happens, and leave the
   compile out of a render's time.
 """
@@ -40,7 +40,7 @@ from numba.core import caching as _caching
 from numba.core import dispatcher as _dispatcher
 from numba.core import event as _event
 
-from .. import registry as _registry
+from .. import compiles as _compiles
 
 _FALLBACK_PREFIX = "weft-numba-"
 
@@ -144,7 +144,7 @@ def _enable_caching_or_not(self):
         if "no locator available" not in str(e):
             raise
         self._cache = _caching.NullCache()
-        _registry.note_kernel_cache(_NO_CACHE_NOTICE.format(tmp=fallback_cache_root()))
+        _compiles.note_kernel_cache(_NO_CACHE_NOTICE.format(tmp=fallback_cache_root()))
 
 
 def _install_no_cache_fallback() -> None:
@@ -197,7 +197,7 @@ def _drop_damaged(cache_file, error: BaseException) -> None:
         except OSError:
             pass
     what = base.split("-")[0]
-    _registry.note_kernel_cache_repair(_DAMAGED_NOTICE.format(what=what, why=type(error).__name__))
+    _compiles.note_kernel_cache_repair(_DAMAGED_NOTICE.format(what=what, why=type(error).__name__))
 
 
 _original_load_index = _caching.IndexDataCacheFile._load_index
@@ -250,7 +250,7 @@ def _install_cache_repair() -> None:
 
 
 class _CompileListener(_event.Listener):
-    """Forwards numba's ``numba:compile`` events to the registry, saying which are a thread's outermost
+    """Forwards numba's ``numba:compile`` events to :mod:`weft.core.compiles`, saying which are a thread's outermost
     (a kernel compiles the kernels it calls inside its own compile)."""
 
     def __init__(self):
@@ -259,18 +259,18 @@ class _CompileListener(_event.Listener):
     def on_start(self, event):
         depth = getattr(self._depth, "n", 0)
         self._depth.n = depth + 1
-        _registry.compile_started(outermost=depth == 0)
+        _compiles.compile_started(outermost=depth == 0)
 
     def on_end(self, event):
         depth = getattr(self._depth, "n", 1) - 1
         self._depth.n = depth
-        _registry.compile_ended(outermost=depth == 0)
+        _compiles.compile_ended(outermost=depth == 0)
 
 
 _install_fallback_locator()
 _install_no_cache_fallback()
 _install_save_lock()
 _install_cache_repair()
-if not getattr(_registry, "_compile_listener_installed", False):
+if not getattr(_compiles, "_compile_listener_installed", False):
     _event.register("numba:compile", _CompileListener())
-    _registry._compile_listener_installed = True  # type: ignore[attr-defined]  # set once per process
+    _compiles._compile_listener_installed = True  # type: ignore[attr-defined]  # set once per process

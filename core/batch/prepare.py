@@ -1,5 +1,6 @@
 """What a batch is and what can be checked before any work: its items (:func:`plan`), their
-memory (:func:`check_memory`), and the records of outcomes and progress (see :mod:`weft.core.batch`)."""
+memory (:func:`check_memory`, in :mod:`.memory`), and the records of outcomes and progress (in
+:mod:`.items`; see :mod:`weft.core.batch`). Every name of the two is importable from here too."""
 
 from __future__ import annotations
 
@@ -9,178 +10,35 @@ import os
 import re
 import secrets
 import string
-import time
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
 
 from ..errors import WeftError
-from ..limits import LimitError, _bytes, available_memory
 from ..readfile import file_key, kind_of, open_regular, shown
+from .items import BatchProgress, Item, Outcome, Plan, Summary
+from .memory import _header_shape, check_memory, item_memory, too_large_alone, workers_that_fit
+
+__all__ = [
+    "IMAGE_EXTENSIONS",
+    "SAVE_EXTENSIONS",
+    "BatchProgress",
+    "Item",
+    "Outcome",
+    "Plan",
+    "Summary",
+    "check_memory",
+    "expand_over",
+    "item_memory",
+    "plan",
+    "too_large_alone",
+    "workers_that_fit",
+    "_header_shape",
+]
 
 #: File extensions a folder given to ``--over`` contributes (what :func:`weft.core.image.load_image` reads).
 IMAGE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp", ".gif")
 #: Output extensions (what :func:`weft.core.image.save_image` writes).
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
-
-
-# --------------------------------------------------------------------------------------------------
-# Items and outcomes (what crosses to a worker and back: plain, picklable values)
-
-
-@dataclass(frozen=True)
-class Item:
-    """One output of a batch: everything a worker needs, with absolute paths.
-
-    ``inputs`` are the files to read (``shipped`` holds their bytes when the client sends them);
-    ``recipe`` is the JSON text the output carries (paths relative to the output's folder, as
-    ``weft run`` writes it); ``write`` says whether the worker writes ``output`` itself or returns the
-    encoded bytes for the client to write.
-    """
-
-    index: int
-    label: str
-    method: str
-    params: Mapping[str, Any]
-    inputs: Mapping[str, str]
-    seed: int
-    region: tuple[int, int, int] | None
-    output: str
-    recipe: str
-    bit_depth: int = 8
-    write: bool = True
-    shipped: Mapping[str, bytes] | None = None
-    #: OpenCV threads in the worker process (local pool: the cores shared out among the workers, so
-    #: two workers on two cores do not each start two threads); None leaves OpenCV's default. The
-    #: pixels do not depend on it (checked for every method: 1 and 2 threads give the same bytes).
-    threads: int | None = None
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """What became of one item: ``status`` is ``"written"``, ``"skipped"`` (its output already
-    exists with this recipe) or ``"failed"`` (``error`` says why, in one line)."""
-
-    index: int
-    label: str
-    output: str
-    status: str
-    error: str | None = None
-    seconds: float = 0.0
-    figures: Mapping[str, Any] = field(default_factory=dict)
-    worker: str = ""
-    data: bytes | None = None
-    #: The item's whole time on its worker: reading, running, encoding, writing (``seconds`` is the
-    #: method's compute alone, as ``weft run --report`` gives it), and the CPU time its process used
-    #: meanwhile (all its threads).
-    elapsed: float = 0.0
-    cpu: float = 0.0
-
-    def report(self) -> dict:
-        """The item's ``--report`` line (without the encoded bytes)."""
-        line = {"index": self.index, "input": self.label, "output": self.output, "status": self.status}
-        if self.error is not None:
-            line["error"] = self.error
-        if self.status == "written":
-            line["seconds"] = round(self.seconds, 6)
-            line["elapsed"] = round(self.elapsed, 6)
-            line["cpu"] = round(self.cpu, 6)
-            line["worker"] = self.worker
-            line.update(self.figures)
-        return line
-
-
-@dataclass(frozen=True)
-class Plan:
-    """A checked batch: every item in order, and which of them are already done."""
-
-    items: tuple[Item, ...]
-    skipped: tuple[Item, ...]
-    method: str
-    seed: int
-    ship_inputs: bool = False  # read each item's inputs here and send their bytes (just before it is submitted)
-
-    @property
-    def todo(self) -> tuple[Item, ...]:
-        done = {i.index for i in self.skipped}
-        return tuple(i for i in self.items if i.index not in done)
-
-
-@dataclass
-class Summary:
-    """The end of a batch: counts, failures (index, label, reason) in item order, wall time."""
-
-    total: int
-    written: int = 0
-    skipped: int = 0
-    failed: list[tuple[int, str, str]] = field(default_factory=list)
-    cancelled: bool = False
-    seconds: float = 0.0
-
-    @property
-    def done(self) -> int:
-        return self.written + self.skipped + len(self.failed)
-
-    def line(self, most: int = 3) -> str:
-        """``898 written, 2 failed: frame_0312.png: truncated PNG …``"""
-        parts = [f"{self.written} written"]
-        if self.skipped:
-            parts.append(f"{self.skipped} already done")
-        if self.cancelled:
-            parts.append(f"{self.total - self.done} not done (cancelled)")
-        text = ", ".join(parts)
-        if self.failed:
-            reasons = "; ".join(f"{label}: {reason}" for _, label, reason in self.failed[:most])
-            more = f"; and {len(self.failed) - most} more" if len(self.failed) > most else ""
-            text += f", {len(self.failed)} failed: {reasons}{more}"
-        return text
-
-    def report(self) -> dict:
-        """The summary ``--report`` line."""
-        return {
-            "summary": True,
-            "total": self.total,
-            "written": self.written,
-            "skipped": self.skipped,
-            "failed": len(self.failed),
-            "cancelled": self.cancelled,
-            "seconds": round(self.seconds, 3),
-            "items_per_second": round(self.written / self.seconds, 4) if self.seconds > 0 else None,
-        }
-
-
-class BatchProgress:
-    """Progress of a running batch, handed to :func:`run`'s ``progress`` after each item."""
-
-    __slots__ = ("total", "done", "failed", "started", "_timed", "_first")
-    _first: float | None
-
-    def __init__(self, total: int, skipped: int):
-        self.total, self.done, self.failed = total, skipped, 0
-        self.started = time.monotonic()
-        self._timed, self._first = 0, None
-
-    def _add(self, outcome: Outcome) -> None:
-        self.done += 1
-        self.failed += outcome.status == "failed"
-        if outcome.status != "skipped":
-            self._timed += 1
-            if self._first is None:
-                self._first = time.monotonic()
-
-    @property
-    def seconds_left(self) -> float | None:
-        """Time left at the rate items have completed since the first one (so the workers' start-up
-        does not count); None before two are done."""
-        if self._timed < 2 or self._first is None:
-            return None
-        rate = (self._timed - 1) / max(1e-9, time.monotonic() - self._first)
-        return (self.total - self.done) / rate
-
-
-# --------------------------------------------------------------------------------------------------
-# Planning: everything that can be wrong about the batch as a whole, before any work
 
 
 def _natural_key(path: str):
@@ -339,8 +197,7 @@ def plan(
     WeftError
         Anything wrong with the batch as a whole (one line); nothing has been run or written.
     """
-    from .. import registry
-    from ..run import check_recipe, load_recipe, output_recipe
+    from ..run import load_recipe
 
     own_file = recipe is None  # the recipe is read from recipe_path: that file is an input too
     if recipe is None:
@@ -348,6 +205,37 @@ def plan(
     base = Path(recipe_path).resolve().parent
     if not over:
         raise WeftError("no --over INPUT FILES given: name the input the files replace")
+    method, names, params_dict = _checked_recipe(recipe, recipe_path, base, over)
+    params = method.params.from_dict(params_dict)
+    if bit_depth is not None and bit_depth not in (8, 16):
+        raise WeftError(f"parameter 'bit-depth' = {bit_depth} must be 8 or 16")
+    lists, n = _over_lists(over)
+    _check_pattern(pattern, bit_depth, lists)
+    rows = _outputs(method, recipe, recipe_path, own_file, pattern, names[0], lists, n)
+    seed = _batch_seed(seed, recipe.seed, rows, method.name, seed_per_item)
+    items = [
+        _item(
+            method,
+            params,
+            params_dict,
+            recipe.region,
+            row,
+            (seed + row[0]) % 2**63 if seed_per_item else seed,
+            bit_depth,
+            ship_outputs,
+        )
+        for row in rows
+    ]
+    skipped = () if force else tuple(it for it in items if _done_already(it))
+    return Plan(items=tuple(items), skipped=skipped, method=method.name, seed=seed, ship_inputs=ship_inputs)
+
+
+def _checked_recipe(recipe, recipe_path: str, base: Path, over: Sequence[tuple[str, str]]):
+    """The recipe's method, the names of the inputs ``over`` replaces, and the recipe's parameters
+    checked (as ``weft run`` checks them, those inputs supplied by the batch)."""
+    from .. import registry
+    from ..run import check_recipe
+
     try:
         method = registry.get(recipe.method)
         takes = [i.name for i in method.inputs]
@@ -360,10 +248,11 @@ def plan(
         params_dict = check_recipe(recipe, base, supplied=tuple(names))
     except WeftError as e:
         raise WeftError(f"{recipe_path}: {e}") from None
-    params = method.params.from_dict(params_dict)
-    if bit_depth is not None and bit_depth not in (8, 16):
-        raise WeftError(f"parameter 'bit-depth' = {bit_depth} must be 8 or 16")
+    return method, names, params_dict
 
+
+def _over_lists(over: Sequence[tuple[str, str]]) -> tuple[dict[str, list[str]], int]:
+    """The files of every ``--over`` by input name, and their common count."""
     lists = {name: expand_over(name, where) for name, where in over}
     counts = {len(v) for v in lists.values()}
     if len(counts) > 1:
@@ -372,8 +261,11 @@ def plan(
             + ", ".join(f"{name}: {len(v)} files" for name, v in lists.items())
             + "); they are taken in step, file by file"
         )
-    n = counts.pop()
+    return lists, counts.pop()
 
+
+def _check_pattern(pattern: str, bit_depth: int | None, lists: Mapping[str, list[str]]) -> None:
+    """The output pattern names a format weft saves (at this bit depth) and only fields it knows."""
     ext = os.path.splitext(pattern)[1].lower()
     if ext not in SAVE_EXTENSIONS:
         raise WeftError(f"pattern {pattern!r}: cannot save this format (end it with {', '.join(SAVE_EXTENSIONS)})")
@@ -387,7 +279,19 @@ def plan(
                 f"pattern {pattern!r} uses {{{f}}}; it may use " + ", ".join("{" + a + "}" for a in allowed)
             )
 
-    first = names[0]
+
+def _outputs(
+    method,
+    recipe,
+    recipe_path: str,
+    own_file: bool,
+    pattern: str,
+    first: str,
+    lists: Mapping[str, list[str]],
+    n: int,
+) -> list[tuple[int, str, dict[str, str], str]]:
+    """``(index, label, inputs, output)`` of every item, refusing an output two items share, one that
+    would overwrite an input or the recipe, and one that is not a file."""
     fixed = {k: str(Path(v).resolve()) for k, v in recipe.inputs.items() if k not in lists}
     rows = []
     seen: dict[str, str] = {}
@@ -432,209 +336,50 @@ def plan(
         inputs = {**fixed, **{k: str(Path(v).resolve()) for k, v in over_files.items()}}
         inputs = {spec.name: inputs[spec.name] for spec in method.inputs if spec.name in inputs}
         rows.append((i, label, inputs, out))
+    return rows
 
+
+def _batch_seed(
+    seed: int | None, recipe_seed: int | None, rows: Sequence[tuple], method: str, seed_per_item: bool
+) -> int:
+    """The batch's seed: the one given, else the recipe's, else a previous run's (read from its
+    outputs, so a resumed batch keeps its look), else a new one."""
     if seed is None:
-        seed = recipe.seed
+        seed = recipe_seed
     if seed is None:
-        found = _existing_seed([(i, out) for i, _, _, out in rows], method.name)
+        found = _existing_seed([(i, out) for i, _, _, out in rows], method)
         if found is not None:
             seed = (found[1] - (found[0] if seed_per_item else 0)) % 2**63
         else:
             seed = secrets.randbits(31)
-
-    items = []
-    for i, label, inputs, out in rows:
-        item_seed = (seed + i) % 2**63 if seed_per_item else seed
-        text = output_recipe(method, params, inputs, item_seed, recipe.region, out).to_json()
-        items.append(
-            Item(
-                index=i,
-                label=label,
-                method=method.name,
-                params=params_dict,
-                inputs=inputs,
-                seed=item_seed,
-                region=recipe.region,
-                output=out,
-                recipe=text,
-                bit_depth=_item_bit_depth(method, inputs, out, bit_depth),
-                write=not ship_outputs,
-            )
-        )
-    skipped = () if force else tuple(it for it in items if _done_already(it))
-    return Plan(items=tuple(items), skipped=skipped, method=method.name, seed=seed, ship_inputs=ship_inputs)
+    return seed
 
 
-def _header_shape(path: str) -> tuple[int, ...] | None:
-    """(H, W) or (H, W, 3) of an image file from its header, or None if it cannot be read."""
-    from ..image.files import _GREY_MODES, _pil_open
+def _item(
+    method,
+    params,
+    params_dict: dict,
+    region,
+    row: tuple[int, str, dict[str, str], str],
+    seed: int,
+    bit_depth: int | None,
+    ship_outputs: bool,
+) -> Item:
+    """One item of the batch, with the recipe its output carries."""
+    from ..run import output_recipe
 
-    try:
-        with open_regular(path, "image file") as f:
-            im, _ = _pil_open(open(os.dup(f.fileno()), "rb"))
-        with im:
-            w, h = im.size
-            return (h, w) if im.mode in _GREY_MODES else (h, w, 3)
-    except Exception:  # noqa: BLE001 - a bad file fails its own item, with its own message
-        return None
-
-
-def item_memory(items: Iterable[Item]) -> tuple[float, str]:
-    """The largest estimated peak memory of one item (``Method.memory`` on the inputs' header sizes).
-
-    Parameters
-    ----------
-    items : iterable of Item
-        The batch's items (one method).
-
-    Returns
-    -------
-    bytes : float
-        The largest estimate; 0 when the method gives none.
-    label : str
-        That item's label ("" with no estimate).
-    """
-    from .. import registry
-
-    best, label = 0.0, ""
-    items = list(items)
-    if not items:
-        return best, label
-    method = registry.get(items[0].method)
-    if method.memory is None:
-        return best, label
-    params = method.params.from_dict(items[0].params)
-    for item in items:
-        found = {name: _header_shape(path) for name, path in item.inputs.items()}
-        shapes = {name: s for name, s in found.items() if s is not None}
-        if len(shapes) < len(found):
-            continue
-        if item.region is not None:
-            first = method.inputs[0].name
-            side = item.region[2]
-            shapes[first] = (side, side) + tuple(shapes[first][2:])
-        try:
-            need = float(method.memory(shapes, params))
-        except (WeftError, KeyError, TypeError, ValueError):
-            continue  # the item's own run refuses it with the precise reason
-        if need > best:
-            best, label = need, item.label
-    return best, label
-
-
-def too_large_alone(items: Iterable[Item], *, available: int | None = None) -> list[tuple[Item, str]]:
-    """The items that cannot run even alone, each with its one-line reason.
-
-    An input whose header claims more pixels than the pixel limit, or an estimated peak memory above
-    ``available``. They fail by themselves; the rest of the batch runs.
-
-    Parameters
-    ----------
-    items : iterable of Item
-        The batch's items.
-    available : int, optional
-        Bytes of memory; default what the system has available now.
-
-    Returns
-    -------
-    list of (Item, str)
-    """
-    from .. import registry
-    from ..image import get_max_pixels
-
-    items = list(items)
-    if not items:
-        return []
-    method = registry.get(items[0].method)
-    params = method.params.from_dict(items[0].params) if method.memory is not None else None
-    available = available_memory() if available is None else available
-    limit = get_max_pixels()
-    alone = []
-    for item in items:
-        shapes = {name: _header_shape(path) for name, path in item.inputs.items()}
-        big = next(((name, s) for name, s in shapes.items() if s is not None and s[0] * s[1] > limit), None)
-        if big is not None:
-            name, (h, w) = big[0], big[1][:2]
-            alone.append(
-                (
-                    item,
-                    f"{shown(item.inputs[name])}: {w}x{h} = {w * h / 1e6:.1f} megapixels exceeds the "
-                    f"limit of {limit / 1e6:g} megapixels (set WEFT_MAX_PIXELS to raise it)",
-                )
-            )
-            continue
-        known = {name: s for name, s in shapes.items() if s is not None}
-        if method.memory is None or params is None or available is None or len(known) < len(shapes):
-            continue
-        if item.region is not None:
-            first = method.inputs[0].name
-            known[first] = (item.region[2], item.region[2]) + tuple(known[first][2:])
-        try:
-            need = float(method.memory(known, params))
-        except (WeftError, KeyError, TypeError, ValueError):
-            continue
-        if need > available:
-            alone.append(
-                (
-                    item,
-                    f"needs about {_bytes(need)} of memory, {_bytes(available)} is available: make its inputs smaller",
-                )
-            )
-    return alone
-
-
-def workers_that_fit(items: Iterable[Item], workers: int, *, available: int | None = None) -> int:
-    """How many workers fit in memory at once by the largest item's estimate.
-
-    Parameters
-    ----------
-    items : iterable of Item
-        The batch's items.
-    workers : int
-        The most workers wanted.
-    available : int, optional
-        Bytes of memory; default what the system has available now.
-
-    Returns
-    -------
-    int
-        At most ``workers``, at least 1.
-    """
-    need, _ = item_memory(items)
-    available = available_memory() if available is None else available
-    if not need or available is None:
-        return workers
-    return max(1, min(workers, int(available // need)))
-
-
-def check_memory(
-    items: Iterable[Item], workers: int, *, available: int | None = None, option: str = "--workers"
-) -> None:
-    """Refuse up front a batch whose largest item's estimate times ``workers`` exceeds the memory.
-
-    Parameters
-    ----------
-    items : iterable of Item
-        The batch's items.
-    workers : int
-        The workers that would run at once.
-    available : int, optional
-        Bytes of memory; default what the system has available now.
-    option : str, default "--workers"
-        The option to name in the advice.
-
-    Raises
-    ------
-    LimitError
-        Saying how many workers would fit.
-    """
-    need, label = item_memory(items)
-    available = available_memory() if available is None else available
-    if not need or available is None or need * workers <= available:
-        return
-    fits = int(available // need)
-    advice = f"use {option} {fits}" if fits >= 1 else "make the inputs smaller (even one item does not fit)"
-    raise LimitError(
-        f"batch: one item ({label}) needs about {_bytes(need)} of memory, {workers} workers at once "
-        f"{_bytes(need * workers)}, {_bytes(available)} is available: {advice}"
+    i, label, inputs, out = row
+    text = output_recipe(method, params, inputs, seed, region, out).to_json()
+    return Item(
+        index=i,
+        label=label,
+        method=method.name,
+        params=params_dict,
+        inputs=inputs,
+        seed=seed,
+        region=region,
+        output=out,
+        recipe=text,
+        bit_depth=_item_bit_depth(method, inputs, out, bit_depth),
+        write=not ship_outputs,
     )

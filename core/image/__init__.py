@@ -1,6 +1,7 @@
 """Images in weft: float32 arrays in [0, 1], shape (H, W) grey or (H, W, 3) RGB.
 
-``weft.core.image.files`` loads, saves, validates and resizes (OpenCV's BGR never leaves it);
+``weft.core.image.files`` loads (its decoders in ``decoding``), ``writing`` saves, ``png_chunks``
+reads a PNG's recipe, ``arrays`` validates and resizes (OpenCV's BGR never leaves this package);
 ``weft.core.image.colour`` holds the colour helpers: luminance (Rec. 601), RGB <-> YIQ, and the
 principal-component grey of Smith & Bhalerao §3.4. Everything public is importable from here.
 """

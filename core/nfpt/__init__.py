@@ -12,18 +12,16 @@ without ``--lines`` the photo is taken as frontal already (plain §2 synthesis, 
 view-warping" column of Figs. 3-4).
 """
 
-from .method import (
-    DEFAULT_BLOCK,
-    DEFAULT_OVERLAP,
+from .method import (  # noqa: F401 (re-exported: callers and tests import them from the package)
     METHOD,
     SELECT_SECONDS_PER_POSITION,
-    NfptParams,
     NfptResult,
     estimate_seconds,
     nfpt,
     synthesize,
     warm_up,
 )
+from .params import DEFAULT_BLOCK, DEFAULT_OVERLAP, NfptParams  # noqa: F401 (re-exported)
 from .synthesis import Synthesis, distance_weights
 
 __all__ = ["NfptParams", "NfptResult", "Synthesis", "distance_weights", "nfpt", "synthesize", "METHOD"]

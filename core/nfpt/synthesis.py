@@ -245,11 +245,68 @@ def synthesize_patches(
     ----------
     Yan, Lee & Lin, "Patch-based synthesis for non-frontal-parallel textures", §2, steps 1-7.
     """
-    import cv2
-
-    from .. import seams
     from .._kernels import nfpt as _k
 
+    tex, mask, valid = _checked_source(texture, block, mask)
+    hs, ws, nc = tex.shape
+    rng = as_rng(rng)
+    width, height = size
+    ys, _, _, hc = block_grid(height, block, overlap, False)  # the patch grid quilting uses too
+    xs, _, _, wc = block_grid(width, block, overlap, False)
+    rows, cols = len(ys), len(xs)
+
+    src_y = luminance(tex[..., 0] if nc == 1 else tex)
+    mean = float(src_y[mask].mean()) if mask is not None else float(src_y.mean())
+    levels = 8 if nc == 3 else 32
+    search = _Search(src_y, mean, levels, sigma_s)
+    canvas = _Canvas(hc, wc, nc, height, width)
+    flat_index = np.arange(hs, dtype=np.int32)[:, None] * ws + np.arange(ws, dtype=np.int32)[None, :]
+    wd_cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+    us = rng.random((rows, cols))
+    ph, pw = valid.shape
+    first_choices = np.flatnonzero(valid)
+    first = int(first_choices[rng.integers(0, len(first_choices))])
+    thr2 = threshold * threshold * nc
+
+    stage_total = rows + (1 if repair else 0)
+    report = ProgressReporter(progress, "nfpt synthesis", stage_total)
+
+    for i in range(rows):
+        if cancel is not None:
+            cancel.raise_if_cancelled()
+        y0 = ys[i]
+        top = overlap if i > 0 else 0
+        for j in range(cols):
+            x0 = xs[j]
+            left = overlap if j > 0 else 0
+            in_l = None
+            if top == 0 and left == 0:
+                k = first
+            else:
+                key = (top, left)
+                if key not in wd_cache:
+                    wd = distance_weights(block, top, left, sigma_d)
+                    wd_cache[key] = (wd, wd > 0)
+                wd, in_l = wd_cache[key]
+                cmap, const = search.cost(canvas.y, canvas.image, y0, x0, wd)
+                k = int(_k.select(cmap, const, valid, tol, us[i, j]))
+            sy, sx = divmod(k, pw)
+            canvas.paste(
+                tex, src_y, flat_index, (sy, sx), (y0, x0), block, top, left, in_l, band if repair else None, thr2
+            )
+        report.update(i + 1, preview=canvas.preview)
+
+    repaired = 0
+    if repair and canvas.todo.any():
+        repaired = _repair_seams(canvas, tex, mask, n, shift, smooth, cancel)
+        report.update(stage_total, preview=canvas.preview)
+    return canvas.result(rows * cols, repaired)
+
+
+def _checked_source(
+    texture: np.ndarray, block: int, mask: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
+    """The source as (H, W, C) float32, its mask as bool, and the patch positions wholly inside it."""
     tex = validate_image(texture, "texture")
     if tex.ndim == 2:
         tex = tex[..., None]
@@ -266,98 +323,105 @@ def synthesize_patches(
             f"no {block}x{block} patch of the source lies wholly inside its valid part "
             f"(the rectified area is too small for the block; use a smaller --block)"
         )
-    rng = as_rng(rng)
-    width, height = size
-    ys, _, _, hc = block_grid(height, block, overlap, False)  # the patch grid quilting uses too
-    xs, _, _, wc = block_grid(width, block, overlap, False)
-    rows, cols = len(ys), len(xs)
+    return tex, mask, valid
 
-    src_y = luminance(tex[..., 0] if nc == 1 else tex)
-    mean = float(src_y[mask].mean()) if mask is not None else float(src_y.mean())
-    levels = 8 if nc == 3 else 32
-    search = _Search(src_y, mean, levels, sigma_s)
-    canvas = np.zeros((hc, wc, nc), np.float32)
-    canvas_y = np.zeros((hc, wc), np.float32)
-    pos = np.full((hc, wc), -1, np.int32)
-    todo = np.zeros((hc, wc), np.uint8)
-    flat_index = np.arange(hs, dtype=np.int32)[:, None] * ws + np.arange(ws, dtype=np.int32)[None, :]
-    wd_cache: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
-    us = rng.random((rows, cols))
-    ph, pw = valid.shape
-    first_choices = np.flatnonzero(valid)
-    first = int(first_choices[rng.integers(0, len(first_choices))])
-    thr2 = threshold * threshold * nc
 
-    stage_total = rows + (1 if repair else 0)
-    report = ProgressReporter(progress, "nfpt synthesis", stage_total)
+class _Canvas:
+    """The output being built (``image``, its luminance ``y``), the flat source index each pixel was
+    copied from (``pos``, -1 where none) and the pixels to repair (``todo``: 1 to do, 2 done)."""
 
-    def preview():
-        img = canvas[:height, :width]
-        return (img[..., 0] if nc == 1 else img).copy()
+    def __init__(self, hc: int, wc: int, nc: int, height: int, width: int):
+        self.image = np.zeros((hc, wc, nc), np.float32)
+        self.y = np.zeros((hc, wc), np.float32)
+        self.pos = np.full((hc, wc), -1, np.int32)
+        self.todo = np.zeros((hc, wc), np.uint8)
+        self.height, self.width = height, width
 
-    for i in range(rows):
+    def paste(
+        self,
+        tex: np.ndarray,
+        src_y: np.ndarray,
+        flat_index: np.ndarray,
+        source: tuple[int, int],
+        at: tuple[int, int],
+        block: int,
+        top: int,
+        left: int,
+        in_l: np.ndarray | None,
+        band: int | None,
+        thr2: float,
+    ) -> None:
+        """Paste the source patch at ``source`` to ``at`` on its side of the minimum-error cut through
+        the L-shaped overlap; with a repair ``band``, mark the mismatched pixels near the cut."""
+        from .. import seams
+
+        (sy, sx), (y0, x0) = source, at
+        new = tex[sy : sy + block, sx : sx + block]
+        foot = (slice(y0, y0 + block), slice(x0, x0 + block))
+        if in_l is not None:  # (None for the first patch, which overlaps nothing)
+            old = self.image[foot]
+            err = seams.overlap_error(old, new)
+            err[~in_l] = 0.0
+            cut = seams.min_cut_mask(err, left=left, top=top)
+            if band is not None:
+                near = _seam_band(cut, in_l, top, left, band)
+                self.todo[foot][cut] = 0  # pixels the new patch covers are no longer by an older seam
+                self.todo[foot][near & (err > thr2)] = 1
+        else:
+            cut = np.ones((block, block), bool)
+        self.image[foot][cut] = new[cut]
+        self.y[foot][cut] = src_y[sy : sy + block, sx : sx + block][cut]
+        self.pos[foot][cut] = flat_index[sy : sy + block, sx : sx + block][cut]
+
+    def preview(self) -> np.ndarray:
+        img = self.image[: self.height, : self.width]
+        return (img[..., 0] if img.shape[2] == 1 else img).copy()
+
+    def result(self, patches: int, repaired: int) -> Synthesis:
+        height, width = self.height, self.width
+        out = np.ascontiguousarray(self.image[:height, :width])
+        if out.shape[2] == 1:
+            out = np.ascontiguousarray(out[..., 0])
+        return Synthesis(
+            out,
+            patches,
+            repaired,
+            np.ascontiguousarray(self.pos[:height, :width]),
+            np.ascontiguousarray(self.todo[:height, :width] == 2),
+        )
+
+
+def _repair_seams(
+    canvas: _Canvas,
+    tex: np.ndarray,
+    mask: np.ndarray | None,
+    n: int,
+    shift: int,
+    smooth: bool,
+    cancel: CancelToken | None,
+) -> int:
+    """Re-make the marked pixels near the seams by neighbourhood matching (scan-line order), then
+    smooth them when asked; returns how many pixels of the output were re-made."""
+    import cv2
+
+    from .._kernels import nfpt as _k
+
+    hs, ws = tex.shape[:2]
+    todo = canvas.todo
+    allowed = np.ascontiguousarray(mask, dtype=np.uint8) if mask is not None else np.ones((hs, ws), np.uint8)
+    half = n // 2
+    order = np.flatnonzero(todo.ravel() == 1).astype(np.int64)  # scan-line order
+    step = max(1, -(-len(order) // 16))
+    for c0 in range(0, len(order), step):
         if cancel is not None:
             cancel.raise_if_cancelled()
-        y0 = ys[i]
-        top = overlap if i > 0 else 0
-        for j in range(cols):
-            x0 = xs[j]
-            left = overlap if j > 0 else 0
-            if top == 0 and left == 0:
-                k = first
-            else:
-                key = (top, left)
-                if key not in wd_cache:
-                    wd = distance_weights(block, top, left, sigma_d)
-                    wd_cache[key] = (wd, wd > 0)
-                wd, in_l = wd_cache[key]
-                cmap, const = search.cost(canvas_y, canvas, y0, x0, wd)
-                k = int(_k.select(cmap, const, valid, tol, us[i, j]))
-            sy, sx = divmod(k, pw)
-            new = tex[sy : sy + block, sx : sx + block]
-            foot = (slice(y0, y0 + block), slice(x0, x0 + block))
-            if top or left:
-                old = canvas[foot]
-                err = seams.overlap_error(old, new)
-                err[~in_l] = 0.0
-                cut = seams.min_cut_mask(err, left=left, top=top)
-                if repair:
-                    near = _seam_band(cut, in_l, top, left, band)
-                    todo[foot][cut] = 0  # pixels the new patch covers are no longer by an older seam
-                    todo[foot][near & (err > thr2)] = 1
-            else:
-                cut = np.ones((block, block), bool)
-            canvas[foot][cut] = new[cut]
-            canvas_y[foot][cut] = src_y[sy : sy + block, sx : sx + block][cut]
-            pos[foot][cut] = flat_index[sy : sy + block, sx : sx + block][cut]
-        report.update(i + 1, preview=preview)
-
-    repaired = 0
-    if repair and todo.any():
-        allowed = np.ascontiguousarray(mask, dtype=np.uint8) if mask is not None else np.ones((hs, ws), np.uint8)
-        half = n // 2
-        order = np.flatnonzero(todo.ravel() == 1).astype(np.int64)  # scan-line order
-        step = max(1, -(-len(order) // 16))
-        for c0 in range(0, len(order), step):
-            if cancel is not None:
-                cancel.raise_if_cancelled()
-            _k.repair(canvas, pos, todo, tex, allowed, half, shift, order[c0 : c0 + step])
-        done = todo[:height, :width] == 2
-        repaired = int(done.sum())
-        if smooth and repaired:
-            blurred = cv2.GaussianBlur(canvas, (0, 0), SMOOTH_SIGMA, borderType=cv2.BORDER_REFLECT)
-            if blurred.ndim == 2:
-                blurred = blurred[..., None]
-            sel = todo == 2
-            canvas[sel] = blurred[sel]
-        report.update(stage_total, preview=preview)
-    out = np.ascontiguousarray(canvas[:height, :width])
-    if nc == 1:
-        out = np.ascontiguousarray(out[..., 0])
-    return Synthesis(
-        out,
-        rows * cols,
-        repaired,
-        np.ascontiguousarray(pos[:height, :width]),
-        np.ascontiguousarray(todo[:height, :width] == 2),
-    )
+        _k.repair(canvas.image, canvas.pos, todo, tex, allowed, half, shift, order[c0 : c0 + step])
+    done = todo[: canvas.height, : canvas.width] == 2
+    repaired = int(done.sum())
+    if smooth and repaired:
+        blurred = cv2.GaussianBlur(canvas.image, (0, 0), SMOOTH_SIGMA, borderType=cv2.BORDER_REFLECT)
+        if blurred.ndim == 2:
+            blurred = blurred[..., None]
+        sel = todo == 2
+        canvas.image[sel] = blurred[sel]
+    return repaired

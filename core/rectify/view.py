@@ -28,10 +28,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import GeometryError
-from ..geometry import _short
 from ..geometry import as_lines as _as_lines
 from ..geometry import as_size as _as_size
 from ..geometry import read_json_or_file as read_json
+from ..geometry.reading import _short
 from ..params import MAX_SIDE
 from .homography import apply_homography
 from .lines import check_lines
@@ -94,7 +94,7 @@ class View:
 
     @classmethod
     def from_json(cls, data: Any, name: str = "view", base=None) -> View:
-        from ..geometry import _from_json_or_path
+        from ..geometry.reading import _from_json_or_path
 
         return _from_json_or_path(cls, data, name, base, "view")
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import GeometryError, InvalidParameter
-from ..geometry import _short
+from ..geometry.reading import _short
 from .homography import HomographyFit, apply_homography, fit_homography, homography_from_points
 from .lines import check_lines, line_correspondences
 

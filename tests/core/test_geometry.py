@@ -100,3 +100,34 @@ def test_every_studio_method_describes_inputs_it_has():
             assert set(g.on) <= names, name
         assert set(studio.preview_inputs) <= names and set(studio.compare) <= names, name
         assert set(studio.examples) <= names, name
+
+
+def test_every_geometry_parameter_type_is_a_geometry_value():
+    """The studio, the CLI and recipes read a geometry parameter only through the GeometryValue
+    interface; every method's geometry types have it, and a value's JSON form reads back equal."""
+    from weft.core.geometry import GeometryValue, Margins
+    from weft.core.params import specs
+
+    types = {spec.type for m in registry.methods().values() for spec in specs(m.params) if spec.kind == "geometry"}
+    assert Square in types and FeatureLines in types
+    for t in types:
+        assert issubclass(t, GeometryValue), t
+    for value in (Square(3, 4, 16), Margins(0, 8, 16, 0), FeatureLines.coerce(LINES)):
+        assert isinstance(value, GeometryValue)
+        assert type(value).from_json(value.to_json()) == value
+
+
+def test_a_geometry_parameter_without_the_interface_is_refused():
+    from weft.core.params import param
+
+    class NoJson:
+        @classmethod
+        def parse(cls, text, name="x"):
+            return cls()
+
+        @classmethod
+        def coerce(cls, value, name="x"):
+            return cls()
+
+    with pytest.raises(TypeError, match="type NoJson has no from_json, to_json"):
+        param(None, kind="geometry", type=NoJson, optional=True)

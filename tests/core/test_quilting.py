@@ -181,7 +181,7 @@ def test_rules_and_schedule():
         sched = transfer_schedule(n)
         for i, (_, _, a) in enumerate(sched, start=1):
             assert a == pytest.approx(0.8 * (i - 1) / (n - 1) + 0.1)
-        for (b0, o0, _), (b1, o1, _) in zip(sched, sched[1:]):
+        for (b0, o0, _), (b1, o1, _) in zip(sched, sched[1:], strict=False):
             assert b1 == max(9, int(np.floor(b0 * 2 / 3 + 0.5))) and o1 < b1
             assert o1 == min(b1 - 1, max(3, int(np.floor(o0 * 2 / 3 + 0.5))))
     assert transfer_schedule(3, block=9, overlap=3) == [(9, 3, 0.1), (9, 3, 0.5), (9, 3, 0.9)]
@@ -313,7 +313,7 @@ def test_seam_rule_kernels_match_numpy():
     """best_k gives the tol rule's candidates in its order (ties included) and seam_error the error
     on the new block's side of the cut, as the numpy engine's versions do."""
     from weft.core._kernels import quilting as k
-    from weft.core.quilting import engine
+    from weft.core.quilting import numpy_kernels as nk
 
     rng = np.random.default_rng(5)
     for ph, pw, levels, kk in ((7, 9, 3, 8), (20, 30, 1000, 8), (12, 12, 2, 40), (3, 3, 5, 20)):
@@ -321,9 +321,9 @@ def test_seam_rule_kernels_match_numpy():
         sq = np.full((ph, pw), 4 * levels, dtype=np.float32)
         out_k, out_n = np.full(kk, -1, np.int64), np.full(kk, -1, np.int64)
         n = k.best_k(cross, sq, 1.0, np.empty(ph * pw), kk, out_k)
-        assert n == engine._best_k_numpy(cross, sq, 1.0, None, kk, out_n) == min(kk, ph * pw)
+        assert n == nk._best_k_numpy(cross, sq, 1.0, None, kk, out_n) == min(kk, ph * pw)
         assert np.array_equal(out_k[:n], out_n[:n])
-        cost = engine._cost_numpy(cross, sq, 1.0)
+        cost = nk._cost_numpy(cross, sq, 1.0)
         assert sorted(cost[out_k[:n]]) == sorted(np.sort(cost)[:n])  # the n smallest
         chosen = k.choose_tol(cross, sq, 1.0, np.empty(ph * pw), kk, 0.999)
         assert chosen == out_k[n - 1]  # the tol rule's last candidate
@@ -333,8 +333,8 @@ def test_seam_rule_kernels_match_numpy():
     mask[0, 2] = 0
     expect = err[1:, 2].sum() + err[0, 3]
     assert k.seam_error(err, mask) == pytest.approx(expect)
-    assert engine._seam_error_numpy(err, mask) == k.seam_error(err, mask)
-    assert k.seam_error(err, np.ones((6, 5), np.uint8)) == 0.0 == engine._seam_error_numpy(err, np.ones((6, 5)))
+    assert nk._seam_error_numpy(err, mask) == k.seam_error(err, mask)
+    assert k.seam_error(err, np.ones((6, 5), np.uint8)) == 0.0 == nk._seam_error_numpy(err, np.ones((6, 5)))
 
 
 @pytest.mark.parametrize(
@@ -357,18 +357,18 @@ def test_stacked_numpy_cuts_match_the_kernel(shape, sides, stack):
     large stack's paths are traced by whole-stack steps, a small one's by scalar steps)."""
     from weft.core._kernels import quilting as k
     from weft.core._kernels import seams
-    from weft.core.quilting import engine
+    from weft.core.quilting import numpy_kernels as nk
 
     rng = np.random.default_rng(sum(shape) + sum(sides))
     # few levels, so that ties between paths happen and the tie rules are compared too
     errs = np.floor(rng.random((stack, *shape)) * 4)
-    masks = engine._cut_mask_numpy(errs, *sides)
-    scores = engine._seam_errors_numpy(errs, masks)
-    for e, m, score in zip(errs, masks, scores):
+    masks = nk._cut_mask_numpy(errs, *sides)
+    scores = nk._seam_errors_numpy(errs, masks)
+    for e, m, score in zip(errs, masks, scores, strict=True):
         mk = np.empty(shape, np.uint8)
         seams.cut_mask(np.ascontiguousarray(e), *sides, mk)
         assert np.array_equal(m, mk.astype(bool))
-        assert score == k.seam_error(np.ascontiguousarray(e), mk) == engine._seam_error_numpy(e, mk)
+        assert score == k.seam_error(np.ascontiguousarray(e), mk) == nk._seam_error_numpy(e, mk)
 
 
 # --------------------------------------------------------------------------------------------
@@ -444,7 +444,7 @@ def test_synthesis_spreads_its_use_of_the_sample(brick64, monkeypatch):
     monkeypatch.setattr(engine, "USAGE_WEIGHT", 0.0)
     without = [run(seed) for seed in range(3)]
     # measured: spread 0.58-0.62 against 0.65-0.69 without; completeness 0.0038-0.0069
-    for seed, ((s, comp), (s0, _)) in enumerate(zip(spread, without)):
+    for seed, ((s, comp), (s0, _)) in enumerate(zip(spread, without, strict=True)):
         assert s < s0 - 0.03, seed
         assert comp < 0.008, seed
 

@@ -83,18 +83,18 @@ def test_accumulated_costs_are_the_kernels_dynamic_program():
     """``accumulated_costs`` (numpy, a stack at once) is E[y, x] = e[y, x] + min of the three below,
     and a trace down it by the kernel's tie rule gives :func:`min_error_path`'s path (tie-heavy
     integer errors, so the tie rules are compared too)."""
-    from weft.core.quilting.engine import _trace_numpy
+    from weft.core.quilting.numpy_kernels import _trace_numpy
     from weft.core.seams import accumulated_costs, min_error_path
 
     rng = np.random.default_rng(11)
     err = np.floor(rng.random((5, 30, 7)) * 3)
     acc = accumulated_costs(err)
-    for e, a in zip(err, acc):
+    for e, a in zip(err, acc, strict=True):
         expect = e.copy()
         for y in range(e.shape[0] - 2, -1, -1):
             below = np.pad(expect[y + 1], 1, constant_values=np.inf)
             expect[y] += np.minimum(np.minimum(below[:-2], below[1:-1]), below[2:])
         assert np.array_equal(a, expect)
     paths = _trace_numpy(acc, np.zeros(5, np.int64), acc[:, 0].argmin(axis=1))
-    for e, path in zip(err, paths):
+    for e, path in zip(err, paths, strict=True):
         assert np.array_equal(path, min_error_path(e))
