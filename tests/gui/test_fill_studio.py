@@ -1388,10 +1388,9 @@ def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, 
 
 
 def test_the_auto_patch_shows_the_patch_the_run_takes_or_none(qtbot, settings):
-    """The greyed "auto" value beside fill's patch box: once a hole is painted, ``auto`` picks its
-    engine from the pixels on a colour picture (patchmatch where the edge guide pairs edges, else the
-    hybrid), so no number is shown, where it showed the hybrid's 64 whatever ran; with the
-    edge guide asked for (patchmatch) it shows 7, the patch the result reports."""
+    """The greyed "auto" value beside fill's patch box is the patch the result reports: on this grey
+    picture the hybrid's block; with the edge guide asked for (patchmatch) its 7. (On a colour
+    picture with a hole, where the pixels decide the engine, it shows no number.)"""
     with _fill_in_the_studio(qtbot, settings) as window:
         view, doc = window.inputs_pane.canvas_view, window.doc
         h, w = doc.image("image").shape[:2]
@@ -1402,7 +1401,9 @@ def test_the_auto_patch_shows_the_patch_the_run_takes_or_none(qtbot, settings):
         first = _final_after(window, qtbot, lambda: _stroke(view, [(w * 0.4, y), (w * 0.5, y)]))
         row = window.method_panel.params_panel.row("patch")
         assert row.auto.isChecked() and doc.current_params.patch is None
-        assert not row.editor.isVisible() and "(now" not in row.editor.toolTip(), (first.figures, row.editor.toolTip())
+        ran = first.figures["patch"]
+        assert first.figures["engine"] == "hybrid" and row.editor.isVisible() and row.editor.value() == ran
+        assert f"(now {ran})" in row.editor.toolTip(), (first.figures, row.editor.toolTip())
         structure = window.method_panel.params_panel.row("structure")
         result = _final_after(
             window, qtbot, lambda: structure.editor.setCurrentIndex(structure.spec.choices.index("yes"))
