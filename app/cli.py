@@ -1,10 +1,11 @@
 """The ``weft`` command.
 
-``weft`` with no arguments opens the desktop studio (``weft IMAGE [TARGET]``: on those images); ``weft METHOD INPUT... -o OUT [options]`` runs a
-method headless; ``weft run RECIPE -o OUT`` reproduces a recipe (a ``.json`` file, or a PNG exported
-by weft, which carries its recipe); ``weft batch RECIPE --over INPUT FILES -o PATTERN`` applies it to
-many files (:mod:`weft.app.batch_cli`). Method options are generated from the method's ``Params`` specs,
-so the CLI and the GUI share one definition of every parameter and its range.
+``weft`` with no arguments opens the desktop studio (``weft IMAGE [TARGET]``: on those images);
+``weft METHOD INPUT... -o OUT [options]`` runs a method headless; ``weft run RECIPE -o OUT`` reproduces
+a recipe (a ``.json`` file, or a PNG exported by weft, which carries its recipe);
+``weft batch RECIPE --over INPUT FILES -o PATTERN`` applies it to many files
+(:mod:`weft.app.batch_cli`). Method options are generated from the method's ``Params`` specs, so the
+CLI and the GUI share one definition of every parameter and its range.
 
 Contract: any bad input (a file, a parameter, a geometry) prints exactly one line on stderr and exits
 with status 2, with no traceback and no output file. ``--report`` prints exactly one JSON line on
@@ -60,7 +61,7 @@ from weft.core.errors import Cancelled, WeftError  # noqa: E402
 from weft.core.params import Params, specs  # noqa: E402
 
 from .options import parse_bit_depth as _parse_bit_depth  # noqa: E402
-from .options import parse_int as _parse_int
+from .options import parse_int as _parse_int  # noqa: E402
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -114,7 +115,8 @@ class _TerminalProgress:
 class _PreparingLine:
     """Says on stderr that kernels are being compiled — the first run's long silent stretch (a cold
     quilting transfer compiled for 39 s before its first progress report) — and keeps the line alive
-    with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes over or the run ends.
+    with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes
+    over or the run ends.
 
     Called from numba's compile events (``registry.watch_compiles``), i.e. only when a kernel really
     compiles: a run that loads every kernel from numba's cache says nothing. Like the progress bar it

@@ -89,7 +89,10 @@ def weft_command(files: dict[str, Path], out: Path, inputs: SuiteInputs, seed: i
 
 def peer_tools() -> list[tuple[str, Any, str | None]]:
     """``(name, command(files, out), why it cannot run or None)`` for each peer."""
-    gmic = lambda f, o: _gmic_command(f, o, None, None)
+
+    def gmic(f, o):
+        return _gmic_command(f, o, None, None)
+
     return [
         (PEERS[0], gmic, None if shutil.which("gmic") else "gmic is not on the PATH (Debian: apt-get install gmic)"),
         (PEERS[1], lambda f, o: _peer_command("shiftmap", lambda: sys.executable)(f, o, None, None), _cv2_missing()),

@@ -454,7 +454,8 @@ def main(argv: list[str] | None = None) -> int:
         )
 
     def agg(kind: str, tool: str) -> dict:
-        sel = [r[tool] for r in rows if r["kind"] == kind]
+        of_kind = [r for r in rows if r["kind"] == kind]
+        sel = [r[tool] for r in of_kind]
         if not sel:
             return {}
         ok = [r for r in sel if not r["refused"]]
@@ -466,15 +467,11 @@ def main(argv: list[str] | None = None) -> int:
             "median_angle_err_deg": round(statistics.median(r["angle_err_deg"] for r in ok), 3) if ok else None,
             "median_aspect_err": round(statistics.median(r["aspect_err"] for r in ok), 4) if ok else None,
             "median_ms_per_mp": round(
-                statistics.median(
-                    r["median_ms"] / rr["megapixels"] for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])
-                ),
+                statistics.median(r["median_ms"] / rr["megapixels"] for r, rr in zip(sel, of_kind, strict=True)),
                 1,
             ),
             "median_cpu_ms_per_mp": round(
-                statistics.median(
-                    r["median_cpu_ms"] / rr["megapixels"] for r, rr in zip(sel, [x for x in rows if x["kind"] == kind])
-                ),
+                statistics.median(r["median_cpu_ms"] / rr["megapixels"] for r, rr in zip(sel, of_kind, strict=True)),
                 1,
             ),
             "first_run_ms": sel[0]["first_ms"],

@@ -90,7 +90,8 @@ class Square(NamedTuple):
                 if isinstance(text, (str, bytes)) or any(isinstance(v, (bool, np.bool_)) for v in text):
                     raise TypeError
                 values = tuple(int(v) for v in text)
-                if any(v != w for v, w in zip(values, text)):  # 8.5 is not a pixel count: no silent rounding
+                # 8.5 is not a pixel count: no silent rounding (text may be any iterable: not strict)
+                if any(v != w for v, w in zip(values, text, strict=False)):
                     values = ()
             except (TypeError, ValueError, OverflowError):
                 values = ()
@@ -695,7 +696,7 @@ class Margins(NamedTuple):
                 values = tuple(whole_number(p) for p in text.replace(" ", "").split(","))
             elif not any(isinstance(v, (bool, np.bool_)) for v in text):
                 values = tuple(int(v) for v in text)
-                if any(v != w for v, w in zip(values, text)):
+                if any(v != w for v, w in zip(values, text, strict=False)):
                     values = ()
         except (TypeError, ValueError, OverflowError):
             values = ()
@@ -706,7 +707,7 @@ class Margins(NamedTuple):
                 name=name,
                 value=text,
             )
-        for side, v in zip(("left", "top", "right", "bottom"), values):
+        for side, v in zip(("left", "top", "right", "bottom"), values, strict=True):
             if not 0 <= v <= MAX_SIDE:
                 raise InvalidParameter(
                     f"parameter '{name}' = {shown}: the {side} margin {v} is outside 0..{MAX_SIDE}",

@@ -87,7 +87,7 @@ def test_each_output_is_weft_run_on_its_recipe_byte_for_byte(scene, capsys):
     items = sorted(lines[:-1], key=lambda d: d["index"])
     assert [d["input"] for d in items] == [f"frame_{i}.png" for i in range(1, 6)]
     assert all(d["status"] == "written" and d["seconds"] >= 0 for d in items)
-    for i, frame in enumerate(frames):
+    for i in range(len(frames)):
         made = tmp / "out" / f"frame_{i + 1}_{i:02d}.png"
         recipe = json.loads(read_recipe(made))
         assert recipe["inputs"] == {"texture": "../gravel.png", "target": f"../frames/frame_{i + 1}.png"}

@@ -83,7 +83,7 @@ def test_lines_and_views_from_a_fifo_or_a_device(fifo, tmp_path, capsys, option)
 
 
 def test_a_recipe_naming_a_device_as_its_lines(tmp_path, capsys):
-    photo = _texture(tmp_path / "p.png")
+    _texture(tmp_path / "p.png")
     recipe = tmp_path / "r.json"
     recipe.write_text(
         json.dumps(

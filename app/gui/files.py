@@ -69,9 +69,10 @@ def _source_depth(shown) -> int:
 def off_gui_thread(fn: Callable[[], T]) -> T:
     """Run ``fn()`` on a worker thread and return its value (or raise its exception).
 
-    For work the caller must wait for (a session's images are decoded before the document is
-    touched, an export is written before it is reported): meanwhile the GUI thread runs a local event loop that keeps painting and running timers
-    but holds back user input, so the window stays alive and nothing can be started twice.
+    For work the caller must wait for (a session's images are decoded before the document is touched, an
+    export is written before it is reported): meanwhile the GUI thread runs a local event loop that keeps
+    painting and running timers but holds back user input, so the window stays alive and nothing can be
+    started twice.
     """
     loop = QEventLoop()
     box: dict = {}

@@ -511,7 +511,7 @@ class MainWindow(QMainWindow):
 
     def open_images(self, paths: list[str]) -> None:
         """Open ``paths`` as the current method's inputs in order (``weft IMAGE [TARGET]``)."""
-        for spec, path in zip(self.doc.current.inputs, paths):
+        for spec, path in zip(self.doc.current.inputs, paths, strict=False):
             self.open_input(spec.name, path)
 
     def _open_nth(self, i: int) -> None:

@@ -169,9 +169,8 @@ class MethodPanel(QWidget):
             return
         values = [b.value() for b in self.square_boxes]
         if doc.value(g.key) is None:  # none drawn: the boxes left blank take the corner and a default side
-            values = [
-                d if v == b.minimum() else v for v, b, d in zip(values, self.square_boxes, _default_square(image))
-            ]
+            defaults = _default_square(image)
+            values = [d if v == b.minimum() else v for v, b, d in zip(values, self.square_boxes, defaults, strict=True)]
         try:
             square = Square.parse(values, g.key)
             square.crop(image, where.replace("_", " "), g.key)
@@ -239,7 +238,7 @@ class MethodPanel(QWidget):
             return
         h, w = image.shape[:2]
         limits = ((0, max(w - Square.MIN_SIDE, 0)), (0, max(h - Square.MIN_SIDE, 0)), (Square.MIN_SIDE, min(w, h)))
-        for i, (box, (lo, hi)) in enumerate(zip(self.square_boxes, limits)):
+        for i, (box, (lo, hi)) in enumerate(zip(self.square_boxes, limits, strict=True)):
             box.blockSignals(True)
             if square is None:  # blank (the minimum shows "–") until a number is typed
                 box.setRange(lo - 1, max(lo, hi))

@@ -12,7 +12,8 @@
 * Jobs carry ids; a result older than the one shown is dropped, so what is shown is always the last
   completed job. A result carries the recipe of its pixels (method, parameters, inputs, seed, region)
   and its "before" image, captured when the job was made: export and Compare use those, never the
-  panel's state at the time of the export. Workers never touch widgets: results and progress arrive through queued signals.
+  panel's state at the time of the export. Workers never touch widgets: results and progress arrive
+  through queued signals.
 * While a mask stroke is painted, ``preview_around(box)`` submits (in the same coalesced preview slot)
   a render of the region around the stroke only, when the method's studio description asks for it
   (``Studio.preview_around``; ``weft.core.studio.crop_around`` crops the inputs to at most

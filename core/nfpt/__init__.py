@@ -12,18 +12,12 @@ without ``--lines`` the photo is taken as frontal already (plain §2 synthesis, 
 view-warping" column of Figs. 3-4).
 """
 
-from .method import (
-    DEFAULT_BLOCK,
-    DEFAULT_OVERLAP,
-    METHOD,
-    SELECT_SECONDS_PER_POSITION,
-    NfptParams,
-    NfptResult,
-    estimate_seconds,
-    nfpt,
-    synthesize,
-    warm_up,
-)
+from .method import DEFAULT_BLOCK as DEFAULT_BLOCK
+from .method import DEFAULT_OVERLAP as DEFAULT_OVERLAP
+from .method import METHOD, NfptParams, NfptResult, nfpt, synthesize
+from .method import SELECT_SECONDS_PER_POSITION as SELECT_SECONDS_PER_POSITION
+from .method import estimate_seconds as estimate_seconds
+from .method import warm_up as warm_up
 from .synthesis import Synthesis, distance_weights
 
 __all__ = ["NfptParams", "NfptResult", "Synthesis", "distance_weights", "nfpt", "synthesize", "METHOD"]

@@ -107,8 +107,9 @@ class NfptParams(WarpParams):
         kind="geometry",
         type=View,
         optional=True,
-        help='put the result into this view: a JSON file (or the JSON text, starting with {), {"quad": [[x, y] x 4], "size": '
-        "[w, h]} or view image_lines + texture frontal_lines; texture pixel coordinates",
+        help="put the result into this view: a JSON file (or the JSON text, starting with {), "
+        '{"quad": [[x, y] x 4], "size": [w, h]} or view image_lines + texture frontal_lines; '
+        "texture pixel coordinates",
     )
     into_photo: bool = param(
         False,

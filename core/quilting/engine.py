@@ -4,9 +4,9 @@ For every block: the SSD of its template against every source position (the squa
 per overlap shape with ``cv2.filter2D``, the cross-term as one FFT product with the source spectra
 computed once per pass), then the numba kernels of ``weft.core._kernels.quilting``: the choice (one
 kernel per selection rule), the overlap error, the cut (``weft.core._kernels.seams``), the paste, the
-Poisson band (only with ``poisson``), so that a run compiles only the kernels it uses -- or, for small syntheses while numba is not loaded yet, the
-same steps in numpy (``_choose_*_numpy``, ``_place_block_numpy``, pixel for pixel the same; a test
-checks it).
+Poisson band (only with ``poisson``), so that a run compiles only the kernels it uses -- or, for small
+syntheses while numba is not loaded yet, the same steps in numpy (``_choose_*_numpy``, ``_place_block_numpy``,
+pixel for pixel the same; a test checks it).
 """
 
 from __future__ import annotations
@@ -732,7 +732,7 @@ def _cut_mask_numpy(err: np.ndarray, top: int, left: int, right: int, bottom: in
     if bottom > 0:
         strips.append(err[:, h - bottom :, :].transpose(0, 2, 1))
         sides.append("bottom")
-    accs = dict(zip(sides, _vertical_accs_numpy(strips)))
+    accs = dict(zip(sides, _vertical_accs_numpy(strips), strict=True))
     if left > 0 and top > 0:
         ev, eh = accs["left"], accs["top"]
         corner = ev[:, :top, :left] + eh[:, :left, :top].transpose(0, 2, 1) - err[:, :top, :left]

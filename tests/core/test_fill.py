@@ -1,6 +1,8 @@
 """weft.core.fill: the engines (known pixels untouched, seeds deterministic, quality bounds from
 weft.core.metrics on small cases), the blend band, alpha, uncrop geometry and the Python API."""
 
+import itertools
+
 import cv2
 import numpy as np
 import pytest
@@ -279,7 +281,7 @@ def test_progress_reaches_the_end_and_cancel_stops(engine, gravel):
     hole = square_hole(gravel.shape)
     seen = []
     fill(gravel, hole, engine=engine, seed=0, progress=seen.append)
-    assert seen and seen[-1].fraction == 1.0 and all(a.done <= b.done for a, b in zip(seen, seen[1:]))
+    assert seen and seen[-1].fraction == 1.0 and all(a.done <= b.done for a, b in itertools.pairwise(seen))
     token = CancelToken()
     token.cancel()
     with pytest.raises(Cancelled):
@@ -449,7 +451,7 @@ def test_batched_cut_is_each_sides_own_cut():
     for _ in range(50):
         err = rng.integers(0, 3, (24, 24)).astype(np.float64)
         err[rng.random((24, 24)) < 0.3] = 1e6
-        sides = {k: int(v) for k, v in zip(("left", "top", "right", "bottom"), rng.integers(0, 9, 4))}
+        sides = {k: int(v) for k, v in zip(("left", "top", "right", "bottom"), rng.integers(0, 9, 4), strict=True)}
         alone = np.ones((24, 24), bool)
         for k, v in sides.items():
             if v:
@@ -490,9 +492,9 @@ def test_quilt_refines_colour_pictures_only():
 
 def test_default_fill_loads_neither_numba_nor_numpy_ma():
     """The default engine's whole path (quilt, its refine on colour, the band), and ``--structure``'s
-    (its edges and patchmatch), run in numpy and OpenCV: a ``weft fill`` process loads no numba
-    (0.4-0.7 s of import and cache loads) and no numpy.ma (np.percentile imports it: ~7 ms of every
-    process, for two percentiles)."""
+    (its edges and patchmatch), run in numpy and OpenCV: a ``weft fill`` process loads no numba (its
+    import and cache loads are a noticeable part of a short run) and no numpy.ma (np.percentile
+    imports it, for two percentiles)."""
     import subprocess
     import sys
 

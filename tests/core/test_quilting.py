@@ -1,5 +1,7 @@
 """Random-block quilting: shapes, determinism, that every block is a real copy, errors, jobs."""
 
+import itertools
+
 import numpy as np
 import pytest
 from weft.core.errors import Cancelled, InvalidParameter
@@ -143,7 +145,7 @@ def test_tileable_output_wraps_like_its_interior(brick):
 def test_cut_and_poisson_band_lower_the_seam_and_leave_the_rest(monkeypatch):
     """Two blocks in a row (the second chosen alike in every mode): overwrite > cut > cut + Poisson.
 
-    The seams of the blocks the seeds chose before the rule against continuations (issue 17) are
+    The seams of the blocks the seeds chose before the rule against continuations are
     what is measured here, so the rule is off (the selection is not this test's subject)."""
     import cv2
     import weft.core.quilting.engine as engine
@@ -181,7 +183,7 @@ def test_rules_and_schedule():
         sched = transfer_schedule(n)
         for i, (_, _, a) in enumerate(sched, start=1):
             assert a == pytest.approx(0.8 * (i - 1) / (n - 1) + 0.1)
-        for (b0, o0, _), (b1, o1, _) in zip(sched, sched[1:]):
+        for (b0, o0, _), (b1, o1, _) in itertools.pairwise(sched):
             assert b1 == max(9, int(np.floor(b0 * 2 / 3 + 0.5))) and o1 < b1
             assert o1 == min(b1 - 1, max(3, int(np.floor(o0 * 2 / 3 + 0.5))))
     assert transfer_schedule(3, block=9, overlap=3) == [(9, 3, 0.1), (9, 3, 0.5), (9, 3, 0.9)]
@@ -364,7 +366,7 @@ def test_stacked_numpy_cuts_match_the_kernel(shape, sides, stack):
     errs = np.floor(rng.random((stack, *shape)) * 4)
     masks = engine._cut_mask_numpy(errs, *sides)
     scores = engine._seam_errors_numpy(errs, masks)
-    for e, m, score in zip(errs, masks, scores):
+    for e, m, score in zip(errs, masks, scores, strict=True):
         mk = np.empty(shape, np.uint8)
         seams.cut_mask(np.ascontiguousarray(e), *sides, mk)
         assert np.array_equal(m, mk.astype(bool))
@@ -372,7 +374,7 @@ def test_stacked_numpy_cuts_match_the_kernel(shape, sides, stack):
 
 
 # --------------------------------------------------------------------------------------------
-# verbatim runs (issue 17): the record of source positions, the rule against continuations
+# verbatim runs: the record of source positions, the rule against continuations
 
 
 @pytest.fixture(scope="module")
@@ -444,13 +446,13 @@ def test_synthesis_spreads_its_use_of_the_sample(brick64, monkeypatch):
     monkeypatch.setattr(engine, "USAGE_WEIGHT", 0.0)
     without = [run(seed) for seed in range(3)]
     # measured: spread 0.58-0.62 against 0.65-0.69 without; completeness 0.0038-0.0069
-    for seed, ((s, comp), (s0, _)) in enumerate(zip(spread, without)):
+    for seed, ((s, comp), (s0, _)) in enumerate(zip(spread, without, strict=True)):
         assert s < s0 - 0.03, seed
         assert comp < 0.008, seed
 
 
 def test_the_default_synthesis_block_scales_with_the_sample(brick64):
-    """Issue 17: the synthesis block defaults to 7/16 of the sample's shorter side (56 for the
+    """The synthesis block defaults to 7/16 of the sample's shorter side (56 for the
     peers' 128-px brick_128), at most 56 and at least 2, and tol to 2, or 6 from block 48 up; the
     defaults give exactly the pixels of those explicit values."""
     from weft.core.quilting import METHOD, QuiltParams, synth_block, synth_tol

@@ -89,12 +89,12 @@ def test_accumulated_costs_are_the_kernels_dynamic_program():
     rng = np.random.default_rng(11)
     err = np.floor(rng.random((5, 30, 7)) * 3)
     acc = accumulated_costs(err)
-    for e, a in zip(err, acc):
+    for e, a in zip(err, acc, strict=True):
         expect = e.copy()
         for y in range(e.shape[0] - 2, -1, -1):
             below = np.pad(expect[y + 1], 1, constant_values=np.inf)
             expect[y] += np.minimum(np.minimum(below[:-2], below[1:-1]), below[2:])
         assert np.array_equal(a, expect)
     paths = _trace_numpy(acc, np.zeros(5, np.int64), acc[:, 0].argmin(axis=1))
-    for e, path in zip(err, paths):
+    for e, path in zip(err, paths, strict=True):
         assert np.array_equal(path, min_error_path(e))

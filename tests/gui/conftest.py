@@ -8,8 +8,8 @@ from weft.app.gui.main_window import MainWindow
 @pytest.fixture(autouse=True)
 def private_recovery(tmp_path, monkeypatch):
     """Every GUI test autosaves into its own folder, and the window's questions are answered yes,
-    "restore" to a recovered session, and "discard" to unsaved edits (a test that cares replaces ``MainWindow._confirm`` or
-    ``MainWindow._ask_unsaved`` itself)."""
+    "restore" to a recovered session, and "discard" to unsaved edits (a test that cares replaces
+    ``MainWindow._confirm`` or ``MainWindow._ask_unsaved`` itself)."""
     folder = tmp_path / "recovery"
     monkeypatch.setenv("WEFT_RECOVERY_DIR", str(folder))
     monkeypatch.setattr(MainWindow, "_confirm", lambda self, question: True)

@@ -1,4 +1,4 @@
-"""Issue 15, the studio side of fill and extend: the mask tool (brush, eraser, lasso, Clear, Invert,
+"""The studio side of fill and extend: the mask tool (brush, eraser, lasso, Clear, Invert,
 Fill transparent) and the margins tool (drag, Extend canvas…), driven with real mouse and key events.
 
 The studio is generic: these tests drive it with a method registered here (it fills its painted mask
@@ -584,7 +584,7 @@ def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
     _click_menu_item(qtbot, studio.geometry_menu, bar.extend_action)  # Edit > Mask and Canvas > Extend canvas…
     dialog = bar.dialog
     qtbot.waitUntil(dialog.isVisible, timeout=5000)
-    for side, value in zip(("left", "top", "right", "bottom"), (3, 5, 0, 12)):
+    for side, value in zip(("left", "top", "right", "bottom"), (3, 5, 0, 12), strict=True):
         box = dialog.boxes[side]
         box.selectAll()
         qtbot.keyClicks(box, str(value))
@@ -639,7 +639,7 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
 
     view = studio.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
-    around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
+    _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     text = studio.result_label.full_text()
     # (a count of pixels describes the crop, not the picture: only the full result states it)
     assert re.fullmatch(
@@ -725,7 +725,7 @@ def test_an_own_input_opened_for_another_method_stays_its_through_a_session(stud
     is still not mean-fill's (seen under Xvfb: after a recovery, the brick open for quilt filled a
     gravel hole in fill, because a restored session counted every own input as the current method's)."""
     doc, view = studio.doc, studio.canvas_view
-    swatch = _swatch_opened_for_another_method(studio, qtbot, tmp_path)
+    _swatch_opened_for_another_method(studio, qtbot, tmp_path)
     studio.inputs_pane.mask_tool().set_size(5)
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     session = tmp_path / "s.weft.json"
@@ -906,7 +906,7 @@ def test_esc_on_the_first_stroke_after_a_method_switch_shows_the_picture_again(s
     view.zoom_by(4.0)
     view.centerOn(W / 2, H / 2)
     studio.inputs_pane.mask_tool().set_size(9)
-    around = _previewed(studio, qtbot, view, [(20.5, 20.5), (30.5, 20.5)])
+    _previewed(studio, qtbot, view, [(20.5, 20.5), (30.5, 20.5)])
     assert not np.array_equal(studio.result_view.image, studio.doc.image("picture"))  # the stroke's preview
     view.setFocus()
     qtbot.keyClick(view, Qt.Key.Key_Escape)
@@ -923,7 +923,7 @@ def test_a_stroke_that_changes_nothing_ends_its_preview_with_no_undo_step(studio
     studio.inputs_pane.mask_tool().set_size(9)
     result = _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (40.5, 20.5)]))
     steps = doc.undo_stack.count()
-    around = _previewed(studio, qtbot, view, [(30.5, 20.5), (31.5, 20.5)])  # over what is painted already
+    _previewed(studio, qtbot, view, [(30.5, 20.5), (31.5, 20.5)])  # over what is painted already
     assert doc.live is not None
     assert not np.array_equal(studio.result_view.image, result.image)  # the crop's own mean: other pixels
     with qtbot.waitSignal(studio.renderer.shown, timeout=10000) as shown:  # the full result again
@@ -959,7 +959,7 @@ def test_a_parameter_change_does_not_redraw_the_masks_overlay(studio, qtbot):
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     drawn = tool.overlay.image().cacheKey()
     for amount in (0.9, 0.8):
-        _final_after(studio, qtbot, lambda: doc.set_param("amount", amount))
+        _final_after(studio, qtbot, lambda amount=amount: doc.set_param("amount", amount))
     assert tool.overlay.image().cacheKey() == drawn  # the same image: not rebuilt
     assert np.array_equal(_painted(tool.overlay), _mask(studio).bits)
     # another mask is drawn: undo brings back the picture with nothing painted, redo the stroke
@@ -1304,7 +1304,7 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
     assert np.array_equal(image[150:, :], picture[150:, :])  # nothing else changed
     _final_after(studio, qtbot, lambda: mouse(view, "release", points[-1]))
     expected = Mask.empty(w, h)
-    for p0, p1 in zip([points[0]] + points[:-1], points):
+    for p0, p1 in zip([points[0]] + points[:-1], points, strict=True):
         expected = expected.painted_line((p0[0] - 0.5, p0[1] - 0.5), (p1[0] - 0.5, p1[1] - 0.5), 3)
     assert _mask(studio) == expected and np.array_equal(_painted(studio.inputs_pane.mask_tool().overlay), expected.bits)
 

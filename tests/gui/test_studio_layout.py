@@ -1,4 +1,4 @@
-"""Issue 14 (friction): figures in words, a status line that never runs into the pixel read-out,
+"""The studio's layout: figures in words, a status line that never runs into the pixel read-out,
 tab titles that fit, the square typed, a usable result view in a small window."""
 
 import json
@@ -88,11 +88,11 @@ def test_tab_titles_are_not_clipped(qtbot, settings, size):
     w = _window(qtbot, settings, size)
     for method in registry.studio_methods():
         w.doc.set_method(method)
-        qtbot.waitUntil(lambda: w.doc.method == method, timeout=5000)
+        qtbot.waitUntil(lambda method=method: w.doc.method == method, timeout=5000)
         bar = w.input_tabs.tabBar()
         if not w.input_tabs.isVisible():
             continue
-        qtbot.waitUntil(lambda: bar.width() > 0, timeout=5000)
+        qtbot.waitUntil(lambda bar=bar: bar.width() > 0, timeout=5000)
         for i in range(bar.count()):
             rect = bar.tabRect(i)
             text = bar.tabText(i)
@@ -150,7 +150,7 @@ def test_no_widget_is_painted_over_the_examples_dock_title(qtbot, settings):
     assert not _widgets_over_the_examples_title(w)
     for method in registry.studio_methods():
         w.doc.set_method(method)
-        qtbot.waitUntil(lambda: w.doc.method == method, timeout=5000)
+        qtbot.waitUntil(lambda method=method: w.doc.method == method, timeout=5000)
         assert not _widgets_over_the_examples_title(w), method
     from weft.app.gui.views import ImageView
 
