@@ -31,6 +31,36 @@ def drag(view, start, end, steps: int = 4):
     mouse(view, "release", end)
 
 
+def settle(qtbot, window, timeout: int = 30000) -> None:
+    """Wait until ``window`` has no render or file load running, queued or about to start, and every
+    result its workers queued for the GUI thread has been delivered: anything that was going to
+    arrive has arrived, so an assertion that something did *not* happen can be made now (no fixed wait)."""
+    from PySide6.QtCore import QCoreApplication
+
+    renderer = window.renderer
+    started: list[int] = []
+
+    def idle() -> bool:
+        busy = renderer.runner.busy("preview") or renderer.runner.busy("final") or window.loader.busy()
+        return not (busy or renderer.running())
+
+    def count(job_id: int, slot: str) -> None:
+        started.append(job_id)
+
+    renderer.submitted.connect(count)
+    try:
+        while True:
+            qtbot.waitUntil(idle, timeout=timeout)
+            before = len(started)
+            # a job leaves the runner's books after queueing its result: deliver what is queued
+            QCoreApplication.sendPostedEvents()
+            QCoreApplication.processEvents()
+            if idle() and len(started) == before:  # nothing delivered started another render
+                return
+    finally:
+        renderer.submitted.disconnect(count)
+
+
 def no_job_threads() -> bool:
     return not [t for t in threading.enumerate() if t.name.startswith("weft-job") and t.is_alive()]
 

@@ -16,7 +16,7 @@ from weft.core.examples import example
 from weft.core.image import load_image, read_recipe
 from weft.core.registry import Method
 
-from .helpers import drag, mouse, no_job_threads
+from .helpers import drag, mouse, no_job_threads, settle
 
 
 def test_opens_on_the_examples_with_a_result(window):
@@ -86,7 +86,7 @@ def test_slider_drag_previews_then_renders_full_size(window, qtbot):
     slider.setSliderDown(False)
     slider.sliderReleased.emit()
     qtbot.waitUntil(lambda: shown and shown[-1].final and window.doc.current_params.n == 11, timeout=10000)
-    qtbot.wait(200)
+    settle(qtbot, window)  # every result still on its way has arrived
     ids = [s.job_id for s in shown]
     assert ids == sorted(ids)  # never an older result over a newer one
     assert window.result_view.image is window.renderer.last.image
@@ -102,8 +102,7 @@ def test_stale_results_are_dropped(window, qtbot):
     for p in (0.1, 0.2, 0.3, 0.4, 0.5):
         window.doc.set_param("p", p)
         r.final(now=True)
-    qtbot.waitUntil(lambda: not r.runner.busy("final"), timeout=10000)
-    qtbot.wait(100)
+    settle(qtbot, window)  # every result still on its way has arrived
     assert shown and shown == sorted(shown)
     assert r.last.job_id == r.latest_final
 
