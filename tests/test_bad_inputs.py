@@ -1,4 +1,4 @@
-"""Issue 8.1: the bad-input corpus through every CLI subcommand that takes an image.
+"""The bad-input corpus through every CLI subcommand that takes an image.
 
 The GUI side is tests/gui/test_open_bad_files.py.
 

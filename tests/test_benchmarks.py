@@ -92,7 +92,7 @@ def test_cold_runs_a_command_with_stderr_on_a_terminal_and_tables_the_rows(tmp_p
     }
 
 
-# --- fill and extend (issue 15): benchmarks/fill.py and its peer runner --------------------------------------
+# --- fill and extend: benchmarks/fill.py and its peer runner --------------------------------------
 
 
 def _tiny_fill_case():

@@ -1,4 +1,4 @@
-"""Issue 13.9: the distribution installs app/ and core/ as ``weft.app`` and ``weft.core`` and claims
+"""The distribution installs app/ and core/ as ``weft.app`` and ``weft.core`` and claims
 no other top-level import name."""
 
 import os

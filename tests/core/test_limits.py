@@ -1,4 +1,4 @@
-"""Issue 8.6: jobs too large are refused up front (pixels, memory, running time), in one line."""
+"""Jobs too large are refused up front (pixels, memory, running time), in one line."""
 
 from __future__ import annotations
 

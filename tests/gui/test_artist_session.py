@@ -1,4 +1,4 @@
-"""Issue 14: the studio as an artist meets it — each bug's test drives the window with real events."""
+"""The studio as an artist meets it: each test drives the window with real events."""
 
 import dataclasses
 
@@ -236,7 +236,7 @@ def _fills_view(view) -> bool:
 
 
 def test_a_result_of_another_size_refits_unless_the_user_zoomed(window, qtbot):
-    """Bug 2 (fixed by issue 13): a new result size refits the result view; a hand zoom is kept."""
+    """A new result size refits the result view; a hand zoom is kept."""
     from .helpers import mouse
 
     view = window.result_view
@@ -416,7 +416,7 @@ def test_the_zoom_label_follows_a_refit_when_the_window_is_resized(window, qtbot
 
 
 def test_auto_block_follows_the_sample_and_its_source_region(window, qtbot):
-    """Issue 17: quilting's synthesis block defaults to a share of the sample's size, so what the
+    """Quilting's synthesis block defaults to a share of the sample's size, so what the
     studio shows beside "auto" follows the texture, then the square drawn on it (the source region
     is the sample a run quilts from)."""
     from .helpers import drag

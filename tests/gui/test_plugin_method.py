@@ -1,4 +1,4 @@
-"""Proof that the studio learns a method from the method itself (issue 13, item 10).
+"""Proof that the studio learns a method from the method itself.
 
 A method registered at run time -- it inverts the pixels of a square of its one input -- is driven
 through the studio with real mouse events: it is in the method list, its square is drawn with the
