@@ -1,5 +1,6 @@
 """Real mouse events for the GUI tests, and a check that no worker thread is left."""
 
+import dataclasses
 import threading
 
 from PySide6.QtCore import QEvent, QPointF, Qt
@@ -97,6 +98,6 @@ def orphan_recovery(folder, settings, text: str):
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"recovery-crashed-{dead_pid()}-0000abcd.weft.json"
     path.write_text(text, encoding="utf-8")
-    owner = recovery.Owner(dead_pid(), recovery._host(), None, recovery.settings_id(settings))
+    owner = dataclasses.replace(recovery.Owner.me(recovery.settings_id(settings)), pid=dead_pid(), started=None)
     recovery.write_lock(path, owner)
     return path

@@ -4,6 +4,7 @@ import dataclasses
 
 import numpy as np
 from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QSlider
 from weft.core.errors import WeftError
 
 
@@ -108,10 +109,10 @@ def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(wind
     doc = window.doc
     target = doc.image("target")
     assert window.renderer.last.image.shape[:2] == target.shape[:2]  # a transfer onto the target
-    box = window.inputs_pane._boxes["target"]
+    box = window.inputs_pane.box("target")
     window.input_tabs.setCurrentWidget(box)
     qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
-    assert not window.inputs_pane._boxes["texture"].clear_button.isVisible()  # required: no Clear
+    assert not window.inputs_pane.box("texture").clear_button.isVisible()  # required: no Clear
     with qtbot.waitSignal(
         window.renderer.shown,
         timeout=20000,
@@ -242,7 +243,7 @@ def test_a_result_of_another_size_refits_unless_the_user_zoomed(window, qtbot):
     view = window.result_view
     old = view.image_size()
     assert _fills_view(view)
-    box = window.inputs_pane._boxes["target"]
+    box = window.inputs_pane.box("target")
     window.input_tabs.setCurrentWidget(box)
     qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
     qtbot.mouseClick(box.clear_button, Qt.MouseButton.LeftButton)  # synthesis: twice the texture
@@ -462,7 +463,7 @@ def test_a_slider_runs_only_over_what_the_open_inputs_allow(window, qtbot, tmp_p
     qtbot.waitUntil(lambda: doc.current_params.block is not None, timeout=5000)
     assert row.editor.maximum() == 112
     assert "range 2..112 for these inputs" in row.toolTip() and "2..1024 in general" in row.toolTip()
-    slider = row.editor._slider
+    slider = row.editor.findChild(QSlider)  # the slider beside the value's label
     slider.setFocus()
     qtbot.keyClick(slider, Qt.Key.Key_End)  # the far end, as a user drags it there
     qtbot.waitUntil(lambda: doc.current_params.block == 112, timeout=5000)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
 from PySide6.QtGui import QDragEnterEvent, QDropEvent, QWheelEvent
-from PySide6.QtWidgets import QApplication
+from PySide6.QtWidgets import QApplication, QSlider
 from weft.app.cli import main as cli_main
 from weft.core.errors import Cancelled, WeftError
 from weft.core.examples import example
@@ -156,7 +156,7 @@ def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, mo
 def test_invalid_value_is_refused_with_a_message(window):
     messages = []
     window.message.connect(messages.append)
-    window.method_panel._param_edited("n", 4, False)  # even: refused by FastParams
+    window.params_panel.row("n").editor.setValue(4)  # even: refused by FastParams
     assert window.doc.current_params.n == 5
     assert "must be odd" in messages[-1]
     assert window.params_panel.row("n").value() == 5
@@ -418,7 +418,7 @@ def test_each_choice_from_a_list_is_its_own_undo_step(window, qtbot):
     assert doc.undo_stack.count() == before + 4
     doc.undo_stack.undo()
     assert doc.current_params.metric == "target"
-    slider = window.params_panel.row("iterations").editor._slider
+    slider = window.params_panel.row("iterations").editor.findChild(QSlider)
     slider.setFocus()
     steps = doc.undo_stack.index()
     for _ in range(2):
