@@ -490,6 +490,7 @@ def test_quilt_refines_colour_pictures_only():
     )
 
 
+@pytest.mark.slow
 def test_default_fill_loads_neither_numba_nor_numpy_ma():
     """The default engine's whole path (quilt, its refine on colour, the band), and ``--structure``'s
     (its edges and patchmatch), run in numpy and OpenCV: a ``weft fill`` process loads no numba (its

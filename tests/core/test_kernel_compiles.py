@@ -88,12 +88,14 @@ def _signatures(method: str) -> tuple[dict, dict]:
     return out["before"], out["after"]
 
 
+@pytest.mark.slow
 def test_fill_runs_no_kernel_at_all():
     """Every fill engine runs in numpy and OpenCV: warm-up and the runs load no numba kernel."""
     before, after = _signatures("fill")
     assert before == {} and after == {}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["quilt", "nfpt", "affine", "fast", "rectify", "blend"])
 def test_a_run_after_warm_up_compiles_nothing_and_each_kernel_once(method):
     before, after = _signatures(method)

@@ -253,6 +253,7 @@ def _memory_cgroup(limit: int):
     return path, None
 
 
+@pytest.mark.slow
 def test_a_job_too_large_for_its_container_is_refused_up_front(tmp_path):
     import os
     import subprocess
