@@ -52,7 +52,6 @@ import argparse  # noqa: E402 (after the start-up Ctrl-C handler)
 import dataclasses  # noqa: E402
 import json  # noqa: E402
 import secrets  # noqa: E402
-import time  # noqa: E402
 from collections.abc import Sequence  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -62,6 +61,8 @@ from weft.core.params import Params, specs  # noqa: E402
 
 from .options import parse_bit_depth as _parse_bit_depth  # noqa: E402
 from .options import parse_int as _parse_int  # noqa: E402
+from .terminal import PreparingLine, TerminalProgress  # noqa: E402
+from .warm_up_cli import warm_up_all  # noqa: E402
 
 SAVE_EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff")
 
@@ -73,105 +74,6 @@ class UsageError(WeftError):
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # argparse would print usage + message and exit itself
         raise UsageError(f"{self.prog}: {message} (see '{self.prog} --help')")
-
-
-class _TerminalProgress:
-    """A one-line progress bar on stderr, drawn only when stderr is a terminal. It owns that line:
-    a :class:`_PreparingLine` ticking on it is ended (kept, with a newline) as the bar first draws."""
-
-    wants_preview = False  # it draws the fraction only: algorithms need not build partial images
-
-    def __init__(self, enabled: bool):
-        self.enabled = enabled and sys.stderr.isatty()
-        self.drawn = False
-        self.lock = threading.Lock()  # the preparing line ticks from its own thread
-        self.line_open = False  # a preparing line without its newline yet
-
-    def __call__(self, p) -> None:
-        if not self.enabled:
-            return
-        width = 30
-        filled = int(round(p.fraction * width))
-        with self.lock:
-            self._end_line()
-            sys.stderr.write(f"\r{p.stage:<14} [{'#' * filled}{' ' * (width - filled)}] {p.fraction * 100:3.0f}%")
-            sys.stderr.flush()
-            self.drawn = True
-
-    def _end_line(self) -> None:
-        if self.line_open:
-            sys.stderr.write("\n")
-            self.line_open = False
-
-    def close(self) -> None:
-        with self.lock:
-            self._end_line()
-            if self.drawn:
-                sys.stderr.write("\n")
-                self.drawn = False
-            sys.stderr.flush()
-
-
-class _PreparingLine:
-    """Says on stderr that kernels are being compiled — the first run's long silent stretch (a cold
-    quilting transfer compiled for 39 s before its first progress report) — and keeps the line alive
-    with the seconds spent, every ``TICK`` s (never a second of silence), until the progress bar takes
-    over or the run ends.
-
-    Called from numba's compile events (``registry.watch_compiles``), i.e. only when a kernel really
-    compiles: a run that loads every kernel from numba's cache says nothing. Like the progress bar it
-    writes to a terminal only: stderr that is a file or a pipe belongs to scripts, for which weft
-    promises silence on success and exactly one line on failure (a ticking ``\r`` line would be
-    noise in a log); installers, render nodes and CI run ``weft warm-up`` first, which prints on
-    stdout what it compiled. ``wait(seconds) -> stopped`` is injectable for tests.
-    """
-
-    TICK = 0.5
-
-    def __init__(self, method: str, bar: _TerminalProgress, wait=None):
-        self.method = method
-        self.bar = bar
-        self.said = False
-        self._stop = threading.Event()
-        self._wait = wait if wait is not None else self._stop.wait
-        self.thread: threading.Thread | None = None
-
-    def text(self) -> str:
-        from weft.core import registry
-
-        if registry.kernel_cache_notice() is not None:
-            return f"weft: compiling the {self.method} method's kernels (no cache: every run)"
-        return f"weft: {registry.preparing_text(self.method)} (compiling kernels)"  # < 80 columns
-
-    def __call__(self) -> None:
-        with self.bar.lock:
-            if self.said or not self.bar.enabled:
-                return
-            self.said = True
-            text = self.text()
-            if self.bar.drawn:  # a bar already drawn keeps its line; this one goes below it
-                sys.stderr.write("\n")
-                self.bar.drawn = False
-            sys.stderr.write(text)
-            sys.stderr.flush()
-            self.bar.line_open = True
-        self.thread = threading.Thread(
-            target=self._tick, args=(text, time.monotonic()), daemon=True, name="weft-preparing"
-        )
-        self.thread.start()
-
-    def _tick(self, text: str, since: float) -> None:
-        while not self._wait(self.TICK):
-            with self.bar.lock:
-                if not self.bar.line_open:
-                    return  # the bar took over, or the run ended
-                sys.stderr.write(f"\r{text} {time.monotonic() - since:.0f} s")
-                sys.stderr.flush()
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self.thread is not None and self.thread is not threading.current_thread():
-            self.thread.join()
 
 
 def _add_common(p: argparse.ArgumentParser, region: bool = True) -> None:
@@ -346,9 +248,11 @@ def _execute(
     read_too: Sequence[str] = (),
 ) -> int:
     from weft.core import registry
+    from weft.core.geometry import Square
     from weft.core.image import save_image
     from weft.core.image.temporaries import remove_stale_temporaries
-    from weft.core.run import output_recipe, render
+    from weft.core.request import RenderRequest
+    from weft.core.run import output_recipe
 
     method = registry.get(method_name)
     # typed parameters (a method's own command line) or their JSON form (a recipe's, read at its edge)
@@ -363,17 +267,22 @@ def _execute(
     if seed is None:
         seed = secrets.randbits(31)
 
-    bar = _TerminalProgress(not args.quiet)
-    preparing = _PreparingLine(method.name, bar)
-    infos: dict = {}
+    bar = TerminalProgress(not args.quiet)
+    preparing = PreparingLine(method.name, bar)
     try:
         with registry.watch_compiles(on_start=preparing):  # a kernel compiling: say so on the terminal
             # Loading every kernel up front only keeps --report's "seconds" free of cache loads; without
             # --report a run loads (or, first time, compiles) just the kernels it uses: a cold
             # `weft affine` 3.8 -> 3.0 s, `weft nfpt` 4.7 -> 3.9 s.
-            result, seconds = render(
-                method, params, input_paths, seed, region, progress=bar, warm_up=args.report, infos=infos
+            request = RenderRequest(
+                method,
+                params,
+                input_paths,
+                seed,
+                None if region is None else Square(*region),
+                warm_up=args.report and method.warm_up_in_cli,
             )
+            rendered = request.run(progress=bar)
     finally:
         preparing.stop()
         bar.close()
@@ -383,22 +292,22 @@ def _execute(
     for repair in registry.kernel_cache_repairs() if not args.quiet else ():
         print(f"weft: {repair}", file=sys.stderr)
     if bit_depth is None:  # not asked for: 8, or the bit depth of the input the method names (fill: the image)
-        info = infos.get(method.depth_from) if method.depth_from else None
+        info = rendered.infos.get(method.depth_from) if method.depth_from else None
         jpeg = out.suffix.lower() in (".jpg", ".jpeg")
         bit_depth = info.bit_depth if info is not None and not jpeg else 8
     recipe = output_recipe(method, params, input_paths, seed, region, out)
     if args.bit_depth is not None:  # asked for (or a recipe's): recorded, so weft run writes it again
         recipe = dataclasses.replace(recipe, bit_depth=bit_depth)
     remove_stale_temporaries([out])  # a killed earlier run's half-written file beside it
-    save_image(out, result.image, recipe=recipe.to_json(), bit_depth=bit_depth)
+    save_image(out, rendered.image, recipe=recipe.to_json(), bit_depth=bit_depth)
     if save_lines is not None:
         from weft.core.image import atomic_write_bytes
 
         atomic_write_bytes(save_lines[0], (save_lines[1].to_text() + "\n").encode("utf-8"))
     if args.report:
-        h, w = result.image.shape[:2]
-        line = {"method": method.name, "seconds": round(seconds, 6), "size": [w, h], "seed": seed}
-        line.update(result.figures)
+        h, w = rendered.image.shape[:2]
+        line = {"method": method.name, "seconds": round(rendered.seconds, 6), "size": [w, h], "seed": seed}
+        line.update(rendered.figures)
         line.update(extra or {})
         print(json.dumps(line), flush=True)
     return 0
@@ -425,58 +334,6 @@ def _check_lines_file(method, params: Params, path: str | None, others: Sequence
     return target, lines
 
 
-def _warm_up_all(args: argparse.Namespace) -> int:
-    """``weft warm-up``: every method's ``warm_up`` in a pool of ``--jobs`` fresh processes."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    from weft.core import registry
-
-    chosen = [registry.get(name) for name in args.methods] if args.methods else registry.methods().values()
-    names = [m.name for m in chosen if m.warm_up is not None]
-    if not names:
-        return 0
-    jobs = _parse_int(args.jobs, "jobs", 1, 1024) or os.cpu_count() or 1
-    say = (lambda text: None) if args.quiet else (lambda text: print(text, flush=True))
-    t0 = time.perf_counter()
-    failed = []
-    notices = set()
-    say(
-        f"weft: warming up {len(names)} method{'s' if len(names) != 1 else ''}, "
-        f"{min(jobs, len(names))} process{'es' if min(jobs, len(names)) != 1 else ''} at once"
-    )
-    # "spawn": fresh interpreters (no inherited numba state or threads). Each worker warms several
-    # methods in turn (quilting, the longest, first): a process per method paid Python's, numba's
-    # and LLVM's start-up six times, 19.7 s of CPU against 12.2 s in one process on this machine.
-    with ProcessPoolExecutor(
-        max_workers=min(jobs, len(names)), mp_context=multiprocessing.get_context("spawn")
-    ) as pool:
-        futures = {pool.submit(registry.warm_up_report, name): name for name in names}
-        for future in as_completed(futures):
-            name = futures[future]
-            try:
-                r = future.result()
-            except Exception as e:  # a broken kernel is a bug: say which method, keep warming the others
-                failed.append(name)
-                print(f"weft: warm-up of {name} failed: {type(e).__name__}: {e}", file=sys.stderr)
-                continue
-            if r["notice"]:
-                notices.add(r["notice"])
-            notices.update(r.get("repairs") or ())
-            what = (
-                f"compiled {r['compiled']} function{'s' if r['compiled'] != 1 else ''}"
-                if r["compiled"]
-                else "loaded from the cache"
-            )
-            say(f"{name:8} {what} in {r['seconds']:.1f} s")
-    for notice in sorted(notices):
-        print(f"weft: {notice}", file=sys.stderr)
-    if failed:
-        return 1
-    say(f"weft: {len(names)} method{'s' if len(names) != 1 else ''} ready in {time.perf_counter() - t0:.1f} s")
-    return 0
-
-
 def _dispatch(args: argparse.Namespace) -> int:
     from weft.core import registry
     from weft.core.geometry import Square
@@ -486,7 +343,7 @@ def _dispatch(args: argparse.Namespace) -> int:
 
         return run_batch(args)
     if args.command == "warm-up":
-        return _warm_up_all(args)
+        return warm_up_all(args)
     if args.command == "run":
         from weft.core.run import check_recipe, load_recipe
 

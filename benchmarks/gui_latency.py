@@ -117,7 +117,7 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
 
         heartbeat, beats = _heartbeat()
 
-        slider = window.params_panel.row("p").editor
+        slider = window.method_panel.params_panel.row("p").editor
         slider.setSliderDown(True)
         series = [round(0.02 + 0.5 * i / (values - 1), 3) for i in range(values)]
         step = 1.0 / hz
@@ -171,7 +171,7 @@ def measure_painting(
         doc.restore(DocumentState(inputs={studio.canvas: InputImage(None, picture)}, method=method))
         window.renderer.final(now=True)
         _wait(app, lambda: bool(answered), 120)
-        view = window.canvas_view
+        view = window.inputs_pane.canvas_view
         tool = window.inputs_pane.mask_tool()
         tool.set_size(max(8, side // 24))
 
@@ -298,7 +298,7 @@ def _opening_run(app, tmp: str, run: int, method: str, side: int, picture: str, 
     doc, studio = window.doc, window.doc.methods[method].studio
     canvas = studio.canvas
     doc.restore(DocumentState(inputs={canvas: item}, method=method))
-    doc.save_session(session)
+    doc.session().save(session)
     doc.restore(DocumentState(inputs={}, method=method))
     _wait(app, lambda: not window.renderer.running(), 30)
     answered: list[float] = []
@@ -306,7 +306,7 @@ def _opening_run(app, tmp: str, run: int, method: str, side: int, picture: str, 
     window.renderer.failed.connect(lambda _m: answered.append(time.perf_counter()))
 
     def views_show(image) -> bool:
-        views = (window.canvas_view, window.result_view)
+        views = (window.inputs_pane.canvas_view, window.result_view)
         return all(
             v.image is not None and v.image.shape[:2] == image.shape[:2] and not getattr(v, "converting", False)
             for v in views
@@ -324,7 +324,7 @@ def _opening_run(app, tmp: str, run: int, method: str, side: int, picture: str, 
     # a session of the picture (nothing drawn: the result view shows the picture)
     step(
         "session",
-        lambda: window.open_session(session),
+        lambda: window.files.open_session(session),
         lambda: answered and views_show(item.image) and window.result_view.image is doc.image(canvas),
     )
     # File > Open of the picture (decoded off the GUI thread, then shown)
@@ -364,7 +364,7 @@ def _opening_run(app, tmp: str, run: int, method: str, side: int, picture: str, 
         since=lambda: answered[0],
     )
     out = os.path.join(tmp, f"out{run}.png")
-    step("export", lambda: window.export_result(out), lambda: os.path.exists(out), settle=0.2)
+    step("export", lambda: window.files.export_result(out), lambda: os.path.exists(out), settle=0.2)
     doc.undo_stack.setClean()
     window.close()
     return stalls
@@ -418,7 +418,7 @@ def _variations_run(app, window, method: str) -> tuple[float, float]:
     from PySide6.QtTest import QTest
 
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     _wait(app, dialog.isVisible, 10)
     done: set = set()
     dialog.cell_done.connect(lambda i, j: done.add((i, j)))

@@ -7,20 +7,19 @@ functions, so a batch output is byte for byte what ``weft run`` gives for that i
   :func:`check_recipe` validates it against its method (inputs it takes, parameters; geometry that
   names a file, as older recipes' ``"lines": "L.json"``, is read there, relative to the recipe);
 * :func:`output_recipe` is the recipe an output at a given path carries (paths relative to its folder);
-* :func:`render` loads the inputs, checks their sizes, runs the method and names the file behind an
-  error about one input; the caller encodes or saves the result with the recipe
-  (:func:`weft.core.image.save_image` / :func:`weft.core.image.encode_image`).
+* a :class:`~weft.core.request.RenderRequest` with the input files loads them, checks their sizes,
+  runs the method and names the file behind an error about one input; the caller encodes or saves
+  the result with the recipe (:func:`weft.core.image.save_image` / :func:`weft.core.image.encode_image`).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-import time
 from collections.abc import Mapping
 from pathlib import Path
 
-from .errors import ImageError, WeftError
+from .errors import WeftError
 from .geometry import Square
 from .params import Params, Recipe, relative_path
 from .readfile import kind_of, open_regular, shown
@@ -104,73 +103,5 @@ def output_recipe(
         params=params.to_dict(),
         inputs=rel_inputs,
         seed=seed,
-        region=None if region is None else Square(*region),
+        region=None if region is None else Square._make(region),
     )
-
-
-def render(
-    method,
-    params: Params,
-    input_paths: Mapping[str, str],
-    seed: int,
-    region: tuple[int, int, int] | None = None,
-    *,
-    progress=None,
-    cancel=None,
-    warm_up: bool = True,
-    shown_paths: Mapping[str, str] | None = None,
-    infos: dict | None = None,
-):
-    """Load the inputs, run ``method`` and return ``(Result, seconds)`` (compute time only).
-
-    The first input is cropped to ``region`` when given; an input smaller than its ``min_side`` is
-    refused naming its file; a ``WeftError`` about one input gets its file name in front.
-    ``warm_up`` loads the method's kernels first (when the method asks for that on the command line),
-    so ``seconds`` is the compute alone; a kernel compiled during the run (this thread's numba
-    compiles) is left out of it too. ``shown_paths`` are the names to use in messages when the
-    files read are copies (a batch's shipped inputs). An input whose ``InputSpec.alpha`` is set keeps
-    its alpha channel. ``infos``, when given, receives each input's :class:`~weft.core.image.ImageInfo`.
-    """
-    from .image import load_image
-
-    shown = dict(shown_paths or input_paths)
-    if region is not None and not method.takes_region:
-        raise WeftError(
-            f"weft {method.name} takes no --region (it works on the whole {method.inputs[0].name}; "
-            f"crop the image first)"
-        )
-    keep_alpha = {spec.name for spec in method.inputs if spec.alpha}
-    loaded = {name: load_image(path, alpha=name in keep_alpha) for name, path in input_paths.items()}
-    images = {name: item.image for name, item in loaded.items()}
-    if infos is not None:
-        infos.update({name: item.info for name, item in loaded.items()})
-    if region is not None:
-        first = method.inputs[0].name
-        images[first] = Square(*region).crop(images[first], what=first)
-    for spec in method.inputs:
-        if spec.name in images and min(images[spec.name].shape[:2]) < spec.min_side:
-            h, w = images[spec.name].shape[:2]
-            cropped = " (the --region crop)" if region is not None and spec is method.inputs[0] else ""
-            raise ImageError(
-                f"{shown[spec.name]}: the {spec.name} is {w}x{h}{cropped}; weft {method.name} "
-                f"needs at least {spec.min_side}x{spec.min_side} pixels",
-                path=shown[spec.name],
-            )
-    from . import registry
-
-    with registry.watch_compiles(this_thread=True) as compiles:
-        if warm_up and method.warm_up_in_cli:
-            registry.warm_up(method.name)  # load compiled kernels now, so "seconds" is the compute alone
-        before = compiles.seconds
-        t0 = time.perf_counter()
-        try:
-            result = method.run(images, params, rng=seed, progress=progress, cancel=cancel)
-        except WeftError as e:
-            if e.input in shown:  # about one image (a block that does not fit it): say which file
-                named = type(e)(f"{shown[e.input]}: {e}")
-                named.__dict__.update(e.__dict__)
-                raise named from None
-            raise
-        # kernels compiled on the way (a first run of a method that loads them lazily) are not compute
-        seconds = time.perf_counter() - t0 - (compiles.seconds - before)
-    return result, max(0.0, seconds)

@@ -84,7 +84,7 @@ def quilt(window) -> None:
     doc.set_square((0, 0, 128))
     doc.set_param("mode", "mincut")
     doc.set_param("size", (384, 384))
-    window.compare_button.setChecked(False)
+    window.method_panel.compare_button.setChecked(False)
 
 
 def nfpt(window) -> None:
@@ -95,7 +95,7 @@ def nfpt(window) -> None:
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     doc.set_lines(data["image_lines"], data["frontal_lines"], frontal_size=data["frontal_size"])
     doc.set_param("size", (640, 480))
-    window.input_tabs.setCurrentIndex(0)
+    window.inputs_pane.tabs.setCurrentIndex(0)
 
 
 def fill(window) -> None:

@@ -90,6 +90,9 @@ def _cluster(tmp: Path, workers: int):
         _wait_for_scheduler(address)
         if workers:
             worker = _start(["worker", address, "--nthreads", "1", "--nworkers", str(workers), "--no-dashboard"], tmp)
+            # the tests shorten weft's wait for workers; a worker starting slowly on a busy machine is not that
+            with distributed.Client(address, timeout="60s") as client:
+                client.wait_for_workers(workers, timeout=120)
         yield address, scheduler, worker
     finally:
         for p in (scheduler, worker):

@@ -344,16 +344,17 @@ def test_fill_takes_no_region(files, tmp_path, capsys):
     from weft.core import registry
     from weft.core.errors import WeftError
     from weft.core.fill import FillParams
-    from weft.core.run import render
+    from weft.core.geometry import Square
+    from weft.core.request import RenderRequest
 
     with pytest.raises(WeftError, match="weft fill takes no --region"):
-        render(
+        RenderRequest(
             registry.get("fill"),
             FillParams(),
             {"image": str(paths["grey"]), "mask": str(paths["mask"])},
             1,
-            region=(0, 0, 40),
-        )
+            region=Square(0, 0, 40),
+        ).run()
 
 
 def test_a_photo_given_as_the_mask_is_refused(files, tmp_path, capsys):

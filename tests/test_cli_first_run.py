@@ -13,8 +13,8 @@ import threading
 import numpy as np
 import pytest
 import weft.core._kernels  # noqa: F401  (the compile-event listener)
-from weft.app import cli
 from weft.app.cli import main
+from weft.app.terminal import PreparingLine, TerminalProgress
 from weft.core import registry
 from weft.core.image import save_image
 from weft.core.jobs import Progress, ProgressReporter
@@ -106,9 +106,9 @@ def test_warm_run_quiet_and_non_terminal_say_nothing(fake, texture, tmp_path, mo
 def test_the_preparing_line_ticks_until_the_bar_takes_over(monkeypatch):
     err = TTY()
     monkeypatch.setattr("sys.stderr", err)
-    bar = cli._TerminalProgress(True)
+    bar = TerminalProgress(True)
     gate = queue.Queue()
-    line = cli._PreparingLine("quilt", bar, wait=lambda seconds: gate.get(timeout=30))
+    line = PreparingLine("quilt", bar, wait=lambda seconds: gate.get(timeout=30))
     line()
     line()  # said once only
     first = "weft: preparing the quilt method — first run only (compiling kernels)"

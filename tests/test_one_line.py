@@ -99,10 +99,10 @@ def test_a_symlink_loop_as_output_is_refused_before_the_work(tmp_path, capfd, mo
     loop = tmp_path / "loop.png"
     os.symlink(loop, loop)
     ran = []
-    import weft.core.run as run_module
+    from weft.core.request import RenderRequest
 
-    real_render = run_module.render
-    monkeypatch.setattr(run_module, "render", lambda *a, **k: ran.append(1) or real_render(*a, **k))
+    real_run = RenderRequest.run
+    monkeypatch.setattr(RenderRequest, "run", lambda *a, **k: ran.append(1) or real_run(*a, **k))
     code, out, err = _run(["quilt", texture, *QUILT, "-o", loop], capfd)
     assert code == 2 and ran == [], err
     assert err == f"weft: {loop}: cannot write there (Too many levels of symbolic links)\n"

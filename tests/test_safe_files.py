@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from weft.app.cli import main
-from weft.app.gui.document import read_session
 from weft.core.errors import WeftError
 from weft.core.image import load_image, read_recipe, save_image
 from weft.core.params import MAX_FILE_BYTES
+from weft.core.session import read_session
 
 ROOT = Path(__file__).resolve().parents[1]
 UNSAFE_MODULES = {
@@ -463,12 +463,12 @@ def test_a_good_session_reads_with_paths_relative_to_it(tmp_path, elsewhere):
         json.dumps(_session(inputs={"texture": "tex.png", "target": "sub/t.png", "photo": str(tmp_path / "abs.png")}))
     )
     data = read_session(path)
-    assert data["inputs"] == {
+    assert data.inputs == {
         "texture": str(tmp_path / "project" / "tex.png"),
         "target": str(tmp_path / "project" / "sub" / "t.png"),
         "photo": str(tmp_path / "abs.png"),
     }
-    assert data["params"]["fast"].p == 0.4 and data["seed"] == 3 and data["method"] == "fast"
+    assert data.params["fast"].p == 0.4 and data.seed == 3 and data.method == "fast"
 
 
 def test_bad_session_files_are_refused_in_one_line(tmp_path, sentinel):

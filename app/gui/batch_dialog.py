@@ -1,10 +1,10 @@
 """File > Apply to Folder…: the current result's recipe over every image of a folder.
 
-The dialog runs the same engine as ``weft batch`` (:mod:`weft.core.batch`: a local process pool, outputs
-byte for byte ``weft run`` on each item's recipe, written atomically, finished items skipped on a
-re-run) on a Python thread, never the GUI thread: progress, failures and time left arrive through
-queued signals, Cancel stops the batch between items (running ones at their next cancel check), and
-the summary line stays in the dialog at the end. The studio stays usable meanwhile.
+The dialog runs the same engine as ``weft batch`` (:mod:`weft.core.batch`: a local process pool, outputs byte
+for byte ``weft run`` on each item's recipe, written atomically, finished items skipped on a re-run) on a
+worker thread (:class:`~weft.app.gui.qjobs.QtJobs`), never the GUI thread: progress, failures and time left
+arrive through queued signals, Cancel stops the batch between items (running ones at their next cancel check),
+and the summary line stays in the dialog at the end. The studio stays usable meanwhile.
 
 Which input the folder's images replace is chosen among the method's inputs (its ``InputSpec`` s);
 nothing here names a method, input or parameter.
@@ -12,7 +12,6 @@ nothing here names a method, input or parameter.
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Callable
 from pathlib import Path
 
@@ -39,6 +38,8 @@ from weft.core.errors import WeftError
 from weft.core.jobs import CancelToken
 from weft.core.params import Recipe
 
+from .qjobs import QtJobs
+
 DEFAULT_NAMES = "{stem}.png"
 OUTPUT_SUBFOLDER = "weft"
 
@@ -59,8 +60,8 @@ def default_over(recipe: Recipe) -> str:
 class BatchDialog(QDialog):
     """Apply ``recipe`` to a folder (see the module docstring).
 
-    Signals: ``progressed(done, total, failed, seconds_left)`` after each item (emitted on the batch
-    thread; ``seconds_left`` < 0 while unknown); ``batch_finished(summary_line, failed, cancelled)``
+    Signals: ``progressed(done, total, failed, seconds_left)`` after each item (emitted on the batch's
+    worker; ``seconds_left`` < 0 while unknown); ``batch_finished(summary_line, failed, cancelled)``
     when the batch has ended, also when it was refused before any work (``failed`` = -1).
     """
 
@@ -75,7 +76,7 @@ class BatchDialog(QDialog):
         self.recipe = recipe = recipe_source()
         self.method = registry.get(recipe.method)
         self._cancel: CancelToken | None = None
-        self._thread: threading.Thread | None = None
+        self.jobs: QtJobs | None = None  # one per batch: its worker thread ends with the batch
 
         self.over = QComboBox()
         for spec in self.method.inputs:
@@ -184,7 +185,7 @@ class BatchDialog(QDialog):
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return self.jobs is not None and self.jobs.busy("batch")
 
     # --- running -------------------------------------------------------------------------------
     def start(self) -> None:
@@ -208,25 +209,23 @@ class BatchDialog(QDialog):
         over = [(self.over.currentData(), folder)]
         options = dict(seed_per_item=self.seed_per_item.isChecked(), force=self.force.isChecked())
         workers = self.workers.value()
-        self._cancel = CancelToken()
         self._set_running(True)
         self.status.setText("starting the worker processes…")
         self.progress.setRange(0, 0)  # busy until the first item is counted
-        self._thread = threading.Thread(
-            target=self._work, args=(over, pattern, options, workers, self._cancel), name="weft-batch", daemon=True
-        )
-        self._thread.start()
+        self.jobs = jobs = QtJobs(self)
+        jobs.finished.connect(lambda _id, _slot: self._job_ended(jobs))
+        self._cancel = self.jobs.submit("batch", self._work, over, pattern, options, workers).token
 
     def _emit(self, signal, *args) -> None:
-        """Emit from the batch thread; if the dialog is gone (the window closed), stop the batch."""
+        """Emit from the batch's worker; if the dialog is gone (the window closed), stop the batch."""
         try:
             signal.emit(*args)
         except RuntimeError:  # the C++ object was deleted
             if self._cancel is not None:
                 self._cancel.cancel()
 
-    def _work(self, over, pattern, options, workers, cancel) -> None:
-        """The batch thread: plan (refusals end it at once), then run; only signals reach the GUI."""
+    def _work(self, over, pattern, options, workers, *, progress=None, cancel=None) -> None:
+        """The batch job (on its worker): plan (refusals end it at once), then run; only signals reach the GUI."""
         try:
             plan = batch.plan("the studio's recipe", over, pattern, recipe=self.recipe, **options)
             self._emit(self.progressed, len(plan.skipped), len(plan.items), 0, -1.0)
@@ -290,6 +289,13 @@ class BatchDialog(QDialog):
         if self.progress.maximum() == 0:
             self.progress.setRange(0, 1)
         self.status.setText(line)
+
+    def _job_ended(self, jobs: QtJobs) -> None:
+        """A batch's job resolved: its worker ends; if it is the current batch and said nothing
+        (cancelled before it started), say so now."""
+        jobs.shutdown(wait=False, cancel=False)
+        if jobs is self.jobs and not self.run_button.isEnabled():
+            self.batch_finished.emit("cancelled before any item started", -1, True)
 
     def closeEvent(self, event):  # noqa: N802 - closing while running cancels (finished outputs stay)
         self.cancel()

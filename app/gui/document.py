@@ -1,24 +1,29 @@
-"""The document: everything the user has set up, and the undo commands that change it.
+"""The document: everything the user has set up; every edit an undo command (``commands.py``).
 
-Contract: views listen to ``Document.changed(name)`` and never own state; they read the document's
-public attributes and change it only through its setters (``set_param``, ``set_params``,
-``set_input``, ``set_method``, ``set_seed``, ``set_geometry``/``set_square``/``set_lines``/``set_mask``) or
+Contract: views listen to the document's signals and never own state; they read its public
+attributes and change it only through its setters (``set_param``, ``set_params``, ``set_input``,
+``set_method``, ``set_seed``, ``set_geometry``/``set_square``/``set_lines``/``set_mask``) or
 :meth:`Document.restore`. Every setter pushes one ``QUndoCommand`` onto one ``QUndoStack`` (consecutive
-changes of one parameter merge: a slider drag is one step). Names emitted: ``"input:<name>"``,
-``"method"``, ``"params"``, ``"geometry"``, ``"seed"``, ``"restored"`` (everything changed).
+changes of one parameter merge: a slider drag is one step). One signal per kind of change:
+``input_changed(name)``, ``method_changed()``, ``params_changed()``, ``geometry_changed()``,
+``seed_changed()``, ``restored()`` (everything changed), and ``changed()`` after any of them.
 ``message(text)`` says what an edit did on the side (a mask of another size dropped).
+
+An edit in progress (a square dragged, a mask stroke painted, a slider held) is the document's
+:attr:`~Document.live` edit, set through :meth:`~Document.set_live` and :meth:`~Document.drag_param`
+and heard as ``live_changed(LiveEdit | None)``: it is not an undo step until it is let go (the
+setter's edit), and :meth:`~Document.end_live` drops it (Esc, a release that changed nothing).
 
 A mask geometry (``Geometry(MASK, input=...)``) is an input of its method that the user paints: its
 :class:`~weft.core.geometry.Mask` is held as geometry (undoable, per method) and given to the method
 as that input (``mask.to_image()``) when it is the size of the image it is painted on; opening an
-image file as that input makes it the mask. A session keeps it as a 1-bit PNG beside the session file.
+image file as that input makes it the mask. Its session (:meth:`Document.session`, a
+:class:`~weft.core.session.Session`) keeps it as a 1-bit PNG beside the session file.
 """
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -28,60 +33,14 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 from weft.core import registry
 from weft.core.errors import WeftError
 from weft.core.geometry import LINES, MASK, SQUARE, LineDraft, Margins, Mask, MaskStroke, Square
-from weft.core.params import Params, Recipe, relative_path
-from weft.core.session import SESSION_VERSION, mask_file, read_session  # noqa: F401 (read_session: the studio reads sessions)
+from weft.core.params import Params, Recipe
+from weft.core.session import Session
 from weft.core.studio import Geometry, Studio
 
-_MERGE_PARAM = 1001
+from .commands import SetGeometry, SetInput, SetMethod, SetParams, SetSeed
+from .state import DocumentState, InputImage, LiveEdit, read_input
 
-
-@dataclass(frozen=True)
-class InputImage:
-    """An input picture: where it came from, its pixels (float32, as ``weft.core.image.load_image``)
-    and, when the file has an alpha channel, the pixels with it (``load_image(..., alpha=True)``:
-    (H, W, 2) or (H, W, 4)). A method gets what ``weft run`` gives it: the pixels with alpha for an
-    input whose ``InputSpec.alpha`` asks for them, the others without; "Fill transparent" paints a
-    mask from :attr:`alpha`."""
-
-    path: str | None
-    image: np.ndarray
-    with_alpha: np.ndarray | None = None
-    opened_for: str | None = None  # the method that was current when it was opened (Studio.own_inputs)
-    bit_depth: int = 8  # of the file (16 for a 16-bit PNG or TIFF): the pixel read-out counts in it
-
-    @property
-    def alpha(self) -> np.ndarray | None:
-        """The alpha channel (H, W) in [0, 1], or None."""
-        return None if self.with_alpha is None else self.with_alpha[..., -1]
-
-
-def read_input(path: str | Path) -> InputImage:
-    """Decode an image file as an input (its pixels as ``load_image`` gives them, and with its alpha
-    when it has one). Slow for a large file: call it off the GUI thread. ``WeftError`` naming the file."""
-    from weft.core.image import load_image
-
-    loaded = load_image(path)
-    with_alpha = None
-    if loaded.info.had_alpha:
-        kept = load_image(path, alpha=True).image
-        if kept.ndim == 3 and kept.shape[2] in (2, 4) and kept.shape[:2] == loaded.image.shape[:2]:
-            with_alpha = kept
-    return InputImage(str(path), loaded.image, with_alpha, bit_depth=loaded.info.bit_depth)
-
-
-@dataclass(frozen=True)
-class DocumentState:
-    """A whole document at once, for :meth:`Document.restore` (sessions, crash recovery, the bundled
-    examples, screenshots, benchmarks). ``geometry`` maps method -> geometry key -> typed value
-    (:class:`~weft.core.geometry.Square`, :class:`~weft.core.geometry.LineDraft`, a
-    :class:`~weft.core.geometry.Mask`, :class:`~weft.core.geometry.Margins`); what is not given is empty
-    or default."""
-
-    inputs: dict[str, InputImage] = field(default_factory=dict)
-    method: str | None = None
-    params: dict[str, Params] = field(default_factory=dict)
-    geometry: dict[str, dict[str, Any]] = field(default_factory=dict)
-    seed: int = 1
+__all__ = ["Document", "DocumentState", "InputImage", "LiveEdit", "read_input"]
 
 
 class Document(QObject):
@@ -93,7 +52,14 @@ class Document(QObject):
     puts the geometry in (typed: no text in between).
     """
 
-    changed = Signal(str)
+    input_changed = Signal(str)  # the input's name
+    method_changed = Signal()
+    params_changed = Signal()
+    geometry_changed = Signal()
+    seed_changed = Signal()
+    restored = Signal()  # everything changed at once (restore)
+    changed = Signal()  # after each of the above
+    live_changed = Signal(object)  # the edit in progress: a LiveEdit, or None when it was dropped
     message = Signal(str)
 
     def __init__(self, parent=None):
@@ -105,11 +71,21 @@ class Document(QObject):
         self.params: dict[str, Params] = {name: m.params() for name, m in self.methods.items()}
         self.geometry: dict[str, dict[str, Any]] = {name: {} for name in self.methods}
         self.seed = 1
-        # The geometry being dragged (key, value): not an edit yet, no undo step until release. A mask
-        # being painted is the tool's ``MaskStroke`` (its bits change in place, dab by dab).
-        self.live: tuple[str, Any] | None = None
+        self._live: LiveEdit | None = None
 
     # --- reading -------------------------------------------------------------------------------
+    @property
+    def live(self) -> LiveEdit | None:
+        """The edit in progress (a geometry dragged or painted, a slider held), or None."""
+        return self._live
+
+    def _live_geometry(self, key: str) -> tuple[bool, Any]:
+        """``(True, value)`` when geometry ``key`` is being dragged or painted, else ``(False, None)``."""
+        live = self._live
+        if live is None or live.param or live.key != key:
+            return False, None
+        return True, live.value
+
     @property
     def current(self) -> registry.Method:
         return self.methods[self.method]
@@ -190,8 +166,9 @@ class Document(QObject):
             if g.kind != MASK:
                 continue
             mask = self.value(g.key)
-            if live and self.live is not None and self.live[0] == g.key:
-                mask = self.live[1]
+            dragged, value = self._live_geometry(g.key)
+            if live and dragged:
+                mask = value
                 if isinstance(mask, MaskStroke):  # a stroke being painted: the mask so far (a copy)
                     mask = mask.snapshot()
             on = self.image(g.input_for(self.inputs))
@@ -201,28 +178,27 @@ class Document(QObject):
 
     def method_inputs(self, *, live: bool = False) -> dict[str, np.ndarray]:
         """The current method's loaded inputs (its painted masks among them, as images; with
-        ``live`` the stroke being drawn); the canvas cropped to the source region if there is one."""
+        ``live`` the stroke being drawn), uncropped: a render request crops to the source region."""
         return self.deferred_inputs(live=live)()
 
     def deferred_inputs(self, *, live: bool = False) -> Callable[..., dict[str, np.ndarray]]:
         """:meth:`method_inputs` captured now and built when called, on any thread: the slow part
-        (a painted mask's float image, 64 MB for a 4096² mask, and a crop to the source region) is
-        left to the call, so a render job does it on its worker, not the GUI thread. The call
-        takes ``names`` (default all): only those inputs."""
-        arrays, masks, region, on = self._input_parts(live)
+        (a painted mask's float image, 64 MB for a 4096² mask) is left to the call, so a render job
+        does it on its worker, not the GUI thread. The call takes ``names`` (default all): only those
+        inputs."""
+        arrays, masks, _, _ = self._input_parts(live)
 
         def build(names=None) -> dict[str, np.ndarray]:
             out = {n: a for n, a in arrays.items() if names is None or n in names}
             out.update({n: m.to_image() for n, m in masks.items() if names is None or n in names})
-            if region is not None and on in out:
-                out[on] = region.crop(out[on], what=on.replace("_", " "))
             return out
 
         return build
 
     def input_shapes(self) -> dict[str, tuple[int, ...]]:
-        """The shapes of what :meth:`method_inputs` gives the current method (input name -> array
-        shape), without building it: what its "auto" parameters depend on (``Studio.resolved``)."""
+        """The shapes of what a render of the current method runs on (input name -> array shape: the
+        source region's crop included), without building it: what its "auto" parameters depend on
+        (``Studio.resolved``)."""
         arrays, masks, region, on = self._input_parts(False)
         out = {name: a.shape for name, a in arrays.items()}
         out.update({name: mask.shape for name, mask in masks.items()})
@@ -268,8 +244,9 @@ class Document(QObject):
             if g.param is None:
                 continue  # the source region (a crop) or a mask (an input)
             value = self.value(g.key)
-            if live and self.live is not None and self.live[0] == g.key:
-                value = self.live[1]
+            dragged, moving = self._live_geometry(g.key)
+            if live and dragged:
+                value = moving
             if isinstance(value, LineDraft):
                 value = value.complete()
             changes[g.param] = value
@@ -306,10 +283,39 @@ class Document(QObject):
     def set_param(self, name: str, value: Any, *, merge: bool = True) -> None:
         """Undoable change of one parameter of the current method (validated first). ``merge``: one
         undo step with the change of the same parameter just before (a slider's drag); False for a
-        choice made from a list, each its own step."""
+        choice made from a list, each its own step. A slider held (:meth:`drag_param`) is let go
+        here: ``live_changed(None)`` follows, whether the value changed or not."""
+        ending = self._live is not None and self._live.param
+        if ending:
+            self._live = None
+        try:
+            new = self.current_params.replace(**{name: value})
+            if new != self.current_params:
+                self.push(SetParams(self, self.method, new, f"{name} = {value}", merge_key=name if merge else None))
+        finally:
+            if ending:
+                self.live_changed.emit(None)
+
+    def drag_param(self, name: str, value: Any) -> None:
+        """A slider of the current method is held at ``value``: the change is made (one undo step
+        with the drag's other moves) while :attr:`live` says the slider is still held; letting it
+        go is :meth:`set_param` (or :meth:`end_live`)."""
         new = self.current_params.replace(**{name: value})
+        self._live = LiveEdit(name, value, param=True)
         if new != self.current_params:
-            self.push(SetParams(self, self.method, new, f"{name} = {value}", merge_key=name if merge else None))
+            self.push(SetParams(self, self.method, new, f"{name} = {value}", merge_key=name))
+
+    def set_live(self, key: str, value: Any, box: tuple | None = None) -> None:
+        """Geometry ``key`` of the current method is being dragged or painted: ``value`` so far
+        (``box``: a stroke's latest dab). Not an edit: the setter's edit on release replaces it."""
+        self._live = LiveEdit(key, value, None if box is None else tuple(box))
+        self.live_changed.emit(self._live)
+
+    def end_live(self) -> None:
+        """The edit in progress ended without an edit (Esc, a release that changed nothing)."""
+        if self._live is not None:
+            self._live = None
+            self.live_changed.emit(None)
 
     def set_params(self, params: Params, text: str) -> None:
         """Undoable change of several parameters of the current method at once (one step)."""
@@ -384,7 +390,7 @@ class Document(QObject):
     # --- the whole document at once ------------------------------------------------------------
     def restore(self, state: DocumentState) -> None:
         """Replace the whole document by ``state``: one clean state with no undo history (inputs
-        the state lacks are closed). Listeners get ``changed("restored")`` once."""
+        the state lacks are closed). Listeners get ``restored()`` once."""
         self.inputs = dict(state.inputs)
         if state.method is not None:
             if state.method not in self.methods:
@@ -394,211 +400,65 @@ class Document(QObject):
         self.params.update({k: v for k, v in state.params.items() if k in self.methods})
         self.geometry = {name: dict(state.geometry.get(name, {})) for name in self.methods}
         self.seed = int(state.seed)
-        self.live = None
+        self._live = None
         self.undo_stack.clear()
-        self.changed.emit("restored")
+        self.restored.emit()
+        self.changed.emit()
 
-    # --- raw mutators (used by the undo commands of this module only) --------------------------
-    def _put_params(self, method: str, params: Params) -> None:
+    # --- the undo commands' changes (commands.py; nothing else calls them) ---------------------
+    def put_params(self, method: str, params: Params) -> None:
         self.params[method] = params
-        self.changed.emit("params")
+        self.params_changed.emit()
+        self.changed.emit()
 
-    def _put_input(self, name: str, item: InputImage | None) -> None:
+    def put_input(self, name: str, item: InputImage | None, dropped=(), restored=()) -> None:
+        """Open (or close) input ``name``; ``dropped`` (method, key) masks that no longer fit it go,
+        ``restored`` (method, key, mask) ones come back (an undo)."""
+        for method, key in dropped:
+            self.geometry[method].pop(key, None)
+        for method, key, mask in restored:
+            self.geometry[method][key] = mask
         if item is None:
             self.inputs.pop(name, None)
         else:
             self.inputs[name] = item
-        self.changed.emit(f"input:{name}")
+        self.input_changed.emit(name)
+        if dropped or restored:
+            self.geometry_changed.emit()
+        self.changed.emit()
 
-    def _put_method(self, method: str) -> None:
+    def put_method(self, method: str) -> None:
         self.method = method
-        self.live = None
-        self.changed.emit("method")
+        self._live = None
+        self.method_changed.emit()
+        self.changed.emit()
 
-    def _put_geometry(self, method: str, key: str, value) -> None:
+    def put_geometry(self, method: str, key: str, value) -> None:
         if value is None:
             self.geometry[method].pop(key, None)
         else:
             self.geometry[method][key] = value
-        self.live = None
-        self.changed.emit("geometry")
+        self._live = None  # (the edit the live one was: it ends here, no live_changed)
+        self.geometry_changed.emit()
+        self.changed.emit()
 
-    def _put_seed(self, seed: int) -> None:
+    def put_seed(self, seed: int) -> None:
         self.seed = seed
-        self.changed.emit("seed")
+        self.seed_changed.emit()
+        self.changed.emit()
 
-    # --- sessions ------------------------------------------------------------------------------
-    def session_dict(self, relative_to: str | Path | None = None, *, session: str | Path | None = None) -> dict:
-        """The session JSON object. A mask is the name of its PNG beside ``session`` (the file the
-        JSON goes to; :meth:`session_masks` says what to write there); without ``session`` masks are
-        left out."""
-
-        def path(p):
-            return p if relative_to is None else relative_path(p, relative_to)
-
-        def geometry(method, key, value):
-            if isinstance(value, Mask):
-                return None if session is None else path(str(mask_file(session, method, key)))
-            return value.to_json()
-
-        return {
-            "weft_session": SESSION_VERSION,
-            "method": self.method,
-            "params": {name: p.to_dict() for name, p in self.params.items()},
-            "inputs": {name: path(item.path) for name, item in self.inputs.items() if item.path},
+    # --- sessions ---------------------------------------------------------------------------
+    def session(self, *, saved_as: str | None = None) -> Session:
+        """The document as a :class:`~weft.core.session.Session` (immutable: it can be written on
+        any thread, with its masks, while the document goes on changing)."""
+        opened = {name: item for name, item in self.inputs.items() if item.path}
+        return Session(
+            method=self.method,
+            params=dict(self.params),
+            inputs={name: item.path for name, item in opened.items()},
             # which method an input was opened for, where a method takes it only then (Studio.own_inputs)
-            "opened_for": {
-                name: item.opened_for for name, item in self.inputs.items() if item.path and item.opened_for is not None
-            },
-            "geometry": {
-                name: {key: geometry(name, key, value) for key, value in values.items()}
-                for name, values in self.geometry.items()
-                if values
-            },
-            "seed": self.seed,
-        }
-
-    def session_masks(self, session: str | Path) -> dict[Path, Mask]:
-        """The mask PNGs a session at ``session`` keeps beside it: file -> mask."""
-        return {
-            mask_file(session, name, key): value
-            for name, values in self.geometry.items()
-            for key, value in values.items()
-            if isinstance(value, Mask)
-        }
-
-    def session_writer(self, path: str | Path) -> Callable[[], None]:
-        """Writing the session at ``path``, captured now: a function that encodes its masks as 1-bit
-        PNGs beside it and writes them, then the JSON, each file atomically -- on any thread (the
-        studio runs it off the GUI thread: a large mask's PNG takes a tenth of a second to encode).
-        Masks are immutable and the JSON text is made here, so later edits do not reach it."""
-        from weft.core.image import atomic_write_bytes
-
-        path = Path(path)
-        masks = self.session_masks(path)
-        text = json.dumps(self.session_dict(relative_to=path.resolve().parent, session=path), indent=1)
-
-        def write() -> None:
-            for file, mask in masks.items():
-                try:
-                    mask.save(file)
-                except OSError as e:
-                    raise WeftError(f"{file}: cannot write the mask ({e.strerror or e})") from None
-            atomic_write_bytes(path, (text + "\n").encode("utf-8"))
-
-        return write
-
-    def save_session(self, path: str | Path) -> None:
-        """Write the session (its masks first, as 1-bit PNGs beside it), each file atomically, here
-        and now (:meth:`session_writer` is the same, to be run elsewhere)."""
-        self.session_writer(path)()
-
-
-# --- undo commands -------------------------------------------------------------------------------
-
-
-class SetParams(QUndoCommand):
-    """Replace the parameters of one method; consecutive edits of one parameter merge."""
-
-    def __init__(self, doc: Document, method: str, new: Params, text: str, merge_key: str | None = None):
-        super().__init__(text)
-        self.doc, self.method, self.new = doc, method, new
-        self.old = doc.params[method]
-        self.merge_key = merge_key
-
-    def id(self) -> int:  # noqa: A003 (Qt naming)
-        return _MERGE_PARAM if self.merge_key else -1
-
-    def mergeWith(self, other) -> bool:  # noqa: N802
-        if not isinstance(other, SetParams) or (other.method, other.merge_key) != (self.method, self.merge_key):
-            return False
-        self.new = other.new
-        self.setText(other.text())
-        return True
-
-    def redo(self):
-        self.doc._put_params(self.method, self.new)
-
-    def undo(self):
-        self.doc._put_params(self.method, self.old)
-
-
-class SetInput(QUndoCommand):
-    """Open (or clear) an input; masks painted on it that do not fit the new image go with the same step."""
-
-    def __init__(self, doc: Document, name: str, item: InputImage | None):
-        if item is None:
-            super().__init__(f"Clear {name.replace('_', ' ')}")
-        else:
-            label = Path(item.path).name if item.path else "image"
-            super().__init__(f"Open {name} {label}")
-        self.doc, self.name, self.new = doc, name, item
-        self.old = doc.inputs.get(name)
-        after = {**doc.inputs, name: item} if item is not None else {k: v for k, v in doc.inputs.items() if k != name}
-        self.dropped = []  # (method, key, mask) that no longer fit
-        for method, m in doc.methods.items():
-            for g in m.studio.geometry:
-                mask = doc.geometry[method].get(g.key)
-                if g.kind != MASK or mask is None or g.input_for(after) != name or item is None:
-                    continue
-                if mask.shape != item.image.shape[:2]:
-                    self.dropped.append((method, g.key, mask))
-
-    def redo(self):
-        for method, key, _mask in self.dropped:
-            self.doc.geometry[method].pop(key, None)
-        self.doc._put_input(self.name, self.new)
-        for method, key, mask in self.dropped:
-            h, w = self.new.image.shape[:2]
-            self.doc.message.emit(
-                f"the {key.replace('_', ' ')} of {method} ({mask.size[0]}x{mask.size[1]}) does not "
-                f"fit the new {self.name.replace('_', ' ')} ({w}x{h}): dropped (Ctrl+Z brings it back)"
-            )
-        if self.dropped:
-            self.doc.changed.emit("geometry")
-
-    def undo(self):
-        for method, key, mask in self.dropped:
-            self.doc.geometry[method][key] = mask
-        self.doc._put_input(self.name, self.old)
-        if self.dropped:
-            self.doc.changed.emit("geometry")
-
-
-class SetMethod(QUndoCommand):
-    def __init__(self, doc: Document, method: str):
-        super().__init__(f"Method {method}")
-        self.doc, self.new, self.old = doc, method, doc.method
-
-    def redo(self):
-        self.doc._put_method(self.new)
-
-    def undo(self):
-        self.doc._put_method(self.old)
-
-
-class SetSeed(QUndoCommand):
-    def __init__(self, doc: Document, seed: int):
-        super().__init__(f"Seed {seed}")
-        self.doc, self.new, self.old = doc, seed, doc.seed
-
-    def redo(self):
-        self.doc._put_seed(self.new)
-
-    def undo(self):
-        self.doc._put_seed(self.old)
-
-
-class SetGeometry(QUndoCommand):
-    """Replace one geometry value of one method."""
-
-    def __init__(self, doc: Document, method: str, key: str, value, text: str):
-        super().__init__(text)
-        self.doc, self.method, self.key, self.new = doc, method, key, value
-        self.old = doc.geometry[method].get(key)
-
-    def redo(self):
-        self.doc._put_geometry(self.method, self.key, self.new)
-
-    def undo(self):
-        self.doc._put_geometry(self.method, self.key, self.old)
+            opened_for={name: item.opened_for for name, item in opened.items() if item.opened_for is not None},
+            geometry={name: dict(values) for name, values in self.geometry.items() if values},
+            seed=self.seed,
+            saved_as=saved_as,
+        )

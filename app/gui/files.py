@@ -3,7 +3,7 @@
 A result rendered with a painted mask (a mask geometry is an input of its method) is exported with
 that mask as a 1-bit PNG beside it, ``OUT.<input>.png`` (``out.png`` -> ``out.mask.png``), which its
 recipe names as that input, so ``weft run OUT.png`` reproduces it; a recipe exported alone gets its
-mask beside it alike. Sessions keep masks beside the session file (``Document.session_writer``).
+mask beside it alike. Sessions keep masks beside the session file (``weft.core.session.Session``).
 
 Image files are encoded and decoded off the GUI thread: an export, its masks, a saved session and
 its masks, and a session's images and masks when it is opened, through :func:`off_gui_thread` (the
@@ -12,8 +12,9 @@ its own (nothing waits; a newer autosave replaces one not yet started, and a rec
 meanwhile is not written again).
 
 Contract: :class:`FileActions` is given the window (a parent for dialogs, with ``show_message(text)``,
-``statusBar()``, ``settings`` and ``_confirm(question) -> bool``, the one place the studio asks), the
-document and the renderer. It exports the *shown result* with that result's own recipe (never the
+``statusBar()``, ``settings``, ``questions`` (:class:`~weft.app.gui.questions.Questions`, the one place
+the studio asks), ``may_drop_edits(doing)`` and ``nothing_to_export(doing)``), the document and the
+renderer. It exports the *shown result* with that result's own recipe (never the
 panel's state), and changes the document only through :meth:`Document.restore`. It imports nothing
 of the window.
 """
@@ -21,8 +22,6 @@ of the window.
 from __future__ import annotations
 
 import dataclasses
-import json
-import os
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -32,27 +31,19 @@ from PySide6.QtCore import QEventLoop, QMetaObject, QObject, Qt, QTimer, Signal
 from PySide6.QtWidgets import QFileDialog
 from weft.core import registry
 from weft.core.errors import WeftError
-from weft.core.image import atomic_write_bytes, save_image
+from weft.core.image import save_image
 from weft.core.jobs import JobResult, JobRunner
 from weft.core.readfile import file_key
+from weft.core.session import Session, write_files, write_masks
 from weft.core.studio import MASK, SQUARE
 
 from . import recovery
-from .document import DocumentState, InputImage, read_input, read_session
+from .document import DocumentState, InputImage, read_input
 
 T = TypeVar("T")
 
 SAVE_FILTER = "PNG with recipe (*.png);;JPEG (*.jpg *.jpeg);;TIFF 16-bit (*.tif *.tiff)"
 AUTOSAVE_MS = 2000  # unsaved edits reach the recovery file at most this long after they are made
-
-
-def _write_masks(masks: dict) -> None:
-    """(Any thread.) Write each mask of :meth:`FileActions._with_masks` as a 1-bit PNG, atomically."""
-    for file, (name, mask) in masks.items():
-        try:
-            mask.save(file)
-        except OSError as e:
-            raise WeftError(f"{file}: cannot write the {name.replace('_', ' ')} ({e.strerror or e})") from None
 
 
 def _source_depth(shown) -> int:
@@ -69,10 +60,10 @@ def _source_depth(shown) -> int:
 def off_gui_thread(fn: Callable[[], T]) -> T:
     """Run ``fn()`` on a worker thread and return its value (or raise its exception).
 
-    For work the caller must wait for (a session's images are decoded before the document is touched, an
-    export is written before it is reported): meanwhile the GUI thread runs a local event loop that keeps
-    painting and running timers but holds back user input, so the window stays alive and nothing can be
-    started twice.
+    For work the caller must wait for (a session's images are decoded before the document is
+    touched, an export is written before it is reported): meanwhile the GUI thread runs a local
+    event loop that keeps painting and running timers but holds back user input, so the window
+    stays alive and nothing can be started twice.
     """
     loop = QEventLoop()
     box: dict = {}
@@ -131,7 +122,7 @@ class FileActions(QObject):
         return self.window.statusBar()
 
     def _confirm(self, question: str) -> bool:
-        return self.window._confirm(question)
+        return self.window.questions.confirm(question)
 
     # --- export, sessions ------------------------------------------------------------------------
     def _start(self, suffix: str) -> str:
@@ -188,7 +179,7 @@ class FileActions(QObject):
         self.statusBar().showMessage(f"exporting {p.name}…")
 
         def write() -> None:
-            _write_masks(masks)
+            write_masks(masks)
             save_image(p, shown.image, recipe=recipe, bit_depth=depth)
 
         try:  # encoding a large PNG (and its mask's) takes a second: off the GUI thread
@@ -216,7 +207,7 @@ class FileActions(QObject):
             recipe = dataclasses.replace(recipe, bit_depth=_source_depth(shown))  # (as a PNG export's)
 
             def write() -> None:
-                _write_masks(masks)
+                write_masks(masks)
                 recipe.save(path)
 
             off_gui_thread(write)
@@ -228,7 +219,7 @@ class FileActions(QObject):
     def _with_masks(self, shown, beside: Path):
         """``(recipe, masks)``: the recipe of ``shown`` with each painted mask it was rendered with
         named as that input, a 1-bit PNG beside ``beside`` (``out.png`` -> ``out.mask.png``), and
-        what :func:`_write_masks` writes there (file -> (input name, mask)); nothing is written here."""
+        what ``write_masks`` writes there (file -> mask); nothing is written here."""
         recipe = shown.recipe
         if not shown.masks:
             return recipe, {}
@@ -238,7 +229,7 @@ class FileActions(QObject):
             file = beside.with_name(f"{beside.stem}.{name}.png")
             if any(item.path and file_key(item.path) == file_key(file) for item in self.doc.inputs.values()):
                 raise WeftError(f"{file.name}: refusing to overwrite an input image with the {name.replace('_', ' ')}")
-            masks[file] = (name, mask)
+            masks[file] = mask
             inputs[name] = str(file.resolve())
         return dataclasses.replace(recipe, inputs=inputs), masks
 
@@ -261,8 +252,9 @@ class FileActions(QObject):
         return bool(path) and self.save_session(path)
 
     def save_session(self, path: str) -> bool:
-        try:  # its masks' PNGs are encoded off the GUI thread (the document's state is captured here)
-            off_gui_thread(self.doc.session_writer(path))
+        session = self.doc.session()  # (captured here; its masks' PNGs are encoded off the GUI thread)
+        try:
+            off_gui_thread(lambda: session.save(path))
         except WeftError as e:
             self.show_message(str(e))
             return False
@@ -295,7 +287,7 @@ class FileActions(QObject):
         self.statusBar().showMessage(f"session {Path(path).name} opened", 4000)
         return True
 
-    def _read_session_files(self, path: str | Path) -> tuple[dict, dict[str, InputImage]]:
+    def _read_session_files(self, path: str | Path) -> tuple[Session, dict[str, InputImage]]:
         """Read a session and its images, checking everything before the document is touched.
 
         Raises ``WeftError`` naming the session file and, for an image, which input it is.
@@ -303,15 +295,15 @@ class FileActions(QObject):
         dropped: list[str] = []
         offered = registry.studio_methods()
 
-        def decode() -> tuple[dict, dict[str, InputImage]]:
-            data = read_session(path, dropped=dropped)  # (its mask PNGs decoded); missing or unreadable: the rest opens
-            if data["method"] not in offered:
+        def decode() -> tuple[Session, dict[str, InputImage]]:
+            data = Session.read(path, dropped=dropped)  # (its mask PNGs decoded); missing or unreadable: the rest opens
+            if data.method not in offered:
                 raise WeftError(
-                    f"{path}: the studio does not offer method {data['method']!r} "
-                    f"(it offers {', '.join(offered)}; use 'weft {data['method']}')"
+                    f"{path}: the studio does not offer method {data.method!r} "
+                    f"(it offers {', '.join(offered)}; use 'weft {data.method}')"
                 )
             images = {}
-            for name, p in data["inputs"].items():
+            for name, p in data.inputs.items():
                 try:
                     images[name] = read_input(p)
                 except WeftError as e:
@@ -320,7 +312,7 @@ class FileActions(QObject):
 
         self.statusBar().showMessage(f"opening {Path(path).name}…")
         data, images = off_gui_thread(decode)
-        for method, values in data["geometry"].items():  # a square must lie inside its image
+        for method, values in data.geometry.items():  # a square must lie inside its image
             for g in offered[method].studio.geometry:
                 value, on = values.get(g.key), g.input_for(images)
                 if g.kind == SQUARE and value is not None and on in images:
@@ -338,27 +330,23 @@ class FileActions(QObject):
             self.show_message(line)
         return data, images
 
-    def _apply_session(self, data: dict, images: dict[str, InputImage]) -> None:
+    def _apply_session(self, data: Session, images: dict[str, InputImage]) -> None:
         """Put a read session into the document (one clean state, no undo history) and render it.
         Each input keeps the method it was opened for (``Studio.own_inputs``: fill's texture is fill's
         only when opened for fill; the brick open for quilt filled a gravel hole after a recovery, seen
         under Xvfb); in a session that did not record it, no own input is taken (an own input a method
         does not get shows as an empty input, which can be opened again; one it gets silently changes the result)."""
-        opened_for = data.get("opened_for") or {}  # (not recorded: no own input counts as opened for its method)
+        opened_for = data.opened_for or {}  # (not recorded: no own input counts as opened for its method)
         images = {name: dataclasses.replace(item, opened_for=opened_for.get(name)) for name, item in images.items()}
         self.doc.restore(
-            DocumentState(
-                inputs=images,
-                method=data["method"],
-                params=data["params"],
-                geometry=data["geometry"],
-                seed=data["seed"],
-            )
+            DocumentState(inputs=images, method=data.method, params=data.params, geometry=data.geometry, seed=data.seed)
         )
         self.renderer.final(now=True)
 
     # --- asking, autosave, recovery --------------------------------------------------------------
-    def _schedule_autosave(self, *_args) -> None:
+    def schedule_autosave(self, *_args) -> None:
+        """The document changed (or was saved): autosave it soon if it has unsaved edits, else
+        remove this window's recovery file."""
         if self.doc.undo_stack.isClean():
             self._autosave_timer.stop()
             if self._owns_recovery:
@@ -382,37 +370,31 @@ class FileActions(QObject):
         """
         if self.doc.undo_stack.isClean():
             return False
-        data = self.doc.session_dict(session=self.recovery_file)
-        data["inputs"] = {name: os.path.abspath(p) for name, p in data["inputs"].items()}
-        if self.session_path:
-            data["saved_as"] = os.path.abspath(self.session_path)  # (Ctrl+S after a recovery saves there)
-        text = json.dumps(data, indent=1) + "\n"
-        masks = self.doc.session_masks(self.recovery_file)
+        session = self.doc.session(saved_as=self.session_path)  # (Ctrl+S after a recovery saves there)
         with self._recovery_lock:
             generation = self._recovery_generation
         self._owns_recovery = True  # (what it writes is this window's to remove, from now)
         if not wait:
-            self._autosaver.submit("autosave", lambda **_: self._write_recovery(generation, masks, text))
+            self._autosaver.submit("autosave", lambda **_: self._write_recovery(generation, session))
             return True
         try:
-            off_gui_thread(lambda: self._write_recovery(generation, masks, text))
+            off_gui_thread(lambda: self._write_recovery(generation, session))
         except (OSError, WeftError) as e:
             self._autosave_failed(e)
             return False
         return True
 
-    def _write_recovery(self, generation: int, masks: dict, text: str) -> bool:
-        """(Any thread.) Encode the masks, then -- unless the recovery was discarded since the
-        autosave was made (``generation``) -- write them and the JSON. False: discarded, nothing written."""
-        pngs = {file: mask.to_png() for file, mask in masks.items()}  # the slow part, outside the lock
+    def _write_recovery(self, generation: int, session: Session) -> bool:
+        """(Any thread.) Encode the session (absolute paths) and its masks, then -- unless the
+        recovery was discarded since the autosave was made (``generation``) -- write them. False:
+        discarded, nothing written."""
+        files = session.files(self.recovery_file, relative=False)  # the slow part, outside the lock
         with self._recovery_lock:
             if generation != self._recovery_generation:
                 return False
             self.recovery_file.parent.mkdir(parents=True, exist_ok=True)
             recovery.write_lock(self.recovery_file, self._me)  # (first: a file without its lock is nobody's)
-            for file, data in pngs.items():
-                atomic_write_bytes(file, data)
-            atomic_write_bytes(self.recovery_file, text.encode("utf-8"))
+            write_files(files)
         return True
 
     def _on_autosaved(self, result: JobResult) -> None:
@@ -430,12 +412,19 @@ class FileActions(QObject):
             self._recovery_generation += 1
             try:
                 self.recovery_file.unlink(missing_ok=True)
-                for mask in self.recovery_file.parent.glob(f"{stem}.*.png"):  # its masks (Document.session_masks)
+                for mask in self.recovery_file.parent.glob(f"{stem}.*.png"):  # its masks (Session.mask_files)
                     mask.unlink(missing_ok=True)
                 recovery.lock_path(self.recovery_file).unlink(missing_ok=True)
             except OSError:
                 pass
         self._owns_recovery = False
+
+    def close(self) -> None:
+        """The window closes with nothing unsaved (saved or discarded): no autosave any more, and this
+        window's recovery file goes."""
+        self._autosave_timer.stop()
+        if self._owns_recovery:
+            self.discard_recovery()
 
     def offer_recovery(self) -> bool:
         """Offer to restore the unsaved session of a window that did not close normally.
@@ -450,7 +439,7 @@ class FileActions(QObject):
             if not recovery.claim(path, self._me):
                 continue
             when = recovery.modified(path)
-            if not self.window._ask_restore(
+            if not self.window.questions.ask_restore(
                 f"A weft window did not close normally{f' ({when})' if when else ''}. Restore its unsaved session?"
             ):
                 self._discard_file(path)
@@ -463,7 +452,7 @@ class FileActions(QObject):
             self._apply_session(data, images)
             self.recovery_file = path  # this window's from now (its lock names this window)
             self._owns_recovery = True
-            self.session_path = _saved_as(path)
+            self.session_path = data.saved_as
             self.doc.undo_stack.resetClean()  # the restored edits are still unsaved
             self.statusBar().showMessage("unsaved session restored", 4000)
             return True
@@ -479,12 +468,3 @@ class FileActions(QObject):
             recovery.lock_path(path).unlink(missing_ok=True)
         except OSError:
             pass
-
-
-def _saved_as(recovery_file: Path) -> str | None:
-    """The session file a recovery file's window saved to (its ``saved_as``), or None."""
-    try:
-        value = json.loads(recovery_file.read_text(encoding="utf-8")).get("saved_as")
-    except (OSError, ValueError, AttributeError):
-        return None
-    return value if isinstance(value, str) and value else None

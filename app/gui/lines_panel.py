@@ -17,9 +17,10 @@ import numpy as np
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QFileDialog, QHBoxLayout, QLabel, QPushButton, QSizePolicy, QSpinBox, QVBoxLayout, QWidget
 from weft.core.errors import WeftError
-from weft.core.jobs import JobResult, JobRunner
+from weft.core.jobs import JobResult
 from weft.core.studio import LINES
 
+from .qjobs import QtJobs
 from .tools import LineTool, QuadTool
 from .views import ImageView
 
@@ -28,8 +29,6 @@ class FeatureLinesPanel(QWidget):
     """The frontal frame tab (see the module docstring); ``message(text)`` reports problems."""
 
     message = Signal(str)
-    _rectified = Signal(object)
-    _suggested = Signal(object)
 
     def __init__(self, doc, photo_view: ImageView, input_name: str, parent=None):
         super().__init__(parent)
@@ -42,10 +41,10 @@ class FeatureLinesPanel(QWidget):
         self.frontal_view = ImageView(self, title="frontal")
         self.frontal_lines = LineTool(self.frontal_view, doc, "frontal", on_drag=self._lines_dragged)
         self.frontal_view.tool = self.frontal_lines
-        self.runner = JobRunner(max_workers=1, on_result=self._rectified.emit)
-        self._rectified.connect(self._on_rectified)
-        self._suggested.connect(self._on_suggested)
-        self.suggest_runner = JobRunner(max_workers=1, on_result=self._suggested.emit)
+        self.runner = QtJobs(self)
+        self.runner.result.connect(self._on_rectified)
+        self.suggest_runner = QtJobs(self)
+        self.suggest_runner.result.connect(self._on_suggested)
         self._suggest_photo = None  # the photo a pending suggestion is for
         self._rectifier = None
         self._build()

@@ -4,12 +4,11 @@ Contract
 --------
 * Built from ``weft.core.registry.studio_methods()`` and the current method's ``Params`` specs and studio
   description; it names no method, input or parameter.
-* It changes the document only through its setters (``set_method``, ``set_param``, ``set_seed``) and
-  shows the document after each ``changed`` through :meth:`show_method`, :meth:`show_params`,
+* It changes the document only through its setters (``set_method``, ``set_param``, ``set_seed``; a
+  slider held is ``drag_param``, let go ``set_param``: the renderer decides what to render) and
+  shows the document after each change through :meth:`show_method`, :meth:`show_params`,
   :meth:`show_seed`, :meth:`show_square`.
-* Signals: ``preview_requested()`` while a slider is held (the edit is already in the document),
-  ``final_requested()`` when it is let go;
-  ``render_requested()``; ``variations_requested()``; ``message(text)`` a one-line problem.
+* Signals: ``render_requested()``; ``variations_requested()``; ``message(text)`` a one-line problem.
   ``compare_button`` is checkable (the window connects it to the result view).
 """
 
@@ -43,8 +42,6 @@ THUMB = 96
 class MethodPanel(QWidget):
     """See the module docstring."""
 
-    preview_requested = Signal()
-    final_requested = Signal()
     render_requested = Signal()
     variations_requested = Signal()
     message = Signal(str)
@@ -52,8 +49,20 @@ class MethodPanel(QWidget):
     def __init__(self, doc, parent=None):
         super().__init__(parent)
         self.doc = doc
-        self.dragging = False  # a slider is held: the document's "params" change asks for no final render
         lay = QVBoxLayout(self)
+        lay.addLayout(self._method_row())
+        self.params_panel = ParamsPanel()
+        self.params_panel.edited.connect(self._param_edited)
+        scroll = QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(self.params_panel)
+        lay.addWidget(scroll, 1)
+        lay.addLayout(self._seed_row())
+        lay.addWidget(self._square_row())
+        lay.addLayout(self._buttons())
+
+    def _method_row(self) -> QHBoxLayout:
+        doc = self.doc
         top = QHBoxLayout()
         top.addWidget(QLabel("Method"))
         self.method_box = QComboBox()
@@ -64,13 +73,10 @@ class MethodPanel(QWidget):
             )
         self.method_box.currentIndexChanged.connect(self._method_chosen)
         top.addWidget(self.method_box, 1)
-        lay.addLayout(top)
-        self.params_panel = ParamsPanel()
-        self.params_panel.edited.connect(self._param_edited)
-        scroll = QScrollArea()
-        scroll.setWidgetResizable(True)
-        scroll.setWidget(self.params_panel)
-        lay.addWidget(scroll, 1)
+        return top
+
+    def _seed_row(self) -> QHBoxLayout:
+        """The seed, New, and the thumbnail of the method's square with its caption."""
         self.square_label = QLabel()
         self.square_label.setFixedSize(THUMB, THUMB)
         self.square_label.setToolTip("the square drawn on the input (drag one on its view)")
@@ -79,7 +85,7 @@ class MethodPanel(QWidget):
         seed_row.addWidget(QLabel("seed"))
         self.seed_box = QSpinBox()
         self.seed_box.setRange(0, 2**31 - 1)
-        self.seed_box.setValue(doc.seed)
+        self.seed_box.setValue(self.doc.seed)
         self.seed_box.setKeyboardTracking(False)
         self.seed_box.valueChanged.connect(lambda value: self.doc.set_seed(int(value)))
         seed_row.addWidget(self.seed_box, 1)
@@ -97,8 +103,10 @@ class MethodPanel(QWidget):
         self.square_caption.setWordWrap(True)
         square_box.addWidget(self.square_caption)
         seed_row.addLayout(square_box)
-        lay.addLayout(seed_row)
-        # the square typed: its corner and side (the same undoable edit as a drag on its view)
+        return seed_row
+
+    def _square_row(self) -> QWidget:
+        """The square typed: its corner and side (the same undoable edit as a drag on its view)."""
         self.square_row = QWidget()
         sq = QHBoxLayout(self.square_row)
         sq.setContentsMargins(0, 0, 0, 0)
@@ -117,7 +125,9 @@ class MethodPanel(QWidget):
             sq.addWidget(label)
             sq.addWidget(box, 1)
             self.square_boxes.append(box)
-        lay.addWidget(self.square_row)
+        return self.square_row
+
+    def _buttons(self) -> QHBoxLayout:
         buttons = QHBoxLayout()
         self.render_button = QPushButton("Render")
         self.render_button.setToolTip("render the full-size result (F5)")
@@ -130,7 +140,7 @@ class MethodPanel(QWidget):
         self.variations_button.clicked.connect(self.variations_requested)
         for b in (self.render_button, self.compare_button, self.variations_button):
             buttons.addWidget(b)
-        lay.addLayout(buttons)
+        return buttons
 
     # --- user edits ----------------------------------------------------------------------------
     def _method_chosen(self, index: int) -> None:
@@ -140,20 +150,15 @@ class MethodPanel(QWidget):
 
     def _param_edited(self, name: str, value, dragging: bool) -> None:
         try:
-            self.dragging = dragging
-            # a slider's moves are one undo step; a choice from a list, a switch or a typed size is its own
-            row = self.params_panel.rows.get(name)
-            self.doc.set_param(name, value, merge=row is not None and row.spec.kind in (INT, FLOAT))
+            if dragging:
+                self.doc.drag_param(name, value)
+            else:
+                # a slider's moves are one undo step; a choice from a list, a switch or a typed size is its own
+                row = self.params_panel.rows.get(name)
+                self.doc.set_param(name, value, merge=row is not None and row.spec.kind in (INT, FLOAT))
         except WeftError as e:
             self.message.emit(str(e))
             self.show_params()  # back to the valid value
-            return
-        finally:
-            self.dragging = False
-        if dragging:
-            self.preview_requested.emit()
-        else:
-            self.final_requested.emit()  # a release on an unchanged value still asks for the full size
 
     def _square_typed(self, _value=None) -> None:
         """X, Y or side typed: the square they give, checked as the CLI checks ``--region X,Y,S`` /
@@ -169,8 +174,10 @@ class MethodPanel(QWidget):
             return
         values = [b.value() for b in self.square_boxes]
         if doc.value(g.key) is None:  # none drawn: the boxes left blank take the corner and a default side
-            defaults = _default_square(image)
-            values = [d if v == b.minimum() else v for v, b, d in zip(values, self.square_boxes, defaults, strict=True)]
+            values = [
+                d if v == b.minimum() else v
+                for v, b, d in zip(values, self.square_boxes, _default_square(image), strict=True)
+            ]
         try:
             square = Square.parse(values, g.key)
             square.crop(image, where.replace("_", " "), g.key)

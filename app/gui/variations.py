@@ -31,11 +31,13 @@ from PySide6.QtWidgets import (
 )
 from weft.core.errors import WeftError
 from weft.core.image import save_image
-from weft.core.jobs import JobResult, JobRunner
+from weft.core.jobs import JobResult
 from weft.core.params import FLOAT, INT, specs
+from weft.core.request import Prepared, Preview, RenderRequest
 
 from .convert import to_qimage
-from .render import preparation
+from .qjobs import QtJobs
+from .render_job import render_request
 
 THUMB_SIDE = 192
 
@@ -56,15 +58,14 @@ class VariationsDialog(QDialog):
     """See the module docstring. ``cell_done(i, j)`` fires when a thumbnail arrives."""
 
     cell_done = Signal(int, int)
-    _delivered = Signal(object)
 
     def __init__(self, doc, parent=None):
         super().__init__(parent)
         self.setWindowTitle(f"Variations — {doc.studio.title}")
         self.doc = doc
         self.method = doc.method
-        self.runner = JobRunner(max_workers=2, on_result=self._delivered.emit)
-        self._delivered.connect(self._on_result)
+        self.runner = QtJobs(self, max_workers=2)
+        self.runner.result.connect(self._on_result)
         self.cells: dict[tuple[int, int], QToolButton] = {}
         self.values: dict[tuple[int, int], tuple] = {}
         # only the parameters that change something with the current settings and inputs
@@ -170,8 +171,9 @@ class VariationsDialog(QDialog):
 
         The document's inputs, parameters and seed are taken now; the thumbnail-size inputs (a
         painted mask's image, the reduction to ``THUMB_SIDE``) are built once per grid on a worker
-        (:func:`~weft.app.gui.render.preparation`, as the main window's renders do), and only then
-        are the cells' jobs submitted (:meth:`_prepared`)."""
+        (the document's :class:`~weft.core.request.RenderRequest` in :class:`~weft.core.request.Preview`
+        mode, as the main window's renders), and only then are the cells' requests, on those inputs,
+        submitted (:meth:`_prepared`)."""
         self.runner.cancel()
         self._preparing = None  # a preparation or cell of an earlier grid that still arrives is dropped
         self._cell_jobs, self._pending = {}, set()
@@ -188,12 +190,11 @@ class VariationsDialog(QDialog):
             return
         rows = grid_values(a, self.lo[0].value(), self.hi[0].value(), n)
         cols = grid_values(b, self.lo[1].value(), self.hi[1].value(), n)
-        prepared = preparation(self.doc, side=THUMB_SIDE)  # (a snapshot: nothing is built here)
-        if prepared is None:
+        request = render_request(self.doc, Preview(THUMB_SIDE))  # (a snapshot: nothing is built here)
+        if request is None:
             self.status.setText("open the method's inputs first")
             return
-        prepare, params = prepared
-        method, seed = self.doc.current, self.doc.seed
+        params = request.params
         self.side = side = self.thumb_side(n)
         for i, va in enumerate(rows):
             for j, vb in enumerate(cols):
@@ -213,9 +214,9 @@ class VariationsDialog(QDialog):
                     self._cell_error(button, str(e))
 
         def prepare_grid(*, progress=None, cancel=None):
-            inputs, base, _ = prepare()
+            prepared = request.prepared()
             cancel.raise_if_cancelled()
-            return inputs, base, method, seed
+            return request, prepared
 
         self._preparing = self.runner.submit("prepare", prepare_grid).id
         self.status.setText("rendering…")
@@ -228,19 +229,23 @@ class VariationsDialog(QDialog):
         if result.error is not None:
             self.status.setText(_one_line(f"could not prepare the grid: {result.error}"))
             return
-        inputs, base, method, seed = result.value
+        request: RenderRequest
+        prepared: Prepared
+        request, prepared = result.value
         for key, button in self.cells.items():
             if not button.isEnabled():
                 continue  # refused when laid out
             (na, va), (nb, vb) = self.values[key]
             try:
-                params = base.replace(**{na: va, nb: vb})
+                params = prepared.params.replace(**{na: va, nb: vb})
             except WeftError as e:  # refused at thumbnail size (e.g. a size reduced below the values)
                 self._cell_error(button, str(e))
                 continue
 
-            def job(*, progress=None, cancel=None, params=params):
-                return method.run(inputs, params, rng=seed, cancel=cancel).image
+            cell = RenderRequest(request.method, params, prepared.images, request.seed)
+
+            def job(*, progress=None, cancel=None, cell=cell):
+                return cell.run(cancel=cancel).image
 
             self._cell_jobs[key] = self.runner.submit("cell-{}-{}".format(*key), job).id
             self._pending.add(key)

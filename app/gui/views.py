@@ -3,147 +3,25 @@
 ``ImageView`` shows one float image. Wheel zooms under the cursor; middle-drag, or left-drag with
 Space held (or with no tool active), pans; ``fit()`` and ``actual_size()`` reset the zoom. A *tool*
 (``weft.app.gui.tools``) may be attached: it receives the left-button events in image coordinates and
-draws its overlay items in the view's scene. ``ResultView`` adds a before/after split.
+draws its overlay items in the view's scene. ``ResultView`` (``result_view.py``) adds a before/after split.
 
-The GUI thread never converts a large image: an image of more than ``ASYNC_PIXELS`` pixels is turned
-into the QImage the view draws (:func:`~weft.app.gui.convert.display_qimage`, numpy only, so the
-worker leaves Python's GIL to the GUI thread) on a worker thread, and the view keeps showing the
-previous image until it is ready (``image_shown`` then; ``image`` is always the image on screen). A
-view draws that QImage itself: no QPixmap (which only the GUI thread may make, 35 ms for a 4096²
-image) is made. Requests made while one is converted are coalesced: the newest is converted next,
-and a conversion older than what is on screen is dropped. ``set_image(image, changed=box)`` redraws
-only a part of the array on screen changed in place (a stroke's preview pasted into the result).
+Large images are converted for display off the GUI thread (``display.py``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QObject, QPoint, QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QImage, QPainter, QPen
-from PySide6.QtWidgets import QGraphicsItem, QGraphicsLineItem, QGraphicsRectItem, QGraphicsScene, QGraphicsView, QLabel
+from PySide6.QtCore import QPoint, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QPainter
+from PySide6.QtWidgets import QGraphicsScene, QGraphicsView
 
-from .convert import display_qimage
+from . import display
+from .display import PART_PIXELS, DisplayConverter, ImageItem
 from .transparency import TransparencyItem
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
-
-#: Images of more pixels than this are converted for display on a worker thread (display_qimage:
-#: 0.4 ms for 512², 10 ms for 1024², 39 ms for 2048², 145 ms for 4096², median of 7, loaded machine).
-ASYNC_PIXELS = 512 * 512
-#: A part of the image on screen changed in place of at most this many pixels is converted on the GUI
-#: thread (``set_image(changed=)``: a stroke's preview), not the whole image on a worker: 2048² in 9 ms
-#: grey, 14 ms RGB (1024² in 3 and 2.4 ms; medians of 5, a quiet machine). At 1024², the part a 4096²
-#: picture's preview changes (its crop, up to ~1100x1200 px once dabs coalesced) outgrew it; the whole
-#: picture then went to the worker (~150 ms), every later preview waited behind that conversion, and
-#: previews reached the screen in bursts: medians 86-130 ms instead of ~31 ms in such runs.
-PART_PIXELS = 2048 * 2048
-
-_converters = ThreadPoolExecutor(max_workers=2, thread_name_prefix="weft-display")
-
-
-class ImageItem(QGraphicsItem):
-    """Draws a QImage (made on any thread) at the scene's origin, one scene unit per pixel, as a
-    ``QGraphicsPixmapItem`` with fast transformation draws its pixmap."""
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self._image = QImage()
-        self._pixels: np.ndarray | None = None  # the buffer the QImage reads (kept alive with it)
-
-    def qimage(self) -> QImage:
-        return self._image
-
-    def pixels(self) -> np.ndarray | None:
-        """The (H, W, 4) buffer the QImage reads (a part written there shows at the next paint), or None."""
-        return self._pixels
-
-    def set_qimage(self, shown: tuple[QImage, np.ndarray] | None) -> None:
-        """Draw ``shown`` = :func:`~weft.app.gui.convert.display_qimage`'s (QImage, pixels); None: nothing."""
-        self.prepareGeometryChange()
-        self._image, self._pixels = (QImage(), None) if shown is None else shown
-        self.update()
-
-    def boundingRect(self) -> QRectF:  # noqa: N802 (Qt naming)
-        return QRectF(0, 0, self._image.width(), self._image.height())
-
-    def paint(self, painter, option, widget=None) -> None:
-        if not self._image.isNull():
-            painter.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, False)
-            painter.drawImage(QPointF(0, 0), self._image)
-
-
-class DisplayConverter(QObject):
-    """Turns images into what a view draws and hands it to ``show(image, (qimage, pixels), extra)``
-    on the GUI thread: at once when small, else from a worker thread (module docstring). One
-    conversion at a time per converter; :meth:`request` while one runs replaces the waiting request."""
-
-    _converted = Signal(int, object, object, object)  # generation, image, (QImage, pixels) or the error, extra
-
-    def __init__(self, show: Callable[[np.ndarray | None, tuple | None, Any], None], parent=None):
-        super().__init__(parent)
-        self._show = show
-        self._generation = 0  # of the latest request
-        self._shown = 0  # of what is on screen
-        self._waiting: tuple[int, np.ndarray, Any] | None = None
-        self._running = False
-        self.latest: np.ndarray | None = None  # the image of the latest request
-        self._converted.connect(self._on_converted)
-
-    @property
-    def pending(self) -> bool:
-        """A requested image is not on screen yet."""
-        return self._shown != self._generation
-
-    def shown_now(self) -> None:
-        """What is on screen was changed by its owner (a part redrawn): newer than any conversion running."""
-        self._generation += 1
-        self._shown = self._generation
-        self._waiting = None
-
-    def request(self, image: np.ndarray | None, extra: Any = None) -> None:
-        self._generation += 1
-        self.latest = image
-        if image is None or image.shape[0] * image.shape[1] <= ASYNC_PIXELS:
-            self._waiting = None
-            self._shown = self._generation
-            self._show(image, None if image is None else display_qimage(image), extra)
-            return
-        self._waiting = (self._generation, image, extra)
-        if not self._running:
-            self._start()
-
-    def _start(self) -> None:
-        generation, image, extra = self._waiting
-        self._waiting = None
-        self._running = True
-        done = self._converted
-
-        def work() -> None:
-            try:
-                q: Any = display_qimage(image)
-            except Exception as e:  # raised on the GUI thread
-                q = e
-            try:
-                done.emit(generation, image, q, extra)
-            except RuntimeError:  # the view is gone
-                pass
-
-        _converters.submit(work)
-
-    def _on_converted(self, generation: int, image, q, extra) -> None:
-        self._running = False
-        if self._waiting is not None:
-            self._start()
-        if isinstance(q, Exception):
-            raise q
-        if generation > self._shown:  # (older than what is on screen: dropped)
-            self._shown = generation
-            self._show(image, q, extra)
 
 
 class ImageView(QGraphicsView):
@@ -253,7 +131,7 @@ class ImageView(QGraphicsView):
         x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
         if x0 >= x1 or y0 >= y1 or pixels is None:
             return  # nothing on screen changed
-        _q, part = display_qimage(image[y0:y1, x0:x1])
+        _q, part = display.display_qimage(image[y0:y1, x0:x1])  # (display's: one function to replace in tests)
         pixels[y0:y1, x0:x1] = part
         self._item.update(QRectF(x0, y0, x1 - x0, y1 - y0))
         self.image_shown.emit()
@@ -522,155 +400,6 @@ class ImageView(QGraphicsView):
         if path:
             event.acceptProposedAction()
             self.file_dropped.emit(path)
-
-
-class ResultView(ImageView):
-    """The result, with an optional before/after split: left of the divider shows ``compare_image``.
-
-    With compare on, dragging with the left button moves the divider.
-    """
-
-    def __init__(self, parent=None, *, title: str = "result"):
-        super().__init__(parent, title=title)
-        self._clip = QGraphicsRectItem()
-        self._clip.setPen(QPen(Qt.PenStyle.NoPen))
-        self._clip.setFlag(QGraphicsRectItem.GraphicsItemFlag.ItemClipsChildrenToShape, True)
-        self._before = ImageItem(self._clip)
-        self._before_converter = DisplayConverter(self._show_compare, self)
-        self._divider = QGraphicsLineItem()
-        pen = QPen(QColor(255, 255, 255, 220), 0)
-        self._divider.setPen(pen)
-        self.scene().addItem(self._clip)
-        self.scene().addItem(self._divider)
-        self._clip.setZValue(1)
-        self._divider.setZValue(2)
-        self.compare_image: np.ndarray | None = None
-        self.split = 0.5
-        self.comparing = False
-        self._dragging_split = False
-        self._update_compare()
-        self.notice = QLabel(self.viewport())
-        self.notice.setObjectName("result-notice")
-        self.notice.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        self.notice.setWordWrap(True)
-        self.notice.setStyleSheet(
-            "QLabel { background: rgba(20, 20, 20, 200); color: white; padding: 12px 18px;"
-            " border-radius: 6px; font-size: 15px; }"
-        )
-        self.notice.hide()
-        # "stale": the result on screen does not match the panel (its render failed); shown along
-        # the top so the pixels stay visible, until a render succeeds
-        self.stale = QLabel(self.viewport())
-        self.stale.setObjectName("result-stale")
-        self.stale.setWordWrap(True)
-        self.stale.setStyleSheet(
-            "QLabel { background: rgba(150, 30, 30, 220); color: white; padding: 6px 10px; font-size: 13px; }"
-        )
-        self.stale.hide()
-
-    def set_stale(self, text: str | None) -> None:
-        """Mark the result as not matching the panel (``text`` says why); None removes the mark."""
-        if not text:
-            self.stale.hide()
-            return
-        self.stale.setText(text)
-        self.stale.setToolTip(text)
-        self._place_stale()
-        self.stale.show()
-
-    def _place_stale(self) -> None:
-        width = self.viewport().width()
-        self.stale.setFixedWidth(width)
-        self.stale.adjustSize()
-        self.stale.move(0, 0)
-
-    def set_notice(self, text: str | None) -> None:
-        """Words shown over the middle of the result (e.g. what a long first run is doing); None hides them."""
-        if not text:
-            self.notice.hide()
-            return
-        self.notice.setText(text)
-        self._place_notice()
-        self.notice.show()
-
-    def _place_notice(self) -> None:
-        vp = self.viewport().rect()
-        text = self.notice.fontMetrics().horizontalAdvance(self.notice.text()) + 48  # + padding
-        width = max(min(vp.width() - 40, text), 120)
-        self.notice.setFixedWidth(width)
-        self.notice.adjustSize()
-        self.notice.move(vp.center().x() - width // 2, vp.center().y() - self.notice.height() // 2)
-
-    def resizeEvent(self, event):  # noqa: N802
-        super().resizeEvent(event)
-        if self.notice.isVisible():
-            self._place_notice()
-        if self.stale.isVisible():
-            self._place_stale()
-
-    def set_compare(self, image: np.ndarray | None) -> None:
-        """The "before" image (e.g. the target), shown left of the divider when comparing (a large
-        one once converted, as :meth:`set_image`)."""
-        if image is not self._before_converter.latest:  # (the same one again: converted once)
-            self._before_converter.request(image)
-
-    def _show_compare(self, image: np.ndarray | None, q: tuple | None, _extra=None) -> None:
-        self.compare_image = image
-        if image is not None:
-            self._before.set_qimage(q)
-        self._update_compare()
-
-    def set_comparing(self, on: bool) -> None:
-        self.comparing = bool(on)
-        self._update_compare()
-
-    def set_split(self, fraction: float) -> None:
-        self.split = float(np.clip(fraction, 0.0, 1.0))
-        self._update_compare()
-
-    def _image_changed(self) -> None:
-        self._update_compare()
-
-    def _update_compare(self) -> None:
-        show = self.comparing and self.compare_image is not None and self.image is not None
-        self._clip.setVisible(show)
-        self._divider.setVisible(show)
-        if not show:
-            return
-        w, h = self.image_size()
-        bw = self._before.qimage().width() or 1
-        bh = self._before.qimage().height() or 1
-        self._before.setTransform(self._before.transform().fromScale(w / bw, h / bh))
-        x = self.split * w
-        self._clip.setRect(QRectF(0, 0, x, h))
-        self._divider.setLine(x, 0, x, h)
-
-    def mousePressEvent(self, event):  # noqa: N802
-        if self.comparing and event.button() == Qt.MouseButton.LeftButton and not self._space:
-            self._dragging_split = True
-            self._drag_split(event)
-            event.accept()
-            return
-        super().mousePressEvent(event)
-
-    def mouseMoveEvent(self, event):  # noqa: N802
-        if self._dragging_split:
-            self._drag_split(event)
-            event.accept()
-            return
-        super().mouseMoveEvent(event)
-
-    def mouseReleaseEvent(self, event):  # noqa: N802
-        if self._dragging_split:
-            self._dragging_split = False
-            event.accept()
-            return
-        super().mouseReleaseEvent(event)
-
-    def _drag_split(self, event) -> None:
-        w, _ = self.image_size()
-        if w:
-            self.set_split(self.mapToScene(event.position().toPoint()).x() / w)
 
 
 def is_image_path(path: str | Path) -> bool:

@@ -95,8 +95,9 @@ def run_item(item: Item) -> Outcome:
     full disk): they become a failed :class:`Outcome` with a one-line reason. Both pools call this.
     """
     from .. import registry
+    from ..geometry import Square
     from ..image import atomic_write_bytes, encode_image
-    from ..run import render
+    from ..request import RenderRequest
 
     worker = f"{os.uname().nodename}:{os.getpid()}" if hasattr(os, "uname") else str(os.getpid())
     t0, c0 = time.perf_counter(), time.process_time()
@@ -116,15 +117,16 @@ def run_item(item: Item) -> Outcome:
                 paths[name] = str(copy)
         cancel = CancelToken(_cancel_event) if _cancel_event is not None else None
         try:
-            result, seconds = render(
-                method, params, paths, item.seed, item.region, cancel=cancel, warm_up=False, shown_paths=item.inputs
-            )
+            region = None if item.region is None else Square._make(item.region)
+            request = RenderRequest(method, params, paths, item.seed, region, shown_paths=item.inputs)
+            rendered = request.run(cancel=cancel)
+            assert rendered is not None  # (a full render always gives a result)
         except WeftError as e:
             message = _one_line(e)
             for name, path in paths.items():  # a shipped copy is named by the file it came from
                 message = message.replace(path, item.inputs[name])
             raise WeftError(message) from None
-        data = encode_image(item.output, result.image, recipe=item.recipe, bit_depth=item.bit_depth)
+        data = encode_image(item.output, rendered.image, recipe=item.recipe, bit_depth=item.bit_depth)
         if item.write:
             os.makedirs(os.path.dirname(item.output), exist_ok=True)
             atomic_write_bytes(Path(item.output), data)
@@ -134,8 +136,8 @@ def run_item(item: Item) -> Outcome:
             item.label,
             item.output,
             "written",
-            seconds=seconds,
-            figures=dict(result.figures),
+            seconds=rendered.seconds,
+            figures=rendered.figures,
             worker=worker,
             data=data,
             elapsed=time.perf_counter() - t0,

@@ -120,7 +120,7 @@ def test_a_session_reads_its_mask_png_and_margins(hole_method, tmp_path):
         )
     )
     data = read_session(session)
-    assert data["geometry"][HOLE.name] == {"hole": mask, "grow": Margins(1, 2, 3, 4)}
+    assert data.geometry[HOLE.name] == {"hole": mask, "grow": Margins(1, 2, 3, 4)}
 
 
 def test_a_session_naming_a_missing_mask_or_bad_margins_says_which(hole_method, tmp_path):
@@ -150,7 +150,7 @@ def test_a_session_read_with_a_dropped_list_leaves_out_a_missing_mask_and_says_s
     )
     dropped = []
     data = read_session(session, dropped=dropped)
-    assert data["geometry"][HOLE.name] == {"grow": Margins(1, 2, 3, 4)}
+    assert data.geometry[HOLE.name] == {"grow": Margins(1, 2, 3, 4)}
     assert len(dropped) == 1 and dropped[0].startswith(f"{session}: hole-test: ") and "gone.png" in dropped[0]
     assert dropped[0].endswith("; dropped")
     session.write_text(

@@ -3,18 +3,19 @@
 import pytest
 from PySide6.QtCore import QSettings
 from weft.app.gui.main_window import MainWindow
+from weft.app.gui.questions import Questions
 
 
 @pytest.fixture(autouse=True)
 def private_recovery(tmp_path, monkeypatch):
     """Every GUI test autosaves into its own folder, and the window's questions are answered yes,
     "restore" to a recovered session, and "discard" to unsaved edits (a test that cares replaces
-    ``MainWindow._confirm`` or ``MainWindow._ask_unsaved`` itself)."""
+    ``Questions.confirm`` or ``Questions.ask_unsaved`` itself)."""
     folder = tmp_path / "recovery"
     monkeypatch.setenv("WEFT_RECOVERY_DIR", str(folder))
-    monkeypatch.setattr(MainWindow, "_confirm", lambda self, question: True)
-    monkeypatch.setattr(MainWindow, "_ask_restore", lambda self, question: True)
-    monkeypatch.setattr(MainWindow, "_ask_unsaved", lambda self, doing: "discard")
+    monkeypatch.setattr(Questions, "confirm", lambda self, question: True)
+    monkeypatch.setattr(Questions, "ask_restore", lambda self, question: True)
+    monkeypatch.setattr(Questions, "ask_unsaved", lambda self, doing: "discard")
     return folder
 
 

@@ -83,7 +83,7 @@ def pretend_crashed(window) -> None:
     from weft.app.gui import recovery
 
     window.files._autosave_timer.stop()
-    lock = recovery.lock_path(window.recovery_file)
+    lock = recovery.lock_path(window.files.recovery_file)
     owner = json.loads(lock.read_text(encoding="utf-8"))
     owner.update(pid=dead_pid(), started=None)
     lock.write_text(json.dumps(owner), encoding="utf-8")

@@ -31,8 +31,8 @@ def main() -> int:
     target, ini = sys.argv[1], sys.argv[2]
     app = QApplication(sys.argv[:1])
     window = MainWindow(settings=QSettings(ini, QSettings.Format.IniFormat))
-    window._confirm = lambda question: False  # never block
-    window._ask_restore = lambda question: False
+    window.questions.confirm = lambda question: False  # never block
+    window.questions.ask_restore = lambda question: False
     window.show()
     window.open_input("target", target)
     state = {"edited": False}
@@ -42,7 +42,7 @@ def main() -> int:
         if not state["edited"]:
             if doc.inputs.get("target") is None or doc.inputs["target"].path != target:
                 return  # the target is still being decoded
-            window.seed_box.setValue(EDITS["seed"])
+            window.method_panel.seed_box.setValue(EDITS["seed"])
             doc.set_param("p", EDITS["p"])
             doc.set_square(tuple(EDITS["prototype"]))  # fast's source region
             doc.set_method("nfpt")  # feature lines belong to the method that uses them
@@ -51,7 +51,7 @@ def main() -> int:
             state["edited"] = True
             return
         try:
-            saved = json.loads(window.recovery_file.read_text(encoding="utf-8"))
+            saved = json.loads(window.files.recovery_file.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             return
         geometry = saved.get("geometry", {})

@@ -36,9 +36,13 @@ def test_unticking_auto_starts_from_the_resolved_value_and_a_disabled_slider_say
     doc = window.doc
     doc.set_method("quilt")  # a transfer (the studio opens a target): block resolves to 9, overlap 3
     qtbot.waitUntil(
-        lambda: "block" in window.params_panel.rows and window.params_panel.row("block").auto.isVisible(), timeout=5000
+        lambda: (
+            "block" in window.method_panel.params_panel.rows
+            and window.method_panel.params_panel.row("block").auto.isVisible()
+        ),
+        timeout=5000,
     )
-    row = window.params_panel.row("block")
+    row = window.method_panel.params_panel.row("block")
     assert row.auto.isChecked() and not row.editor.isEnabled()
     assert "auto" in row.editor.toolTip() and "now 9" in row.editor.toolTip()
     qtbot.mouseClick(row.auto, Qt.MouseButton.LeftButton)
@@ -60,7 +64,7 @@ def test_every_dock_is_in_the_view_menu_and_reset_layout_restores_it(window, qtb
     from PySide6.QtWidgets import QAbstractButton, QDockWidget
 
     docks = window.findChildren(QDockWidget)
-    menu = window.view_menu
+    menu = window.menus.view_menu
     assert {d.toggleViewAction() for d in docks} <= set(menu.actions())
     method = window.method_dock
     close = method.findChild(QAbstractButton, "qt_dockwidget_closebutton")
@@ -76,7 +80,7 @@ def test_every_dock_is_in_the_view_menu_and_reset_layout_restores_it(window, qtb
         window.examples_dock.findChild(QAbstractButton, "qt_dockwidget_closebutton"), Qt.MouseButton.LeftButton
     )
     qtbot.waitUntil(lambda: not window.examples_dock.isVisible(), timeout=5000)
-    _click_menu_item(qtbot, menu, window.reset_layout_action)
+    _click_menu_item(qtbot, menu, window.menus.reset_layout_action)
     qtbot.waitUntil(lambda: all(d.isVisible() and not d.isFloating() for d in docks), timeout=5000)
     assert window.dockWidgetArea(method) == Qt.DockWidgetArea.RightDockWidgetArea
     assert window.dockWidgetArea(window.examples_dock) == Qt.DockWidgetArea.LeftDockWidgetArea
@@ -85,7 +89,7 @@ def test_every_dock_is_in_the_view_menu_and_reset_layout_restores_it(window, qtb
 def test_zoom_shortcuts_act_on_the_view_under_the_mouse_and_the_label_shows_its_zoom(window, qtbot):
     from .helpers import mouse
 
-    result, canvas = window.result_view, window.canvas_view
+    result, canvas = window.result_view, window.inputs_pane.canvas_view
     canvas.setFocus()  # the keyboard focus is on the canvas ...
     qtbot.waitUntil(canvas.hasFocus, timeout=5000)
     canvas_scale = canvas.scale_factor()
@@ -95,14 +99,14 @@ def test_zoom_shortcuts_act_on_the_view_under_the_mouse_and_the_label_shows_its_
     qtbot.keyClick(window, Qt.Key.Key_1, Qt.KeyboardModifier.ControlModifier)  # Actual Size
     qtbot.waitUntil(lambda: abs(result.scale_factor() - 1.0) < 1e-6, timeout=5000)
     assert canvas.scale_factor() == canvas_scale
-    assert window.zoom_label.text() == "result 100%"
+    assert window.status.zoom_label.text() == "result 100%"
     cw, ch = canvas.image_size()
     mouse(canvas, "move", (cw / 2, ch / 2))
-    assert window.zoom_label.text() == f"{canvas.title} {canvas_scale * 100:.0f}%"
+    assert window.status.zoom_label.text() == f"{canvas.title} {canvas_scale * 100:.0f}%"
     qtbot.keyClick(window, Qt.Key.Key_Plus, Qt.KeyboardModifier.ControlModifier)  # Zoom In
     qtbot.waitUntil(lambda: abs(canvas.scale_factor() - canvas_scale * 1.25) < 1e-6, timeout=5000)
     assert abs(result.scale_factor() - 1.0) < 1e-6
-    assert window.zoom_label.text() == f"{canvas.title} {canvas_scale * 125:.0f}%"
+    assert window.status.zoom_label.text() == f"{canvas.title} {canvas_scale * 125:.0f}%"
 
 
 def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(window, qtbot):
@@ -110,7 +114,7 @@ def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(wind
     target = doc.image("target")
     assert window.renderer.last.image.shape[:2] == target.shape[:2]  # a transfer onto the target
     box = window.inputs_pane.box("target")
-    window.input_tabs.setCurrentWidget(box)
+    window.inputs_pane.tabs.setCurrentWidget(box)
     qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
     assert not window.inputs_pane.box("texture").clear_button.isVisible()  # required: no Clear
     with qtbot.waitSignal(
@@ -121,8 +125,8 @@ def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(wind
         qtbot.mouseClick(box.clear_button, Qt.MouseButton.LeftButton)
     assert doc.image("target") is None and not box.clear_button.isEnabled()
     assert window.renderer.last.image.shape[:2] != target.shape[:2]  # plain synthesis now
-    assert [a.text() for a in window.clear_input_menu.actions()] == ["target", "mask"]  # File > Clear Input
-    assert not window.clear_input_menu.isEnabled()  # neither is open now
+    assert [a.text() for a in window.menus.clear_input_menu.actions()] == ["target", "mask"]  # File > Clear Input
+    assert not window.menus.clear_input_menu.isEnabled()  # neither is open now
     with qtbot.waitSignal(
         window.renderer.shown,
         timeout=20000,
@@ -154,11 +158,11 @@ def _click_in_box_when_shown(qtbot, button):
 
 def test_quitting_with_unsaved_edits_offers_save_discard_cancel(window, qtbot, monkeypatch, tmp_path):
     from PySide6.QtWidgets import QFileDialog, QMessageBox
-    from weft.app.gui.main_window import MainWindow
+    from weft.app.gui.questions import Questions
 
     monkeypatch.undo()  # the real question, not the conftest's answer ...
     monkeypatch.setenv("WEFT_RECOVERY_DIR", str(tmp_path / "recovery"))  # ... with a private autosave
-    monkeypatch.setattr(MainWindow, "_confirm", lambda self, question: True)
+    monkeypatch.setattr(Questions, "confirm", lambda self, question: True)
     window.doc.set_param("p", 0.5)
     seen = _click_in_box_when_shown(qtbot, QMessageBox.StandardButton.Cancel)
     qtbot.keyClick(window, Qt.Key.Key_Q, Qt.KeyboardModifier.ControlModifier)  # File > Quit
@@ -200,7 +204,7 @@ def test_square_handles_keep_their_size_on_screen_through_zooming(window, qtbot)
 
     from .helpers import drag, mouse
 
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     drag(view, (20, 20), (60, 60))  # a source square on the texture
     qtbot.waitUntil(lambda: window.doc.square is not None, timeout=5000)
     tool = view.tool
@@ -244,7 +248,7 @@ def test_a_result_of_another_size_refits_unless_the_user_zoomed(window, qtbot):
     old = view.image_size()
     assert _fills_view(view)
     box = window.inputs_pane.box("target")
-    window.input_tabs.setCurrentWidget(box)
+    window.inputs_pane.tabs.setCurrentWidget(box)
     qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
     qtbot.mouseClick(box.clear_button, Qt.MouseButton.LeftButton)  # synthesis: twice the texture
     qtbot.waitUntil(lambda: view.image_size() != old and window.renderer.last.final, timeout=20000)
@@ -262,7 +266,7 @@ def test_variations_default_to_ranges_near_the_resolved_values_fit_the_screen_an
 
     window.doc.set_method("quilt")  # a transfer: block resolves to 9, overlap to 3 (texture 112x128)
     qtbot.mouseClick(window.method_panel.variations_button, Qt.MouseButton.LeftButton)
-    dialog = window._variations
+    dialog = window.variations
     qtbot.waitUntil(dialog.isVisible, timeout=5000)
     assert [dialog._spec(0).name, dialog._spec(1).name] == ["block", "overlap"]
     assert (dialog.lo[0].value(), dialog.hi[0].value()) == (5, 13) and dialog.lo[0].decimals() == 0
@@ -332,9 +336,11 @@ def test_quad_says_on_screen_which_corner_to_click(window, qtbot):
     from .helpers import mouse
 
     window.doc.set_method("nfpt")
-    qtbot.waitUntil(lambda: window.lines_panel is not None and window.lines_panel.active, timeout=5000)
-    panel = window.lines_panel
-    window.input_tabs.setCurrentWidget(panel)
+    qtbot.waitUntil(
+        lambda: window.inputs_pane.lines_panel is not None and window.inputs_pane.lines_panel.active, timeout=5000
+    )
+    panel = window.inputs_pane.lines_panel
+    window.inputs_pane.tabs.setCurrentWidget(panel)
     qtbot.mouseClick(panel.quad_button, Qt.MouseButton.LeftButton)
     assert "top-left corner" in panel.rectify_status.text() and "1 of 4" in panel.rectify_status.text()
     view = panel.photo_view
@@ -352,7 +358,7 @@ def test_the_square_thumbnail_is_labelled(window, qtbot):
 
     caption = window.method_panel.square_caption
     assert caption.isVisible() and caption.text() == "source region: none drawn"
-    drag(window.canvas_view, (20, 20), (60, 60))
+    drag(window.inputs_pane.canvas_view, (20, 20), (60, 60))
     qtbot.waitUntil(lambda: window.doc.square is not None, timeout=5000)
     assert caption.text() == f"source region {window.doc.square[2]} px"
     window.doc.set_method("affine")
@@ -392,7 +398,7 @@ def test_a_long_render_shows_an_estimate_of_the_time_left(window, qtbot, monkeyp
 
     monkeypatch.setitem(window.doc.methods, "fast", dataclasses.replace(window.doc.methods["fast"], run=run))
     qtbot.keyClick(window, Qt.Key.Key_F5)
-    bar = window.progress_bar
+    bar = window.status.progress_bar
     qtbot.waitUntil(lambda: bar.isVisible() and "left" in bar.format(), timeout=15000)
     import re
 
@@ -413,7 +419,9 @@ def test_the_zoom_label_follows_a_refit_when_the_window_is_resized(window, qtbot
     before = result.scale_factor()
     window.resize(window.width() + 300, window.height() + 200)
     qtbot.waitUntil(lambda: abs(result.scale_factor() - before) > 0.01, timeout=5000)
-    qtbot.waitUntil(lambda: window.zoom_label.text() == f"result {result.scale_factor() * 100:.0f}%", timeout=5000)
+    qtbot.waitUntil(
+        lambda: window.status.zoom_label.text() == f"result {result.scale_factor() * 100:.0f}%", timeout=5000
+    )
 
 
 def test_auto_block_follows_the_sample_and_its_source_region(window, qtbot):
@@ -426,12 +434,16 @@ def test_auto_block_follows_the_sample_and_its_source_region(window, qtbot):
     doc.set_method("quilt")
     doc.clear_input("target")  # a synthesis: the wood-grain sample, 128x112
     qtbot.waitUntil(
-        lambda: "block" in window.params_panel.rows and window.params_panel.row("block").auto.isVisible(), timeout=5000
+        lambda: (
+            "block" in window.method_panel.params_panel.rows
+            and window.method_panel.params_panel.row("block").auto.isVisible()
+        ),
+        timeout=5000,
     )
-    row = window.params_panel.row("block")
+    row = window.method_panel.params_panel.row("block")
     qtbot.waitUntil(lambda: "now 49" in row.editor.toolTip(), timeout=5000)  # 7/16 of 112
-    view = window.views["texture"]
-    window.input_tabs.setCurrentIndex(0)
+    view = window.inputs_pane.views["texture"]
+    window.inputs_pane.tabs.setCurrentIndex(0)
     view.actual_size()
     view.centerOn(40, 40)
     drag(view, (8.2, 8.2), (72.2, 72.2))
@@ -457,8 +469,8 @@ def test_a_slider_runs_only_over_what_the_open_inputs_allow(window, qtbot, tmp_p
     qtbot.waitUntil(
         lambda: doc.image("texture") is not None and doc.image("texture").shape[:2] == (128, 112), timeout=10000
     )
-    qtbot.waitUntil(lambda: window.params_panel.row("block").auto.isVisible(), timeout=5000)
-    row = window.params_panel.row("block")
+    qtbot.waitUntil(lambda: window.method_panel.params_panel.row("block").auto.isVisible(), timeout=5000)
+    row = window.method_panel.params_panel.row("block")
     qtbot.mouseClick(row.auto, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: doc.current_params.block is not None, timeout=5000)
     assert row.editor.maximum() == 112
@@ -476,5 +488,5 @@ def test_a_slider_runs_only_over_what_the_open_inputs_allow(window, qtbot, tmp_p
         timeout=60000,
     )
     assert not window.result_view.stale.isVisible()
-    overlap = window.params_panel.row("overlap")
+    overlap = window.method_panel.params_panel.row("overlap")
     assert overlap.editor.maximum() == 111  # smaller than the block

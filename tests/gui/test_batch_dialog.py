@@ -46,7 +46,7 @@ def test_apply_to_folder_writes_what_weft_run_writes(window, qtbot, tmp_path):
     with qtbot.waitSignal(dialog.batch_finished, timeout=120000) as done:
         qtbot.mouseClick(dialog.run_button, Qt.MouseButton.LeftButton)
         assert dialog.running and dialog.cancel_button.isEnabled() and not dialog.run_button.isEnabled()
-        window.new_seed()  # the studio stays usable; the running batch keeps the recipe it started with
+        window.method_panel.new_seed()  # the studio stays usable; the running batch keeps the recipe it started with
     assert done.args == ["4 written", 0, False]
     assert dialog.status.text() == "4 written" and dialog.progress.value() == 4
     assert dialog.run_button.isEnabled() and not dialog.cancel_button.isEnabled()
@@ -112,11 +112,14 @@ def test_a_refused_batch_says_why_in_one_line(window, qtbot, tmp_path):
     assert dialog.status.text() == "choose a folder of images first" and not dialog.running
     (tmp_path / "empty").mkdir()
     qtbot.keyClicks(dialog.folder, str(tmp_path / "empty"))
+    before = set(threading.enumerate())
     with qtbot.waitSignal(dialog.batch_finished, timeout=60000) as done:
         qtbot.mouseClick(dialog.run_button, Qt.MouseButton.LeftButton)
     assert done.args[1] == -1
     assert "the folder holds no image files" in dialog.status.text()
     assert "\n" not in dialog.status.text() and dialog.run_button.isEnabled()
+    # the batch's worker thread ends with the batch (none left behind by the dialog)
+    qtbot.waitUntil(lambda: not (set(threading.enumerate()) - before), timeout=10000)
 
 
 def test_nothing_to_apply_before_a_full_size_result(qtbot, settings):

@@ -41,7 +41,7 @@ def test_a_16_bit_source_exports_16_bit_png_and_weft_run_reproduces_it(window, q
     with qtbot.waitSignal(window.renderer.shown, timeout=60000, check_params_cb=lambda s: s.final):
         doc.set_mask(g.key, Mask.empty(w, h).painted_line((30, 30), (60, 34), 6), "Brush stroke")
     out = tmp_path / "out.png"
-    assert window.export_result(str(out))
+    assert window.files.export_result(str(out))
     assert file_bit_depth(out) == 16
     assert json.loads(read_recipe(out))["bit_depth"] == 16
     again = tmp_path / "again.png"
@@ -52,7 +52,7 @@ def test_a_16_bit_source_exports_16_bit_png_and_weft_run_reproduces_it(window, q
 
 def test_an_8_bit_source_exports_8_bit_png_that_records_it(window, qtbot, tmp_path, capsys):
     out = tmp_path / "out.png"
-    assert window.export_result(str(out))
+    assert window.files.export_result(str(out))
     assert file_bit_depth(out) == 8 and json.loads(read_recipe(out))["bit_depth"] == 8
     again = tmp_path / "again.png"
     assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
@@ -86,7 +86,7 @@ def test_transparency_shows_as_a_checkerboard_with_its_outline(window, qtbot, tm
     qtbot.waitUntil(
         lambda: doc.item(doc.studio.canvas) is not None and doc.item(doc.studio.canvas).path == str(path), timeout=10000
     )
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     qtbot.waitUntil(lambda: view.image is not None and view.image.shape[:2] == (72, 96), timeout=5000)
     view.actual_size()
     view.zoom_by(4.0)
@@ -117,18 +117,18 @@ def test_the_pixel_read_out_counts_0_255_and_0_65535_for_16_bit(window, qtbot, t
     view.centerOn(10.5, 20.5)
     mouse(view, "move", (10.5, 20.5), buttons=Qt.MouseButton.NoButton)
     expected = " ".join(str(int(round(float(c) * 255))) for c in view.image[20, 10])
-    assert window.pixel_label.toolTip() == f"result  x 10  y 20  {expected}"
+    assert window.status.pixel_label.toolTip() == f"result  x 10  y 20  {expected}"
     source = _picture16(tmp_path / "deep.png")
     doc = window.doc
     window.open_input(doc.studio.canvas, str(source))
-    canvas = window.canvas_view
+    canvas = window.inputs_pane.canvas_view
     qtbot.waitUntil(lambda: canvas.image is not None and canvas.image.shape[:2] == (72, 96), timeout=10000)
     canvas.actual_size()
     canvas.zoom_by(4.0)
     canvas.centerOn(40.5, 30.5)
     mouse(canvas, "move", (40.5, 30.5), buttons=Qt.MouseButton.NoButton)
     stored = cv2.imread(str(source), cv2.IMREAD_UNCHANGED)[30, 40][::-1]  # (BGR -> RGB)
-    assert window.pixel_label.toolTip() == (
+    assert window.status.pixel_label.toolTip() == (
         f"{canvas.title}  x 40  y 30  {' '.join(str(int(v)) for v in stored)}  (16-bit)"
     )
-    assert window.pixel_label.text() == window.pixel_label.toolTip()  # whole, not elided
+    assert window.status.pixel_label.text() == window.status.pixel_label.toolTip()  # whole, not elided

@@ -133,7 +133,7 @@ def studio(plugin, qtbot, make_window, tmp_path):
     picture = _picture(tmp_path / "picture.png")
     window = _window_on(make_window, plugin.name, qtbot, picture)
     assert window.doc.image("picture") is not None
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     view.actual_size()
     view.zoom_by(4.0)
     view.centerOn(W / 2, H / 2)
@@ -186,8 +186,8 @@ def test_with_nothing_painted_the_result_shows_the_picture_and_what_to_do(studio
 
 
 def test_the_mask_input_is_painted_over_its_image_not_a_view_of_its_own(studio):
-    assert "hole" not in studio.views
-    tabs = [studio.input_tabs.tabText(i) for i in range(studio.input_tabs.count())]
+    assert "hole" not in studio.inputs_pane.views
+    tabs = [studio.inputs_pane.tabs.tabText(i) for i in range(studio.inputs_pane.tabs.count())]
     assert not any("hole" in t for t in tabs)
     bar = studio.inputs_pane.bar()
     assert bar is not None and bar.isVisible()
@@ -196,7 +196,7 @@ def test_the_mask_input_is_painted_over_its_image_not_a_view_of_its_own(studio):
 
 
 def test_a_brush_stroke_paints_the_pixels_under_it_and_is_one_undo_step(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     tool = studio.inputs_pane.mask_tool()
     tool.set_size(5)  # radius 2
     steps = doc.undo_stack.count()
@@ -226,7 +226,7 @@ def test_a_brush_stroke_paints_the_pixels_under_it_and_is_one_undo_step(studio, 
 
 
 def test_square_brackets_size_the_brush_and_its_circle_cursor(studio, qtbot):
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     tool = studio.inputs_pane.mask_tool()
     bar = studio.inputs_pane.bar()
     tool.set_size(8)
@@ -259,7 +259,7 @@ def test_square_brackets_size_the_brush_and_its_circle_cursor(studio, qtbot):
 
 
 def test_the_eraser_removes_and_esc_cancels_a_stroke_in_progress(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     tool = studio.inputs_pane.mask_tool()
     bar = studio.inputs_pane.bar()
     tool.set_size(9)
@@ -286,7 +286,7 @@ def test_the_eraser_removes_and_esc_cancels_a_stroke_in_progress(studio, qtbot):
 
 
 def test_the_lasso_adds_and_subtracts_a_polygon(studio, qtbot):
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     bar = studio.inputs_pane.bar()
     qtbot.mouseClick(bar.mode_buttons["lasso add"], Qt.MouseButton.LeftButton)
     square = [(10.5, 10.5), (40.5, 10.5), (40.5, 40.5), (10.5, 40.5)]
@@ -302,7 +302,7 @@ def test_the_lasso_adds_and_subtracts_a_polygon(studio, qtbot):
 
 
 def test_clear_and_invert_are_undoable(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     bar = studio.inputs_pane.bar()
     studio.inputs_pane.mask_tool().set_size(5)
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
@@ -339,7 +339,7 @@ def test_fill_transparent_paints_the_images_transparent_pixels(studio, qtbot, tm
 
 
 def test_a_mask_that_no_longer_fits_its_image_is_dropped_with_a_message(studio, qtbot, tmp_path):
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     painted = _mask(studio)
     other = tmp_path / "other.png"
@@ -354,12 +354,12 @@ def test_a_mask_that_no_longer_fits_its_image_is_dropped_with_a_message(studio, 
 
 
 def test_session_save_and_open_restores_the_mask_and_margins(studio, qtbot, tmp_path):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 25.5)]))
     doc.set_margins("grow", Margins(4, 0, 8, 2))
     painted = _mask(studio)
     session = tmp_path / "s.weft.json"
-    assert studio.save_session(str(session))
+    assert studio.files.save_session(str(session))
     png = tmp_path / "s.weft.mean-fill.hole.png"
     assert png.is_file() and Mask.read(png) == painted
     from PIL import Image
@@ -367,18 +367,18 @@ def test_session_save_and_open_restores_the_mask_and_margins(studio, qtbot, tmp_
     assert Image.open(png).mode == "1"  # a 1-bit PNG
     doc.set_mask("hole", None, "Clear mask")
     doc.set_margins("grow", None)
-    assert studio.open_session(str(session))
+    assert studio.files.open_session(str(session))
     assert _mask(studio) == painted and doc.value("grow") == Margins(4, 0, 8, 2)
     assert studio.inputs_pane.mask_tool().overlay.image().width() == W
 
 
 def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(studio, qtbot, tmp_path, capsys):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     _final_after(studio, qtbot, lambda: _stroke(view, [(15.5, 15.5), (35.5, 40.5)]))
     _final_after(studio, qtbot, lambda: doc.set_margins("grow", Margins(6, 0, 0, 3)))
     painted = _mask(studio)
     out = tmp_path / "out.png"
-    assert studio.export_result(str(out))
+    assert studio.files.export_result(str(out))
     beside = tmp_path / "out.hole.png"
     assert beside.is_file() and Mask.read(beside) == painted
     recipe = read_recipe(out)
@@ -389,7 +389,7 @@ def test_export_writes_the_mask_beside_it_and_weft_run_reproduces_the_pixels(stu
     assert exported.shape == (H + 3, W + 6, 3)
     assert np.array_equal(exported, load_image(again).image)
     # a recipe exported alone gets its mask beside it too
-    assert studio.export_recipe(str(tmp_path / "r.json"))
+    assert studio.files.export_recipe(str(tmp_path / "r.json"))
     assert Mask.read(tmp_path / "r.hole.png") == painted
 
 
@@ -415,23 +415,23 @@ def test_mask_pngs_are_encoded_and_decoded_off_the_gui_thread(
     monkeypatch.setattr(Mask, "to_png", encode)
     monkeypatch.setattr(Mask, "read", classmethod(decode))
     studio.files._autosave_timer.setInterval(10**7)  # no autosave until asked for below
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     _final_after(studio, qtbot, lambda: _stroke(view, [(15.5, 15.5), (35.5, 40.5)]))
     painted = _mask(studio)
     out = tmp_path / "out.png"
-    assert studio.export_result(str(out))
-    assert studio.export_recipe(str(tmp_path / "r.json"))
+    assert studio.files.export_result(str(out))
+    assert studio.files.export_recipe(str(tmp_path / "r.json"))
     session = tmp_path / "s.weft.json"
-    assert studio.save_session(str(session))
+    assert studio.files.save_session(str(session))
     assert len(threads["encode"]) == 3 and not any(threads["encode"])
     # the autosave (its timer's): off the GUI thread, and nothing waits for it
     doc.set_margins("grow", Margins(0, 0, 2, 0))
     studio.files._autosave_timer.setInterval(10)
-    recovery = studio.recovery_file.with_name(studio.recovery_file.name[:-5] + ".mean-fill.hole.png")
-    qtbot.waitUntil(lambda: studio.recovery_file.is_file() and recovery.is_file(), timeout=10000)
+    recovery = studio.files.recovery_file.with_name(studio.files.recovery_file.name[:-5] + ".mean-fill.hole.png")
+    qtbot.waitUntil(lambda: studio.files.recovery_file.is_file() and recovery.is_file(), timeout=10000)
     assert len(threads["encode"]) == 4 and not any(threads["encode"])
     doc.set_mask("hole", None, "Clear mask")
-    assert studio.open_session(str(session))
+    assert studio.files.open_session(str(session))
     assert threads["decode"] == [False] and _mask(studio) == painted  # bit-exact
     assert Mask.read(tmp_path / "out.hole.png") == painted and Mask.read(tmp_path / "r.hole.png") == painted
     again = tmp_path / "again.png"
@@ -468,7 +468,7 @@ def _screen_drag(view, start_scene, steps_px, *, last=True, modifiers=Qt.Keyboar
 
 
 def test_extend_canvas_by_dragging_an_edge_outward(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     view.fit()  # the whole image with room around it
     tool = studio.inputs_pane.margins_tool()
     studio.inputs_pane.mask_tool().set_size(1)  # presses 1 px outside the image: beyond the brush's circle
@@ -493,7 +493,7 @@ def test_a_brush_press_just_outside_the_image_paints_and_farther_out_or_with_shi
     """The rule (mask_tools' docstring): outside the image a brush or eraser press paints while the
     brush's circle covers a pixel of the image; farther out, or with Shift, it drags the canvas edges;
     the pointer says which before the press (the brush's circle, or a resize arrow)."""
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     view.fit()
     tool, margins = studio.inputs_pane.mask_tool(), studio.inputs_pane.margins_tool()
     tool.set_size(9)  # its circle reaches 4.5 px: the centres of the last column from up to 4 px outside
@@ -562,7 +562,7 @@ def test_square_brackets_size_the_brush_wherever_the_focus_is_but_a_text_field_k
     qtbot.keyClick(slider, Qt.Key.Key_BracketLeft)
     assert tool.size == 16
     # Edit > Mask and Canvas lists them with their keys
-    texts = {a.text(): a.shortcut().toString() for a in studio.geometry_menu.actions()}
+    texts = {a.text(): a.shortcut().toString() for a in studio.menus.geometry_menu.actions()}
     assert texts["Smaller brush"] == "[" and texts["Larger brush"] == "]"
     # a text field keeps its keys
     field = QLineEdit(studio.method_panel)
@@ -575,7 +575,7 @@ def test_square_brackets_size_the_brush_wherever_the_focus_is_but_a_text_field_k
 
 def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
     bar = studio.inputs_pane.bar()
-    _click_menu_item(qtbot, studio.geometry_menu, bar.extend_action)  # Edit > Mask and Canvas > Extend canvas…
+    _click_menu_item(qtbot, studio.menus.geometry_menu, bar.extend_action)  # Edit > Mask and Canvas > Extend canvas…
     dialog = bar.dialog
     qtbot.waitUntil(dialog.isVisible, timeout=5000)
     for side, value in zip(("left", "top", "right", "bottom"), (3, 5, 0, 12), strict=True):
@@ -593,14 +593,14 @@ def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
 def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
     from weft.core.studio import AROUND_SIDE
 
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     CALLS.clear()
     around = _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     shown = around[-1]
     assert not shown.final and shown.image.shape == (H, W, 3)
     assert CALLS and max(CALLS[0]) < max(H, W) and max(CALLS[0]) <= AROUND_SIDE  # a crop, not the whole picture
-    live = studio.doc.live[1]
+    live = studio.doc.live.value
     assert np.array_equal(_painted(studio.inputs_pane.mask_tool().overlay), live.bits)  # drawn as it is painted
     # the stroke so far is filled in the preview, pasted into the picture (no full result yet: nothing
     # was painted before)
@@ -631,10 +631,10 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
     says the figures come on release (test_a_strokes_preview_states_only_figures_of_the_whole_image)."""
     import re
 
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
-    text = studio.result_label.full_text()
+    text = studio.status.result_label.full_text()
     # (a count of pixels describes the crop, not the picture: only the full result states it)
     assert re.fullmatch(
         r"preview around the stroke in \d+ ms — its \d+x\d+ crop( \(rendered at \d+x\d+\))?; "
@@ -642,21 +642,21 @@ def test_previews_say_their_figures_in_the_methods_words_as_the_full_result_does
         text,
     ), text
     result = _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
-    assert studio.result_label.full_text().endswith(f"— filled {result.figures['hole_pixels']} px")
+    assert studio.status.result_label.full_text().endswith(f"— filled {result.figures['hole_pixels']} px")
     previews, text = _slider_previewed(studio, qtbot, "amount")  # a slider's preview
     assert re.fullmatch(rf"preview {W}x{H} in \d+ ms — filled {previews[-1].figures['hole_pixels']} px", text), text
     qtbot.waitUntil(lambda: not studio.renderer.running(), timeout=10000)  # (its release render ends the test)
 
 
 def test_a_session_whose_mask_no_longer_fits_its_image_opens_without_it_and_says_so(studio, qtbot, tmp_path):
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     session = tmp_path / "s.weft.json"
-    assert studio.save_session(str(session))
+    assert studio.files.save_session(str(session))
     save_image(studio.picture, np.random.default_rng(9).random((40, 40, 3)).astype(np.float32))  # the file changed
     messages = []
     studio.message.connect(messages.append)
-    assert studio.open_session(str(session))
+    assert studio.files.open_session(str(session))
     assert _mask(studio) is None and studio.doc.image("picture").shape == (40, 40, 3)
     assert any("must be the size of its image" in m and m.endswith("dropped") for m in messages)
 
@@ -664,12 +664,12 @@ def test_a_session_whose_mask_no_longer_fits_its_image_opens_without_it_and_says
 def test_unsaved_masks_and_margins_reach_the_recovery_file(studio, qtbot, settings, private_recovery):
     from weft.app.gui.main_window import MainWindow
 
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 28.5)]))
     doc.set_margins("grow", Margins(0, 2, 0, 0))
     painted = _mask(studio)
-    assert studio.autosave()
-    file = studio.recovery_file
+    assert studio.files.autosave()
+    file = studio.files.recovery_file
     hole = file.with_name(file.name[:-5] + ".mean-fill.hole.png")
     assert hole.is_file()
     # a new window (the first one "crashed") offers the recovery and gets the mask back
@@ -680,7 +680,7 @@ def test_unsaved_masks_and_margins_reach_the_recovery_file(studio, qtbot, settin
         assert again.doc.method == "mean-fill" and again.doc.value("hole") == painted
         assert again.doc.value("grow") == Margins(0, 2, 0, 0)
         again.doc.undo_stack.setClean()  # saved: the recovery file and its mask go
-        again.files._schedule_autosave()
+        again.files.schedule_autosave()
         assert not file.exists() and not hole.exists()
     finally:
         again.shutdown()
@@ -701,7 +701,7 @@ def _swatch_opened_for_another_method(studio, qtbot, tmp_path):
 def test_an_own_input_opened_for_another_method_is_not_used(studio, qtbot, tmp_path):
     """mean-fill's optional "swatch" is its own (Studio.own_inputs): the swatch opened for another
     method of the studio does not change its fill; one opened for it does."""
-    doc, view = studio.doc, studio.canvas_view
+    doc, view = studio.doc, studio.inputs_pane.canvas_view
     swatch = _swatch_opened_for_another_method(studio, qtbot, tmp_path)
     assert doc.image("swatch") is None and "swatch" not in doc.method_inputs()
     studio.inputs_pane.mask_tool().set_size(5)
@@ -718,13 +718,13 @@ def test_an_own_input_opened_for_another_method_stays_its_through_a_session(stud
     """Saved and reopened (or recovered) with mean-fill current, the swatch opened for another method
     is still not mean-fill's (seen under Xvfb: after a recovery, the brick open for quilt filled a
     gravel hole in fill, because a restored session counted every own input as the current method's)."""
-    doc, view = studio.doc, studio.canvas_view
+    doc, view = studio.doc, studio.inputs_pane.canvas_view
     _swatch_opened_for_another_method(studio, qtbot, tmp_path)
     studio.inputs_pane.mask_tool().set_size(5)
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     session = tmp_path / "s.weft.json"
-    assert studio.save_session(str(session))
-    result = _final_after(studio, qtbot, lambda: studio.open_session(str(session)))
+    assert studio.files.save_session(str(session))
+    result = _final_after(studio, qtbot, lambda: studio.files.open_session(str(session)))
     assert doc.method == MEAN_FILL.name and doc.image("swatch") is None
     bits = _mask(studio).bits
     picture = doc.image("picture")
@@ -736,13 +736,13 @@ def test_an_own_input_opened_for_another_method_stays_its_through_a_session(stud
 def _slider_previewed(studio, qtbot, name: str):
     """Hold parameter ``name``'s slider down and move it a quarter of its range, as a hand does, until
     its first preview shows, then release it: ``(the previews shown, the status text meanwhile)``."""
-    slider = studio.params_panel.row(name).editor
+    slider = studio.method_panel.params_panel.row(name).editor
     previews = []
     studio.renderer.shown.connect(lambda shown: previews.append(shown) if not shown.final else None)
     slider.setSliderDown(True)
     slider.setValue(slider.value() - max(1, (slider.maximum() - slider.minimum()) // 4))
     qtbot.waitUntil(lambda: len(previews) > 0, timeout=10000)
-    text = studio.result_label.full_text()
+    text = studio.status.result_label.full_text()
     slider.setSliderDown(False)
     slider.sliderReleased.emit()
     return previews, text
@@ -773,7 +773,7 @@ def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, ma
     with _fill_in_the_studio(make_window, qtbot) as window:
         assert window.doc.image("texture") is None  # the other methods' texture is not fill's source
         assert window.result_view.notice.isVisible() and "Paint what to fill" in window.result_view.notice.text()
-        view, doc = window.canvas_view, window.doc
+        view, doc = window.inputs_pane.canvas_view, window.doc
         image = doc.image("image")
         h, w = image.shape[:2]
         view.actual_size()
@@ -793,7 +793,7 @@ def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, ma
         assert np.array_equal(result.image[~near], image[~near])  # known pixels outside the blend band untouched
         assert not np.allclose(result.image[hole], image[hole])
         out = tmp_path / "filled.png"
-        assert window.export_result(str(out))
+        assert window.files.export_result(str(out))
         assert (tmp_path / "filled.mask.png").is_file()
         again = tmp_path / "again.png"
         assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
@@ -832,7 +832,7 @@ def test_an_image_opened_as_another_methods_input_of_the_masks_name_stays_out_of
     assert result.figures["hole_pixels"] == 8 * H  # the margins only: show-hole's image is no hole here
     assert "hole" not in result.recipe.inputs and set(result.recipe.inputs) == {"picture"}
     out = tmp_path / "out.png"
-    assert studio.export_result(str(out))
+    assert studio.files.export_result(str(out))
     assert "hole" not in read_recipe(out)
     again = tmp_path / "again.png"
     assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
@@ -872,7 +872,7 @@ def test_with_the_input_shown_instead_of_a_result_export_and_copy_refuse(studio,
         qtbot.keyClick(studio, Qt.Key.Key_B, Qt.KeyboardModifier.ControlModifier | Qt.KeyboardModifier.ShiftModifier)
     assert said.args == ["nothing to apply: paint the hole; drag an edge outward"]
     # a fill, then Clear mask: the picture again, and the fill from before is not exported either
-    view, bar = studio.canvas_view, studio.inputs_pane.bar()
+    view, bar = studio.inputs_pane.canvas_view, studio.inputs_pane.bar()
     studio.inputs_pane.mask_tool().set_size(9)
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (40.5, 20.5)]))
     with qtbot.waitSignal(studio.renderer.failed, timeout=10000):
@@ -881,7 +881,7 @@ def test_with_the_input_shown_instead_of_a_result_export_and_copy_refuse(studio,
     with qtbot.waitSignal(studio.message, timeout=5000) as said:
         qtbot.keyClick(studio, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier)
     assert said.args == [words] and not out.exists()
-    assert not studio.export_recipe(str(tmp_path / "r.json")) and not (tmp_path / "r.json").exists()
+    assert not studio.files.export_recipe(str(tmp_path / "r.json")) and not (tmp_path / "r.json").exists()
     # a result again: exported
     _final_after(studio, qtbot, lambda: studio.doc.set_margins("grow", Margins(0, 0, 4, 0)))
     qtbot.keyClick(studio, Qt.Key.Key_E, Qt.KeyboardModifier.ControlModifier)
@@ -890,7 +890,7 @@ def test_with_the_input_shown_instead_of_a_result_export_and_copy_refuse(studio,
 
 def test_esc_on_the_first_stroke_after_a_method_switch_shows_the_picture_again(studio, qtbot, tmp_path):
     _switch_to_mean_fill_from_show_swatch(studio, qtbot, tmp_path)
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     view.actual_size()
     view.zoom_by(4.0)
     view.centerOn(W / 2, H / 2)
@@ -908,7 +908,7 @@ def test_esc_on_the_first_stroke_after_a_method_switch_shows_the_picture_again(s
 
 
 def test_a_stroke_that_changes_nothing_ends_its_preview_with_no_undo_step(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     studio.inputs_pane.mask_tool().set_size(9)
     result = _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (40.5, 20.5)]))
     steps = doc.undo_stack.count()
@@ -923,14 +923,14 @@ def test_a_stroke_that_changes_nothing_ends_its_preview_with_no_undo_step(studio
 
 
 def test_an_eraser_stroke_is_previewed_live(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     tool, bar = studio.inputs_pane.mask_tool(), studio.inputs_pane.bar()
     tool.set_size(9)
     _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 30.5), (60.5, 30.5)]))
     qtbot.mouseClick(bar.mode_buttons["eraser"], Qt.MouseButton.LeftButton)
     tool.set_size(5)
     around = _previewed(studio, qtbot, view, [(35.5, 24.5), (35.5, 36.5)])
-    live = doc.live[1].snapshot()  # (the tool's MaskStroke: the mask so far, copied)
+    live = doc.live.value.snapshot()  # (the tool's MaskStroke: the mask so far, copied)
     assert not live.bits[28:33, 34:37].any() and live.bits[30, 30]
     source = doc.image("picture")
     # erased pixels show the picture again (once a preview covers the last dab: the first may cover only
@@ -943,7 +943,7 @@ def test_an_eraser_stroke_is_previewed_live(studio, qtbot):
 
 
 def test_a_parameter_change_does_not_redraw_the_masks_overlay(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     tool = studio.inputs_pane.mask_tool()
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     drawn = tool.overlay.image().cacheKey()
@@ -961,18 +961,18 @@ def test_a_parameter_change_does_not_redraw_the_masks_overlay(studio, qtbot):
 
 
 def test_a_session_whose_mask_png_is_missing_or_unreadable_opens_without_it_and_says_so(studio, qtbot, tmp_path):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     _final_after(studio, qtbot, lambda: _stroke(view, [(20.5, 20.5), (30.5, 20.5)]))
     doc.set_margins("grow", Margins(0, 3, 0, 0))
     session = tmp_path / "s.weft.json"
-    assert studio.save_session(str(session))
+    assert studio.files.save_session(str(session))
     png = tmp_path / "s.weft.mean-fill.hole.png"
     for spoil in (png.unlink, lambda: png.write_bytes(b"not a png")):
         spoil()
         doc.set_margins("grow", None)
         messages = []
         studio.message.connect(messages.append)
-        assert studio.open_session(str(session))
+        assert studio.files.open_session(str(session))
         studio.message.disconnect(messages.append)
         assert len(messages) == 1 and messages[0].startswith(f"{session}: mean-fill: ")
         assert "s.weft.mean-fill.hole.png" in messages[0] and messages[0].endswith("; dropped")
@@ -982,7 +982,7 @@ def test_a_session_whose_mask_png_is_missing_or_unreadable_opens_without_it_and_
 
 
 def test_ctrl_z_during_a_stroke_cancels_it_and_the_release_does_not_undo_the_undo(studio, qtbot):
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     tool = studio.inputs_pane.mask_tool()
     tool.set_size(5)
     _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 10.5), (20.5, 10.5)]))
@@ -1001,7 +1001,7 @@ def test_ctrl_z_during_a_stroke_cancels_it_and_the_release_does_not_undo_the_und
 
 
 def test_after_clear_mask_a_strokes_previews_are_pasted_into_the_picture_not_the_old_fill(studio, qtbot):
-    view, bar = studio.canvas_view, studio.inputs_pane.bar()
+    view, bar = studio.inputs_pane.canvas_view, studio.inputs_pane.bar()
     studio.inputs_pane.mask_tool().set_size(9)
     old = _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 10.5), (30.5, 10.5)]))
     source = studio.doc.image("picture")
@@ -1043,9 +1043,9 @@ def test_a_background_autosave_that_fails_says_so_in_one_line(studio, qtbot, pri
     with qtbot.waitSignal(
         studio.statusBar().messageChanged, timeout=10000, check_params_cb=lambda text: "autosave failed" in text
     ) as said:
-        _stroke(studio.canvas_view, [(20.5, 20.5), (30.5, 25.5)])
+        _stroke(studio.inputs_pane.canvas_view, [(20.5, 20.5), (30.5, 25.5)])
     text = said.args[0]
-    assert text.startswith(f"{studio.recovery_file}: autosave failed (") and "\n" not in text
+    assert text.startswith(f"{studio.files.recovery_file}: autosave failed (") and "\n" not in text
     assert _mask(studio) is not None  # the edit stands
 
 
@@ -1056,7 +1056,7 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, make_wi
     from weft.core.studio import AROUND_SIDE
 
     with _fill_in_the_studio(make_window, qtbot) as window:
-        view, doc = window.canvas_view, window.doc
+        view, doc = window.inputs_pane.canvas_view, window.doc
         h, w = doc.image("image").shape[:2]
         assert max(h, w) > AROUND_SIDE  # (the crop is a part of the image)
         view.actual_size()
@@ -1064,7 +1064,7 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, make_wi
         window.inputs_pane.mask_tool().set_size(9)
         y = h / 2 + 0.5
         around = _previewed(window, qtbot, view, [(w * 0.4, y), (w * 0.5, y)], timeout=30000)
-        text = window.result_label.full_text()
+        text = window.status.result_label.full_text()
         assert text.startswith("preview around the stroke") and "crop" in text, text
         assert "of the image" not in text, text  # the crop's hole fraction is not the image's
         studio = doc.studio
@@ -1078,7 +1078,7 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, make_wi
         assert doc.current_params.engine == "auto" and "engine" not in text, text
         result = _final_after(window, qtbot, lambda: mouse(view, "release", (w * 0.5, y)))
         hole = doc.value("mask").bits
-        text = window.result_label.full_text()
+        text = window.status.result_label.full_text()
         assert studio.figures["hole_fraction"].render(round(float(hole.mean()), 4)) in text, text  # the image's
         assert result.figures["hole_pixels"] == int(hole.sum())
 
@@ -1124,7 +1124,7 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
     the render job on its worker: at 4096² they stalled the GUI thread 0.15-0.57 s per stroke preview."""
     import threading
 
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
 
     on_gui: dict[str, list[bool]] = {"to_image": [], "crop_around": [], "reduce_for_preview": []}
 
@@ -1136,9 +1136,10 @@ def test_a_renders_inputs_are_built_on_its_worker_not_the_gui_thread(studio, qtb
         return wrapper
 
     monkeypatch.setattr(Mask, "to_image", recorded("to_image", Mask.to_image))
-    monkeypatch.setattr(render, "crop_around", recorded("crop_around", render.crop_around))
-    monkeypatch.setattr(render, "reduce_for_preview", recorded("reduce_for_preview", render.reduce_for_preview))
-    view = studio.canvas_view
+    monkeypatch.setattr(core_request, "crop_around", recorded("crop_around", core_request.crop_around))
+    reduce = recorded("reduce_for_preview", core_request.reduce_for_preview)
+    monkeypatch.setattr(core_request, "reduce_for_preview", reduce)
+    view = studio.inputs_pane.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
     _previewed(studio, qtbot, view, [(10.5, 10.5), (14.5, 12.5)])
     _final_after(studio, qtbot, lambda: mouse(view, "release", (14.5, 12.5)))
@@ -1154,7 +1155,7 @@ def test_a_strokes_later_previews_name_the_part_they_changed(studio, qtbot):
     (``over``); each later one is pasted into that same image and names the part it changed. So the
     view converts only that part (a 4096² result is neither copied on the GUI thread nor converted
     again per preview)."""
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     shown_before = studio.result_view.image
     picture = studio.doc.image("picture")
     assert np.array_equal(shown_before, picture)  # (nothing painted yet: the picture)
@@ -1190,7 +1191,7 @@ def _large_picture(studio, qtbot, tmp_path, w=480, h=360, at=(105, 102)):
     save_image(path, np.random.default_rng(5).random((h, w, 3)).astype(np.float32))
     with qtbot.waitSignal(studio.renderer.failed, timeout=10000):  # nothing to fill yet
         studio.open_input("picture", str(path))
-    view = studio.canvas_view
+    view = studio.inputs_pane.canvas_view
     qtbot.waitUntil(lambda: view.image is not None and view.image.shape[:2] == (h, w), timeout=10000)
     view.actual_size()
     view.zoom_by(4.0)
@@ -1204,7 +1205,7 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
     """The job of a preview around a stroke is given the part of the stroke's mask its crop can reach
     (``around_region``), cut on the GUI thread, never the whole mask (at 4096² a 64 MB float image per
     preview); the whole mask is made into an image only for the full render on release."""
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
     from weft.core.studio import around_region
 
     w, h = 480, 360
@@ -1215,8 +1216,8 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
         calls.append((set(inputs), stroke, kwargs.get("mask_part")))
         return crop_around(studio_, inputs, params, stroke, **kwargs)
 
-    crop_around = render.crop_around
-    monkeypatch.setattr(render, "crop_around", recorded_crop)
+    crop_around = core_request.crop_around
+    monkeypatch.setattr(core_request, "crop_around", recorded_crop)
     to_image = Mask.to_image
     monkeypatch.setattr(Mask, "to_image", lambda self: images.append(self.shape) or to_image(self))
     studio.inputs_pane.mask_tool().set_size(9)  # radius 4
@@ -1250,12 +1251,12 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
     preview of all of them follows (the latest dab wins), not one per mouse move."""
     import threading
 
-    import weft.app.gui.render as render
+    import weft.core.request as core_request
 
     w, h = 480, 360
     view = _large_picture(studio, qtbot, tmp_path, w, h, at=(130, 102))
     gate = threading.Event()
-    crop_around = render.crop_around
+    crop_around = core_request.crop_around
     entered = []
 
     def held(*args, **kwargs):
@@ -1263,7 +1264,7 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
         assert gate.wait(20)  # the first preview's job waits here until the moves are made
         return crop_around(*args, **kwargs)
 
-    monkeypatch.setattr(render, "crop_around", held)
+    monkeypatch.setattr(core_request, "crop_around", held)
     submitted = []
     studio.renderer.submitted.connect(lambda job, slot: submitted.append(job) if slot == "preview" else None)
     around = []
@@ -1301,7 +1302,7 @@ def test_dabs_while_a_preview_runs_are_coalesced_and_the_next_preview_covers_the
 def test_esc_restores_the_overlay_of_the_mask_a_stroke_began_on(studio, qtbot):
     """A stroke over a painted mask draws its dabs into the overlay; Esc puts back exactly the mask's
     pixels where the stroke changed them (the rest was not redrawn), brush and eraser alike."""
-    view, doc = studio.canvas_view, studio.doc
+    view, doc = studio.inputs_pane.canvas_view, studio.doc
     tool, bar = studio.inputs_pane.mask_tool(), studio.inputs_pane.bar()
     tool.set_size(7)
     _final_after(studio, qtbot, lambda: _stroke(view, [(10.5, 20.5), (60.5, 20.5)]))
@@ -1313,7 +1314,7 @@ def test_esc_restores_the_overlay_of_the_mask_a_stroke_began_on(studio, qtbot):
         qtbot.mouseClick(bar.mode_buttons[mode], Qt.MouseButton.LeftButton)
         _stroke(view, points, release=False)
         drawn = _painted(tool.overlay)
-        assert not np.array_equal(drawn, start.bits) and np.array_equal(drawn, doc.live[1].bits)
+        assert not np.array_equal(drawn, start.bits) and np.array_equal(drawn, doc.live.value.bits)
         view.setFocus()
         qtbot.keyClick(view, Qt.Key.Key_Escape)
         mouse(view, "release", points[-1])
@@ -1356,9 +1357,9 @@ def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, 
     registry.register(SPREAD_FILL)
     try:
         window = _window_on(make_window, SPREAD_FILL.name, qtbot, _picture(tmp_path / "picture.png"))
-        row = window.params_panel.row("spread")
+        row = window.method_panel.params_panel.row("spread")
         assert "(now 3)" in row.editor.toolTip()
-        view = window.canvas_view
+        view = window.inputs_pane.canvas_view
         view.fit()
         window.inputs_pane.mask_tool().set_size(1)  # a press 1 px outside the image drags the edge
         k = view.scale_factor()

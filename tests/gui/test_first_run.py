@@ -45,8 +45,8 @@ def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest
     qtbot.addWidget(window)
     window.show()
     rng = np.random.default_rng(1)
-    window.doc._put_input("texture", InputImage(None, rng.random((32, 32, 3)).astype(np.float32)))
-    window.doc._put_input("target", InputImage(None, rng.random((40, 48, 3)).astype(np.float32)))
+    window.doc.put_input("texture", InputImage(None, rng.random((32, 32, 3)).astype(np.float32)))
+    window.doc.put_input("target", InputImage(None, rng.random((40, 48, 3)).astype(np.float32)))
     assert window.doc.method == "fast"
     window.renderer.final(now=True)
 
@@ -58,9 +58,9 @@ def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest
     )
     held_from = time.perf_counter()
     assert seen == ["loading the fast method", words]  # words at once, then what it turned out to be
-    qtbot.waitUntil(lambda: window.progress_bar.isVisible(), timeout=20000)
-    assert window.progress_bar.maximum() == 0  # a busy bar, no percentage
-    assert not window.progress_bar.isTextVisible() and window.progress_bar.toolTip() == words
+    qtbot.waitUntil(lambda: window.status.progress_bar.isVisible(), timeout=20000)
+    assert window.status.progress_bar.maximum() == 0  # a busy bar, no percentage
+    assert not window.status.progress_bar.isTextVisible() and window.status.progress_bar.toolTip() == words
     assert window.renderer.runner.latest("warm-up") is None  # nothing competes with the visible method
     assert window.renderer.last is None
 
@@ -70,11 +70,11 @@ def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest
     result = shown.args[0]
     assert result.final and result.image.shape == (40, 48, 3)
     assert result.compiled and result.prepared >= held  # the compile, measured apart ...
-    message = window.result_label.full_text()
+    message = window.status.result_label.full_text()
     assert message.startswith(f"result 48x40 in {result.seconds * 1000:.0f} ms (after preparing its kernels for ")
     assert message.split(" — ")[0].endswith(" s, first run only)")  # ... and not counted as render time
     qtbot.waitUntil(lambda: not window.result_view.notice.isVisible(), timeout=5000)
-    assert window.progress_bar.maximum() == 1000 and window.progress_bar.isTextVisible()
+    assert window.status.progress_bar.maximum() == 1000 and window.status.progress_bar.isTextVisible()
     assert registry.is_warm("fast")
     qtbot.waitUntil(lambda: background == ["fast"], timeout=10000)  # the others, once the result is in
 
@@ -82,7 +82,7 @@ def test_first_render_prepares_in_words_then_shows_the_result_and_warms_the_rest
     with qtbot.waitSignal(window.renderer.shown, timeout=30000) as again:
         window.renderer.final(now=True)
     assert again.args[0].prepared == 0.0 and not again.args[0].compiled
-    assert "preparing" not in window.result_label.full_text()
+    assert "preparing" not in window.status.result_label.full_text()
     window.doc.undo_stack.setClean()
     window.shutdown()
 
@@ -95,8 +95,8 @@ def test_a_warm_method_renders_without_preparing(qtbot, settings, cold_fast, mon
     seen = []
     window.renderer.preparing.connect(seen.append)
     rng = np.random.default_rng(2)
-    window.doc._put_input("texture", InputImage(None, rng.random((32, 32)).astype(np.float32)))
-    window.doc._put_input("target", InputImage(None, rng.random((24, 24)).astype(np.float32)))
+    window.doc.put_input("texture", InputImage(None, rng.random((32, 32)).astype(np.float32)))
+    window.doc.put_input("target", InputImage(None, rng.random((24, 24)).astype(np.float32)))
     with qtbot.waitSignal(window.renderer.shown, timeout=30000) as shown:
         window.renderer.final(now=True)
     assert shown.args[0].prepared == 0.0 and seen == [] and not started.is_set()
@@ -117,8 +117,8 @@ def test_waiting_behind_another_methods_compile_says_preparing_at_once(qtbot, se
     seen = []
     window.renderer.preparing.connect(seen.append)
     rng = np.random.default_rng(3)
-    window.doc._put_input("texture", InputImage(None, rng.random((32, 32)).astype(np.float32)))
-    window.doc._put_input("target", InputImage(None, rng.random((24, 24)).astype(np.float32)))
+    window.doc.put_input("texture", InputImage(None, rng.random((32, 32)).astype(np.float32)))
+    window.doc.put_input("target", InputImage(None, rng.random((24, 24)).astype(np.float32)))
     registry.compile_started()  # another thread's compile under way
     try:
         window.renderer.final(now=True)
@@ -130,6 +130,6 @@ def test_waiting_behind_another_methods_compile_says_preparing_at_once(qtbot, se
     finally:
         registry.compile_ended()
     assert shown.args[0].compiled and shown.args[0].prepared > 0
-    assert "(after preparing its kernels for " in window.result_label.full_text()
+    assert "(after preparing its kernels for " in window.status.result_label.full_text()
     window.doc.undo_stack.setClean()
     window.shutdown()

@@ -1,5 +1,5 @@
 """Large images reach the views without blocking the GUI thread (the brief: "The GUI thread never
-blocks on image work"): an image of more than ``views.ASYNC_PIXELS`` pixels is converted for display
+blocks on image work"): an image of more than ``display.ASYNC_PIXELS`` pixels is converted for display
 on a worker thread, the previous image stays on screen until it is ready, a stale conversion never
 replaces a newer image, and what is drawn is what a QPixmap of the image drew before."""
 
@@ -7,33 +7,34 @@ import threading
 
 import numpy as np
 import pytest
-import weft.app.gui.views as views
+import weft.app.gui.display as display
 from PySide6.QtCore import QRectF, Qt, QTimer
 from PySide6.QtGui import QColor, QPainter, QPixmap
 from PySide6.QtWidgets import QGraphicsPixmapItem, QGraphicsScene, QGraphicsView
 from weft.app.gui.convert import to_qimage
-from weft.app.gui.views import ImageView, ResultView
+from weft.app.gui.result_view import ResultView
+from weft.app.gui.views import ImageView
 from weft.core.image import save_image
 
-BIG = 640  # 640² > views.ASYNC_PIXELS (512²): converted on a worker thread
+BIG = 640  # 640² > display.ASYNC_PIXELS (512²): converted on a worker thread
 
 
 class _Held:
-    """``views.display_qimage`` replaced: each call records whether it ran on the GUI thread and
+    """``display.display_qimage`` replaced: each call records whether it ran on the GUI thread and
     waits until :meth:`release` (so a test sees what is on screen meanwhile)."""
 
     def __init__(self, monkeypatch):
-        self.real = getattr(views, "display_qimage", None)
+        self.real = getattr(display, "display_qimage", None)
         self.on_gui_thread: list[bool] = []
         self.sizes: list[tuple[int, int]] = []
         self.gate = threading.Event()
         self.started = threading.Event()
-        monkeypatch.setattr(views, "display_qimage", self, raising=False)
+        monkeypatch.setattr(display, "display_qimage", self, raising=False)
 
     def __call__(self, image):
         self.on_gui_thread.append(threading.current_thread() is threading.main_thread())
         self.sizes.append(image.shape[:2])
-        if image.shape[0] * image.shape[1] > views.ASYNC_PIXELS:
+        if image.shape[0] * image.shape[1] > display.ASYNC_PIXELS:
             self.started.set()
             assert self.gate.wait(20), "never released"
         return self.real(image)
@@ -169,14 +170,14 @@ def test_a_large_input_opened_in_the_window_reaches_both_views_off_the_gui_threa
     held = _Held(monkeypatch)
     with qtbot.waitSignal(window.doc.changed, timeout=20000):
         window.open_input(canvas, str(path))
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     qtbot.waitUntil(held.started.is_set, timeout=10000)
     assert view.converting and (view.image is None or view.image.shape[:2] != (BIG, BIG))
     held.release()
     qtbot.waitUntil(lambda: not view.converting, timeout=10000)
     assert view.image is window.doc.image(canvas) and view.image.shape[:2] == (BIG, BIG)
     assert held.on_gui_thread and not any(
-        held.on_gui_thread[i] for i, s in enumerate(held.sizes) if s[0] * s[1] > views.ASYNC_PIXELS
+        held.on_gui_thread[i] for i, s in enumerate(held.sizes) if s[0] * s[1] > display.ASYNC_PIXELS
     )
 
 
@@ -261,12 +262,12 @@ def test_parts_changed_while_their_array_converts_are_redrawn_once_it_is_shown(q
         held.on_gui_thread.append(threading.current_thread() is threading.main_thread())
         held.sizes.append(image.shape[:2])
         out = real(image)
-        if image.shape[0] * image.shape[1] > views.ASYNC_PIXELS:
+        if image.shape[0] * image.shape[1] > display.ASYNC_PIXELS:
             read.set()
             assert held.gate.wait(20), "never released"
         return out
 
-    monkeypatch.setattr(views, "display_qimage", convert_then_wait)
+    monkeypatch.setattr(display, "display_qimage", convert_then_wait)
     image = _picture(BIG, 4)
     view.set_image(image, fit=True)
     assert read.wait(10)  # converted as it was; not shown yet

@@ -17,7 +17,7 @@ def _key(widget, key):
 
 
 def test_draw_edit_delete_lines_with_undo(nfpt):
-    doc, photo, frontal = nfpt.doc, nfpt.canvas_view, nfpt.lines_panel.frontal_view
+    doc, photo, frontal = nfpt.doc, nfpt.inputs_pane.canvas_view, nfpt.inputs_pane.lines_panel.frontal_view
     photo.actual_size()
     photo.zoom_by(2.0)
     photo.centerOn(100, 100)
@@ -35,7 +35,7 @@ def test_draw_edit_delete_lines_with_undo(nfpt):
     # Click the line to select it, Delete removes the pair from both views.
     mouse(photo, "press", (110.0, 100.0))
     mouse(photo, "release", (110.0, 100.0))
-    assert nfpt.lines_panel.photo_lines.selected == 0
+    assert nfpt.inputs_pane.lines_panel.photo_lines.selected == 0
     _key(photo, Qt.Key.Key_Delete)
     assert doc.image_lines == [] and doc.frontal_lines == []
     doc.undo_stack.undo()
@@ -43,7 +43,7 @@ def test_draw_edit_delete_lines_with_undo(nfpt):
 
 
 def test_escape_cancels_a_line_in_progress(nfpt):
-    photo = nfpt.canvas_view
+    photo = nfpt.inputs_pane.canvas_view
     before = list(nfpt.doc.image_lines)
     mouse(photo, "press", (50.0, 50.0))
     mouse(photo, "move", (120.0, 60.0))
@@ -55,17 +55,17 @@ def test_escape_cancels_a_line_in_progress(nfpt):
 def test_quad_preset_and_live_rectification(nfpt, qtbot):
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     corners = [line[:2] for line in data["image_lines"][:4]]  # the plane's corners, clockwise
-    nfpt.lines_panel.quad_button.setChecked(True)
+    nfpt.inputs_pane.lines_panel.quad_button.setChecked(True)
     for x, y in corners:
-        mouse(nfpt.canvas_view, "press", (x, y))
-        mouse(nfpt.canvas_view, "release", (x, y))
-    assert not nfpt.lines_panel.quad_button.isChecked()
+        mouse(nfpt.inputs_pane.canvas_view, "press", (x, y))
+        mouse(nfpt.inputs_pane.canvas_view, "release", (x, y))
+    assert not nfpt.inputs_pane.lines_panel.quad_button.isChecked()
     doc = nfpt.doc
     assert len(doc.image_lines) == 4 and len(doc.frontal_lines) == 4
     w, h = doc.frontal_size
     assert doc.frontal_lines[1] == pytest.approx([w - 1, 0, w - 1, h - 1])
-    qtbot.waitUntil(lambda: nfpt.lines_panel.rectify_status.text() == "rectified", timeout=10000)
-    assert nfpt.lines_panel.frontal_view.image.shape[:2] == (h, w)
+    qtbot.waitUntil(lambda: nfpt.inputs_pane.lines_panel.rectify_status.text() == "rectified", timeout=10000)
+    assert nfpt.inputs_pane.lines_panel.frontal_view.image.shape[:2] == (h, w)
     # The render uses the lines: the recipe carries them as their JSON object (held typed until then).
     recipe = doc.recipe()
     assert recipe.params["lines"]["image_lines"] == doc.image_lines
@@ -74,23 +74,23 @@ def test_quad_preset_and_live_rectification(nfpt, qtbot):
 def test_too_few_lines_say_why(nfpt, qtbot):
     doc = nfpt.doc
     doc.set_lines([[10, 10, 100, 12]], [[0, 0, 200, 0]])
-    qtbot.waitUntil(lambda: nfpt.lines_panel.rectify_status.text() not in ("", "rectified"), timeout=10000)
-    assert "line" in nfpt.lines_panel.rectify_status.text()
+    qtbot.waitUntil(lambda: nfpt.inputs_pane.lines_panel.rectify_status.text() not in ("", "rectified"), timeout=10000)
+    assert "line" in nfpt.inputs_pane.lines_panel.rectify_status.text()
 
 
 def test_lines_file_round_trip(nfpt, tmp_path):
     doc = nfpt.doc
-    assert nfpt.lines_panel.load_lines(str(RESOURCES / "perspective-lines.json"))
+    assert nfpt.inputs_pane.lines_panel.load_lines(str(RESOURCES / "perspective-lines.json"))
     assert len(doc.image_lines) == 6 and doc.frontal_size == (512, 384)
     out = tmp_path / "lines.json"
-    assert nfpt.lines_panel.save_lines(str(out))
+    assert nfpt.inputs_pane.lines_panel.save_lines(str(out))
     saved = json.loads(out.read_text())
     assert saved["image_lines"] == doc.image_lines and saved["frontal_size"] == [512, 384]
     bad = tmp_path / "bad.json"
     bad.write_text('{"image_lines": [[0, 0, 1]], "frontal_size": [10, 10]}')
     messages = []
     nfpt.message.connect(messages.append)
-    assert not nfpt.lines_panel.load_lines(str(bad))
+    assert not nfpt.inputs_pane.lines_panel.load_lines(str(bad))
     assert messages and "\n" not in messages[-1]
 
 
@@ -98,7 +98,7 @@ def test_affine_prototype_by_mouse_and_live_swap(window, qtbot):
     doc = window.doc
     doc.set_method("affine")
     doc.set_param("block", 16)
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     view.actual_size()
     view.zoom_by(2.0)
     view.centerOn(50, 50)
@@ -150,12 +150,12 @@ def test_the_frontal_frame_does_not_move_under_a_drag(nfpt, qtbot):
     from PySide6.QtWidgets import QGraphicsLineItem
 
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
-    doc, panel = nfpt.doc, nfpt.lines_panel
+    doc, panel = nfpt.doc, nfpt.inputs_pane.lines_panel
     nfpt.resize(1100, 760)
     panel.quad_button.setChecked(True)
     for x, y in [line[:2] for line in data["image_lines"][:4]]:
-        mouse(nfpt.canvas_view, "press", (x, y))
-        mouse(nfpt.canvas_view, "release", (x, y))
+        mouse(nfpt.inputs_pane.canvas_view, "press", (x, y))
+        mouse(nfpt.inputs_pane.canvas_view, "release", (x, y))
     image_lines, frontal_lines = [list(x) for x in doc.image_lines], [list(x) for x in doc.frontal_lines]
     doc.set_lines(image_lines[:3], frontal_lines[:3], text="Delete line 4")
     qtbot.waitUntil(lambda: "needs at least 4" in panel.rectify_status.text(), timeout=10000)
@@ -193,13 +193,13 @@ def test_quad_corners_move_together(nfpt, qtbot):
 
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     corners = [line[:2] for line in data["image_lines"][:4]]
-    doc, panel = nfpt.doc, nfpt.lines_panel
+    doc, panel = nfpt.doc, nfpt.inputs_pane.lines_panel
     panel.quad_button.setChecked(True)
     for x, y in corners:
-        mouse(nfpt.canvas_view, "press", (x, y))
-        mouse(nfpt.canvas_view, "release", (x, y))
+        mouse(nfpt.inputs_pane.canvas_view, "press", (x, y))
+        mouse(nfpt.inputs_pane.canvas_view, "release", (x, y))
     x, y = corners[1]  # the top-right corner: the end of line 1 and the start of line 2
-    drag(nfpt.canvas_view, (x, y), (x + 12, y + 9))
+    drag(nfpt.inputs_pane.canvas_view, (x, y), (x + 12, y + 9))
     assert doc.image_lines[0][2:] == pytest.approx([x + 12, y + 9], abs=0.6)
     assert doc.image_lines[1][:2] == pytest.approx([x + 12, y + 9], abs=0.6)
     assert doc.undo_stack.undoText().startswith("Move end")
@@ -212,9 +212,9 @@ def test_quad_corners_move_together(nfpt, qtbot):
     assert doc.frontal_lines[2][:2] == pytest.approx([w - 40, h - 30], abs=1.0)
     before = [list(v) for v in doc.image_lines]
     x, y = before[2][:2]
-    mouse(nfpt.canvas_view, "press", (x, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
-    mouse(nfpt.canvas_view, "move", (x - 10, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
-    mouse(nfpt.canvas_view, "release", (x - 10, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
+    mouse(nfpt.inputs_pane.canvas_view, "press", (x, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
+    mouse(nfpt.inputs_pane.canvas_view, "move", (x - 10, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
+    mouse(nfpt.inputs_pane.canvas_view, "release", (x - 10, y), key_modifiers=_Qt.KeyboardModifier.AltModifier)
     moved = [doc.image_lines[2][:2], doc.image_lines[1][2:]]  # the two ends that met there
     assert sorted(abs(m[0] - (x - 10)) < 0.6 for m in moved) == [False, True]  # Alt: one alone
     assert before[2][:2] in moved or before[1][2:] in moved
@@ -236,9 +236,9 @@ def test_nfpt_without_lines_shows_the_photo_and_says_what_to_draw(window, qtbot)
     assert window.nothing_to_export().startswith("nothing to export: draw feature lines")
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     window.doc.set_param("size", (128, 96))
-    window.lines_panel.quad_button.setChecked(True)
+    window.inputs_pane.lines_panel.quad_button.setChecked(True)
     for x, y in [line[:2] for line in data["image_lines"][:4]]:
-        mouse(window.canvas_view, "press", (x, y))
-        mouse(window.canvas_view, "release", (x, y))
+        mouse(window.inputs_pane.canvas_view, "press", (x, y))
+        mouse(window.inputs_pane.canvas_view, "release", (x, y))
     qtbot.waitUntil(lambda: window.renderer.last.final and window.renderer.last.recipe.method == "nfpt", timeout=60000)
     assert not view.notice.isVisible() and window.nothing_to_export() is None

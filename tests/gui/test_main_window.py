@@ -26,12 +26,12 @@ def test_opens_on_the_examples_with_a_result(window):
     assert shown.final and shown.image.shape == window.doc.image("target").shape
     assert window.result_view.image is shown.image
     assert window.example_list.count() >= 10
-    assert "result" in window.result_label.full_text()
+    assert "result" in window.status.result_label.full_text()
 
 
 @pytest.mark.parametrize("zoom", [2.0, 0.5])
 def test_drawing_a_prototype_sets_the_rectangle_in_image_pixels(window, qtbot, zoom):
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     view.actual_size()
     view.zoom_by(zoom)
     view.centerOn(40, 40)
@@ -49,11 +49,11 @@ def test_drawing_a_prototype_sets_the_rectangle_in_image_pixels(window, qtbot, z
 
 
 def test_escape_cancels_a_prototype_drag(window):
-    view = window.canvas_view
+    view = window.inputs_pane.canvas_view
     window.doc.set_square((4, 4, 20))
     mouse(view, "press", (60, 60))
     mouse(view, "move", (90, 90))
-    assert window.canvas_view.tool.live is not None
+    assert window.inputs_pane.canvas_view.tool.live is not None
     from PySide6.QtCore import QEvent
     from PySide6.QtGui import QKeyEvent
 
@@ -67,7 +67,7 @@ def test_the_prototype_is_the_source_region_of_fast_and_is_in_the_recipe(window,
     window.doc.set_square((10, 10, 40))
     qtbot.waitUntil(lambda: window.renderer.last.job_id > before and window.renderer.last.final, timeout=10000)
     out = tmp_path / "r.png"
-    assert window.export_result(str(out))
+    assert window.files.export_result(str(out))
     assert json.loads(read_recipe(out))["region"] == [10, 10, 40]
     again = tmp_path / "again.png"
     assert cli_main(["run", str(out), "-o", str(again)]) == 0
@@ -75,7 +75,7 @@ def test_the_prototype_is_the_source_region_of_fast_and_is_in_the_recipe(window,
 
 
 def test_slider_drag_previews_then_renders_full_size(window, qtbot):
-    row = window.params_panel.row("n")
+    row = window.method_panel.params_panel.row("n")
     slider = row.editor
     shown = []
     window.renderer.shown.connect(lambda s: shown.append(s))
@@ -126,12 +126,12 @@ def test_cancel_keeps_the_previous_result(window, qtbot, monkeypatch):
     monkeypatch.setitem(window.doc.methods, "fast", _slow_method(started))
     window.renderer.final(now=True)
     qtbot.waitUntil(started.is_set, timeout=5000)
-    qtbot.waitUntil(window.cancel_button.isVisible, timeout=5000)  # long job: progress + Cancel shown
-    window.cancel_button.click()
+    qtbot.waitUntil(window.status.cancel_button.isVisible, timeout=5000)  # long job: progress + Cancel shown
+    window.status.cancel_button.click()
     qtbot.waitUntil(lambda: not window.renderer.runner.busy("final"), timeout=5000)
     assert window.renderer.last is previous
     assert window.result_view.image is previous.image
-    assert not window.cancel_button.isVisible()
+    assert not window.status.cancel_button.isVisible()
 
 
 def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, monkeypatch):
@@ -156,10 +156,10 @@ def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, mo
 def test_invalid_value_is_refused_with_a_message(window):
     messages = []
     window.message.connect(messages.append)
-    window.params_panel.row("n").editor.setValue(4)  # even: refused by FastParams
+    window.method_panel.params_panel.row("n").editor.setValue(4)  # even: refused by FastParams
     assert window.doc.current_params.n == 5
     assert "must be odd" in messages[-1]
-    assert window.params_panel.row("n").value() == 5
+    assert window.method_panel.params_panel.row("n").value() == 5
 
 
 def test_undo_redo_parameters_and_method(window):
@@ -168,20 +168,20 @@ def test_undo_redo_parameters_and_method(window):
     doc.set_param("w", 3.0)  # merges with the previous change of w
     doc.set_param("iterations", 2)
     doc.set_method("quilt")
-    assert window.params_panel.params_cls is doc.methods["quilt"].params
+    assert window.method_panel.params_panel.params_cls is doc.methods["quilt"].params
     doc.undo_stack.undo()
-    assert doc.method == "fast" and window.params_panel.params_cls is doc.methods["fast"].params
+    assert doc.method == "fast" and window.method_panel.params_panel.params_cls is doc.methods["fast"].params
     doc.undo_stack.undo()
     assert doc.current_params.iterations == 1
     doc.undo_stack.undo()
     assert doc.current_params.w == 1.0
     doc.undo_stack.redo()
     assert doc.current_params.w == 3.0
-    assert window.params_panel.row("w").value() == 3.0
+    assert window.method_panel.params_panel.row("w").value() == 3.0
 
 
 def test_dropping_a_file_on_the_target_view_opens_it(window, qtbot):
-    view = window.views["target"]
+    view = window.inputs_pane.views["target"]
     path = str(example("camera"))
     data = QMimeData()
     data.setUrls([QUrl.fromLocalFile(path)])
@@ -215,9 +215,9 @@ def test_session_round_trip(window, qtbot, tmp_path):
     doc = window.doc
     doc.set_param("p", 0.3)
     doc.set_square((2, 4, 16))
-    window.seed_box.setValue(42)
+    window.method_panel.seed_box.setValue(42)
     path = tmp_path / "s.weft.json"
-    assert window.save_session(str(path))
+    assert window.files.save_session(str(path))
     data = json.loads(path.read_text())
     assert (
         data["params"]["fast"]["p"] == 0.3
@@ -226,37 +226,37 @@ def test_session_round_trip(window, qtbot, tmp_path):
     )
     doc.set_param("p", 0.9)
     doc.set_square(None)
-    window.seed_box.setValue(1)
-    assert window.open_session(str(path))
+    window.method_panel.seed_box.setValue(1)
+    assert window.files.open_session(str(path))
     assert doc.current_params.p == 0.3 and doc.square == (2, 4, 16) and doc.seed == 42
-    assert window.seed_box.value() == 42 and window.params_panel.row("p").value() == 0.3
+    assert window.method_panel.seed_box.value() == 42 and window.method_panel.params_panel.row("p").value() == 0.3
     bad = tmp_path / "bad.json"
     bad.write_text("{")
     messages = []
     window.message.connect(messages.append)
-    assert not window.open_session(str(bad))
+    assert not window.files.open_session(str(bad))
     assert "not a weft session" in messages[-1]
 
 
 def test_export_png_jpeg_tiff_and_weft_run_reproduces_bit_for_bit(window, qtbot, tmp_path):
     png = tmp_path / "out.png"
-    assert window.export_result(str(png))
+    assert window.files.export_result(str(png))
     recipe = json.loads(read_recipe(png))
     assert recipe["method"] == "fast" and recipe["seed"] == window.doc.seed
     again = tmp_path / "again.png"
     assert cli_main(["run", str(png), "-o", str(again)]) == 0
     assert np.array_equal(load_image(png).image, load_image(again).image)
     tif = tmp_path / "out.tif"
-    assert window.export_result(str(tif))
+    assert window.files.export_result(str(tif))
     assert load_image(tif).info.bit_depth == 16
     jpg = tmp_path / "out.jpg"
-    assert window.export_result(str(jpg))
+    assert window.files.export_result(str(jpg))
     assert load_image(jpg).image.shape == window.renderer.last.image.shape
 
 
 def test_compare_split_and_wheel_zoom_on_the_result(window):
     view = window.result_view
-    window.compare_button.click()
+    window.method_panel.compare_button.click()
     assert view.comparing and view._clip.isVisible()
     view.actual_size()
     mouse(view, "press", (64, 10))
@@ -287,12 +287,12 @@ def test_hover_shows_pixel_coordinates_and_value(window):
     view.zoom_by(4.0)
     view.centerOn(10.5, 20.5)
     mouse(view, "move", (10.5, 20.5), buttons=Qt.MouseButton.NoButton)
-    assert window.pixel_label.text().startswith("result  x 10  y 20")
+    assert window.status.pixel_label.text().startswith("result  x 10  y 20")
 
 
 def test_variations_grid_renders_and_adopts_a_cell(window, qtbot):
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     dialog.combo[0].setCurrentText("p")
     dialog.combo[1].setCurrentText("target_weight")
     dialog.lo[0].setValue(0.0)
@@ -351,8 +351,8 @@ def test_result_figures_stay_while_a_menu_shows_status_tips(window, qtbot):
         )
 
     assert figures_shown()
-    menu = window.view_menu
-    action = window.reset_layout_action  # (has a status tip)
+    menu = window.menus.view_menu
+    action = window.menus.reset_layout_action  # (has a status tip)
     menu.popup(window.mapToGlobal(window.rect().center()))
     qtbot.waitUntil(menu.isVisible, timeout=5000)
     QTest.mouseMove(menu, menu.actionGeometry(action).center())
@@ -367,22 +367,22 @@ def test_result_figures_stay_while_a_menu_shows_status_tips(window, qtbot):
 def test_progress_text_fits_the_bar(window, qtbot):
     """A long stage with the time left still reads whole in the bar (shortened to what fits; the
     whole text in its tooltip), at the default size and in a narrow window."""
-    import time
-
+    now = [1000.0]
+    window.status.clock = lambda: now[0]
     for width in (1280, 1024):
         window.resize(width, 760)
-        window.progress_bar.show()
+        window.status.progress_bar.show()
         qtbot.wait(10)
-        window._on_progress(0.05, "nfpt synthesis")
-        window._work_started = time.monotonic() - 10  # 10 s of work so far: the time left is known
-        window._on_progress(0.63, "nfpt synthesis")
-        bar = window.progress_bar
+        window.status.show_progress(0.05, "nfpt synthesis")
+        now[0] += 10  # 10 s of work so far: the time left is known
+        window.status.show_progress(0.63, "nfpt synthesis")
+        bar = window.status.progress_bar
         assert bar.value() == 630
         text = bar.text()
         assert "63%" in text
         assert bar.fontMetrics().horizontalAdvance(text) <= bar.contentsRect().width(), (width, text)
         assert "about 6 s left" in bar.toolTip()
-    window.progress_bar.hide()
+    window.status.progress_bar.hide()
 
 
 def test_the_file_menu_keeps_its_entries_in_place_for_every_method(window, qtbot):
@@ -392,7 +392,7 @@ def test_the_file_menu_keeps_its_entries_in_place_for_every_method(window, qtbot
     layouts = {}
     for name in registry.studio_methods():
         window.doc.set_method(name)
-        menu = window.file_menu
+        menu = window.menus.file_menu
         menu.popup(window.mapToGlobal(window.rect().center()))
         qtbot.waitUntil(menu.isVisible, timeout=5000)
         quit_action = next(a for a in menu.actions() if a.text() == "&Quit")
@@ -407,7 +407,7 @@ def test_each_choice_from_a_list_is_its_own_undo_step(window, qtbot):
     from PySide6.QtCore import Qt
 
     doc = window.doc
-    combo = window.params_panel.row("metric").editor
+    combo = window.method_panel.params_panel.row("metric").editor
     before = doc.undo_stack.count()
     combo.setFocus()
     picked = []
@@ -418,7 +418,7 @@ def test_each_choice_from_a_list_is_its_own_undo_step(window, qtbot):
     assert doc.undo_stack.count() == before + 4
     doc.undo_stack.undo()
     assert doc.current_params.metric == "target"
-    slider = window.params_panel.row("iterations").editor.findChild(QSlider)
+    slider = window.method_panel.params_panel.row("iterations").editor.findChild(QSlider)
     slider.setFocus()
     steps = doc.undo_stack.index()
     for _ in range(2):

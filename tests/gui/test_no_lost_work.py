@@ -13,13 +13,14 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QSettings
 from weft.app.gui.main_window import MainWindow
+from weft.app.gui.questions import Questions
 from weft.core.image import save_image
 
 from .helpers import no_job_threads, orphan_recovery, pretend_crashed
 from .recovery_helper import EDITS
 
 ROOT = Path(__file__).resolve().parents[2]
-REAL_ASK_RESTORE = MainWindow._ask_restore  # (before the conftest replaces it)
+REAL_ASK_RESTORE = Questions.ask_restore  # (before the conftest replaces it)
 
 
 def answer(monkeypatch, reply: bool) -> list[str]:
@@ -30,7 +31,7 @@ def answer(monkeypatch, reply: bool) -> list[str]:
         asked.append(question)
         return reply
 
-    monkeypatch.setattr(MainWindow, "_confirm", confirm)
+    monkeypatch.setattr(Questions, "confirm", confirm)
     return asked
 
 
@@ -39,14 +40,14 @@ def test_export_asks_before_overwriting(window, tmp_path, monkeypatch, reply):
     out = tmp_path / "old.png"
     out.write_bytes(b"precious")
     asked = answer(monkeypatch, reply)
-    assert window.export_result(str(out)) is reply
+    assert window.files.export_result(str(out)) is reply
     assert len(asked) == 1 and "old.png" in asked[0]
     assert (out.read_bytes() == b"precious") is (not reply)
 
 
 def test_export_to_a_new_file_does_not_ask(window, tmp_path, monkeypatch):
     asked = answer(monkeypatch, False)
-    assert window.export_result(str(tmp_path / "new.png"))
+    assert window.files.export_result(str(tmp_path / "new.png"))
     assert asked == []
 
 
@@ -59,7 +60,7 @@ def answer_unsaved(monkeypatch, reply: str) -> list[str]:
         asked.append(doing)
         return reply
 
-    monkeypatch.setattr(MainWindow, "_ask_unsaved", ask)
+    monkeypatch.setattr(Questions, "ask_unsaved", ask)
     return asked
 
 
@@ -80,19 +81,19 @@ def test_close_when_clean_does_not_ask(window, monkeypatch):
 
 def test_open_session_with_unsaved_edits_asks(window, tmp_path, monkeypatch):
     session = tmp_path / "s.weft.json"
-    assert window.save_session(str(session))
+    assert window.files.save_session(str(session))
     window.doc.set_param("p", 0.5)
     asked = answer_unsaved(monkeypatch, "cancel")
-    assert window.open_session(str(session)) is False
+    assert window.files.open_session(str(session)) is False
     assert len(asked) == 1 and window.doc.current_params.p == 0.5
     answer_unsaved(monkeypatch, "discard")
-    assert window.open_session(str(session)) is True
+    assert window.files.open_session(str(session)) is True
     assert window.doc.current_params.p != 0.5
 
 
 def test_autosave_while_edited_and_removed_when_clean(window, qtbot, private_recovery):
-    window._autosave_timer.setInterval(20)
-    recovery = window.recovery_file
+    window.files._autosave_timer.setInterval(20)
+    recovery = window.files.recovery_file
     assert recovery.parent == private_recovery
     assert not recovery.exists()
     window.doc.set_param("p", 0.25)
@@ -116,7 +117,7 @@ def answer_restore(monkeypatch, reply: bool) -> list[str]:
         asked.append(question)
         return reply
 
-    monkeypatch.setattr(MainWindow, "_ask_restore", ask)
+    monkeypatch.setattr(Questions, "ask_restore", ask)
     return asked
 
 
@@ -136,24 +137,24 @@ def test_a_second_window_never_offers_or_removes_the_first_windows_work(
     """Two studios at once: the second does not offer the first one's recovery file (its window
     runs), so declining cannot remove it; each window autosaves to a file of its own."""
     window.doc.set_param("p", 0.25)
-    assert window.autosave()
-    first = window.recovery_file
+    assert window.files.autosave()
+    first = window.files.recovery_file
     assert first.is_file()
     asked = answer_restore(monkeypatch, False)
     second = MainWindow(settings=settings)
     qtbot.addWidget(second)
     assert asked == [] and first.is_file()
     second.doc.set_param("p", 0.75)
-    assert second.autosave()
-    assert second.recovery_file != first and second.recovery_file.is_file()
+    assert second.files.autosave()
+    assert second.files.recovery_file != first and second.files.recovery_file.is_file()
     assert json.loads(first.read_text(encoding="utf-8"))["params"]["fast"]["p"] == 0.25
     # the first window "crashes": a third window offers its work (and only its: the second runs)
     pretend_crashed(window)
     asked = answer_restore(monkeypatch, True)
     third = MainWindow(settings=settings, load_defaults=False)
     qtbot.addWidget(third)
-    assert len(asked) == 1 and third.doc.params["fast"].p == 0.25 and third.recovery_file == first
-    assert second.recovery_file.is_file()
+    assert len(asked) == 1 and third.doc.params["fast"].p == 0.25 and third.files.recovery_file == first
+    assert second.files.recovery_file.is_file()
     for w in (second, third):
         w.shutdown()
 
@@ -175,7 +176,7 @@ def test_the_restore_question_restores_on_enter(qtbot, settings, private_recover
     from PySide6.QtCore import Qt, QTimer
     from PySide6.QtWidgets import QApplication, QMessageBox
 
-    monkeypatch.setattr(MainWindow, "_ask_restore", REAL_ASK_RESTORE)
+    monkeypatch.setattr(Questions, "ask_restore", REAL_ASK_RESTORE)
     target = tmp_path / "t.png"
     save_image(target, np.random.default_rng(1).random((40, 48, 3), dtype=np.float32))
     session = {
@@ -212,9 +213,9 @@ def test_ctrl_s_after_a_recovery_saves_to_the_sessions_file(
     from PySide6.QtWidgets import QFileDialog
 
     session = tmp_path / "mine.weft.json"
-    assert window.save_session(str(session))
+    assert window.files.save_session(str(session))
     window.doc.set_param("p", 0.4)
-    assert window.autosave()
+    assert window.files.autosave()
     pretend_crashed(window)
     again = MainWindow(settings=settings, load_defaults=False)
     qtbot.addWidget(again)
@@ -289,7 +290,7 @@ def test_kill_9_then_restart_offers_to_restore(qtbot, tmp_path, private_recovery
     lines = doc.value("lines", "nfpt")
     assert [list(x) for x in lines.image_lines] == EDITS["image_lines"]
     assert [list(x) for x in lines.frontal_lines] == EDITS["frontal_lines"]
-    assert doc.seed == EDITS["seed"] and w.seed_box.value() == EDITS["seed"]
+    assert doc.seed == EDITS["seed"] and w.method_panel.seed_box.value() == EDITS["seed"]
     assert not doc.undo_stack.isClean()  # still unsaved: the recovery file stays until saved or discarded
     assert w.windowTitle().endswith(" *")  # and the title says so
     assert recovery.exists()
@@ -311,7 +312,7 @@ def test_export_to_a_full_disk_keeps_the_old_file_and_says_why(window, tmp_path,
     monkeypatch.setattr("weft.core.image.files.os.fdopen", to_dev_full)
     messages = []
     window.message.connect(messages.append)
-    assert window.export_result(str(out)) is False
+    assert window.files.export_result(str(out)) is False
     assert out.read_bytes() == b"precious"
     assert len(messages) == 1 and "old.png" in messages[0] and "No space left" in messages[0]
 
@@ -324,7 +325,7 @@ def test_export_over_an_input_is_refused_without_asking(window, tmp_path, monkey
     asked = answer(monkeypatch, True)
     messages = []
     window.message.connect(messages.append)
-    assert window.export_result(str(texture)) is False
+    assert window.files.export_result(str(texture)) is False
     assert asked == [] and texture.read_bytes() == before
     assert len(messages) == 1 and "texture.png" in messages[0] and "input" in messages[0]
 
@@ -340,5 +341,5 @@ def test_export_over_an_input_through_another_name_is_refused(window, tmp_path, 
     os.link(texture, alias)
     before = texture.read_bytes()
     asked = answer(monkeypatch, True)
-    assert window.export_result(str(alias)) is False
+    assert window.files.export_result(str(alias)) is False
     assert asked == [] and texture.read_bytes() == before

@@ -37,7 +37,7 @@ def test_gui_drop_keeps_document_and_says_which_file(corpus, window, qtbot, item
     from PySide6.QtWidgets import QApplication
 
     path = corpus[item]
-    view = window.views["target"]
+    view = window.inputs_pane.views["target"]
     before = window.doc.inputs["target"]
     undo_count = window.doc.undo_stack.count()
     messages = []

@@ -74,7 +74,7 @@ def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qt
         assert np.allclose(window.renderer.last.image, load_image(picture).image)  # no square yet: unchanged
 
         # the square is drawn with the mouse on the canvas
-        view = window.canvas_view
+        view = window.inputs_pane.canvas_view
         view.actual_size()
         view.zoom_by(2.0)
         view.centerOn(30, 30)
@@ -92,7 +92,7 @@ def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qt
         # a slider drag previews, the release renders full size
         results = []
         window.renderer.shown.connect(results.append)
-        row = window.params_panel.row("amount")
+        row = window.method_panel.params_panel.row("amount")
         row.editor.setSliderDown(True)
         row.editor.setValue(0.5)
         qtbot.waitUntil(lambda: any(not r.final for r in results), timeout=10000)
@@ -102,7 +102,7 @@ def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qt
 
         # export: the PNG's recipe is the result's, and weft run reproduces it
         out = tmp_path / "out.png"
-        assert window.export_result(str(out))
+        assert window.files.export_result(str(out))
         assert '"square": [10, 12, 20]' in read_recipe(out)
         again = tmp_path / "again.png"
         assert weft(["run", str(out), "-o", str(again)]) == 0, capsys.readouterr().err
@@ -110,10 +110,10 @@ def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qt
 
         # a session round trip keeps its square and parameter
         session = tmp_path / "s.weft.json"
-        assert window.save_session(str(session))
+        assert window.files.save_session(str(session))
         window.doc.set_square(None)
         window.doc.set_param("amount", 1.0)
-        assert window.open_session(str(session))
+        assert window.files.open_session(str(session))
         assert window.doc.method == plugin.name and window.doc.square == (10, 12, 20)
         assert window.doc.current_params.amount == 0.5
     finally:

@@ -40,12 +40,12 @@ def _cancelled_render(window, qtbot, monkeypatch):
 def test_export_after_a_cancelled_render_writes_the_recipe_of_the_shown_pixels(window, qtbot, tmp_path, monkeypatch):
     shown = _cancelled_render(window, qtbot, monkeypatch)
     out = tmp_path / "out.png"
-    assert window.export_result(str(out))
+    assert window.files.export_result(str(out))
     recipe = json.loads(read_recipe(out))
     assert recipe["params"]["p"] == 0.3 and recipe["seed"] == shown.recipe.seed
     assert np.array_equal(load_image(out).image, np.round(shown.image * 255) / 255)
     recipe_file = tmp_path / "r.json"
-    assert window.export_recipe(str(recipe_file))
+    assert window.files.export_recipe(str(recipe_file))
     assert json.loads(recipe_file.read_text())["params"]["p"] == 0.3
 
 
@@ -96,13 +96,13 @@ def test_a_seed_change_is_an_undo_step_and_unsaved(window, qtbot):
     doc = window.doc
     doc.undo_stack.setClean()
     old = doc.seed
-    window.seed_box.setValue(old + 41)
+    window.method_panel.seed_box.setValue(old + 41)
     assert doc.seed == old + 41 and doc.undo_stack.count() == 1 and not doc.undo_stack.isClean()
     assert "*" in window.windowTitle()
     doc.undo_stack.undo()
-    assert doc.seed == old and window.seed_box.value() == old and doc.undo_stack.isClean()
+    assert doc.seed == old and window.method_panel.seed_box.value() == old and doc.undo_stack.isClean()
     doc.undo_stack.redo()
-    assert doc.seed == old + 41 and window.seed_box.value() == old + 41
+    assert doc.seed == old + 41 and window.method_panel.seed_box.value() == old + 41
 
 
 def test_the_affine_square_is_drawn_on_the_prototype_image_once_one_is_open(window, qtbot):
@@ -110,13 +110,13 @@ def test_the_affine_square_is_drawn_on_the_prototype_image_once_one_is_open(wind
 
     doc = window.doc
     doc.set_method("affine")
-    texture_view = window.views["texture"]
+    texture_view = window.inputs_pane.views["texture"]
     assert texture_view.tool is not None and texture_view.tool.square is None
     other = np.random.default_rng(2).random((96, 96, 3)).astype(np.float32)
     doc.set_input("prototype_image", None, other)
-    view = window.views["prototype_image"]
+    view = window.inputs_pane.views["prototype_image"]
     assert view.tool is not None and texture_view.tool is None  # the square moved to the prototype image
-    window.input_tabs.setCurrentIndex(0)
+    window.inputs_pane.tabs.setCurrentIndex(0)
     view.actual_size()
     view.zoom_by(2.0)
     view.centerOn(30, 30)

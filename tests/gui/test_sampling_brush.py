@@ -57,7 +57,7 @@ def _fill_window(make_window, qtbot, picture, size=(1300, 820)):
         box.setCurrentIndex(box.findData("fill"))
         with qtbot.waitSignal(window.renderer.failed, timeout=30000):  # nothing to fill yet
             window.open_input("image", str(picture))
-        view = window.canvas_view
+        view = window.inputs_pane.canvas_view
         view.actual_size()
         view.zoom_by(4.0)
         view.centerOn(W / 2, H / 2)
@@ -72,7 +72,7 @@ def fill(qtbot, make_window, tmp_path):
     """Fill on the three-colour picture with a hole painted in its red half (filled red)."""
     with _fill_window(make_window, qtbot, _picture(tmp_path / "three.png")) as window:
         window.inputs_pane.mask_tool().set_size(7)
-        _final_after(window, qtbot, lambda: _stroke(window.canvas_view, HOLE))
+        _final_after(window, qtbot, lambda: _stroke(window.inputs_pane.canvas_view, HOLE))
         yield window
 
 
@@ -101,7 +101,7 @@ def _sampling(window, qtbot):
 
 
 def test_a_sampling_stroke_sets_where_fill_copies_from_and_undo_restores_it(fill, qtbot):
-    window, doc, view = fill, fill.doc, fill.canvas_view
+    window, doc, view = fill, fill.doc, fill.inputs_pane.canvas_view
     inside = _hole_inside(window)
     assert inside.sum() > 10
     before = window.renderer.last.image
@@ -142,7 +142,7 @@ def test_a_sampling_stroke_sets_where_fill_copies_from_and_undo_restores_it(fill
 
 def test_exclude_on_nothing_painted_keeps_fill_from_copying_there(fill, qtbot):
     """Exclude starts from everything (outside the hole) and takes the painted part away."""
-    window, doc, view = fill, fill.doc, fill.canvas_view
+    window, doc, view = fill, fill.doc, fill.inputs_pane.canvas_view
     bar, tool = _sampling(window, qtbot)
     qtbot.mouseClick(bar.mode_buttons["eraser"], Qt.MouseButton.LeftButton)
     assert tool.mode == "eraser"
@@ -159,7 +159,7 @@ def test_exclude_on_nothing_painted_keeps_fill_from_copying_there(fill, qtbot):
 def test_the_live_preview_follows_a_sampling_stroke(fill, qtbot):
     """While the sampling area is painted (before the release), a preview of the whole picture with
     the stroke so far is rendered and shown, as a hole stroke's preview is."""
-    window, view = fill, fill.canvas_view
+    window, view = fill, fill.inputs_pane.canvas_view
     bar, tool = _sampling(window, qtbot)
     tool.set_size(25)
     previews = []
@@ -180,7 +180,7 @@ def test_the_live_preview_follows_a_sampling_stroke(fill, qtbot):
 
 
 def test_esc_cancels_a_sampling_stroke_and_the_result_comes_back(fill, qtbot):
-    window, view, doc = fill, fill.canvas_view, fill.doc
+    window, view, doc = fill, fill.inputs_pane.canvas_view, fill.doc
     last = window.renderer.last
     bar, tool = _sampling(window, qtbot)
     tool.set_size(25)
@@ -196,26 +196,26 @@ def test_esc_cancels_a_sampling_stroke_and_the_result_comes_back(fill, qtbot):
 def test_the_sampling_area_round_trips_through_a_session_and_an_export_reproduced_by_weft_run(
     fill, qtbot, settings, tmp_path, capsys
 ):
-    window, doc, view = fill, fill.doc, fill.canvas_view
+    window, doc, view = fill, fill.doc, fill.inputs_pane.canvas_view
     bar, tool = _sampling(window, qtbot)
     tool.set_size(25)
     result = _final_after(window, qtbot, lambda: _stroke(view, BOTTOM_RIGHT))
     painted, hole = doc.value("source_mask"), doc.value("mask")
     # the session keeps both masks as 1-bit PNGs beside it
     session = tmp_path / "s.weft.json"
-    assert window.save_session(str(session))
+    assert window.files.save_session(str(session))
     assert Mask.read(tmp_path / "s.weft.fill.source_mask.png") == painted
     data = json.loads(session.read_text())
     assert data["geometry"]["fill"]["source_mask"] == "s.weft.fill.source_mask.png"
     doc.set_mask("source_mask", None, "clear")
-    assert window.open_session(str(session))
+    assert window.files.open_session(str(session))
     assert doc.value("source_mask") == painted and doc.value("mask") == hole
     assert tool.overlay.image().width() == W
     # the export names it in its recipe, a PNG beside it; weft run gives the same pixels
     out = tmp_path / "out.png"
     shown = _final_after(window, qtbot, lambda: window.renderer.final(now=True))
     assert np.array_equal(shown.image, result.image)
-    assert window.export_result(str(out))
+    assert window.files.export_result(str(out))
     recipe = json.loads(read_recipe(out))
     assert recipe["inputs"]["source_mask"] == "out.source_mask.png" and recipe["inputs"]["mask"] == "out.mask.png"
     assert Mask.read(tmp_path / "out.source_mask.png") == painted
@@ -258,8 +258,8 @@ def test_the_brush_is_sized_to_the_picture_and_keeps_its_size_through_a_recovery
     with _fill_window(make_window, qtbot, big) as window:
         tool, bar = window.inputs_pane.mask_tool(), window.inputs_pane.bar()
         assert tool.size == 20 and bar.size_box.value() == 20
-        window.canvas_view.setFocus()
-        qtbot.keyClick(window.canvas_view, Qt.Key.Key_BracketRight)
+        window.inputs_pane.canvas_view.setFocus()
+        qtbot.keyClick(window.inputs_pane.canvas_view, Qt.Key.Key_BracketRight)
         assert tool.size == 25
     settings.sync()
     with _fill_window(make_window, qtbot, big) as window:  # the next studio, on the same picture
@@ -296,16 +296,19 @@ def test_every_button_over_the_picture_shows_and_the_picture_is_the_large_view(
         # the picture painted on gets most of the inputs' height, and the larger share of the width
         # while the result keeps a usable 350 px (at 1024 px the result's 350 px leave it 45 %)
         pane = window.inputs_pane
-        assert pane.sizes()[0] >= 0.75 * sum(pane.sizes()) and window.canvas_view.height() > 0.6 * pane.height()
+        assert (
+            pane.sizes()[0] >= 0.75 * sum(pane.sizes())
+            and window.inputs_pane.canvas_view.height() > 0.6 * pane.height()
+        )
         assert window.result_view.width() >= 350
         if size[0] >= 1280:
-            assert window.canvas_view.width() > window.result_view.width()
+            assert window.inputs_pane.canvas_view.width() > window.result_view.width()
         else:
             assert pane.width() >= 0.44 * (pane.width() + window.result_view.width())
         # View > Large Picture to Paint (Ctrl+L): the picture gets the larger share at any width, remembered
-        assert window.paint_large_action.isEnabled() and not window.paint_large_action.isChecked()
+        assert window.menus.paint_large_action.isEnabled() and not window.menus.paint_large_action.isChecked()
         qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
-        assert window.paint_large_action.isChecked() and settings.value("paint_large", type=bool)
-        qtbot.waitUntil(lambda: window.canvas_view.width() > 1.5 * window.result_view.width(), timeout=5000)
+        assert window.menus.paint_large_action.isChecked() and settings.value("paint_large", type=bool)
+        qtbot.waitUntil(lambda: window.inputs_pane.canvas_view.width() > 1.5 * window.result_view.width(), timeout=5000)
         qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
         qtbot.waitUntil(lambda: window.result_view.width() >= 350, timeout=5000)

@@ -70,7 +70,7 @@ def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_mov
         doc.set_input(name, str(_image(path, i)), load_image(path).image)
     doc.set_param("p", 0.3)
     session = project / "s.weft.json"
-    assert window.save_session(str(session))
+    assert window.files.save_session(str(session))
 
     data = json.loads(session.read_text(encoding="utf-8"))  # plain JSON, nothing else
     assert data["inputs"] == {
@@ -87,7 +87,7 @@ def test_saved_session_is_json_relative_to_itself_and_opens_after_the_folder_mov
     shutil.move(project, moved)
     assert not project.exists()
     doc.set_param("p", 0.7)
-    assert window.open_session(str(moved / "s.weft.json"))
+    assert window.files.open_session(str(moved / "s.weft.json"))
     for name, path in files.items():
         new = moved / path.relative_to(project)
         assert doc.inputs[name].path == str(new)
@@ -102,13 +102,13 @@ def test_a_session_naming_a_missing_image_says_which_and_keeps_the_document(edit
     window, doc = edited, edited.doc
     _image(tmp_path / "tex.png", 0)
     session = tmp_path / "s.weft.json"
-    data = doc.session_dict(relative_to=tmp_path)
+    data = doc.session().to_data(tmp_path / "s.weft.json")
     data["inputs"] = {"texture": "tex.png", "target": "gone.png"}
     session.write_text(json.dumps(data))
     before = _state(doc)
     messages = []
     window.message.connect(messages.append)
-    assert window.open_session(str(session)) is False
+    assert window.files.open_session(str(session)) is False
     settle(qtbot, window)  # anything else it was going to say has been said
     assert messages == [f"{session}: the target image: {tmp_path / 'gone.png'}: no such file"]
     assert _state(doc) == before
@@ -117,7 +117,7 @@ def test_a_session_naming_a_missing_image_says_which_and_keeps_the_document(edit
     assert doc.square is None and doc.current_params.p == 0.3
     data["inputs"] = {"texture": "tex.png", "target": "tex.png"}
     session.write_text(json.dumps(data))
-    assert window.open_session(str(session))
+    assert window.files.open_session(str(session))
     assert doc.inputs["target"].path == str(tmp_path / "tex.png") and len(messages) == 1
 
 
@@ -125,7 +125,7 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
     window, doc = edited, edited.doc
     sentinel = tmp_path / "EXECUTED"
     _image(tmp_path / "tex.png", 0)
-    good = doc.session_dict(relative_to=tmp_path)
+    good = doc.session().to_data(tmp_path / "s.weft.json")
     good["inputs"] = {"texture": "tex.png", "target": "tex.png"}
 
     def field(**kw):
@@ -155,7 +155,7 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
         path = tmp_path / f"{name}.weft.json"
         path.write_bytes(data)
         del messages[:]
-        assert window.open_session(str(path)) is False, name
+        assert window.files.open_session(str(path)) is False, name
         settle(qtbot, window)  # anything else it was going to say has been said
         assert len(messages) == 1 and "\n" not in messages[0], (name, messages)
         assert messages[0].startswith(f"{path}: ") and fragment in messages[0], (name, messages)
@@ -164,7 +164,7 @@ def test_a_session_that_is_not_a_session_keeps_the_document(edited, qtbot, tmp_p
     assert window.isVisible()
     path = tmp_path / "good.weft.json"
     path.write_text(json.dumps(good))
-    assert window.open_session(str(path))  # and a good one still opens
+    assert window.files.open_session(str(path))  # and a good one still opens
 
 
 def _runs_off_gui_thread(monkeypatch, module, name, action):
@@ -204,8 +204,8 @@ def test_session_images_are_decoded_off_the_gui_thread_while_it_keeps_running(wi
     texture = _image(tmp_path / "tex.png", 7)
     window.doc.set_input("texture", str(texture), load_image(texture).image)
     session = tmp_path / "s.weft.json"
-    assert window.save_session(str(session))
-    flags = _runs_off_gui_thread(monkeypatch, files, "read_input", lambda: window.open_session(str(session)))
+    assert window.files.save_session(str(session))
+    flags = _runs_off_gui_thread(monkeypatch, files, "read_input", lambda: window.files.open_session(str(session)))
     assert flags and not any(flags)  # every image of the session, none on the GUI thread
     assert window.doc.inputs["texture"].path == str(texture)
 
@@ -215,7 +215,7 @@ def test_export_is_encoded_off_the_gui_thread(window, qtbot, tmp_path, monkeypat
 
     qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
     out = tmp_path / "out.png"
-    flags = _runs_off_gui_thread(monkeypatch, files, "save_image", lambda: window.export_result(str(out)))
+    flags = _runs_off_gui_thread(monkeypatch, files, "save_image", lambda: window.files.export_result(str(out)))
     assert flags == [False]
     written, shown = load_image(out).image, window.renderer.last.image
     assert written.shape == shown.shape

@@ -31,7 +31,7 @@ def test_open_session_on_a_fifo_is_refused_and_keeps_the_document(window, qtbot,
     messages = []
     window.message.connect(messages.append)
     try:
-        assert window.open_session(fifo) is False
+        assert window.files.open_session(fifo) is False
     finally:
         stop.set()
         guard.join()

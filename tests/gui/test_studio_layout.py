@@ -41,7 +41,7 @@ def test_the_status_line_gives_a_results_figures_in_words_and_units(window, qtbo
         window.doc.set_mask(g.key, Mask.empty(w, h).painted_line((w / 3, h / 2), (w / 2, h / 2), 6), "Brush stroke")
     qtbot.waitUntil(lambda: _final_of(window, method) and not window.renderer.running(), timeout=60000)
     shown = window.renderer.last
-    text = window.result_label.full_text()
+    text = window.status.result_label.full_text()
     assert text.startswith("result ") and " — " in text
     assert not SNAKE.findall(text), text
     assert not [k for k in shown.figures if "_" in k and k in text], text
@@ -61,8 +61,8 @@ def test_the_status_text_never_runs_into_the_pixel_read_out(qtbot, make_window):
     view.actual_size()
     view.centerOn(10.5, 12.5)
     mouse(view, "move", (10.5, 12.5), buttons=Qt.MouseButton.NoButton)
-    assert re.match(r"result  x \d+  y \d+  [0-9.]+ ", w.pixel_label.text()), w.pixel_label.text()
-    status, pixel, zoom = w.status_label, w.pixel_label, w.zoom_label
+    assert re.match(r"result  x \d+  y \d+  [0-9.]+ ", w.status.pixel_label.text()), w.status.pixel_label.text()
+    status, pixel, zoom = w.status.status_label, w.status.pixel_label, w.status.zoom_label
     assert status.isVisible() and pixel.isVisible()
     assert not status.geometry().intersects(pixel.geometry())
     assert not status.geometry().intersects(zoom.geometry())
@@ -72,7 +72,7 @@ def test_the_status_text_never_runs_into_the_pixel_read_out(qtbot, make_window):
     assert status.toolTip() == long
     assert pixel.fontMetrics().horizontalAdvance(pixel.text()) <= pixel.contentsRect().width()
     # a short message is shown whole, even beside long result figures (those give way)
-    w.result_label.set_full_text(long)
+    w.status.result_label.set_full_text(long)
     w.statusBar().showMessage("cancelled; the previous result is kept")
     qtbot.waitUntil(lambda: status.text() == "cancelled; the previous result is kept", timeout=2000)
     assert not status.geometry().intersects(pixel.geometry())
@@ -84,11 +84,11 @@ def test_tab_titles_are_not_clipped(qtbot, make_window, size):
     w = _window(make_window, qtbot, size)
     for method in registry.studio_methods():
         w.doc.set_method(method)
-        qtbot.waitUntil(lambda method=method: w.doc.method == method, timeout=5000)
-        bar = w.input_tabs.tabBar()
-        if not w.input_tabs.isVisible():
+        qtbot.waitUntil(lambda m=method: w.doc.method == m, timeout=5000)
+        bar = w.inputs_pane.tabs.tabBar()
+        if not w.inputs_pane.tabs.isVisible():
             continue
-        qtbot.waitUntil(lambda bar=bar: bar.width() > 0, timeout=5000)
+        qtbot.waitUntil(lambda b=bar: b.width() > 0, timeout=5000)
         for i in range(bar.count()):
             rect = bar.tabRect(i)
             text = bar.tabText(i)
@@ -146,7 +146,7 @@ def test_no_widget_is_painted_over_the_examples_dock_title(qtbot, make_window):
     assert not _widgets_over_the_examples_title(w)
     for method in registry.studio_methods():
         w.doc.set_method(method)
-        qtbot.waitUntil(lambda method=method: w.doc.method == method, timeout=5000)
+        qtbot.waitUntil(lambda m=method: w.doc.method == m, timeout=5000)
         assert not _widgets_over_the_examples_title(w), method
     from weft.app.gui.views import ImageView
 
@@ -161,7 +161,7 @@ def test_the_square_can_be_typed_and_the_edit_undone(window, qtbot):
     panel = window.method_panel
     x_box, y_box, side_box = panel.square_boxes
     assert panel.square_row.isVisible()
-    drag(window.canvas_view, (20, 20), (60, 60))
+    drag(window.inputs_pane.canvas_view, (20, 20), (60, 60))
     qtbot.waitUntil(lambda: window.doc.square is not None, timeout=5000)
     before = window.doc.square
     assert (x_box.value(), y_box.value(), side_box.value()) == tuple(before)
@@ -170,7 +170,7 @@ def test_the_square_can_be_typed_and_the_edit_undone(window, qtbot):
         qtbot.keyClicks(box.lineEdit(), text)
         qtbot.keyClick(box.lineEdit(), Qt.Key.Key_Return)
     assert tuple(window.doc.square) == (30, before[1], 24)
-    assert window.undo_action.text().endswith("Square")
+    assert window.menus.undo_action.text().endswith("Square")
     qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # the side's edit
     qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)  # the corner's
     assert window.doc.square == before
@@ -206,9 +206,9 @@ def test_a_square_can_be_typed_when_none_is_drawn(window, qtbot):
 def test_quads_prompt_is_not_cut_off_in_a_narrow_pane(qtbot, make_window):
     w = _window(make_window, qtbot, (1024, 700))
     w.doc.set_method("nfpt")
-    qtbot.waitUntil(lambda: w.lines_panel is not None and w.lines_panel.active, timeout=5000)
-    panel = w.lines_panel
-    w.input_tabs.setCurrentWidget(panel)
+    qtbot.waitUntil(lambda: w.inputs_pane.lines_panel is not None and w.inputs_pane.lines_panel.active, timeout=5000)
+    panel = w.inputs_pane.lines_panel
+    w.inputs_pane.tabs.setCurrentWidget(panel)
     qtbot.mouseClick(panel.quad_button, Qt.MouseButton.LeftButton)
     status = panel.rectify_status
     qtbot.waitUntil(lambda: status.isVisible() and "top-left corner" in status.text(), timeout=5000)

@@ -11,7 +11,7 @@ from weft.core.rectify.homography import apply_homography
 
 
 def test_suggest_lines_button_proposes_editable_pairs_and_one_undo_removes_them(nfpt, qtbot):
-    panel, doc = nfpt.lines_panel, nfpt.doc
+    panel, doc = nfpt.inputs_pane.lines_panel, nfpt.doc
     assert panel.suggest_button.isVisible()
     before = (list(doc.image_lines), list(doc.frontal_lines))
     depth = doc.undo_stack.count()
@@ -36,7 +36,7 @@ def test_suggest_lines_button_proposes_editable_pairs_and_one_undo_removes_them(
 
 
 def test_suggest_lines_on_a_photo_without_lines_says_so_and_keeps_the_lines(nfpt, qtbot):
-    panel, doc = nfpt.lines_panel, nfpt.doc
+    panel, doc = nfpt.inputs_pane.lines_panel, nfpt.doc
     rng = np.random.default_rng(0)
     noise = np.clip(0.5 + 0.1 * rng.standard_normal((240, 320)), 0, 1).astype(np.float32)
     doc.set_input("photo", None, noise)
@@ -101,7 +101,7 @@ def test_a_plugin_method_gets_the_button_only_when_it_declares_a_suggestion(decl
         box.setCurrentIndex(box.findData(method.name))
         window.open_input("picture", str(picture))
         qtbot.waitUntil(lambda: window.doc.image("picture") is not None, timeout=10000)
-        panel = window.lines_panel
+        panel = window.inputs_pane.lines_panel
         assert panel.suggest_button.isVisible() == declared
         if declared:
             qtbot.mouseClick(panel.suggest_button, Qt.MouseButton.LeftButton)

@@ -4,11 +4,12 @@ import threading
 
 import numpy as np
 import pytest
-import weft.app.gui.render as render
 import weft.core.jobs as jobs_module
+import weft.core.request as core_request
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QApplication
 from weft.app.gui.document import Document, DocumentState
+from weft.app.gui.render_job import render_request
 from weft.app.gui.variations import THUMB_SIDE
 from weft.core.errors import WeftError
 
@@ -17,7 +18,7 @@ from .helpers import no_job_threads
 
 def _dialog(window, p=(0.0, 0.5), w=(0.0, 4.0)):
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     dialog.combo[0].setCurrentText("p")
     dialog.combo[1].setCurrentText("target_weight")
     _ranges(dialog, p, w)
@@ -52,7 +53,7 @@ def _submits(dialog, monkeypatch) -> list:
 def held_preparation(monkeypatch):
     """The first thumbnail reduction waits (on its worker) until ``release`` is set; later ones run."""
     started, release, calls = threading.Event(), threading.Event(), []
-    real = render.reduce_for_preview
+    real = core_request.reduce_for_preview
 
     def held(*args, **kwargs):
         calls.append(args[3])
@@ -61,14 +62,14 @@ def held_preparation(monkeypatch):
             assert release.wait(30)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(render, "reduce_for_preview", held)
+    monkeypatch.setattr(core_request, "reduce_for_preview", held)
     yield started, release, calls
     release.set()
 
 
 def test_the_grids_inputs_are_built_once_on_a_worker_not_the_gui_thread(window, qtbot, monkeypatch):
     on_gui: dict[str, list[bool]] = {"inputs": [], "reduce_for_preview": []}
-    real_deferred, real_reduce = Document.deferred_inputs, render.reduce_for_preview
+    real_deferred, real_reduce = Document.deferred_inputs, core_request.reduce_for_preview
 
     def deferred(self, *args, **kwargs):
         build = real_deferred(self, *args, **kwargs)
@@ -85,7 +86,7 @@ def test_the_grids_inputs_are_built_once_on_a_worker_not_the_gui_thread(window, 
         return real_reduce(*args, **kwargs)
 
     monkeypatch.setattr(Document, "deferred_inputs", deferred)
-    monkeypatch.setattr(render, "reduce_for_preview", reduce)
+    monkeypatch.setattr(core_request, "reduce_for_preview", reduce)
     dialog = _dialog(window)
     done = set()
     dialog.cell_done.connect(lambda i, j: done.add((i, j)))
@@ -122,8 +123,8 @@ def test_a_second_render_during_the_preparation_cancels_the_first_grid(window, q
     assert {v for (_, v), _ in dialog.values.values()} == {0.1, 0.2, 0.3}
     assert dialog.cells[(0, 0)].text() == "p=0.1  target_weight=1.0"
     # the cell shows the second grid's values' pixels
-    prepare, _ = render.preparation(window.doc, side=THUMB_SIDE)
-    inputs, base, _ = prepare()
+    prepared = render_request(window.doc, core_request.Preview(THUMB_SIDE)).prepared()
+    inputs, base = prepared.images, prepared.params
     expected = window.doc.current.run(inputs, base.replace(p=0.1, target_weight=1.0), rng=window.doc.seed).image
     assert np.array_equal(dialog.images[(0, 0)], expected)
     assert dialog.status.text() == "click a cell to adopt its values"
@@ -131,12 +132,12 @@ def test_a_second_render_during_the_preparation_cancels_the_first_grid(window, q
 
 
 def test_a_failing_preparation_says_why_and_the_dialog_keeps_working(window, qtbot, monkeypatch):
-    real = render.reduce_for_preview
+    real = core_request.reduce_for_preview
 
     def failing(*args, **kwargs):
         raise WeftError("target: cannot be reduced\n(broken on purpose)")
 
-    monkeypatch.setattr(render, "reduce_for_preview", failing)
+    monkeypatch.setattr(core_request, "reduce_for_preview", failing)
     dialog = _dialog(window)
     jobs = _submits(dialog, monkeypatch)
     _click(qtbot, dialog)
@@ -144,7 +145,7 @@ def test_a_failing_preparation_says_why_and_the_dialog_keeps_working(window, qtb
     qtbot.waitUntil(lambda: dialog.status.text() == expected, timeout=10000)
     assert [j.slot for j in jobs] == ["prepare"]  # no cell ran
     assert all(b.icon().isNull() for b in dialog.cells.values()) and not dialog.export_button.isEnabled()
-    monkeypatch.setattr(render, "reduce_for_preview", real)
+    monkeypatch.setattr(core_request, "reduce_for_preview", real)
     done = set()
     dialog.cell_done.connect(lambda i, j: done.add((i, j)))
     _click(qtbot, dialog)
@@ -207,8 +208,8 @@ def test_a_late_result_of_an_earlier_grid_is_dropped(window, qtbot, monkeypatch)
     qtbot.waitUntil(lambda: len(done) == 9, timeout=30000)
     shown = dialog.images[(0, 0)]
     count = len(jobs)
-    dialog._delivered.emit(JobResult(old_prepare.id, "prepare", prepared))
-    dialog._delivered.emit(JobResult(old_cell.id, "cell-0-0", np.zeros_like(shown)))
+    dialog.runner.result.emit(JobResult(old_prepare.id, "prepare", prepared))
+    dialog.runner.result.emit(JobResult(old_cell.id, "cell-0-0", np.zeros_like(shown)))
     QApplication.processEvents()
     assert len(jobs) == count and dialog.images[(0, 0)] is shown
     dialog.close()
@@ -239,13 +240,13 @@ def test_variations_offers_only_parameters_that_matter_and_labels_its_export(win
     doc.set_method("nfpt")
     assert doc.current_params.warp == "homography"
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     offered = [dialog.combo[0].itemText(k) for k in range(dialog.combo[0].count())]
     assert offered and not {"a", "b", "p"} & set(offered)
     dialog.close()
     doc.set_param("warp", "morph")
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     offered = [dialog.combo[0].itemText(k) for k in range(dialog.combo[0].count())]
     assert {"a", "b", "p"} <= set(offered)
     dialog.close()
@@ -253,12 +254,12 @@ def test_variations_offers_only_parameters_that_matter_and_labels_its_export(win
     data = json.loads((RESOURCES / "perspective-lines.json").read_text())
     doc.set_param("warp", "homography")
     doc.set_param("size", (96, 64))
-    window.lines_panel.quad_button.setChecked(True)
+    window.inputs_pane.lines_panel.quad_button.setChecked(True)
     for x, y in [line[:2] for line in data["image_lines"][:4]]:
-        mouse(window.canvas_view, "press", (x, y))
-        mouse(window.canvas_view, "release", (x, y))
+        mouse(window.inputs_pane.canvas_view, "press", (x, y))
+        mouse(window.inputs_pane.canvas_view, "release", (x, y))
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     dialog.combo[0].setCurrentText("tol")
     dialog.combo[1].setCurrentText("sigma_s")
     done = set()
@@ -293,7 +294,7 @@ def test_variations_ranges_stay_within_what_the_inputs_allow(window, qtbot, tmp_
     )
     doc.set_param("block", 112)
     window.open_variations()
-    dialog = window._variations
+    dialog = window.variations
     dialog.combo[0].setCurrentText("block")
     assert dialog.hi[0].maximum() == 112 and dialog.hi[0].value() <= 112
     dialog.close()
