@@ -1,10 +1,11 @@
 """The ``weft`` command.
 
-``weft`` with no arguments opens the desktop studio (``weft IMAGE [TARGET]``: on those images); ``weft METHOD
-INPUT... -o OUT [options]`` runs a method headless; ``weft run RECIPE -o OUT`` reproduces a recipe (a
-``.json`` file, or a PNG exported by weft, which carries its recipe); ``weft batch RECIPE --over INPUT FILES
--o PATTERN`` applies it to many files (:mod:`weft.app.batch_cli`). Method options are generated from the
-method's ``Params`` specs, so the CLI and the GUI share one definition of every parameter and its range.
+``weft`` with no arguments opens the desktop studio (``weft IMAGE [TARGET]``: on those images);
+``weft METHOD INPUT... -o OUT [options]`` runs a method headless; ``weft run RECIPE -o OUT`` reproduces
+a recipe (a ``.json`` file, or a PNG exported by weft, which carries its recipe);
+``weft batch RECIPE --over INPUT FILES -o PATTERN`` applies it to many files
+(:mod:`weft.app.batch_cli`). Method options are generated from the method's ``Params`` specs, so the
+CLI and the GUI share one definition of every parameter and its range.
 
 Contract: any bad input (a file, a parameter, a geometry) prints exactly one line on stderr and exits
 with status 2, with no traceback and no output file. ``--report`` prints exactly one JSON line on

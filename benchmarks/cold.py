@@ -148,7 +148,7 @@ def timed_run(cmd: list[str], cache: str, timeout: float = 600.0, cwd: Path = RO
         seconds = probe["shown_at"] - t0
         end = probe["shown_at"]
         writes = [t0, end]  # the studio says what it does in its window, not on a terminal
-    gaps = [b - a for a, b in zip(writes, writes[1:] + [end])]
+    gaps = [b - a for a, b in zip(writes, writes[1:] + [end], strict=True)]
     return {"seconds": seconds, "silent": max(gaps), "first_words": gaps[0], "stderr": text.decode(errors="replace")}
 
 
@@ -166,7 +166,7 @@ def measure(
             cold, silent, first = [], [], []
             cache = ""
             try:
-                for i in range(runs):
+                for _ in range(runs):
                     cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
                     r = timed_run(cmd, cache, cwd=root)
                     cold.append(r["seconds"])

@@ -652,13 +652,13 @@ def seed_medians(
                 **kw,
             )
             rows.append(figures(np.clip(np.rint(filled * 255), 0, 255).astype(np.uint8), inputs))
-        med = lambda key: statistics.median(r[key] for r in rows)  # noqa: E731
+        med = {key: statistics.median(r[key] for r in rows) for key in ("coherence", "detail", "seam")}
         out.append(
             {
                 "case": name,
-                "coherence": med("coherence"),
-                "detail": med("detail") / truth["detail"],
-                "seam": med("seam") - truth["seam"],
+                "coherence": med["coherence"],
+                "detail": med["detail"] / truth["detail"],
+                "seam": med["seam"] - truth["seam"],
                 "each": [round(r["coherence"], 2) for r in rows],
             }
         )

@@ -34,6 +34,7 @@ and the main window idle; a fresh dialog per run. Prints one JSON line with the 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import statistics
@@ -122,7 +123,7 @@ def measure(values: int = 30, hz: float = 60.0) -> dict:
         step = 1.0 / hz
         start = time.perf_counter()
         for i, v in enumerate(series):
-            _wait(app, lambda: time.perf_counter() - start >= i * step, 5)
+            _wait(app, lambda i=i: time.perf_counter() - start >= i * step, 5)
             changed_at[v] = time.perf_counter()
             slider.setValue(v)
         _wait(app, lambda: time.perf_counter() - start >= values * step + 0.3, 5)
@@ -225,7 +226,7 @@ def measure_painting(
         send("press", *points[0])
         start = time.perf_counter()
         for i, (x, y) in enumerate(points[1:], 1):
-            _wait(app, lambda: time.perf_counter() - start >= i * step, 5)
+            _wait(app, lambda i=i: time.perf_counter() - start >= i * step, 5)
             moved_at.append(time.perf_counter())
             send("move", x, y)
         _wait(app, lambda: time.perf_counter() - start >= values * step + 0.5, 5)
@@ -259,15 +260,13 @@ def _picture_file(folder: str, side: int) -> str:
 
 def _stall_since(beats: list[float], t0: float) -> float:
     """The longest gap between heartbeats that ends after ``t0`` (ms)."""
-    gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:]) if b >= t0]
+    gaps = [(b - a) * 1000 for a, b in itertools.pairwise(beats) if b >= t0]
     return round(max(gaps), 1) if gaps else 0.0
 
 
 def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> dict:
-    from weft.app.gui.document import DocumentState, read_input
+    from weft.app.gui.document import read_input
     from weft.core import registry
-    from weft.core.geometry import Mask
-    from weft.core.studio import MASK
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     registry.warm_up(method)  # (the studio loads them at start: no kernel loading in the figures)
@@ -277,82 +276,8 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
         item = read_input(picture)
         session = os.path.join(tmp, "big.weft.json")
         for run in range(runs):
-            window = _window(tmp, f"weft{run}.ini")
-            doc, studio = window.doc, window.doc.methods[method].studio
-            canvas = studio.canvas
-            doc.restore(DocumentState(inputs={canvas: item}, method=method))
-            doc.session().save(session)
-            doc.restore(DocumentState(inputs={}, method=method))
-            _wait(app, lambda: not window.renderer.running(), 30)
-            answered: list[float] = []
-            window.renderer.shown.connect(lambda _s: answered.append(time.perf_counter()))
-            window.renderer.failed.connect(lambda _m: answered.append(time.perf_counter()))
-
-            def views_show(image) -> bool:
-                views = (window.inputs_pane.canvas_view, window.result_view)
-                return all(
-                    v.image is not None and v.image.shape[:2] == image.shape[:2] and not getattr(v, "converting", False)
-                    for v in views
-                )
-
-            def step(name: str, action, done, settle: float = 0.3, since=None) -> None:
-                heartbeat, beats = _heartbeat()
-                t0 = time.perf_counter()
-                action()
-                _wait(app, done, 300)
-                _wait(app, lambda: False, settle)
-                heartbeat.stop()
-                steps[name].append(_stall_since(beats, since() if since is not None else t0))
-
-            # a session of the picture (nothing drawn: the result view shows the picture)
-            step(
-                "session",
-                lambda: window.files.open_session(session),
-                lambda: answered and views_show(item.image) and window.result_view.image is doc.image(canvas),
-            )
-            # File > Open of the picture (decoded off the GUI thread, then shown)
-            del answered[:]
-            step(
-                "open",
-                lambda: window.open_input(canvas, picture),
-                lambda: (
-                    doc.image(canvas) is not item.image
-                    and answered
-                    and views_show(item.image)
-                    and window.result_view.image is doc.image(canvas)
-                ),
-            )
-            # the method's full-size result (a small painted mask if it fills one): the stall from its arrival
-            g = next((g for g in studio.geometry if g.kind == MASK), None)
-            del answered[:]
-            if g is not None:
-                doc.set_mask(
-                    g.key,
-                    Mask.empty(side, side).painted_line(
-                        (side * 0.4, side * 0.4), (side * 0.45, side * 0.42), side / 200, True
-                    ),
-                    "stroke",
-                )
-            else:
-                window.renderer.final(now=True)
-            step(
-                "result",
-                lambda: None,
-                lambda: (
-                    bool(answered)
-                    and window.renderer.last is not None
-                    and window.renderer.last.final
-                    and window.result_view.image is window.renderer.last.image
-                    and not getattr(window.result_view, "converting", False)
-                ),
-                settle=0.5,
-                since=lambda: answered[0],
-            )
-            out = os.path.join(tmp, f"out{run}.png")
-            step("export", lambda: window.files.export_result(out), lambda: os.path.exists(out), settle=0.2)
-            doc.undo_stack.setClean()
-            window.close()
-            del window
+            for name, stall in _opening_run(app, tmp, run, method, side, picture, item, session).items():
+                steps[name].append(stall)
     return {
         "side": side,
         "method": method,
@@ -362,9 +287,90 @@ def measure_opening(side: int = 4096, runs: int = 5, method: str = "fill") -> di
     }
 
 
+def _opening_run(app, tmp: str, run: int, method: str, side: int, picture: str, item, session: str) -> dict[str, float]:
+    """One run of :func:`measure_opening` in a fresh window: each step's longest stall (ms)."""
+    from weft.app.gui.document import DocumentState
+    from weft.core.geometry import Mask
+    from weft.core.studio import MASK
+
+    stalls: dict[str, float] = {}
+    window = _window(tmp, f"weft{run}.ini")
+    doc, studio = window.doc, window.doc.methods[method].studio
+    canvas = studio.canvas
+    doc.restore(DocumentState(inputs={canvas: item}, method=method))
+    doc.session().save(session)
+    doc.restore(DocumentState(inputs={}, method=method))
+    _wait(app, lambda: not window.renderer.running(), 30)
+    answered: list[float] = []
+    window.renderer.shown.connect(lambda _s: answered.append(time.perf_counter()))
+    window.renderer.failed.connect(lambda _m: answered.append(time.perf_counter()))
+
+    def views_show(image) -> bool:
+        views = (window.inputs_pane.canvas_view, window.result_view)
+        return all(
+            v.image is not None and v.image.shape[:2] == image.shape[:2] and not getattr(v, "converting", False)
+            for v in views
+        )
+
+    def step(name: str, action, done, settle: float = 0.3, since=None) -> None:
+        heartbeat, beats = _heartbeat()
+        t0 = time.perf_counter()
+        action()
+        _wait(app, done, 300)
+        _wait(app, lambda: False, settle)
+        heartbeat.stop()
+        stalls[name] = _stall_since(beats, since() if since is not None else t0)
+
+    # a session of the picture (nothing drawn: the result view shows the picture)
+    step(
+        "session",
+        lambda: window.files.open_session(session),
+        lambda: answered and views_show(item.image) and window.result_view.image is doc.image(canvas),
+    )
+    # File > Open of the picture (decoded off the GUI thread, then shown)
+    del answered[:]
+    step(
+        "open",
+        lambda: window.open_input(canvas, picture),
+        lambda: (
+            doc.image(canvas) is not item.image
+            and answered
+            and views_show(item.image)
+            and window.result_view.image is doc.image(canvas)
+        ),
+    )
+    # the method's full-size result (a small painted mask if it fills one): the stall from its arrival
+    g = next((g for g in studio.geometry if g.kind == MASK), None)
+    del answered[:]
+    if g is not None:
+        doc.set_mask(
+            g.key,
+            Mask.empty(side, side).painted_line((side * 0.4, side * 0.4), (side * 0.45, side * 0.42), side / 200, True),
+            "stroke",
+        )
+    else:
+        window.renderer.final(now=True)
+    step(
+        "result",
+        lambda: None,
+        lambda: (
+            bool(answered)
+            and window.renderer.last is not None
+            and window.renderer.last.final
+            and window.result_view.image is window.renderer.last.image
+            and not getattr(window.result_view, "converting", False)
+        ),
+        settle=0.5,
+        since=lambda: answered[0],
+    )
+    out = os.path.join(tmp, f"out{run}.png")
+    step("export", lambda: window.files.export_result(out), lambda: os.path.exists(out), settle=0.2)
+    doc.undo_stack.setClean()
+    window.close()
+    return stalls
+
+
 def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") -> dict:
-    from PySide6.QtCore import Qt
-    from PySide6.QtTest import QTest
     from weft.app.gui.document import DocumentState, read_input
     from weft.core import registry
     from weft.core.geometry import Mask
@@ -391,32 +397,9 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
             )
         _wait(app, lambda: not window.renderer.running(), 30)
         for _run in range(runs):
-            window.open_variations()
-            dialog = window.variations
-            _wait(app, dialog.isVisible, 10)
-            done: set = set()
-            dialog.cell_done.connect(lambda i, j: done.add((i, j)))
-            heartbeat, beats = _heartbeat()
-            _wait(app, lambda: len(beats) > 2, 5)
-            t0 = time.perf_counter()
-            QTest.mouseClick(dialog.render_button, Qt.MouseButton.LeftButton)
-            _wait(
-                app,
-                lambda: (
-                    dialog.cells
-                    and done == {k for k, b in dialog.cells.items() if b.isEnabled()}
-                    and not dialog.runner.busy()
-                ),
-                300,
-            )
-            seconds.append(round(time.perf_counter() - t0, 2))
-            _wait(app, lambda: False, 0.1)  # the last thumbnail painted
-            heartbeat.stop()
-            stalls.append(_stall_since(beats, t0))
-            if not done:
-                raise SystemExit(f"no cell of the {method} grid rendered: {dialog.status.text()}")
-            dialog.close()
-            dialog.deleteLater()
+            stall, took = _variations_run(app, window, method)
+            stalls.append(stall)
+            seconds.append(took)
         doc.undo_stack.setClean()
         window.close()
     return {
@@ -427,6 +410,38 @@ def measure_variations(side: int = 4096, runs: int = 5, method: str = "fill") ->
         "each": stalls,
         "grid_s": seconds,
     }
+
+
+def _variations_run(app, window, method: str) -> tuple[float, float]:
+    """One run of :func:`measure_variations` in a fresh dialog: the longest stall (ms) and the grid's time (s)."""
+    from PySide6.QtCore import Qt
+    from PySide6.QtTest import QTest
+
+    window.open_variations()
+    dialog = window.variations
+    _wait(app, dialog.isVisible, 10)
+    done: set = set()
+    dialog.cell_done.connect(lambda i, j: done.add((i, j)))
+    heartbeat, beats = _heartbeat()
+    _wait(app, lambda: len(beats) > 2, 5)
+    t0 = time.perf_counter()
+    QTest.mouseClick(dialog.render_button, Qt.MouseButton.LeftButton)
+    _wait(
+        app,
+        lambda: (
+            dialog.cells and done == {k for k, b in dialog.cells.items() if b.isEnabled()} and not dialog.runner.busy()
+        ),
+        300,
+    )
+    took = round(time.perf_counter() - t0, 2)
+    _wait(app, lambda: False, 0.1)  # the last thumbnail painted
+    heartbeat.stop()
+    stall = _stall_since(beats, t0)
+    if not done:
+        raise SystemExit(f"no cell of the {method} grid rendered: {dialog.status.text()}")
+    dialog.close()
+    dialog.deleteLater()
+    return stall, took
 
 
 def _heartbeat() -> tuple[QTimer, list[float]]:
@@ -442,7 +457,7 @@ def _heartbeat() -> tuple[QTimer, list[float]]:
 def _summary(latencies: list[float], beats: list[float], values: int) -> dict:
     """Median and p95 latency (ms), the longest gap between heartbeats, and the counts."""
     latencies = sorted(latencies)
-    gaps = [(b - a) * 1000 for a, b in zip(beats, beats[1:])]
+    gaps = [(b - a) * 1000 for a, b in itertools.pairwise(beats)]
     return {
         "median_ms": round(statistics.median(latencies), 1) if latencies else None,
         "p95_ms": round(latencies[min(len(latencies) - 1, int(0.95 * len(latencies)))], 1) if latencies else None,

@@ -80,7 +80,8 @@ def main(argv=None) -> int:
         print(
             f"| {name} {w}x{h} | {synth_block(tex.shape)} | "
             + " | ".join(
-                f"{a:.4f} → {b:.4f}" if i < 2 else f"{a:.3f} → {b:.3f}" for i, (a, b) in enumerate(zip(old, new))
+                f"{a:.4f} → {b:.4f}" if i < 2 else f"{a:.3f} → {b:.3f}"
+                for i, (a, b) in enumerate(zip(old, new, strict=True))
             )
             + " |",
             flush=True,

@@ -13,6 +13,7 @@ issue) as points. Drawn with OpenCV (no plotting library).
 
 from __future__ import annotations
 
+import itertools
 import sys
 from pathlib import Path
 
@@ -130,7 +131,7 @@ def draw(rows: list[tuple[str, float, float]], path: Path = OUT) -> None:
     cv2.putText(img, "fidelity (higher is better)", (8, 24), font, 0.55, black, 1, cv2.LINE_AA)
     blue, red = (200, 90, 20), (30, 30, 210)  # BGR
     front = sorted(pareto(rows), key=lambda r: r[2])
-    for a, b in zip(front, front[1:]):
+    for a, b in itertools.pairwise(front):
         cv2.line(img, xy(a[2], a[1]), xy(b[2], b[1]), blue, 2, cv2.LINE_AA)
     for k, row in enumerate(rows):
         _, fid, coh = row

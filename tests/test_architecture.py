@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 #: Input names that are also the plain word the studio uses for any picture (fill's input is called
-#: "image", fixed by issue 15's agreed interface; the studio's "image" labels mean the word, not it).
+#: "image", fixed by the fill interface; the studio's "image" labels mean the word, not it).
 GENERIC_WORDS = {"image"}
 
 

@@ -1,4 +1,4 @@
-"""Issue 8.1: the bad-input corpus through every CLI subcommand that takes an image.
+"""The bad-input corpus through every CLI subcommand that takes an image.
 
 The GUI side is tests/gui/test_open_bad_files.py.
 
@@ -125,6 +125,7 @@ def test_bomb_is_refused_without_decoding(corpus, tmp_path, capsys, monkeypatch)
     assert "megapixels exceeds the limit" in err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "method,item",
     [
@@ -148,6 +149,7 @@ def test_real_process_refuses_broken_file(corpus, tmp_path, method, item):
     check_refusal(proc.stderr, path, proc.returncode, out)
 
 
+@pytest.mark.slow
 def test_real_process_reads_non_ascii_path(corpus, tmp_path):
     out = tmp_path / "sortie ü.png"
     proc = subprocess.run(

@@ -63,6 +63,7 @@ def run(argv, capsys):
     return code, out, err
 
 
+@pytest.mark.slow
 def test_each_output_is_weft_run_on_its_recipe_byte_for_byte(scene, capsys):
     tmp, frames = scene
     code, out, err = run(
@@ -108,6 +109,7 @@ def test_each_output_is_weft_run_on_its_recipe_byte_for_byte(scene, capsys):
         assert ref.read_bytes() == made.read_bytes()
 
 
+@pytest.mark.slow
 def test_an_exported_png_is_a_recipe_and_seed_per_item_varies_the_seed(scene, capsys):
     tmp, frames = scene
     assert run(["run", tmp / "look.json", "-o", tmp / "look.png"], capsys)[0] == 0
@@ -135,6 +137,7 @@ def test_an_exported_png_is_a_recipe_and_seed_per_item_varies_the_seed(scene, ca
     assert a.shape == b.shape == (40, 48, 3)
 
 
+@pytest.mark.slow
 def test_a_corrupt_frame_fails_alone_with_its_reason(scene, capsys):
     tmp, frames = scene
     data = frames[2].read_bytes()
@@ -170,6 +173,7 @@ def test_a_corrupt_frame_fails_alone_with_its_reason(scene, capsys):
     assert all(d["error"].startswith(str(tmp / "frames")) for d in failed)
 
 
+@pytest.mark.slow
 def test_rerun_skips_what_is_done_and_force_redoes_it(scene, capsys):
     tmp, frames = scene
     argv = [
@@ -206,6 +210,7 @@ def test_rerun_skips_what_is_done_and_force_redoes_it(scene, capsys):
     assert code == 0 and err.strip() == "5 written"
 
 
+@pytest.mark.slow
 def test_a_recipe_without_seed_keeps_the_seed_of_its_first_run_when_resumed(scene, capsys):
     tmp, frames = scene
     data = json.loads((tmp / "look.json").read_text())
@@ -326,6 +331,7 @@ def test_memory_for_all_workers_is_checked_up_front(scene, capsys, monkeypatch):
     assert err.strip().splitlines()[-1].startswith("0 written, 5 failed: frame_1.png: needs about 0 MiB of memory")
 
 
+@pytest.mark.slow
 def test_shipped_inputs_and_outputs_give_the_same_files(scene, capsys):
     tmp, frames = scene
     base = ["batch", tmp / "look.json", "--over", "target", tmp / "frames"]
@@ -338,6 +344,7 @@ def test_shipped_inputs_and_outputs_give_the_same_files(scene, capsys):
         assert (tmp / "a" / f.name).read_bytes() == (tmp / "b" / f.name).read_bytes()
 
 
+@pytest.mark.slow
 def test_shipped_inputs_name_the_original_file_when_bad(scene, capsys):
     tmp, frames = scene
     frames[1].write_bytes(b"not an image at all")
@@ -379,6 +386,7 @@ def test_plan_lists_in_natural_order_and_zips_several_inputs(scene):
     assert p.skipped == () and len(p.todo) == 12 and p.seed == 7
 
 
+@pytest.mark.slow
 def test_cancel_stops_the_batch_between_items(scene):
     tmp, frames = scene
     from weft.core.jobs import CancelToken
@@ -421,6 +429,7 @@ def slow_scene(tmp_path):
     return tmp_path, frames
 
 
+@pytest.mark.slow
 def test_a_killed_batch_leaves_whole_outputs_and_resumes(slow_scene):
     tmp, frames = slow_scene
     argv = [
@@ -483,6 +492,7 @@ def test_a_killed_batch_leaves_whole_outputs_and_resumes(slow_scene):
         assert np.array_equal(load_image(tmp / "out" / f.name).image, load_image(tmp / "ref" / f.name).image)
 
 
+@pytest.mark.slow
 def test_a_local_worker_killed_mid_batch_is_replaced_and_no_item_is_lost(slow_scene):
     tmp, frames = slow_scene
     p = batch.plan(str(tmp / "look.json"), [("target", str(tmp / "frames"))], str(tmp / "o" / "{stem}.png"))
@@ -523,6 +533,7 @@ def test_check_memory_names_the_largest_item(scene):
     batch.check_memory(p.items, 3, available=3 * 50 * 200 * 100)  # fits: no error
 
 
+@pytest.mark.slow
 def test_importing_weft_does_not_import_dask():
     code = (
         "import sys, weft.app.cli, weft.core.batch, weft.app.batch_cli; weft.app.cli.build_parser(); "
@@ -532,6 +543,7 @@ def test_importing_weft_does_not_import_dask():
     assert out.strip() == "[]"
 
 
+@pytest.mark.slow
 def test_a_fill_batch_keeps_each_items_bit_depth_as_weft_fill_does(tmp_path, capsys):
     """`weft fill` keeps its image's bit depth (Method.depth_from); a batch over a fill recipe does so
     per item unless --bit-depth is given: a 16-bit frame gives a 16-bit output, an 8-bit one 8 bits,

@@ -29,6 +29,7 @@ def cluster():
         yield c
 
 
+@pytest.mark.slow
 def test_dask_gives_the_local_pools_bytes(scene, cluster, capsys, monkeypatch):
     tmp, frames = scene
     base = ["batch", str(tmp / "look.json"), "--over", "target", str(tmp / "frames")]
@@ -64,6 +65,7 @@ def test_dask_gives_the_local_pools_bytes(scene, cluster, capsys, monkeypatch):
         assert (tmp / "shipped" / f.name).read_bytes() == local
 
 
+@pytest.mark.slow
 def test_a_bad_frame_fails_alone_on_dask(scene, cluster, capsys):
     tmp, frames = scene
     frames[0].write_bytes(frames[0].read_bytes()[:100])
@@ -132,6 +134,7 @@ def client(cluster):
         yield c
 
 
+@pytest.mark.slow
 def test_a_worker_killed_mid_batch_loses_no_item(slow_scene, cluster, client):
     tmp, frames = slow_scene
     p = batch.plan(str(tmp / "look.json"), [("target", str(tmp / "frames"))], str(tmp / "o" / "{stem}.png"))

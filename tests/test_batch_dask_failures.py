@@ -203,9 +203,9 @@ def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_sce
 @pytest.mark.skipif(not DASK.exists(), reason="no dask command beside this Python")
 def test_a_result_lost_with_its_worker_fails_instead_of_waiting_forever(tmp_path, monkeypatch):
     # The window the batch can fall into: an item done, its worker killed before the result is fetched.
-    monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)
     with _cluster(tmp_path, workers=1) as (address, _scheduler, worker):
-        pool = execute.DaskPool(address, "quilt")
+        pool = execute.DaskPool(address, "quilt")  # waits the usual time for the worker to join
+        monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)  # the wait for a worker once it is lost
         try:
             future = pool.client.submit(sum, [1, 2], pure=False)
             distributed.wait([future])

@@ -58,6 +58,7 @@ def test_command_line_writes_json(tmp_path, capsys, monkeypatch):
     assert bench_main(["no-such-case"]) == 2
 
 
+@pytest.mark.slow
 def test_cold_runs_a_command_with_stderr_on_a_terminal_and_tables_the_rows(tmp_path):
     import sys
 
@@ -92,7 +93,7 @@ def test_cold_runs_a_command_with_stderr_on_a_terminal_and_tables_the_rows(tmp_p
     }
 
 
-# --- fill and extend (issue 15): benchmarks/fill.py and its peer runner --------------------------------------
+# --- fill and extend: benchmarks/fill.py and its peer runner --------------------------------------
 
 
 def _tiny_fill_case():
@@ -220,6 +221,7 @@ def test_fill_goals_compare_weft_with_the_peers_and_the_truth():
     assert fill.goals({**good, "process_s": 1.4}, peers, truth, uncrop).endswith("time yes")  # ≤ 1.5 s
 
 
+@pytest.mark.slow
 def test_fill_process_peak_is_the_childs_own():
     import os
 

@@ -170,6 +170,7 @@ def test_version(capsys):
     assert capsys.readouterr().out.startswith("weft 0.")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["missing", "truncated"])
 def test_real_process_prints_one_line_and_no_traceback(tmp_path, texture_path, kind):
     """A separate process, so that C libraries' own stderr output would show: one line, status 2."""

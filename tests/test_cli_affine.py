@@ -1,5 +1,6 @@
 """`weft affine` as a user runs it: synthesis with figures, shaker box, transfer, fields, bad input."""
 
+import itertools
 import json
 
 import numpy as np
@@ -50,7 +51,7 @@ def test_shaker_box_reports_iterations_and_errors(tmp_path, capsys):
     report = json.loads(stdout)
     errs = report["boundary_error"]
     assert report["shaker_iterations"] == len(errs) - 1 >= 1
-    assert all(b <= a for a, b in zip(errs, errs[1:]))
+    assert all(b <= a for a, b in itertools.pairwise(errs))
     assert len(stdout) < 2000  # short enough to read
 
 

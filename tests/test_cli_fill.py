@@ -1,5 +1,5 @@
 """`weft fill` as a user runs it: grey, colour, 16-bit, RGBA, --extend, --size/--anchor, --source-mask,
---texture; `weft run` on the output's recipe reproduces it; every bad input of issue 15 item 4 is one
+--texture; `weft run` on the output's recipe reproduces it; every bad input is one
 line naming the file or parameter, exit 2, nothing written."""
 
 import json

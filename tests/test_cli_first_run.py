@@ -127,6 +127,7 @@ def test_the_preparing_line_ticks_until_the_bar_takes_over(monkeypatch):
     assert err.getvalue().endswith("0%\n")
 
 
+@pytest.mark.slow
 def test_warm_up_command_prepares_every_method_in_processes(monkeypatch, capsys):
     calls = []
 
@@ -161,6 +162,7 @@ def test_warm_up_command_prepares_every_method_in_processes(monkeypatch, capsys)
     assert capsys.readouterr() == ("", "")
 
 
+@pytest.mark.slow
 def test_warm_up_command_for_real_in_processes(tmp_path):
     """The real subcommand (spawned processes, a fresh cache folder: cold) on the two methods with the
     smallest kernels: exit 0, a line per method, the cache filled (a second run loads both)."""

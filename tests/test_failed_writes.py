@@ -1,4 +1,4 @@
-"""Issue 8.5: a failing write (full disk, read-only folder) leaves the old file intact and says why.
+"""A failing write (full disk, read-only folder) leaves the old file intact and says why.
 
 The full disk is the real ``/dev/full`` (every write to it fails with ENOSPC): the temporary file's
 bytes are sent there. A read-only folder is ``chmod 555`` when not running as root (root writes

@@ -62,6 +62,7 @@ def bind():
         pytest.skip(reason)
 
 
+@pytest.mark.slow
 def test_an_input_reached_through_a_bind_mount_is_not_overwritten(tmp_path, bind):
     src, dst = tmp_path / "src", tmp_path / "dst"
     src.mkdir(), dst.mkdir()
@@ -75,6 +76,7 @@ def test_an_input_reached_through_a_bind_mount_is_not_overwritten(tmp_path, bind
     assert texture.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_a_batch_never_overwrites_its_frames_through_a_bind_mount(tmp_path, bind):
     src, dst = tmp_path / "src", tmp_path / "dst"
     (src / "frames").mkdir(parents=True), dst.mkdir()
@@ -131,6 +133,7 @@ def test_weft_run_never_overwrites_the_recipe_it_reproduces(tmp_path, capsys):
     assert code == 2 and "refusing to overwrite the input file" in err and look.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_a_batch_never_overwrites_its_recipe_png(tmp_path, capsys):
     look = _export(tmp_path, capsys)
     before = look.read_bytes()
@@ -178,6 +181,7 @@ def _fast_batch(tmp_path, n=3):
     ]
 
 
+@pytest.mark.slow
 def test_a_rerun_redoes_an_output_cut_short_or_damaged(tmp_path, capsys):
     argv = _fast_batch(tmp_path)
     assert _run(argv, capsys)[0] == 0
@@ -207,6 +211,7 @@ def _bomb_png(path: Path, width: int, height: int) -> None:
     )
 
 
+@pytest.mark.slow
 def test_one_bomb_frame_fails_alone_and_the_rest_are_written(tmp_path, capsys):
     argv = _fast_batch(tmp_path)
     _bomb_png(tmp_path / "frames" / "f9.png", 60000, 60000)
@@ -220,6 +225,7 @@ def test_one_bomb_frame_fails_alone_and_the_rest_are_written(tmp_path, capsys):
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f0.png", "f1.png", "f2.png"]
 
 
+@pytest.mark.slow
 def test_a_frame_too_large_for_memory_fails_alone(tmp_path, capsys, monkeypatch):
     argv = _fast_batch(tmp_path)
     save_image(tmp_path / "frames" / "f3.png", np.zeros((400, 400, 3), np.float32))
@@ -231,6 +237,7 @@ def test_a_frame_too_large_for_memory_fails_alone(tmp_path, capsys, monkeypatch)
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f0.png", "f1.png", "f2.png"]
 
 
+@pytest.mark.slow
 def test_a_killed_writers_temporary_files_are_removed_on_the_next_run(tmp_path, capsys):
     from weft.core.image.temporaries import _writer_tag
 

@@ -1,4 +1,4 @@
-"""Issue 13.9: the distribution installs app/ and core/ as ``weft.app`` and ``weft.core`` and claims
+"""The distribution installs app/ and core/ as ``weft.app`` and ``weft.core`` and claims
 no other top-level import name."""
 
 import os
@@ -6,6 +6,8 @@ import pathlib
 import subprocess
 import sys
 import tomllib
+
+import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -21,6 +23,7 @@ def test_every_package_of_the_tree_is_listed_under_weft():
     assert set(config["packages"]) == found
 
 
+@pytest.mark.slow
 def test_weft_imports_without_top_level_app_or_core(tmp_path):
     """From a folder outside the repository (so the checkout is not on sys.path), the installed
     package imports as weft.* and puts no ``app`` or ``core`` module in sys.modules."""

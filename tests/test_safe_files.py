@@ -1,4 +1,4 @@
-"""Issue 8.7, "safe files": recipes and sessions are JSON only (no pickle, no eval), relative paths
+"""Safe files: recipes and sessions are JSON only (no pickle, no eval), relative paths
 resolve against the file that names them (never the current directory), and a bad file is refused in
 one line naming the file and the problem: status 2, no traceback, no output written, nothing run."""
 

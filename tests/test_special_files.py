@@ -83,7 +83,7 @@ def test_lines_and_views_from_a_fifo_or_a_device(fifo, tmp_path, capsys, option)
 
 
 def test_a_recipe_naming_a_device_as_its_lines(tmp_path, capsys):
-    photo = _texture(tmp_path / "p.png")
+    _texture(tmp_path / "p.png")
     recipe = tmp_path / "r.json"
     recipe.write_text(
         json.dumps(
@@ -94,6 +94,7 @@ def test_a_recipe_naming_a_device_as_its_lines(tmp_path, capsys):
     assert code == 2 and err.count("\n") == 1 and "/dev/zero: is a character device" in err, err
 
 
+@pytest.mark.slow
 def test_a_batch_whose_fixed_input_or_resumed_output_is_a_fifo(fifo, tmp_path, capsys):
     _texture(tmp_path / "f0.png")
     os.rename(fifo, tmp_path / "gravel.png")  # the recipe's fixed texture is a pipe

@@ -108,6 +108,12 @@ class InputsPane(QSplitter):
             self._boxes[name].clear_button.clicked.connect(lambda _=False, n=name: self.clear_requested.emit(n))
         return view
 
+    def box(self, name: str) -> QWidget:
+        """The titled box that shows input ``name`` (its tab's page; an optional input's box has a
+        ``clear_button``)."""
+        self.view(name)
+        return self._boxes[name]
+
     @property
     def canvas_view(self) -> ImageView:
         return self.view(self.doc.studio.canvas)

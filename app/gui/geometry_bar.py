@@ -202,7 +202,7 @@ class GeometryBar(QWidget):
         self.refresh()
 
     def _make_targets(self, tools: list[MaskTool]) -> None:
-        for action, button in zip(self.target_actions, self.target_buttons):
+        for action, button in zip(self.target_actions, self.target_buttons, strict=True):
             self.target_group.removeAction(action)
             self.flow.removeWidget(button)
             self.buttons.pop(action, None)

@@ -91,7 +91,9 @@ class MarginsTool(Tool):
         at = event.position()
         dx, dy = (at.x() - x0) * k, (at.y() - y0) * k
         moves = (-dx, -dy, dx, dy)
-        return Margins(*(max(0, min(MAX_SIDE, int(round(v + d)))) if s else v for v, d, s in zip(m, moves, sides)))
+        return Margins(
+            *(max(0, min(MAX_SIDE, int(round(v + d)))) if s else v for v, d, s in zip(m, moves, sides, strict=True))
+        )
 
     def move(self, view, pos, event):
         if self.drag is None and self.hover_cursor:
@@ -131,7 +133,7 @@ class ExtendDialog(QDialog):
         self.size_ = size
         form = QFormLayout(self)
         self.boxes = {}
-        for side, value in zip(("left", "top", "right", "bottom"), margins):
+        for side, value in zip(("left", "top", "right", "bottom"), margins, strict=True):
             box = QSpinBox()
             box.setRange(0, MAX_SIDE)
             box.setSuffix(" px")

@@ -114,7 +114,7 @@ class PatchTool(Tool):
             return
         x, y, s = rect
         self.rect_item.setRect(QRectF(x, y, s, s))
-        for h, (cx, cy) in zip(self.handles, self._corners(rect)):
+        for h, (cx, cy) in zip(self.handles, self._corners(rect), strict=True):
             h.setRect(QRectF(-_HALF, -_HALF, HANDLE_PX, HANDLE_PX))
             _screen_sized(h, cx, cy)
 
@@ -367,7 +367,8 @@ class LineTool(Tool):
 
 
 class QuadTool(Tool):
-    """Four clicks on the plane's corners, clockwise from top-left -> four line pairs (the frontal rectangle's edges)."""
+    """Four clicks on the plane's corners, clockwise from top-left -> four line pairs (the frontal
+    rectangle's edges)."""
 
     CORNERS = ("top-left", "top-right", "bottom-right", "bottom-left")
 

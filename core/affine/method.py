@@ -199,6 +199,24 @@ _cache: OrderedDict = OrderedDict()
 _cache_lock = threading.Lock()
 
 
+def cached_analyses() -> int:
+    """How many analyses are remembered for runs with reused transforms.
+
+    Returns
+    -------
+    int
+        At most two: an analysis is kept by the texture's content and the analysis parameters.
+    """
+    with _cache_lock:
+        return len(_cache)
+
+
+def forget_analyses() -> None:
+    """Forget the remembered analyses: the next run with reused transforms analyses its texture again."""
+    with _cache_lock:
+        _cache.clear()
+
+
 def _cached_analysis(texture: np.ndarray, arect, params: AffineParams, progress, cancel) -> AffineModel:
     """:func:`analyse` of the texture for ``arect``, remembered by content and parameters (models
     are never modified, so threads may share them)."""

@@ -220,7 +220,7 @@ def centroid_pairs(M: np.ndarray, f1: np.ndarray, f2: np.ndarray) -> Centroids:
     cM[:, 1 : half + 1] = np.cumsum(M, axis=1)
     c1[:, 1 : half + 1] = np.cumsum(f1, axis=1)
     c2[:, 1 : half + 1] = np.cumsum(f2, axis=1)
-    for l in range(half + 1, 3 * half + 1):
+    for l in range(half + 1, 3 * half + 1):  # noqa: E741 (the paper's segment indices k, l)
         base = l - half if l <= N else l - N
         if l <= N:  # eqs. 14-16
             cM[:, l] = cM[:, half] + cM[:, base]

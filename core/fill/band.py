@@ -4,7 +4,8 @@ The only place where known pixels may change. The band is every pixel within ``b
 (8-connected steps, i.e. a ``(2 band + 1)``-square neighbourhood) of the hole's edge, on both sides:
 known pixels up to ``band`` px outside the hole and filled pixels up to ``band`` px inside it. On
 the band, the image is re-solved (Pérez et al.'s Poisson equation, the system of
-:func:`weft.core.blending.poisson_blend`, solved by conjugate gradient in numpy, :func:`weft.core.fill.cut.poisson_cg`) with the pixels
+:func:`weft.core.blending.poisson_blend`, solved by conjugate gradient in numpy,
+:func:`weft.core.fill.cut.poisson_cg`) with the pixels
 around the band as fixed (Dirichlet) values and, as the guidance field, the image's own gradients
 -- except across the hole's edge, where the difference between a known and a filled pixel (the
 seam) is replaced by the mean of the differences one step further on either side (the local slope

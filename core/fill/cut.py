@@ -82,7 +82,7 @@ def min_cut(err: np.ndarray, *, left: int = 0, top: int = 0, right: int = 0, bot
     paths = {}
     for shape in dict.fromkeys(s.shape for _, s in strips):
         group = [(side, s) for side, s in strips if s.shape == shape]
-        for (side, _), path in zip(group, _vertical_paths(np.stack([s for _, s in group]))):
+        for (side, _), path in zip(group, _vertical_paths(np.stack([s for _, s in group])), strict=True):
             paths[side] = path
     if left > 0:
         new &= cols >= paths["left"][:, None]

@@ -145,7 +145,7 @@ def structure_guide(
         ey, ex = np.nonzero(((comp == ca) | (comp == cb)) & (depth <= _EDGE_REACH) & ~struct)
         struct[ey, ex] = True
         nx_[ey, ex], ny_[ey, ex] = np.cos(angle[ey, ex]), np.sin(angle[ey, ex])
-        reached = _orient(struct, nx_, ny_, list(zip(ys.tolist(), xs.tolist())))
+        reached = _orient(struct, nx_, ny_, list(zip(ys.tolist(), xs.tolist(), strict=True)))
         d, labels = cv2.distanceTransformWithLabels(
             (~reached).astype(np.uint8), cv2.DIST_L2, 5, labelType=cv2.DIST_LABEL_PIXEL
         )

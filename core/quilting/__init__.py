@@ -28,24 +28,23 @@ compiles only what it uses). Source and templates are centred on the source's me
 FFT loses little to cancellation.
 """
 
-from .checks import estimate_seconds, memory_estimate
+from .checks import estimate_seconds as estimate_seconds
+from .checks import memory_estimate as memory_estimate
 from .engine import _K, RULES, _pad_to, _Pass, _quilt_pass  # noqa: F401 (tests compare _K to the kernel)
-from .method import METHOD, warm_up
-from .params import (
-    CORR_SIGMA,
-    CORRESPONDENCES,
-    ITERATIVE_BLOCK,
-    MIN_BLOCK,
-    MIN_OVERLAP,
-    MODES,
-    SYNTH_BLOCK_MAX,
-    SYNTH_TOL,
-    TRANSFER_BLOCK,
-    QuiltParams,
-    synth_block,
-    synth_tol,
-    transfer_schedule,
-)
+from .method import METHOD
+from .method import warm_up as warm_up
+from .params import CORR_SIGMA as CORR_SIGMA
+from .params import CORRESPONDENCES as CORRESPONDENCES
+from .params import ITERATIVE_BLOCK as ITERATIVE_BLOCK
+from .params import MIN_BLOCK as MIN_BLOCK
+from .params import MIN_OVERLAP as MIN_OVERLAP
+from .params import MODES as MODES
+from .params import SYNTH_BLOCK_MAX as SYNTH_BLOCK_MAX
+from .params import SYNTH_TOL as SYNTH_TOL
+from .params import TRANSFER_BLOCK as TRANSFER_BLOCK
+from .params import QuiltParams, transfer_schedule
+from .params import synth_block as synth_block
+from .params import synth_tol as synth_tol
 from .synthesis import synthesize
 from .transfer import transfer
 

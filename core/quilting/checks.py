@@ -1,4 +1,5 @@
-"""Checks shared by quilting's synthesis and transfer: input sizes, and the up-front limits (time and memory estimates)."""
+"""Checks shared by quilting's synthesis and transfer: input sizes, and the up-front limits (time and
+memory estimates)."""
 
 from __future__ import annotations
 

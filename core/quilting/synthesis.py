@@ -56,9 +56,9 @@ def synthesize(
         of the texture, and pasted over them (Fig. 2b). ``mincut``: as ``overlap``, then pasted only
         on its side of the minimum-error boundary cut through the overlap (Fig. 2c, :mod:`weft.core.seams`).
     tol : int, optional
-        Default (None) 2, or 6 from block 48 up. Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD positions (Ngo's ``tol``; 1 =
-        always the best). In ``mincut`` mode the seam rule takes its place: of the ``4 x tol``
-        lowest-cost positions, the one whose minimum-error cut runs through the least error
+        Default (None) 2, or 6 from block 48 up. Rule ``tol``: pick uniformly among the ``tol`` lowest-SSD
+        positions (Ngo's ``tol``; 1 = always the best). In ``mincut`` mode the seam rule takes its place: of
+        the ``4 x tol`` lowest-cost positions, the one whose minimum-error cut runs through the least error
         (``weft.core.quilting.engine.SEAM_POOL``).
     rule : {"tol", "epsilon", "sampled"}, default "tol"
         ``epsilon``: pick uniformly among positions with SSD <= (1 + epsilon) x the least (E&F

@@ -31,22 +31,15 @@ the photo (:mod:`weft.core.rectify.detect`).
 from .detect import REFUSAL, Suggestion, suggest_lines
 from .homography import HomographyFit, apply_homography, fit_homography
 from .lines import FeatureLines, line_correspondences, load_feature_lines, parse_feature_lines
-from .method import (
-    FIGURES,
-    INTERPOLATIONS,
-    METHOD,
-    Rectified,
-    Rectifier,
-    RectifyParams,
-    WarpParams,
-    homography_figure,
-    rectify,
-    rectify_feature_lines,
-    scale_lines,
-    warm_up,
-)
+from .method import FIGURES as FIGURES
+from .method import INTERPOLATIONS as INTERPOLATIONS
+from .method import METHOD, Rectified, Rectifier, RectifyParams, WarpParams, rectify, rectify_feature_lines, scale_lines
+from .method import homography_figure as homography_figure
+from .method import warm_up as warm_up
 from .view import View, load_view
-from .warps import PLANAR_TOL_PX, WARPS, WarpPlan, homography_plan, plan_warp
+from .warps import PLANAR_TOL_PX as PLANAR_TOL_PX
+from .warps import WARPS, WarpPlan, plan_warp
+from .warps import homography_plan as homography_plan
 
 __all__ = [
     "FeatureLines",

@@ -74,7 +74,10 @@ def transfer() -> np.ndarray:
     photo = load_image(example("chelsea")).image
     plain = synthesize(photo, prototype_image=scales, prototype=proto_rect)
     shaken = synthesize(photo, prototype_image=scales, prototype=proto_rect, boundary="shaker", rng=1)
-    crop = lambda img: img[:, 22:278]  # the photo is 300x200: show 256 columns of it
+
+    def crop(img):  # the photo is 300x200: show 256 columns of it
+        return img[:, 22:278]
+
     x, y, s = proto_rect
     snake_proto = cv2.resize(snake[y : y + s, x : x + s], (256, 256), interpolation=cv2.INTER_NEAREST)
     panels = [

@@ -35,6 +35,6 @@ for frame in frames:
 panels = [label(load_image(f).image, f.name) for f in frames]
 panels += [
     label(np.repeat(o[..., None], 3, axis=2) if o.ndim == 2 else o, f"out/{Path(f).stem}.png")
-    for f, o in zip(frames, outputs)
+    for f, o in zip(frames, outputs, strict=True)
 ]
 save_image("batch-frames.png", grid(panels, len(frames)))

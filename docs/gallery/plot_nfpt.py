@@ -212,7 +212,10 @@ def repair() -> np.ndarray:
     smooth = synthesize(fur, smooth=True, **kw)
     marked = raw.image.copy()
     marked[fixed.repaired_mask] = [0.1, 0.9, 0.2]
-    z = lambda a: cv2.resize(a[:96, :96], (288, 288), interpolation=cv2.INTER_NEAREST)
+
+    def z(a):
+        return cv2.resize(a[:96, :96], (288, 288), interpolation=cv2.INTER_NEAREST)
+
     print("repair", fixed.figures())
     return _row(
         [

@@ -1,5 +1,5 @@
 """What the fuzz tests (``test_fuzz_*.py``) share: hypothesis settings, warnings as errors, and the
-checks of issue 8.2 (an output is a finite float32 image in [0, 1] of the documented shape; a refusal
+checks (an output is a finite float32 image in [0, 1] of the documented shape; a refusal
 is one line naming what is wrong)."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, settings
 from weft.core.errors import InvalidParameter, WeftError
 
 # Per example: generous enough for the first example to compile numba kernels in a fresh clone
-# (measured 14.7 s in CI, cold cache), still a bound that turns a hang into a failure.
+# (cold cache), still a bound that turns a hang into a failure.
 COLD_DEADLINE_MS = 60_000
 
 #: ``pytestmark`` of every fuzz module: a NumPy RuntimeWarning would print extra lines on stderr,

@@ -73,7 +73,7 @@ def _brute_force(patch, segments):
     half = segments // 2
     best = (np.inf, None)
     for k in range(segments):
-        for l in range(k + 1, k + half):
+        for l in range(k + 1, k + half):  # noqa: E741 (the paper's segment indices k, l)
             total = 0.0
             mus = []
             for a, b in ((k, l), (l, k + half)):

@@ -243,17 +243,17 @@ def test_reused_transforms_are_cached_between_runs(scales):
     transforms the analysis is remembered (by content and parameters) and only the render redone."""
     from weft.core.affine import method
 
-    method._cache.clear()
+    method.forget_analyses()
     params = AffineParams(reuse_transforms=True, prototype="40,40,64")
     first = METHOD.run({"texture": scales}, params, rng=0).image
-    assert len(method._cache) == 1
+    assert method.cached_analyses() == 1
     moved = METHOD.run({"texture": scales}, params.replace(prototype="60,50,64"), rng=0).image
-    assert len(method._cache) == 1  # the same analysis served the move
-    method._cache.clear()
+    assert method.cached_analyses() == 1  # the same analysis served the move
+    method.forget_analyses()
     fresh = METHOD.run({"texture": scales}, params.replace(prototype="60,50,64"), rng=0).image
     np.testing.assert_array_equal(moved, fresh)
     assert not np.array_equal(first, moved)
     other = scales[::-1].copy()  # other content: another analysis
     METHOD.run({"texture": other}, params, rng=0)
     METHOD.run({"texture": scales}, params.replace(block=16), rng=0)  # other parameters: another one
-    assert len(method._cache) == 2  # at most two are kept
+    assert method.cached_analyses() == 2  # at most two are kept

@@ -46,7 +46,7 @@ def test_poisson_matches_a_direct_sparse_solve(pair):
     idx[ys, xs] = np.arange(len(ys))
     rows, cols, vals = [], [], []
     b = np.zeros(len(ys))
-    for i, (y, x) in enumerate(zip(ys, xs)):
+    for i, (y, x) in enumerate(zip(ys, xs, strict=True)):
         deg = 0
         for dy, dx in ((1, 0), (-1, 0), (0, 1), (0, -1)):
             qy, qx = y + dy, x + dx

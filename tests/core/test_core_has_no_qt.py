@@ -5,6 +5,8 @@ import pathlib
 import subprocess
 import sys
 
+import pytest
+
 CORE = pathlib.Path(__file__).resolve().parents[2] / "core"
 FORBIDDEN = ("PySide6", "shiboken6", "superqt", "qtpy", "weft.app")
 
@@ -27,6 +29,7 @@ def test_no_qt_import_statements_in_core():
     assert offenders == []
 
 
+@pytest.mark.slow
 def test_importing_every_core_module_loads_no_qt():
     modules = sorted(f"weft.core.{p.stem}" for p in CORE.glob("*.py") if p.stem != "__init__")
     code = (

@@ -36,8 +36,8 @@ def test_perspective_lines_follow_the_recorded_homography():
     assert len(data["image_lines"]) == len(data["frontal_lines"]) >= 4
     w, hgt = data["frontal_size"]
     photo = load_image(example("perspective")).image
-    for img_line, fr_line in zip(data["image_lines"], data["frontal_lines"]):
-        for (xi, yi), (xf, yf) in zip(np.reshape(img_line, (2, 2)), np.reshape(fr_line, (2, 2))):
+    for img_line, fr_line in zip(data["image_lines"], data["frontal_lines"], strict=True):
+        for (xi, yi), (xf, yf) in zip(np.reshape(img_line, (2, 2)), np.reshape(fr_line, (2, 2)), strict=True):
             assert 0 <= xf <= w and 0 <= yf <= hgt
             assert np.allclose(_apply(h, xf, yf), (xi, yi), atol=0.01)
             assert 0 <= xi < photo.shape[1] and 0 <= yi < photo.shape[0]

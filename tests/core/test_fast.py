@@ -210,7 +210,7 @@ def test_two_threads_give_the_same_pixels_as_one(gravel, camera):
         t.start()
     for t in threads:
         t.join(timeout=60)
-    assert all(np.array_equal(g, e) for g, e in zip(got, expected))
+    assert all(np.array_equal(g, e) for g, e in zip(got, expected, strict=True))
 
 
 def test_metric_codes_match_the_kernel():

@@ -512,11 +512,12 @@ def test_quilt_refines_colour_pictures_only():
     )
 
 
+@pytest.mark.slow
 def test_default_fill_loads_neither_numba_nor_numpy_ma():
     """The default engine's whole path (quilt, its refine on colour, the band), and ``--structure``'s
-    (its edges and patchmatch), run in numpy and OpenCV: a ``weft fill`` process loads no numba
-    (0.4-0.7 s of import and cache loads) and no numpy.ma (np.percentile imports it: ~7 ms of every
-    process, for two percentiles)."""
+    (its edges and patchmatch), run in numpy and OpenCV: a ``weft fill`` process loads no numba (its
+    import and cache loads are a noticeable part of a short run) and no numpy.ma (np.percentile
+    imports it, for two percentiles)."""
     import subprocess
     import sys
 

@@ -224,6 +224,7 @@ def test_a_coherence_bias_lets_propagation_take_a_neighbours_offset_within_the_m
         assert (sy[0], sx[0]) == (2, 2) and dist[0] == d_cand / 1.5
 
 
+@pytest.mark.slow
 def test_a_patchmatch_fill_loads_no_numba():
     """The engine is numpy only: a ``weft fill --engine patchmatch`` process pays no numba import
     or kernel cache loads (0.4-0.5 s of its whole-process time when it had them)."""

@@ -1,4 +1,4 @@
-"""Issue 8.2 / 8.3 for the affine prototype model (``weft.core.affine``).
+"""Parameter fuzzing and degenerate geometry for the affine prototype model (``weft.core.affine``).
 
 Hypothesis over the public functions: ``synthesize`` end to end (analysis, reuse of transforms,
 fields, boundary matching), ``analyse`` + ``render`` with swapped prototypes, the prototype

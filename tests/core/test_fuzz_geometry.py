@@ -1,4 +1,4 @@
-"""Issue 8.3 (part): rectification under random, degenerate feature lines.
+"""Rectification under random, degenerate feature lines.
 
 Lines drawn from a small grid of points (so coincident, parallel, zero-length and crossing lines come
 up often), sometimes outside the photo: ``rectify`` gives a finite image in [0, 1] of the frontal size,

@@ -1,4 +1,4 @@
-"""Issue 8.2 for the shared building blocks: blending, seams, metrics, colour, square regions.
+"""Fuzzing the shared building blocks: blending, seams, metrics, colour, square regions.
 
 Hypothesis over ``weft.core.blending`` (Laplacian pyramid and Poisson blend: random, all-black and
 all-white masks, sizes 1..16, grey/colour mixes, mismatched sizes), ``weft.core.seams`` (minimum cuts on
@@ -381,7 +381,10 @@ def test_fidelity_snr_psnr_fuzz(kind_a, kind_b, h, w, colour, seed, sigma):
     else:
         assert not small and not bad_sigma
         assert math.isfinite(fid) and -1.0 <= fid <= 1.0
-        constant = lambda img: np.ptp(luminance(img)) == 0
+
+        def constant(img):
+            return np.ptp(luminance(img)) == 0
+
         if constant(a) or constant(b):
             assert fid == 0.0  # documented: undefined correlation -> 0
         if kind_a == "ramp" and kind_a == kind_b and sigma <= 1.0:  # (a wide blur of a tiny ramp is flat: 0)

@@ -1,4 +1,4 @@
-"""Issue 8.2 / 8.3 for NFPT (``weft.core.nfpt``): parameter fuzzing and degenerate geometry.
+"""NFPT (``weft.core.nfpt``): parameter fuzzing and degenerate geometry.
 
 * ``synthesize`` (§2 alone) over block, overlap, weights, repair, smooth, size and source masks, on
   tiny textures of every awkward kind (flat patches, a lone dot, noise): a finite float32 image in

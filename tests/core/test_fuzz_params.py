@@ -1,4 +1,4 @@
-"""Issue 8.2: parameter fuzzing.
+"""Parameter fuzzing.
 
 Every registered method's ``Params`` class, built from arbitrary values (in and out of range, wrong
 types, None, non-finite numbers, odd text), either builds (and round-trips through to_dict/from_dict)

@@ -313,7 +313,7 @@ def test_exif_orientation_matches_pillow_and_opencv(tmp_path, monkeypatch, orien
     bgr = cv2.imdecode(np.fromfile(path, np.uint8), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)
     np.testing.assert_array_equal(img, bgr[..., ::-1] / np.float32(255))
     assert info.orientation == orientation
-    assert ("EXIF orientation %d applied" % orientation in info.notes) == (orientation != 1)
+    assert (f"EXIF orientation {orientation} applied" in info.notes) == (orientation != 1)
     assert (info.width, info.height) == ((4, 6) if orientation >= 5 else (6, 4))
     # the Pillow fallback applies it the same way
     monkeypatch.setattr(cv2, "imdecode", lambda *a, **k: None)

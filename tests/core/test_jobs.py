@@ -581,7 +581,7 @@ def test_reporter_builds_previews_at_most_every_preview_interval(monkeypatch):
     reporter = ProgressReporter(cb, "rows", 10)
     for done in range(1, 11):
         clock[0] += 0.2  # 0.2 s per unit of work
-        reporter.update(done, preview=lambda: built.append(done) or np.zeros(1))
+        reporter.update(done, preview=lambda done=done: built.append(done) or np.zeros(1))
     assert len(cb.calls) == 10  # progress itself is not throttled
     # First preview only after 0.5 s (done = 3), then at most every 0.5 s.
     assert built == [3, 6, 9]

@@ -1,4 +1,4 @@
-"""Issue 8.4: JobRunner under 500 random submit/cancel/shutdown sequences.
+"""JobRunner under 500 random submit/cancel/shutdown sequences.
 
 No deadlock (every wait has a timeout), no 'weft-job' thread left after shutdown, the last result
 delivered per slot is the newest job of the slot that was not cancelled, and memory returns near

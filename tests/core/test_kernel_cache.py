@@ -72,6 +72,7 @@ def run_blend(setup, *, package_writable=True, home_writable=True, numba_dir_wri
     return r.returncode, r.stderr, env
 
 
+@pytest.mark.slow
 def test_unwritable_numba_cache_dir_runs(setup):
     code, err, _ = run_blend(setup, numba_dir_writable=False)
     assert code == 0, err
@@ -81,18 +82,21 @@ def test_unwritable_numba_cache_dir_runs(setup):
     )  # numba's next folder
 
 
+@pytest.mark.slow
 def test_unwritable_package_folder_runs(setup):
     code, err, _ = run_blend(setup, package_writable=False)
     assert code == 0, err
     assert err == ""
 
 
+@pytest.mark.slow
 def test_unwritable_home_runs(setup):
     code, err, _ = run_blend(setup, home_writable=False)
     assert code == 0, err
     assert err == ""
 
 
+@pytest.mark.slow
 def test_nothing_writable_falls_back_to_a_private_temp_folder_that_stays_warm(setup):
     tmpdir = setup / "tmp-all"
     code, err, _ = run_blend(
@@ -112,6 +116,7 @@ def test_nothing_writable_falls_back_to_a_private_temp_folder_that_stays_warm(se
     assert index[0].stat().st_mtime_ns == stamp  # loaded from there, not compiled and saved again
 
 
+@pytest.mark.slow
 def test_a_temp_folder_open_to_others_is_not_used(setup):
     tmpdir = setup / "tmp-shared"
     folder = tmpdir / f"weft-numba-{os.getuid()}"
@@ -125,6 +130,7 @@ def test_a_temp_folder_open_to_others_is_not_used(setup):
     assert not list(folder.iterdir())
 
 
+@pytest.mark.slow
 def test_no_writable_folder_at_all_runs_uncached_with_a_one_line_notice(setup):
     code, err, _ = run_blend(setup, package_writable=False, home_writable=False, numba_dir_writable=False, no_temp=True)
     assert code == 0, err
@@ -169,6 +175,7 @@ def _cut_cache_files(folder: Path) -> int:
     return len(files)
 
 
+@pytest.mark.slow
 def test_a_cache_cut_short_is_dropped_recompiled_and_said_once(setup):
     code, err, _ = run_blend(setup, numba_dir_writable=True)
     assert code == 0 and err == "", err
@@ -185,6 +192,7 @@ def test_a_cache_cut_short_is_dropped_recompiled_and_said_once(setup):
     assert code == 0 and err == "", err
 
 
+@pytest.mark.slow
 def test_warm_up_repairs_a_damaged_cache(setup):
     env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "PYTHONPATH")}
     env.update(NUMBA_CACHE_DIR=str(setup / "numba-warm"), PYTHONPATH=str(setup / "pkg"), HOME=str(setup / "home"))

@@ -1,6 +1,6 @@
-"""Issue 12: a method's ``warm_up()`` compiles every numba specialisation its real runs use, and no
-kernel compiles more than one specialisation (the literal-argument and C/F-layout explosion that
-made a cold quilting transfer compile 122 functions must not come back silently).
+"""A method's ``warm_up()`` compiles every numba specialisation its real runs use, and no
+kernel compiles more than one specialisation (literal arguments or C/F layouts multiplying a cold
+run's compiles must not come back silently).
 
 Each method runs in a fresh interpreter (in this one other tests have already compiled kernels for
 their own inputs): ``warm_up()``, then the signatures of every kernel in ``weft.core._kernels``, then
@@ -88,12 +88,14 @@ def _signatures(method: str) -> tuple[dict, dict]:
     return out["before"], out["after"]
 
 
+@pytest.mark.slow
 def test_fill_runs_no_kernel_at_all():
     """Every fill engine runs in numpy and OpenCV: warm-up and the runs load no numba kernel."""
     before, after = _signatures("fill")
     assert before == {} and after == {}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["quilt", "nfpt", "affine", "fast", "rectify", "blend"])
 def test_a_run_after_warm_up_compiles_nothing_and_each_kernel_once(method):
     before, after = _signatures(method)

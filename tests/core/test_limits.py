@@ -1,4 +1,4 @@
-"""Issue 8.6: jobs too large are refused up front (pixels, memory, running time), in one line."""
+"""Jobs too large are refused up front (pixels, memory, running time), in one line."""
 
 from __future__ import annotations
 
@@ -253,6 +253,7 @@ def _memory_cgroup(limit: int):
     return path, None
 
 
+@pytest.mark.slow
 def test_a_job_too_large_for_its_container_is_refused_up_front(tmp_path):
     import os
     import subprocess

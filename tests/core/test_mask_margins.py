@@ -1,4 +1,4 @@
-"""The mask and margins geometry types (issue 15): parse, paint, serialise, refuse."""
+"""The mask and margins geometry types: parse, paint, serialise, refuse."""
 
 import numpy as np
 import pytest

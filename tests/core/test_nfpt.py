@@ -69,7 +69,10 @@ def test_feature_weight_is_eq_2_and_3():
     w = np.zeros((16, 16), np.float32)
     tw = np.zeros((16, 16), np.float32)
     const = _k.l_template(canvas[..., 0], canvas, 0, 0, 8, wd, 0.35, 32, 0.5, w, tw)
-    g = lambda f: np.exp(-((f - 1) ** 2) / (2 * 0.35**2)) / (np.sqrt(2 * np.pi) * 0.35)
+
+    def g(f):
+        return np.exp(-((f - 1) ** 2) / (2 * 0.35**2)) / (np.sqrt(2 * np.pi) * 0.35)
+
     assert w[3, 0] == pytest.approx(wd[3, 0] + g(0.0), rel=1e-5)  # background: M = 0.5
     assert w[2, 0] == pytest.approx(wd[2, 0] + g(0.4), rel=1e-5)  # feature: |P - M| = 0.4
     assert w[2, 0] > w[3, 0] and (w[:, 2:] == 0).all()

@@ -5,6 +5,8 @@ imports (~0.15 s and ~0.1 s) were most of the gap between ``weft quilt`` and G'M
 import subprocess
 import sys
 
+import pytest
+
 SCRIPT = """
 import sys
 import numpy as np
@@ -17,12 +19,14 @@ print(" ".join(m for m in ("numba", "scipy.sparse", "weft.core._kernels") if m i
 """
 
 
+@pytest.mark.slow
 def test_small_synthesis_loads_neither_numba_nor_scipy_sparse():
     out = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "none"
 
 
+@pytest.mark.slow
 def test_the_command_line_loads_no_scipy_fft_until_a_method_needs_it():
     """``weft`` imports every method's module (the registry); affine's spectral code imported
     scipy.fft at the top, 0.12 s of every process's start (``weft fill``, ``weft quilt``...)."""

@@ -143,7 +143,7 @@ def test_tileable_output_wraps_like_its_interior(brick):
 def test_cut_and_poisson_band_lower_the_seam_and_leave_the_rest(monkeypatch):
     """Two blocks in a row (the second chosen alike in every mode): overwrite > cut > cut + Poisson.
 
-    The seams of the blocks the seeds chose before the rule against continuations (issue 17) are
+    The seams of the blocks the seeds chose before the rule against continuations are
     what is measured here, so the rule is off (the selection is not this test's subject)."""
     import cv2
     import weft.core.quilting.engine as engine
@@ -372,7 +372,7 @@ def test_stacked_numpy_cuts_match_the_kernel(shape, sides, stack):
 
 
 # --------------------------------------------------------------------------------------------
-# verbatim runs (issue 17): the record of source positions, the rule against continuations
+# verbatim runs: the record of source positions, the rule against continuations
 
 
 @pytest.fixture(scope="module")
@@ -450,7 +450,7 @@ def test_synthesis_spreads_its_use_of_the_sample(brick64, monkeypatch):
 
 
 def test_the_default_synthesis_block_scales_with_the_sample(brick64):
-    """Issue 17: the synthesis block defaults to 7/16 of the sample's shorter side (56 for the
+    """The synthesis block defaults to 7/16 of the sample's shorter side (56 for the
     peers' 128-px brick_128), at most 56 and at least 2, and tol to 2, or 6 from block 48 up; the
     defaults give exactly the pixels of those explicit values."""
     from weft.core.quilting import METHOD, QuiltParams, synth_block, synth_tol

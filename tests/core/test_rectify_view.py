@@ -39,7 +39,10 @@ def test_lines_view_matches_the_equivalent_quad(checker):
     tex_corners = np.array([[0, 0], [159, 0], [159, 119], [0, 119]], float)
     h = np.linalg.inv(quad_homography(quad, (160, 120)))  # texture -> view
     view_corners = apply_homography(h, tex_corners)
-    sides = lambda c: np.array([[*c[i], *c[(i + 1) % 4]] for i in range(4)])
+
+    def sides(c):
+        return np.array([[*c[i], *c[(i + 1) % 4]] for i in range(4)])
+
     view = parse_view(
         {"image_lines": sides(view_corners).tolist(), "frontal_lines": sides(tex_corners).tolist(), "size": [300, 220]}
     )

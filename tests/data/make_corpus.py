@@ -1,4 +1,4 @@
-"""Generate the bad-input corpus of issue 8 (files weft must refuse cleanly or read correctly).
+"""Generate the bad-input corpus (files weft must refuse cleanly or read correctly).
 
 Nothing here is committed as data: :func:`make_corpus` writes the files into a folder (a pytest
 ``tmp_path``) each time. Run as a script to write them into a folder of your choice::

@@ -25,11 +25,36 @@ def settings(tmp_path):
 
 
 @pytest.fixture
-def window(qtbot, settings):
-    w = MainWindow(settings=settings)
-    qtbot.addWidget(w)
-    w.resize(1300, 820)
-    w.show()
+def make_window(qtbot, settings):
+    """Make shown studio windows, each shut down after the test: ``make_window()`` opens nothing,
+    ``make_window(load_defaults=True)`` the bundled examples; ``size`` is the window's size."""
+    made = []
+
+    def make(*, load_defaults: bool = False, size: tuple[int, int] = (1300, 820)) -> MainWindow:
+        w = MainWindow(settings=settings, load_defaults=load_defaults)
+        qtbot.addWidget(w)
+        w.resize(*size)
+        w.show()
+        made.append(w)
+        return w
+
+    yield make
+    for w in made:
+        w.shutdown()
+
+
+@pytest.fixture
+def window(make_window, qtbot):
+    """The studio as it opens on its bundled examples, its first full-size result shown."""
+    w = make_window(load_defaults=True)
     qtbot.waitUntil(lambda: w.renderer.last is not None and w.renderer.last.final, timeout=20000)
-    yield w
-    w.shutdown()
+    return w
+
+
+@pytest.fixture
+def nfpt(window, qtbot):
+    """The studio switched to the nfpt method on its bundled photo, a result of it shown."""
+    window.doc.set_method("nfpt")
+    assert window.doc.image("photo") is not None
+    qtbot.waitUntil(lambda: window.renderer.last.job_id > 0, timeout=20000)
+    return window

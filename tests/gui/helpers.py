@@ -1,5 +1,6 @@
 """Real mouse events for the GUI tests, and a check that no worker thread is left."""
 
+import dataclasses
 import threading
 
 from PySide6.QtCore import QEvent, QPointF, Qt
@@ -29,6 +30,36 @@ def drag(view, start, end, steps: int = 4):
         t = i / steps
         mouse(view, "move", (start[0] + t * (end[0] - start[0]), start[1] + t * (end[1] - start[1])))
     mouse(view, "release", end)
+
+
+def settle(qtbot, window, timeout: int = 30000) -> None:
+    """Wait until ``window`` has no render or file load running, queued or about to start, and every
+    result its workers queued for the GUI thread has been delivered: anything that was going to
+    arrive has arrived, so an assertion that something did *not* happen can be made now (no fixed wait)."""
+    from PySide6.QtCore import QCoreApplication
+
+    renderer = window.renderer
+    started: list[int] = []
+
+    def idle() -> bool:
+        busy = renderer.runner.busy("preview") or renderer.runner.busy("final") or window.loader.busy()
+        return not (busy or renderer.running())
+
+    def count(job_id: int, slot: str) -> None:
+        started.append(job_id)
+
+    renderer.submitted.connect(count)
+    try:
+        while True:
+            qtbot.waitUntil(idle, timeout=timeout)
+            before = len(started)
+            # a job leaves the runner's books after queueing its result: deliver what is queued
+            QCoreApplication.sendPostedEvents()
+            QCoreApplication.processEvents()
+            if idle() and len(started) == before:  # nothing delivered started another render
+                return
+    finally:
+        renderer.submitted.disconnect(count)
 
 
 def no_job_threads() -> bool:
@@ -67,6 +98,6 @@ def orphan_recovery(folder, settings, text: str):
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"recovery-crashed-{dead_pid()}-0000abcd.weft.json"
     path.write_text(text, encoding="utf-8")
-    owner = recovery.Owner(dead_pid(), recovery._host(), None, recovery.settings_id(settings))
+    owner = dataclasses.replace(recovery.Owner.me(recovery.settings_id(settings)), pid=dead_pid(), started=None)
     recovery.write_lock(path, owner)
     return path

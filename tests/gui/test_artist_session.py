@@ -1,9 +1,10 @@
-"""Issue 14: the studio as an artist meets it — each bug's test drives the window with real events."""
+"""The studio as an artist meets it: each test drives the window with real events."""
 
 import dataclasses
 
 import numpy as np
 from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QSlider
 from weft.core.errors import WeftError
 
 
@@ -112,10 +113,10 @@ def test_an_optional_input_can_be_cleared_from_its_tab_and_the_clear_undone(wind
     doc = window.doc
     target = doc.image("target")
     assert window.renderer.last.image.shape[:2] == target.shape[:2]  # a transfer onto the target
-    box = window.inputs_pane._boxes["target"]
+    box = window.inputs_pane.box("target")
     window.inputs_pane.tabs.setCurrentWidget(box)
     qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
-    assert not window.inputs_pane._boxes["texture"].clear_button.isVisible()  # required: no Clear
+    assert not window.inputs_pane.box("texture").clear_button.isVisible()  # required: no Clear
     with qtbot.waitSignal(
         window.renderer.shown,
         timeout=20000,
@@ -240,13 +241,13 @@ def _fills_view(view) -> bool:
 
 
 def test_a_result_of_another_size_refits_unless_the_user_zoomed(window, qtbot):
-    """Bug 2 (fixed by issue 13): a new result size refits the result view; a hand zoom is kept."""
+    """A new result size refits the result view; a hand zoom is kept."""
     from .helpers import mouse
 
     view = window.result_view
     old = view.image_size()
     assert _fills_view(view)
-    box = window.inputs_pane._boxes["target"]
+    box = window.inputs_pane.box("target")
     window.inputs_pane.tabs.setCurrentWidget(box)
     qtbot.waitUntil(box.clear_button.isVisible, timeout=5000)
     qtbot.mouseClick(box.clear_button, Qt.MouseButton.LeftButton)  # synthesis: twice the texture
@@ -424,7 +425,7 @@ def test_the_zoom_label_follows_a_refit_when_the_window_is_resized(window, qtbot
 
 
 def test_auto_block_follows_the_sample_and_its_source_region(window, qtbot):
-    """Issue 17: quilting's synthesis block defaults to a share of the sample's size, so what the
+    """Quilting's synthesis block defaults to a share of the sample's size, so what the
     studio shows beside "auto" follows the texture, then the square drawn on it (the source region
     is the sample a run quilts from)."""
     from .helpers import drag
@@ -474,7 +475,7 @@ def test_a_slider_runs_only_over_what_the_open_inputs_allow(window, qtbot, tmp_p
     qtbot.waitUntil(lambda: doc.current_params.block is not None, timeout=5000)
     assert row.editor.maximum() == 112
     assert "range 2..112 for these inputs" in row.toolTip() and "2..1024 in general" in row.toolTip()
-    slider = row.editor._slider
+    slider = row.editor.findChild(QSlider)  # the slider beside the value's label
     slider.setFocus()
     qtbot.keyClick(slider, Qt.Key.Key_End)  # the far end, as a user drags it there
     qtbot.waitUntil(lambda: doc.current_params.block == 112, timeout=5000)

@@ -6,6 +6,7 @@ import json
 import threading
 from pathlib import Path
 
+import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction
 from weft.app.cli import main as cli_main
@@ -34,6 +35,7 @@ def open_dialog(window, qtbot) -> BatchDialog:
     return dialog
 
 
+@pytest.mark.slow
 def test_apply_to_folder_writes_what_weft_run_writes(window, qtbot, tmp_path):
     frames = make_frames(tmp_path / "frames", 4)
     seed = window.doc.seed
@@ -72,6 +74,7 @@ def test_apply_to_folder_writes_what_weft_run_writes(window, qtbot, tmp_path):
     assert done.args[0] == "0 written, 4 already done"
 
 
+@pytest.mark.slow
 def test_cancel_stops_between_items_and_keeps_finished_ones(window, qtbot, tmp_path):
     make_frames(tmp_path / "frames", 12)
     dialog = open_dialog(window, qtbot)

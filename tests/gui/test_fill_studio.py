@@ -1,4 +1,4 @@
-"""Issue 15, the studio side of fill and extend: the mask tool (brush, eraser, lasso, Clear, Invert,
+"""The studio side of fill and extend: the mask tool (brush, eraser, lasso, Clear, Invert,
 Fill transparent) and the margins tool (drag, Extend canvas…), driven with real mouse and key events.
 
 The studio is generic: these tests drive it with a method registered here (it fills its painted mask
@@ -116,14 +116,9 @@ def _picture(path, seed=3, alpha=None):
     return path
 
 
-def _window_on(method: str, qtbot, settings, picture):
+def _window_on(make_window, method: str, qtbot, picture):
     """The main window on ``method`` with ``picture`` open as its picture (nothing to fill yet)."""
-    from weft.app.gui.main_window import MainWindow
-
-    window = MainWindow(settings=settings, load_defaults=False)
-    qtbot.addWidget(window)
-    window.resize(1300, 820)
-    window.show()
+    window = make_window()
     box = window.method_panel.method_box
     box.setCurrentIndex(box.findData(method))
     with qtbot.waitSignal(window.renderer.failed, timeout=10000):  # nothing to fill yet
@@ -132,19 +127,18 @@ def _window_on(method: str, qtbot, settings, picture):
 
 
 @pytest.fixture
-def studio(plugin, qtbot, settings, tmp_path):
+def studio(plugin, qtbot, make_window, tmp_path):
     """The window on the mean-fill method with a picture open, its first result shown, zoomed 4x."""
     CALLS.clear()
     picture = _picture(tmp_path / "picture.png")
-    window = _window_on(plugin.name, qtbot, settings, picture)
+    window = _window_on(make_window, plugin.name, qtbot, picture)
     assert window.doc.image("picture") is not None
     view = window.inputs_pane.canvas_view
     view.actual_size()
     view.zoom_by(4.0)
     view.centerOn(W / 2, H / 2)
     window.picture = picture
-    yield window
-    window.shutdown()
+    return window
 
 
 def _mask(window) -> Mask | None:
@@ -755,15 +749,10 @@ def _slider_previewed(studio, qtbot, name: str):
 
 
 @contextmanager
-def _fill_in_the_studio(qtbot, settings):
+def _fill_in_the_studio(make_window, qtbot):
     """The studio as it opens on its bundled examples, switched to fill with the method box (nothing
     is painted yet, so that render fails); shut down on leaving."""
-    from weft.app.gui.main_window import MainWindow
-
-    window = MainWindow(settings=settings)
-    qtbot.addWidget(window)
-    window.resize(1300, 820)
-    window.show()
+    window = make_window(load_defaults=True)
     try:
         qtbot.waitUntil(lambda: window.renderer.last is not None and window.renderer.last.final, timeout=30000)
         assert window.doc.image("texture") is not None  # the other methods' texture is open
@@ -776,12 +765,12 @@ def _fill_in_the_studio(qtbot, settings):
         window.shutdown()
 
 
-def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, settings, tmp_path, capsys):
+def test_the_fill_method_in_the_studio_paints_previews_and_round_trips(qtbot, make_window, tmp_path, capsys):
     """The real fill, as an artist meets it: the studio opens on its examples, fill is picked, a hole
     is painted with the mouse (previewed around the stroke), filled on release, exported and re-run."""
     from scipy.ndimage import binary_dilation
 
-    with _fill_in_the_studio(qtbot, settings) as window:
+    with _fill_in_the_studio(make_window, qtbot) as window:
         assert window.doc.image("texture") is None  # the other methods' texture is not fill's source
         assert window.result_view.notice.isVisible() and "Paint what to fill" in window.result_view.notice.text()
         view, doc = window.inputs_pane.canvas_view, window.doc
@@ -1060,13 +1049,13 @@ def test_a_background_autosave_that_fails_says_so_in_one_line(studio, qtbot, pri
     assert _mask(studio) is not None  # the edit stands
 
 
-def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, settings):
+def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, make_window):
     """The real fill, painted with the mouse: its preview around the stroke renders a crop, so it
     must not state the crop's hole as the image's ("filled 9.4 % of the image" while the stroke
     covered 1.3 % of it, seen in the studio); on release the full result states the image's own."""
     from weft.core.studio import AROUND_SIDE
 
-    with _fill_in_the_studio(qtbot, settings) as window:
+    with _fill_in_the_studio(make_window, qtbot) as window:
         view, doc = window.inputs_pane.canvas_view, window.doc
         h, w = doc.image("image").shape[:2]
         assert max(h, w) > AROUND_SIDE  # (the crop is a part of the image)
@@ -1358,7 +1347,7 @@ SPREAD_FILL = Method(
 )
 
 
-def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, qtbot, settings, tmp_path):
+def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, qtbot, make_window, tmp_path):
     """An unset parameter shows the value a run resolves it to, the canvas's margins (a geometry
     parameter, edited with the mouse) included: fill's patch is 48 along an extended border, not
     the 24 it showed (or a colour picture's 7) while its run took 48. Its tooltip and the variations'
@@ -1367,7 +1356,7 @@ def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, 
 
     registry.register(SPREAD_FILL)
     try:
-        window = _window_on(SPREAD_FILL.name, qtbot, settings, _picture(tmp_path / "picture.png"))
+        window = _window_on(make_window, SPREAD_FILL.name, qtbot, _picture(tmp_path / "picture.png"))
         row = window.method_panel.params_panel.row("spread")
         assert "(now 3)" in row.editor.toolTip()
         view = window.inputs_pane.canvas_view

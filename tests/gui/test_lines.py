@@ -12,14 +12,6 @@ from weft.core.geometry import Square
 from .helpers import drag, mouse
 
 
-@pytest.fixture
-def nfpt(window, qtbot):
-    window.doc.set_method("nfpt")
-    assert window.doc.image("photo") is not None
-    qtbot.waitUntil(lambda: window.renderer.last.job_id > 0, timeout=20000)
-    return window
-
-
 def _key(widget, key):
     QApplication.sendEvent(widget, QKeyEvent(QEvent.Type.KeyPress, key, Qt.KeyboardModifier.NoModifier))
 

@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
 from PySide6.QtGui import QDragEnterEvent, QDropEvent, QWheelEvent
-from PySide6.QtWidgets import QApplication
+from PySide6.QtWidgets import QApplication, QSlider
 from weft.app.cli import main as cli_main
 from weft.core.errors import Cancelled, WeftError
 from weft.core.examples import example
 from weft.core.image import load_image, read_recipe
 from weft.core.registry import Method
 
-from .helpers import drag, mouse, no_job_threads
+from .helpers import drag, mouse, no_job_threads, settle
 
 
 def test_opens_on_the_examples_with_a_result(window):
@@ -86,7 +86,7 @@ def test_slider_drag_previews_then_renders_full_size(window, qtbot):
     slider.setSliderDown(False)
     slider.sliderReleased.emit()
     qtbot.waitUntil(lambda: shown and shown[-1].final and window.doc.current_params.n == 11, timeout=10000)
-    qtbot.wait(200)
+    settle(qtbot, window)  # every result still on its way has arrived
     ids = [s.job_id for s in shown]
     assert ids == sorted(ids)  # never an older result over a newer one
     assert window.result_view.image is window.renderer.last.image
@@ -102,8 +102,7 @@ def test_stale_results_are_dropped(window, qtbot):
     for p in (0.1, 0.2, 0.3, 0.4, 0.5):
         window.doc.set_param("p", p)
         r.final(now=True)
-    qtbot.waitUntil(lambda: not r.runner.busy("final"), timeout=10000)
-    qtbot.wait(100)
+    settle(qtbot, window)  # every result still on its way has arrived
     assert shown and shown == sorted(shown)
     assert r.last.job_id == r.latest_final
 
@@ -157,7 +156,7 @@ def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, mo
 def test_invalid_value_is_refused_with_a_message(window):
     messages = []
     window.message.connect(messages.append)
-    window.method_panel._param_edited("n", 4, False)  # even: refused by FastParams
+    window.method_panel.params_panel.row("n").editor.setValue(4)  # even: refused by FastParams
     assert window.doc.current_params.n == 5
     assert "must be odd" in messages[-1]
     assert window.method_panel.params_panel.row("n").value() == 5
@@ -452,7 +451,7 @@ def test_each_choice_from_a_list_is_its_own_undo_step(window, qtbot):
     assert doc.undo_stack.count() == before + 4
     doc.undo_stack.undo()
     assert doc.current_params.metric == "target"
-    slider = window.method_panel.params_panel.row("iterations").editor._slider
+    slider = window.method_panel.params_panel.row("iterations").editor.findChild(QSlider)
     slider.setFocus()
     steps = doc.undo_stack.index()
     for _ in range(2):

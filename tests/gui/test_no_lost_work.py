@@ -1,4 +1,4 @@
-"""Issue 8.5: no lost work in the studio — it asks before overwriting and before discarding unsaved
+"""No lost work in the studio: it asks before overwriting and before discarding unsaved
 edits, autosaves unsaved edits to a recovery file, and after ``kill -9`` the next start restores them."""
 
 import json

@@ -1,4 +1,4 @@
-"""Proof that the studio learns a method from the method itself (issue 13, item 10).
+"""Proof that the studio learns a method from the method itself.
 
 A method registered at run time -- it inverts the pixels of a square of its one input -- is driven
 through the studio with real mouse events: it is in the method list, its square is drawn with the
@@ -57,16 +57,11 @@ def plugin():
     registry.unregister(INVERT.name)
 
 
-def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qtbot, settings, tmp_path, capsys):
-    from weft.app.gui.main_window import MainWindow
-
+def test_a_method_registered_at_run_time_is_driven_through_the_studio(plugin, qtbot, make_window, tmp_path, capsys):
     picture = tmp_path / "picture.png"
     pixels = np.random.default_rng(3).random((64, 80, 3)).astype(np.float32)
     save_image(picture, pixels)
-    window = MainWindow(settings=settings, load_defaults=False)
-    qtbot.addWidget(window)
-    window.resize(1300, 820)
-    window.show()
+    window = make_window()
     try:
         box = window.method_panel.method_box
         index = box.findData(plugin.name)

@@ -1,8 +1,8 @@
-"""Issue 8.4, GUI side: the studio's Renderer under 100 rapid parameter changes and cancels."""
+"""The studio's Renderer under 100 rapid parameter changes and cancels."""
 
 import random
 
-from .helpers import no_job_threads
+from .helpers import no_job_threads, settle
 
 
 def test_rapid_changes_and_cancels_show_only_newer_results(window, qtbot):
@@ -30,7 +30,7 @@ def test_rapid_changes_and_cancels_show_only_newer_results(window, qtbot):
     renderer.final(now=True)
     last_final = renderer.latest_final
     qtbot.waitUntil(lambda: renderer.last is not None and renderer.last.job_id == last_final, timeout=30000)
-    qtbot.wait(100)  # any straggler would arrive now
+    settle(qtbot, window)  # any straggler has arrived
     assert shown_ids == sorted(shown_ids), shown_ids
     assert all(view_followed)
     assert renderer.last.job_id == last_final and renderer.last.final

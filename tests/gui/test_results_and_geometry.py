@@ -1,4 +1,4 @@
-"""Issue 13, items 4-6: a result carries its recipe; geometry belongs to its method; the seed is an edit."""
+"""A result carries its recipe; geometry belongs to its method; the seed is an edit."""
 
 import dataclasses
 import json

@@ -11,7 +11,7 @@ from contextlib import contextmanager
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QSettings, Qt
+from PySide6.QtCore import Qt
 from weft.app.cli import main as weft
 from weft.core.geometry import Mask
 from weft.core.image import load_image, read_recipe, save_image
@@ -50,13 +50,8 @@ def _final_after(window, qtbot, action, timeout=30000):
 
 
 @contextmanager
-def _fill_window(qtbot, settings, picture, size=(1300, 820)):
-    from weft.app.gui.main_window import MainWindow
-
-    window = MainWindow(settings=settings, load_defaults=False)
-    qtbot.addWidget(window)
-    window.resize(*size)
-    window.show()
+def _fill_window(make_window, qtbot, picture, size=(1300, 820)):
+    window = make_window(size=size)
     try:
         box = window.method_panel.method_box
         box.setCurrentIndex(box.findData("fill"))
@@ -73,9 +68,9 @@ def _fill_window(qtbot, settings, picture, size=(1300, 820)):
 
 
 @pytest.fixture
-def fill(qtbot, settings, tmp_path):
+def fill(qtbot, make_window, tmp_path):
     """Fill on the three-colour picture with a hole painted in its red half (filled red)."""
-    with _fill_window(qtbot, settings, _picture(tmp_path / "three.png")) as window:
+    with _fill_window(make_window, qtbot, _picture(tmp_path / "three.png")) as window:
         window.inputs_pane.mask_tool().set_size(7)
         _final_after(window, qtbot, lambda: _stroke(window.inputs_pane.canvas_view, HOLE))
         yield window
@@ -249,37 +244,39 @@ def test_the_sampling_area_round_trips_through_a_session_and_an_export_reproduce
     assert np.array_equal(load_image(out).image, load_image(cli).image)
 
 
-def test_the_brush_is_sized_to_the_picture_and_keeps_its_size_through_a_recovery(qtbot, tmp_path):
+def test_the_brush_is_sized_to_the_picture_and_keeps_its_size_through_a_recovery(
+    qtbot, make_window, settings, tmp_path
+):
     """The default brush is a 25th of the picture's longer side (a 600 px photo: 24 px; a 4000 px
     one: 160 px, not 24); a size picked is kept relative to the picture in the settings, so a
     restarted studio (a crash recovery) paints with it again."""
     from weft.app.gui.mask_tool import default_size
 
     assert default_size(600, 400) == 24 and default_size(4000, 3000) == 160 and default_size(40, 30) == 3
-    settings = QSettings(str(tmp_path / "weft.ini"), QSettings.Format.IniFormat)
     big = tmp_path / "big.png"
     save_image(big, np.random.default_rng(1).random((300, 500, 3)).astype(np.float32))
-    with _fill_window(qtbot, settings, big) as window:
+    with _fill_window(make_window, qtbot, big) as window:
         tool, bar = window.inputs_pane.mask_tool(), window.inputs_pane.bar()
         assert tool.size == 20 and bar.size_box.value() == 20
         window.inputs_pane.canvas_view.setFocus()
         qtbot.keyClick(window.inputs_pane.canvas_view, Qt.Key.Key_BracketRight)
         assert tool.size == 25
     settings.sync()
-    with _fill_window(qtbot, settings, big) as window:  # the next studio, on the same picture
+    with _fill_window(make_window, qtbot, big) as window:  # the next studio, on the same picture
         assert window.inputs_pane.mask_tool().size == 25
         assert window.inputs_pane.bar().size_box.value() == 25
-    with _fill_window(qtbot, settings, _picture(tmp_path / "small.png")) as window:  # 96 px: the same share
+    with _fill_window(make_window, qtbot, _picture(tmp_path / "small.png")) as window:  # 96 px: the same share
         assert window.inputs_pane.mask_tool().size == 5
 
 
 @pytest.mark.parametrize("size", [(1024, 700), (1440, 900)])
-def test_every_button_over_the_picture_shows_and_the_picture_is_the_large_view(qtbot, tmp_path, size):
+def test_every_button_over_the_picture_shows_and_the_picture_is_the_large_view(
+    qtbot, make_window, settings, tmp_path, size
+):
     """No button of the bar hides behind an overflow menu, at 1024x700 as at 1440x900 (Fill
     transparent and Extend canvas… did, and the brush size at 1024); the picture painted on has the
     larger share of the window, beside the result."""
-    settings = QSettings(str(tmp_path / "weft.ini"), QSettings.Format.IniFormat)
-    with _fill_window(qtbot, settings, _picture(tmp_path / "three.png"), size=size) as window:
+    with _fill_window(make_window, qtbot, _picture(tmp_path / "three.png"), size=size) as window:
         bar = window.inputs_pane.bar()
         qtbot.waitUntil(lambda: bar.width() > 0, timeout=5000)
         buttons = [

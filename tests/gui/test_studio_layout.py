@@ -1,4 +1,4 @@
-"""Issue 14 (friction): figures in words, a status line that never runs into the pixel read-out,
+"""The studio's layout: figures in words, a status line that never runs into the pixel read-out,
 tab titles that fit, the square typed, a usable result view in a small window."""
 
 import json
@@ -6,7 +6,6 @@ import re
 
 import pytest
 from PySide6.QtCore import QRect, Qt
-from weft.app.gui.main_window import MainWindow
 from weft.core import registry
 from weft.core.examples import RESOURCES
 from weft.core.geometry import MASK, Mask
@@ -16,11 +15,8 @@ from .helpers import drag, mouse
 SNAKE = re.compile(r"\b[a-z0-9]+(?:_[a-z0-9]+)+\b")
 
 
-def _window(qtbot, settings, size):
-    w = MainWindow(settings=settings)
-    qtbot.addWidget(w)
-    w.resize(*size)
-    w.show()
+def _window(make_window, qtbot, size):
+    w = make_window(load_defaults=True, size=size)
     qtbot.waitExposed(w)
     qtbot.waitUntil(lambda: w.renderer.last is not None and w.renderer.last.final, timeout=20000)
     return w
@@ -57,8 +53,8 @@ def test_the_status_line_gives_a_results_figures_in_words_and_units(window, qtbo
         assert re.search(r"coherent pixels \d+(\.\d+)? %", text), text
 
 
-def test_the_status_text_never_runs_into_the_pixel_read_out(qtbot, settings):
-    w = _window(qtbot, settings, (760, 560))
+def test_the_status_text_never_runs_into_the_pixel_read_out(qtbot, make_window):
+    w = _window(make_window, qtbot, (760, 560))
     long = "result 1500x1000 in 4321 ms — " + ", ".join(f"rectification figure {i} 0.123 px" for i in range(30))
     w.statusBar().showMessage(long)
     view = w.result_view
@@ -84,8 +80,8 @@ def test_the_status_text_never_runs_into_the_pixel_read_out(qtbot, settings):
 
 
 @pytest.mark.parametrize("size", [(1280, 800), (1024, 700)])
-def test_tab_titles_are_not_clipped(qtbot, settings, size):
-    w = _window(qtbot, settings, size)
+def test_tab_titles_are_not_clipped(qtbot, make_window, size):
+    w = _window(make_window, qtbot, size)
     for method in registry.studio_methods():
         w.doc.set_method(method)
         qtbot.waitUntil(lambda m=method: w.doc.method == m, timeout=5000)
@@ -102,8 +98,8 @@ def test_tab_titles_are_not_clipped(qtbot, settings, size):
     w.shutdown()
 
 
-def test_the_result_view_keeps_a_usable_share_of_a_1024x700_window(qtbot, settings):
-    w = _window(qtbot, settings, (1024, 700))
+def test_the_result_view_keeps_a_usable_share_of_a_1024x700_window(qtbot, make_window):
+    w = _window(make_window, qtbot, (1024, 700))
     for method in registry.studio_methods():
         w.doc.set_method(method)
         qtbot.waitUntil(lambda: w.result_view.width() >= 350, timeout=5000)
@@ -143,10 +139,10 @@ def _widgets_over_the_examples_title(w):
     return over
 
 
-def test_no_widget_is_painted_over_the_examples_dock_title(qtbot, settings):
+def test_no_widget_is_painted_over_the_examples_dock_title(qtbot, make_window):
     """Seen under Xvfb: a view made for an input no method had shown yet (parented to the window and
     never laid out) was painted over the Examples title; every input's view now lives in its pane."""
-    w = _window(qtbot, settings, (1280, 800))
+    w = _window(make_window, qtbot, (1280, 800))
     assert not _widgets_over_the_examples_title(w)
     for method in registry.studio_methods():
         w.doc.set_method(method)
@@ -207,8 +203,8 @@ def test_a_square_can_be_typed_when_none_is_drawn(window, qtbot):
     assert window.doc.square is None and side_box.text() == "–"
 
 
-def test_quads_prompt_is_not_cut_off_in_a_narrow_pane(qtbot, settings):
-    w = _window(qtbot, settings, (1024, 700))
+def test_quads_prompt_is_not_cut_off_in_a_narrow_pane(qtbot, make_window):
+    w = _window(make_window, qtbot, (1024, 700))
     w.doc.set_method("nfpt")
     qtbot.waitUntil(lambda: w.inputs_pane.lines_panel is not None and w.inputs_pane.lines_panel.active, timeout=5000)
     panel = w.inputs_pane.lines_panel

@@ -10,14 +10,6 @@ from weft.core.examples import RESOURCES
 from weft.core.rectify.homography import apply_homography
 
 
-@pytest.fixture
-def nfpt(window, qtbot):
-    window.doc.set_method("nfpt")
-    assert window.doc.image("photo") is not None
-    qtbot.waitUntil(lambda: window.renderer.last.job_id > 0, timeout=20000)
-    return window
-
-
 def test_suggest_lines_button_proposes_editable_pairs_and_one_undo_removes_them(nfpt, qtbot):
     panel, doc = nfpt.inputs_pane.lines_panel, nfpt.doc
     assert panel.suggest_button.isVisible()
@@ -98,17 +90,12 @@ def _method(suggest):
 
 
 @pytest.mark.parametrize("declared", [True, False])
-def test_a_plugin_method_gets_the_button_only_when_it_declares_a_suggestion(declared, qtbot, settings, tmp_path):
-    from weft.app.gui.main_window import MainWindow
-
+def test_a_plugin_method_gets_the_button_only_when_it_declares_a_suggestion(declared, qtbot, make_window, tmp_path):
     method = _method((lambda image: (_PROPOSED, "four pairs")) if declared else None)
     registry.register(method)
     picture = tmp_path / "picture.png"
     save_image(picture, np.random.default_rng(2).random((60, 70, 3)).astype(np.float32))
-    window = MainWindow(settings=settings, load_defaults=False)
-    qtbot.addWidget(window)
-    window.resize(1300, 820)
-    window.show()
+    window = make_window()
     try:
         box = window.method_panel.method_box
         box.setCurrentIndex(box.findData(method.name))
