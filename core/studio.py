@@ -22,18 +22,12 @@ import numpy as np
 
 from .errors import WeftError
 from .geometry import KINDS, LINES, MARGINS, MASK, SQUARE  # noqa: F401 (the kinds are re-exported)
-from .preview import AROUND_SIDE, Around, around_region, crop_around, reduce_for_preview  # noqa: F401 (re-exported)
 
 __all__ = [
     "Studio",
     "Geometry",
     "Figure",
     "describe_figures",
-    "reduce_for_preview",
-    "crop_around",
-    "around_region",
-    "Around",
-    "AROUND_SIDE",
     "SQUARE",
     "LINES",
     "MASK",
@@ -128,7 +122,7 @@ class Figure:
     after : words after the value and unit, e.g. ``"of the sample"``.
     digits : significant digits of a number.
     whole : the value is the same whatever part of the image is rendered (a parameter, e.g. the
-        engine): a preview around a stroke, which renders a crop (:func:`crop_around`), shows it.
+        engine): a preview around a stroke, which renders a crop (:func:`weft.core.preview.crop_around`), shows it.
         A figure that counts or measures pixels (``False``, the default) would describe the crop,
         not the image, and is shown only with the full result.
 
@@ -219,7 +213,7 @@ class Studio:
         status bar shows them in words and units (:meth:`describe`), the CLI's ``--report`` keeps the keys.
     preview_around : the input of a mask geometry whose painting previews *around the stroke*: while a
         stroke is drawn, the method runs on a crop of its inputs around the painted region
-        (:func:`crop_around`) and the crop's result is pasted into the last full result; None: a
+        (:func:`weft.core.preview.crop_around`) and the crop's result is pasted into the last full result; None: a
         stroke previews nothing until it is released. Such a preview states only the figures that
         hold for the whole image (:attr:`Figure.whole`).
     own_inputs : optional inputs the method takes only when they were opened for it (while it was the
@@ -236,7 +230,7 @@ class Studio:
         them. Takes the same ``shapes`` as ``auto``.
     masks_of : inputs that are masks of another input without being painted (opened as files): each
         belongs to the first of its images that is open (a source mask of a texture when one is
-        open, else of the image); :func:`crop_around` crops it with that image. A painted mask
+        open, else of the image); :func:`weft.core.preview.crop_around` crops it with that image. A painted mask
         (a :class:`Geometry` of kind ``mask``) is cropped with its image without being listed here.
     """
 

@@ -16,8 +16,8 @@ import numpy as np
 from weft.core.geometry import MaskStroke
 from weft.core.jobs import Progress
 from weft.core.params import Recipe
+from weft.core.preview import around_region
 from weft.core.request import FULL, AroundStroke, Full, Mode, RenderRequest, RenderResult
-from weft.core.studio import around_region
 
 PARTIAL_INTERVAL = 0.25
 

@@ -14,7 +14,8 @@ import numpy as np
 from panels import grid, label
 from weft.core import registry
 from weft.core.image import load_image, save_image
-from weft.core.run import load_recipe, render
+from weft.core.request import RenderRequest
+from weft.core.run import load_recipe
 
 EXAMPLES = Path("../examples")  # docs/examples, seen from docs/gallery (or docs/images)
 
@@ -30,8 +31,8 @@ frames = sorted((EXAMPLES / "frames").glob("frame_*.png"))
 
 outputs = []
 for frame in frames:
-    result, _ = render(method, params, {**recipe.inputs, "target": str(frame)}, recipe.seed)
-    outputs.append(result.image)
+    request = RenderRequest(method, params, {**recipe.inputs, "target": str(frame)}, recipe.seed)
+    outputs.append(request.run().image)
 panels = [label(load_image(f).image, f.name) for f in frames]
 panels += [
     label(np.repeat(o[..., None], 3, axis=2) if o.ndim == 2 else o, f"out/{Path(f).stem}.png")

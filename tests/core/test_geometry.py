@@ -8,7 +8,7 @@ from weft.core import registry
 from weft.core.errors import GeometryError, InvalidParameter
 from weft.core.geometry import FeatureLines, LineDraft, Square
 from weft.core.params import Recipe
-from weft.core.studio import reduce_for_preview
+from weft.core.preview import reduce_for_preview
 
 LINES = {
     "image_lines": [[1, 1, 30, 2], [2, 20, 31, 22]],

@@ -1,4 +1,4 @@
-"""core.studio.crop_around (the preview around a mask stroke) and sessions' masks and margins (Qt-free)."""
+"""core.preview.crop_around (the preview around a mask stroke) and sessions' masks and margins (Qt-free)."""
 
 import json
 from dataclasses import dataclass
@@ -9,9 +9,10 @@ from weft.core import registry
 from weft.core.errors import WeftError
 from weft.core.geometry import Margins, Mask
 from weft.core.params import Params, param
+from weft.core.preview import AROUND_SIDE, crop_around
 from weft.core.registry import InputSpec, Method, Result
 from weft.core.session import mask_file, read_session
-from weft.core.studio import AROUND_SIDE, MARGINS, MASK, Geometry, Studio, crop_around
+from weft.core.studio import MARGINS, MASK, Geometry, Studio
 
 
 @dataclass(frozen=True)
@@ -194,7 +195,7 @@ def test_a_texture_the_size_of_the_painted_image_is_kept_whole_and_a_source_mask
 def test_a_part_of_the_mask_around_the_stroke_gives_the_crop_the_whole_mask_gives(stroke):
     """The studio cuts only ``around_region`` of a stroke's mask (not the whole mask, 64 MB as a
     float image at 4096²): the crop, its inputs and its box are those of the whole mask."""
-    from weft.core.studio import around_region
+    from weft.core.preview import around_region
 
     rng = np.random.default_rng(3)
     hole = np.zeros((300, 400), np.float32)
@@ -221,7 +222,7 @@ def test_a_part_of_the_mask_around_the_stroke_gives_the_crop_the_whole_mask_give
 
 
 def test_a_part_with_nothing_painted_near_the_stroke_gives_no_crop():
-    from weft.core.studio import around_region
+    from weft.core.preview import around_region
 
     x0, y0, x1, y1 = around_region((100, 100, 110, 110), 400, 300)
     part = np.zeros((y1 - y0, x1 - x0), bool)

@@ -591,7 +591,7 @@ def test_extend_canvas_dialog_takes_four_typed_fields(studio, qtbot):
 
 
 def test_painting_previews_the_region_around_the_stroke_live(studio, qtbot):
-    from weft.core.studio import AROUND_SIDE
+    from weft.core.preview import AROUND_SIDE
 
     view = studio.inputs_pane.canvas_view
     studio.inputs_pane.mask_tool().set_size(5)
@@ -1053,7 +1053,7 @@ def test_a_strokes_preview_states_only_figures_of_the_whole_image(qtbot, make_wi
     """The real fill, painted with the mouse: its preview around the stroke renders a crop, so it
     must not state the crop's hole as the image's ("filled 9.4 % of the image" while the stroke
     covered 1.3 % of it, seen in the studio); on release the full result states the image's own."""
-    from weft.core.studio import AROUND_SIDE
+    from weft.core.preview import AROUND_SIDE
 
     with _fill_in_the_studio(make_window, qtbot) as window:
         view, doc = window.inputs_pane.canvas_view, window.doc
@@ -1206,7 +1206,7 @@ def test_a_strokes_preview_job_gets_the_part_of_the_mask_around_it_not_the_whole
     (``around_region``), cut on the GUI thread, never the whole mask (at 4096² a 64 MB float image per
     preview); the whole mask is made into an image only for the full render on release."""
     import weft.core.request as core_request
-    from weft.core.studio import around_region
+    from weft.core.preview import around_region
 
     w, h = 480, 360
     view = _large_picture(studio, qtbot, tmp_path, w, h)
