@@ -76,7 +76,8 @@ class Spec:
     optional : ``None`` is allowed (meaning "derived from the inputs", see the method's docs).
     symbol : the paper's symbol (shown in tooltips), e.g. ``"p_l"`` or ``"α"``.
     help : one sentence for tooltips and ``--help``.
-    step : slider step for ``float`` parameters.
+    step : slider step for ``float`` parameters; for an ``int``, the values lie on ``lo + k * step``
+        (2 for a side that must be odd from 3, or even from 8): sliders and grids keep to them.
     type : the class of a ``geometry`` parameter (a :class:`~weft.core.geometry.GeometryValue`).
     """
 
@@ -95,6 +96,41 @@ class Spec:
     @property
     def option(self) -> str:
         return "--" + self.name.replace("_", "-")
+
+    def on_grid(self, value: float, lo: float | None = None, hi: float | None = None, up: bool | None = None) -> int:
+        """The value of an ``int`` parameter with a ``step`` nearest to ``value`` on its grid
+        ``lo + k * step`` (the Spec's ``lo``), within ``lo``..``hi`` (the Spec's range unless given).
+
+        Parameters
+        ----------
+        value : float
+            A value from a slider or a range.
+        lo, hi : float, optional
+            A narrower range to stay in (the range the open inputs allow).
+        up : bool, optional
+            Round up (True) or down (False) when ``value`` is off the grid: the way a slider moved;
+            None rounds to the nearer.
+
+        Returns
+        -------
+        int
+            ``value`` itself when the parameter has no step or it is on the grid.
+        """
+        v = int(round(value))
+        step = int(self.step or 1)
+        if self.kind != "int" or step <= 1:
+            return v
+        base = int(self.lo or 0)
+        k = (v - base) / step
+        k = math.ceil(k) if up else math.floor(k) if up is False else math.floor(k + 0.5)
+        out = base + int(k) * step
+        low = self.lo if lo is None else lo
+        high = self.hi if hi is None else hi
+        while high is not None and out > high:
+            out -= step
+        while low is not None and out < low:
+            out += step
+        return out
 
     def range_text(self) -> str:
         if self.kind == "choice":
@@ -304,7 +340,7 @@ def param(
     help : str, optional
         One line for the CLI's help, the slider's tooltip and the docs.
     step : float, optional
-        The slider's step for a float.
+        The slider's step for a float; for an int, the values lie on ``lo + k * step``.
     type : type, optional
         The geometry type of a ``geometry`` parameter (and only of one).
 

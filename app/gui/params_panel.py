@@ -57,6 +57,10 @@ class _Row(QWidget):
             if k == FLOAT:
                 self.editor.setDecimals(3)
                 self.editor.setSingleStep(spec.step or (hi - lo) / 100)
+            elif spec.step:  # values on a grid (odd sides): keys and the wheel step along it
+                self.editor.setSingleStep(int(spec.step))
+                self.editor.setPageStep(int(spec.step))
+            self._shown = self.editor.value()
             self.editor.valueChanged.connect(self._value_changed)
             self.editor.sliderReleased.connect(lambda: self.changed.emit(self.value(), False))
         elif k == CHOICE:
@@ -122,6 +126,7 @@ class _Row(QWidget):
             self.editor.blockSignals(True)
             try:
                 self.editor.setRange(lo, hi)
+                self._shown = self.editor.value()
             finally:
                 self.editor.blockSignals(False)
         self._set_tip()
@@ -145,7 +150,15 @@ class _Row(QWidget):
         else:
             self.editor.setToolTip(self.toolTip())
 
-    def _value_changed(self, _v) -> None:
+    def _value_changed(self, v) -> None:
+        if self.spec.kind == INT and self.spec.step:
+            # a drag or a typed value between grid values lands on the next one the way it moved
+            on = self.spec.on_grid(v, self.editor.minimum(), self.editor.maximum(), up=v > self._shown)
+            if on != v:
+                self.editor.blockSignals(True)
+                self.editor.setValue(on)
+                self.editor.blockSignals(False)
+            self._shown = on
         if self.auto is not None and self.auto.isChecked():
             self.auto.blockSignals(True)
             self.auto.setChecked(False)
@@ -192,6 +205,7 @@ class _Row(QWidget):
             k = self.spec.kind
             if k in (INT, FLOAT):
                 self.editor.setValue(value)
+                self._shown = self.editor.value()
             elif k == CHOICE:
                 self.editor.setCurrentIndex(list(self.spec.choices).index(value))
             elif k == BOOL:

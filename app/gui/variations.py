@@ -47,10 +47,11 @@ def numeric_specs(params_cls) -> list:
 
 
 def grid_values(spec, lo: float, hi: float, n: int) -> list:
-    """``n`` values from ``lo`` to ``hi`` (integers for int parameters, duplicates removed)."""
+    """``n`` values from ``lo`` to ``hi`` (integers for int parameters, on the parameter's grid when
+    it has a step, e.g. odd sides; duplicates removed)."""
     values = np.linspace(lo, hi, n)
     if spec.kind == INT:
-        return [int(round(v)) for v in values]
+        return list(dict.fromkeys(spec.on_grid(v, lo, hi) for v in values))
     return [round(float(v), 4) for v in values]
 
 
@@ -141,7 +142,7 @@ class VariationsDialog(QDialog):
         for box in (self.lo[row], self.hi[row]):
             box.setRange(lo_limit, hi_limit)
             box.setDecimals(0 if spec.kind == INT else 3)
-            box.setSingleStep(1 if spec.kind == INT else (spec.step or (spec.hi - spec.lo) / 20))
+            box.setSingleStep(int(spec.step or 1) if spec.kind == INT else (spec.step or (spec.hi - spec.lo) / 20))
         params = self.doc.params[self.method]
         current = getattr(params, spec.name)
         if current is None and self.method == self.doc.method:  # what "auto" resolves to, as a run resolves it
@@ -152,7 +153,8 @@ class VariationsDialog(QDialog):
         if current:
             span = min(span, abs(current) / 2)
         if spec.kind == INT:
-            span = max(1, int(span))  # whole steps: the middle of the grid is the current value
+            step = int(spec.step or 1)
+            span = max(step, int(span) // step * step)  # whole steps: the middle of the grid is the current value
         self.lo[row].setValue(max(lo_limit, current - span))
         self.hi[row].setValue(min(hi_limit, current + span))
 

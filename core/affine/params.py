@@ -104,6 +104,7 @@ class AffineParams(Params):
         32,
         lo=8,
         hi=256,
+        step=2,
         symbol="B",
         help="side of the patches (even), overlapping by half: smaller"
         " follows the texture more closely and costs more time, "
@@ -113,6 +114,7 @@ class AffineParams(Params):
         32,
         lo=4,
         hi=128,
+        step=2,
         symbol="N",
         help="angular segments of each patch's spectrum, used to "
         "find its orientation (even): more finds finer angles "

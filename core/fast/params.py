@@ -35,6 +35,7 @@ class FastParams(Params):
         5,
         lo=3,
         hi=15,
+        step=2,
         symbol="n",
         help="side of the neighbourhood compared (odd): small copies fine "
         "grain, large carries larger structures of the texture",

@@ -83,6 +83,7 @@ class NfptParams(WarpParams):
         5,
         lo=3,
         hi=15,
+        step=2,
         help="repair: side of the neighbourhood matched when a pixel is re-made (odd); "
         "larger follows larger structures",
     )

@@ -154,12 +154,35 @@ def test_an_error_in_a_job_shows_a_message_and_the_app_goes_on(window, qtbot, mo
 
 
 def test_invalid_value_is_refused_with_a_message(window):
+    """quilt's Poisson blend needs overlapping blocks: ticked with random blocks, it is refused with
+    a message and the box shows the value kept."""
     messages = []
     window.message.connect(messages.append)
-    window.method_panel.params_panel.row("n").editor.setValue(4)  # even: refused by FastParams
+    window.doc.set_method("quilt")
+    window.doc.set_param("mode", "random")
+    window.method_panel.params_panel.row("poisson").editor.setChecked(True)
+    assert window.doc.current_params.poisson is False
+    assert "needs mode overlap or mincut" in messages[-1]
+    assert window.method_panel.params_panel.row("poisson").value() is False
+
+
+def test_an_odd_only_slider_steps_through_odd_values(window, qtbot):
+    """fast's n must be odd: the keyboard steps 5 -> 7 -> 5, and a drag or a typed value between two
+    odd values lands on the next one the way it moved, without an error."""
+    messages = []
+    window.message.connect(messages.append)
+    row = window.method_panel.params_panel.row("n")
+    slider = row.editor.findChild(QSlider)
+    slider.setFocus()
+    qtbot.keyClick(slider, Qt.Key.Key_Right)
+    assert window.doc.current_params.n == 7
+    qtbot.keyClick(slider, Qt.Key.Key_Left)
     assert window.doc.current_params.n == 5
-    assert "must be odd" in messages[-1]
-    assert window.method_panel.params_panel.row("n").value() == 5
+    row.editor.setValue(6)  # between 5 and 7, moving up
+    assert window.doc.current_params.n == 7 and row.value() == 7
+    row.editor.setValue(4)  # moving down
+    assert window.doc.current_params.n == 3 and row.value() == 3
+    assert not any("odd" in m for m in messages), messages
 
 
 def test_undo_redo_parameters_and_method(window):

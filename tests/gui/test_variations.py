@@ -298,3 +298,20 @@ def test_variations_ranges_stay_within_what_the_inputs_allow(window, qtbot, tmp_
     dialog.combo[0].setCurrentText("block")
     assert dialog.hi[0].maximum() == 112 and dialog.hi[0].value() <= 112
     dialog.close()
+
+
+def test_an_odd_only_parameters_grid_has_odd_values(window, qtbot):
+    """fast's n must be odd: the grid's range and its values keep to odd sides (it offered even ones,
+    each cell then refused)."""
+    from weft.app.gui.variations import grid_values
+    from weft.core.params import specs
+
+    window.open_variations()
+    dialog = window.variations
+    dialog.combo[0].setCurrentText("n")
+    lo, hi = dialog.lo[0].value(), dialog.hi[0].value()
+    assert lo % 2 == 1 and hi % 2 == 1, (lo, hi)
+    spec = next(s for s in specs(type(window.doc.current_params)) if s.name == "n")
+    assert grid_values(spec, 3, 15, 5) == [3, 7, 9, 13, 15]
+    assert grid_values(spec, lo, hi, 5) and all(v % 2 == 1 for v in grid_values(spec, lo, hi, 5))
+    dialog.close()
