@@ -2,7 +2,8 @@
 :mod:`.local_pool`, or the Dask pool of :mod:`.dask_pool`), a few per worker at a time, counts what
 comes back, and runs an item again when the worker running it died (see :mod:`weft.core.batch`).
 
-The pools and the worker's side are re-exported here under their earlier names."""
+The pools' classes and the worker's functions are re-exported here for callers that import them
+from this module."""
 
 from __future__ import annotations
 
