@@ -109,7 +109,7 @@ def test_workers_without_scheduler_is_a_usage_error(scene, capsys):
 
 def test_an_unreachable_scheduler_is_one_line(scene, capsys, monkeypatch):
     tmp, _ = scene
-    monkeypatch.setattr("weft.core.batch.execute.CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr("weft.core.batch.dask_pool.CONNECT_TIMEOUT", "1s")
     code = main(
         [
             "batch",

@@ -19,7 +19,8 @@ import pytest
 distributed = pytest.importorskip("distributed")
 
 from weft.app.cli import main  # noqa: E402
-from weft.core.batch import execute  # noqa: E402
+from weft.core.batch import dask_pool  # noqa: E402
+from weft.core.errors import WeftError  # noqa: E402
 
 from .test_batch import make_frames, scene, slow_scene  # noqa: E402,F401  (fixtures)
 
@@ -121,7 +122,7 @@ def _kill_when_one_is_written(out_dir: Path, process: subprocess.Popen) -> threa
 def test_a_scheduler_without_workers_is_a_time_limit_not_a_silent_wait(scene, capfd, monkeypatch, tmp_path):
     tmp, _ = scene
     with _cluster(tmp_path, workers=0) as (address, _scheduler, _worker):
-        monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)
+        monkeypatch.setattr(dask_pool, "WORKER_TIMEOUT", 2.0)
         code, out, err = _run(
             [
                 "batch",
@@ -175,7 +176,7 @@ def test_a_scheduler_killed_mid_batch_ends_with_the_summary(slow_scene, capfd, t
 def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_scene, capfd, tmp_path, monkeypatch):
     tmp, _ = slow_scene
     with _cluster(tmp_path, workers=1) as (address, _scheduler, worker):
-        monkeypatch.setattr(execute, "WORKER_TIMEOUT", 3.0)
+        monkeypatch.setattr(dask_pool, "WORKER_TIMEOUT", 3.0)
         out_dir = tmp / "orphaned"
         killer = _kill_when_one_is_written(out_dir, worker)
         code, out, err = _run(
@@ -204,8 +205,8 @@ def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_sce
 def test_a_result_lost_with_its_worker_fails_instead_of_waiting_forever(tmp_path, monkeypatch):
     # The window the batch can fall into: an item done, its worker killed before the result is fetched.
     with _cluster(tmp_path, workers=1) as (address, _scheduler, worker):
-        pool = execute.DaskPool(address, "quilt")  # waits the usual time for the worker to join
-        monkeypatch.setattr(execute, "WORKER_TIMEOUT", 2.0)  # the wait for a worker once it is lost
+        pool = dask_pool.DaskPool(address, "quilt")  # waits the usual time for the worker to join
+        monkeypatch.setattr(dask_pool, "WORKER_TIMEOUT", 2.0)  # the wait for a worker once it is lost
         try:
             future = pool.client.submit(sum, [1, 2], pure=False)
             distributed.wait([future])
@@ -223,7 +224,7 @@ def test_a_result_lost_with_its_worker_fails_instead_of_waiting_forever(tmp_path
             fetcher.start()
             fetcher.join(120)  # a bound on a regression (it would wait forever), not a timing
             assert not fetcher.is_alive(), "fetching a lost result waited for a worker forever"
-            assert len(raised) == 1 and isinstance(raised[0], execute.WeftError), raised
+            assert len(raised) == 1 and isinstance(raised[0], WeftError), raised
             assert str(raised[0]) == f"the Dask scheduler at {address} had no workers left for 2 s"
         finally:
             pool.close()

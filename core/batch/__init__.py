@@ -25,24 +25,13 @@ workers must fit in the memory available (:mod:`weft.core.limits`); a Dask worke
 is checked against the estimate times its threads.
 
 Importing this package imports neither Dask nor the method modules. :mod:`.prepare` holds what a
-batch is and the checks before any work; :mod:`.execute` runs its items.
+batch is and the checks before any work; :mod:`.execute` runs its items on a pool (:mod:`.local_pool`
+or :mod:`.dask_pool`), whose workers run each one with :mod:`.worker`.
 """
 
-from .execute import (
-    CONNECT_TIMEOUT,
-    IN_FLIGHT_PER_WORKER,
-    MAX_ATTEMPTS,
-    SCHEDULER_ENV,
-    DaskPool,
-    LocalPool,
-    WorkerDied,
-    default_workers,
-    run,
-    run_item,
-    scheduler_address,
-    set_threads,
-    warm_up,
-)
+from .dask_pool import CONNECT_TIMEOUT, SCHEDULER_ENV, DaskPool, scheduler_address
+from .execute import IN_FLIGHT_PER_WORKER, MAX_ATTEMPTS, run
+from .local_pool import LocalPool, default_workers
 from .prepare import (
     IMAGE_EXTENSIONS,
     SAVE_EXTENSIONS,
@@ -56,6 +45,7 @@ from .prepare import (
     item_memory,
     plan,
 )
+from .worker import WorkerDied, run_item, set_threads, warm_up
 
 __all__ = [
     "BatchProgress",
