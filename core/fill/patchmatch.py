@@ -10,7 +10,7 @@ et al., "PatchMatch" (SIGGRAPH 2009) from :mod:`weft.core.fill.search`:
    channels, the absolute luminance derivatives averaged over 5x5, filled like the colours, so the
    search does not settle on the flattest patches and the fill keeps the texture's energy.
 3. The coarsest level starts from an onion-peel diffusion of the hole's edge. Every level but the
-   finest runs EM iterations (:func:`weft.core.fill.search.em`) with each target pixel's squared
+   finest runs EM iterations (:func:`weft.core.fill.search.em.em`) with each target pixel's squared
    difference weighted by its confidence (1 known, ``GAMMA ** -d`` at depth ``d`` in the hole), so
    the known edge decides the match. A finer level starts from the coarser level's matches, doubled
    and voted (an upsampled image would be blurred, and the flattest patches would match it best).

@@ -79,6 +79,10 @@ import numpy as np
 from ..params import as_rng
 from .common import Progress, check_engine_args, whole_patches
 from .cut import min_cut
+from .quilt_costs import GAP_SIGMA as GAP_SIGMA  # (re-exported: step 5's constants, read here)
+from .quilt_costs import GAP_WIDTH as GAP_WIDTH
+from .quilt_costs import _ccorr, _chroma, _coarse_guide, _gap_cost, _planes
+from .quilt_order import DATA, _edges, _Front, _score
 
 #: E&F's tolerance: a block within (1 + EPSILON) of the best cost may be chosen.
 EPSILON = 0.1
@@ -99,8 +103,6 @@ GUIDE_SCALE = 4
 COHERE = 1.0
 #: How many of the copies already in a window (the most frequent first) are tried for continuing.
 CONTINUE = 4
-#: Weight of the structure term in the fill order (step 1; colour images only); 0 = the count alone.
-DATA = 3.0
 #: EM iterations of the final patch-search refine (step 7; colour images only); 0 = none.
 REFINE = 1
 #: The refine searches, in each iteration, the inexact patches at or above this percentile of their distances.
@@ -109,10 +111,6 @@ REFINE_WORST = 50.0
 REFINE_PATCH = 7
 #: Weight of the thin-gap cost on a continued copy (step 5; grey pictures only); 0 = none.
 GAP = 3.0
-#: A window's unknown pixels form a thin gap when none is farther than this (px) from a valued one.
-GAP_WIDTH = 5.0
-#: The source blocks are blurred by this sigma (px) to meet the gap's diffusion fill.
-GAP_SIGMA = 1.5
 
 
 def is_colour(img: np.ndarray, known: np.ndarray) -> bool:
@@ -160,142 +158,6 @@ def refines(image, hole, refine: bool | None = None) -> bool:
         return bool(refine) and REFINE > 0
     img = np.asarray(image)
     return REFINE > 0 and img.ndim == 3 and is_colour(img, ~np.asarray(hole, dtype=bool))
-
-
-def _chroma(img: np.ndarray) -> np.ndarray:
-    """(H, W, 3) float32: the colour of ``img``'s first three channels less their mean (grey = 0)."""
-    rgb = img[..., :3]
-    return np.ascontiguousarray(rgb - rgb.mean(axis=2, keepdims=True), dtype=np.float32)
-
-
-def _planes(img: np.ndarray) -> list[np.ndarray]:
-    """The channels of (H, W, C) ``img`` as C contiguous (H, W) float32 arrays."""
-    return [np.ascontiguousarray(img[..., k], dtype=np.float32) for k in range(img.shape[2])]
-
-
-def _ccorr(planes: list[np.ndarray], crop: tuple[slice, slice], template: np.ndarray) -> np.ndarray:
-    """``cv2.matchTemplate(image[crop], template, TM_CCORR)`` of the multi-channel image whose channels
-    are ``planes``, as the sum of one single-channel correlation per channel: OpenCV's multi-channel
-    correlation took 1.5-2.5x as long as three single-channel ones on the 216 px crops and 24 px
-    blocks of a fill (equal to float32 rounding)."""
-    out: np.ndarray = cv2.matchTemplate(planes[0][crop], np.ascontiguousarray(template[..., 0]), cv2.TM_CCORR)
-    for k in range(1, len(planes)):
-        out += cv2.matchTemplate(planes[k][crop], np.ascontiguousarray(template[..., k]), cv2.TM_CCORR)
-    return out
-
-
-def _coarse_guide(canvas: np.ndarray, hole: np.ndarray, scale: int) -> np.ndarray:
-    """(H, W, C) float32: the hole filled by diffusion (cv2.inpaint, Telea) at 1/scale, brought back
-    to full size; the known pixels' own values elsewhere (only the hole's are read)."""
-    h, w, c = canvas.shape
-    sh, sw = max(1, h // scale), max(1, w // scale)
-    small = cv2.resize(canvas, (sw, sh), interpolation=cv2.INTER_AREA).reshape(sh, sw, c)
-    cover = cv2.resize(hole.astype(np.float32), (sw, sh), interpolation=cv2.INTER_AREA)
-    known_share = np.maximum(1.0 - cover, 1e-6)[..., None]
-    small = small / known_share  # the mean of the known pixels alone (the hole is 0 in the canvas)
-    up = cv2.resize(_telea(small, cover > 0.5), (w, h), interpolation=cv2.INTER_LINEAR).reshape(h, w, c)
-    return np.ascontiguousarray(up, dtype=np.float32)
-
-
-def _telea(img: np.ndarray, unknown: np.ndarray) -> np.ndarray:
-    """(H, W, C) float32: ``img`` in 8-bit levels, its ``unknown`` pixels (bool (H, W)) filled by
-    diffusion from the others (``cv2.inpaint``, Telea, radius 3, channel by channel)."""
-    mask = unknown.astype(np.uint8)
-    out = np.empty(img.shape, dtype=np.float32)
-    for k in range(img.shape[2]):
-        ch8 = np.clip(np.rint(img[..., k] * 255), 0, 255).astype(np.uint8)
-        out[..., k] = (cv2.inpaint(ch8, mask, 3, cv2.INPAINT_TELEA) if mask.any() else ch8).astype(np.float32) / 255.0
-    return out
-
-
-def _gap_cost(
-    template: np.ndarray, unknown: np.ndarray, search: np.ndarray, crop: tuple[slice, slice], blurred: list[np.ndarray]
-) -> np.ndarray | None:
-    """Step 5's thin-gap cost of every block position of ``search[crop]``, or None when the window's
-    ``unknown`` pixels (float32 0/1) are no thin gap (one lies more than :data:`GAP_WIDTH` px from a
-    valued pixel): the SSD, over those pixels, between the window's diffusion fill (``cv2.inpaint``,
-    Telea, radius 3, from its valued pixels) and the source block blurred by :data:`GAP_SIGMA`.
-    ``blurred`` caches the blurred source (its channel planes, then their summed squares)."""
-    gap = unknown > 0
-    if float(cv2.distanceTransform(gap.astype(np.uint8), cv2.DIST_L2, 3).max()) > GAP_WIDTH:
-        return None
-    if not blurred:
-        soft = cv2.GaussianBlur(search, (0, 0), GAP_SIGMA).reshape(search.shape)
-        blurred.extend(_planes(soft))
-        blurred.append(np.ascontiguousarray((soft * soft).sum(axis=2)))
-    est = _telea(template, gap)
-    g = np.ascontiguousarray(est * unknown[..., None])
-    out = cv2.matchTemplate(blurred[-1][crop], unknown, cv2.TM_CCORR) - 2.0 * _ccorr(blurred[:-1], crop, g)
-    out += float((g * est).sum())
-    return np.maximum(out, 0.0)
-
-
-def _edges(canvas: np.ndarray, known: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The structure term's inputs (step 1): float32 (H, W) gradient magnitude of the known pixels
-    whose 3x3 neighbourhood is known (0 elsewhere, ~normalised by its mean there) and that mask."""
-    grey = canvas.mean(axis=2).astype(np.float32)
-    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
-    inner = (
-        cv2.erode(known.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=1) > 0
-    )
-    mag = np.where(inner, np.sqrt(gx * gx + gy * gy), 0.0).astype(np.float32)
-    mean = float(mag[inner].mean()) if inner.any() else 0.0
-    return (mag / mean if mean > 0 else mag), inner.astype(np.float32)
-
-
-def _score(
-    have: np.ndarray,
-    score: np.ndarray,
-    b: int,
-    y0: int,
-    y1: int,
-    x0: int,
-    x1: int,
-    edges: tuple[np.ndarray, np.ndarray] | None = None,
-) -> None:
-    """Recompute ``score`` (see :func:`fill_quilt`) on rows ``[y0, y1)`` and columns ``[x0, x1)``."""
-    h, w = have.shape
-    m = b // 2 + 2  # context the box filter and the front's dilation read around the region
-    ya, yb, xa, xb = max(0, y0 - m), min(h, y1 + m), max(0, x0 - m), min(w, x1 + m)
-    sub = have[ya:yb, xa:xb]
-    # the window of a centre pixel: rows [y - b//2, y - b//2 + b) (cv2's anchor for even sizes too)
-    count = cv2.boxFilter(sub.astype(np.float32), -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
-    near = (
-        cv2.dilate(sub.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=0) > 0
-    )
-    front = ~sub & near
-    if edges is not None:  # step 1's structure term: count x (1 + DATA g / G)
-        mag, inner = edges[0][ya:yb, xa:xb], edges[1][ya:yb, xa:xb]
-        g = cv2.boxFilter(mag, -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
-        n = cv2.boxFilter(inner, -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
-        count = count * (1.0 + DATA * g / np.maximum(n, 1.0))
-    part = np.where(front, count, -1.0)
-    score[y0:y1, x0:x1] = part[y0 - ya : y1 - ya, x0 - xa : x1 - xa]
-
-
-#: Rows per strip of :class:`_Front`.
-_STRIP = 32
-
-
-class _Front:
-    """The first maximum of ``score`` in scan order (``np.argmax``'s answer), found through the
-    maxima of its strips of :data:`_STRIP` rows: ``update(y0, y1)`` after rows ``[y0, y1)`` of it
-    changed. ``np.argmax`` over a whole 4096² score took 2 ms per block, 13 of a long stroke's 22 s."""
-
-    def __init__(self, score: np.ndarray):
-        self.score = score
-        self.maxima = np.empty(-(-score.shape[0] // _STRIP), dtype=score.dtype)
-        self.update(0, score.shape[0])
-
-    def update(self, y0: int, y1: int) -> None:
-        for k in range(y0 // _STRIP, -(-y1 // _STRIP)):
-            self.maxima[k] = self.score[k * _STRIP : (k + 1) * _STRIP].max()
-
-    def first_max(self) -> tuple[int, int]:
-        k = int(np.argmax(self.maxima))  # the first strip holding the maximum, then its first in scan order
-        y, x = divmod(int(np.argmax(self.score[k * _STRIP : (k + 1) * _STRIP])), self.score.shape[1])
-        return k * _STRIP + y, x
 
 
 def fill_quilt(
@@ -447,8 +309,8 @@ def fill_quilt(
         if COHERE > 0:  # continue a neighbouring block's copy when it costs little more: no seam there at all
             mine = filled[win] & ~cutonly[win]  # pixels earlier blocks wrote
             if mine.any():
-                # the copies' offsets as one int64 each, ordered as (dy, dx) rows are (np.unique with
-                # axis=0 sorted them the same way, 5x slower)
+                # the copies' offsets as one int64 each, ordered as (dy, dx) rows are (as np.unique with
+                # axis=0 orders them, for less)
                 sh = shift[:, y0 : y0 + b, x0 : x0 + b][:, mine].astype(np.int64)
                 codes, counts = np.unique((sh[0] + span) * (2 * span + 1) + (sh[1] + span), return_counts=True)
                 shifts = np.stack([codes // (2 * span + 1) - span, codes % (2 * span + 1) - span], axis=1)

@@ -1376,11 +1376,11 @@ def test_an_auto_value_that_depends_on_the_margins_follows_an_edge_drag(plugin, 
         registry.unregister(SPREAD_FILL.name)
 
 
-def test_the_auto_patch_shows_the_patch_the_run_takes_or_none(qtbot, settings):
+def test_the_auto_patch_shows_the_patch_the_run_takes_or_none(make_window, qtbot):
     """The greyed "auto" value beside fill's patch box is the patch the result reports: on this grey
     picture the hybrid's block; with the edge guide asked for (patchmatch) its 7. (On a colour
     picture with a hole, where the pixels decide the engine, it shows no number.)"""
-    with _fill_in_the_studio(qtbot, settings) as window:
+    with _fill_in_the_studio(make_window, qtbot) as window:
         view, doc = window.inputs_pane.canvas_view, window.doc
         h, w = doc.image("image").shape[:2]
         view.actual_size()
