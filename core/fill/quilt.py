@@ -73,6 +73,8 @@ feed on themselves.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
 
@@ -220,21 +222,7 @@ def fill_quilt(
     if cuttable is not None:
         filled |= cuttable
         cutonly |= cuttable
-    # the search image: the bounding box of the source, its non-source pixels never inside a chosen block
-    ys, xs = np.nonzero(src)
-    sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
-    search = canvas[sy0:sy1, sx0:sx1].copy()  # never a view: the canvas is written
-    valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
-    search_sq = np.ascontiguousarray((search * search).sum(axis=2))
-    search_sum = np.ascontiguousarray(search.sum(axis=2))
-    search_planes = _planes(search)
-    guided = GUIDE > 0 and c >= 3
-    if guided:  # the colour (not the texture) of a coarse diffusion fill steers the blocks: chroma only
-        guide = _chroma(_coarse_guide(canvas, hole, GUIDE_SCALE))
-        blur = _chroma(cv2.GaussianBlur(search, (0, 0), GUIDE_SCALE / 2.0).reshape(search.shape))
-        blur_sq = np.ascontiguousarray((blur * blur).sum(axis=2))
-        blur_planes = _planes(blur)
-    gap_search: list[np.ndarray] = []  # step 5's blurred source, made when first needed
+    s = _search_image(canvas, hole, src, b)
     total = int(hole.sum())
     refining = refines(img, hole, refine)
     # the refine's share of the progress: about its share of the time (a fifth)
@@ -254,54 +242,12 @@ def fill_quilt(
         py, px = front.first_max()
         if score[py, px] < 0:  # an unknown region touching nothing valued (cannot happen, kept safe)
             py, px = np.unravel_index(int(np.argmax(~have)), have.shape)  # type: ignore[assignment]  # numpy ints
-        # the window centred there, moved away from its known pixels so that they fill about an
-        # overlap's width of it (a straight front: B/2 known -> B/3) and the block fills more
-        y0 = int(min(max(py - b // 2, 0), h - b))
-        x0 = int(min(max(px - b // 2, 0), w - b))
-        sub = have[y0 : y0 + b, x0 : x0 + b]
-        if sub.any() and not sub.all():
-            ky, kx = np.nonzero(sub)
-            y0 = int(min(max(y0 - round(SHIFT * (ky.mean() - (b - 1) / 2)), 0), h - b))
-            x0 = int(min(max(x0 - round(SHIFT * (kx.mean() - (b - 1) / 2)), 0), w - b))
+        y0, x0 = _window(have, py, px, b)
         win = (slice(y0, y0 + b), slice(x0, x0 + b))
-        weight = have[win].astype(np.float32)
         template = np.ascontiguousarray(canvas[win])
         un = (~have[win]).astype(np.float32)
-        hs, ws = valid.shape
-        ry0, rx0, ry1, rx1 = 0, 0, hs, ws
-        reach = REACH
-        while (
-            0 < reach < max(hs, ws)
-        ):  # the locality prior: blocks from near the window, the nearest reach that has any
-            ry0, ry1 = max(0, y0 - sy0 - reach), min(hs, y0 - sy0 + reach + 1)
-            rx0, rx1 = max(0, x0 - sx0 - reach), min(ws, x0 - sx0 + reach + 1)
-            if ry0 < ry1 and rx0 < rx1 and valid[ry0:ry1, rx0:rx1].any():
-                break
-            reach *= 2
-        else:
-            ry0, rx0, ry1, rx1 = 0, 0, hs, ws
-        crop = (slice(ry0, ry1 + b - 1), slice(rx0, rx1 + b - 1))
-        ok = valid[ry0:ry1, rx0:rx1]
-        if weight.any():
-            # masked SSD = sum M I^2 - 2 sum M T I + sum M T^2 (the squares summed over channels first)
-            energy = cv2.matchTemplate(search_sq[crop], weight, cv2.TM_CCORR)  # sum M I^2
-            cost = energy - 2.0 * _ccorr(search_planes, crop, template * weight[..., None])
-            cost += float((weight[..., None] * template * template).sum())
-            if DETAIL > 0:  # the contrast term: the block's and the template's standard deviations
-                n = float(weight.sum()) * c
-                s1 = cv2.matchTemplate(search_sum[crop], weight, cv2.TM_CCORR) / n
-                sq = np.maximum(energy / n - s1 * s1, 0)
-                tm = float((weight[..., None] * template).sum()) / n
-                tv = max(float((weight[..., None] * template * template).sum()) / n - tm * tm, 0.0)
-                cost += DETAIL * n * (np.sqrt(sq) - np.sqrt(tv)) ** 2
-        else:
-            cost = np.zeros(ok.shape, dtype=np.float32)
-        if guided and un.any():
-            g = np.ascontiguousarray(guide[win] * un[..., None])
-            gc = cv2.matchTemplate(blur_sq[crop], un, cv2.TM_CCORR) - 2.0 * _ccorr(blur_planes, crop, g)
-            gc += float((g * guide[win]).sum())
-            cost = cost + GUIDE * np.maximum(gc, 0.0)
-        cost = np.where(ok & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
+        ry0, rx0, crop, ok = _reach(s, y0, x0, b)
+        cost = _block_cost(s, win, crop, ok, template, have[win].astype(np.float32), un)
         best = float(cost.min())
         cand = np.flatnonzero(cost.ravel() <= best * (1.0 + EPSILON) + 1e-9)
         pick = int(cand[gen.integers(len(cand))])
@@ -309,48 +255,20 @@ def fill_quilt(
         if COHERE > 0:  # continue a neighbouring block's copy when it costs little more: no seam there at all
             mine = filled[win] & ~cutonly[win]  # pixels earlier blocks wrote
             if mine.any():
-                # the copies' offsets as one int64 each, ordered as (dy, dx) rows are (as np.unique with
-                # axis=0 orders them, for less)
-                sh = shift[:, y0 : y0 + b, x0 : x0 + b][:, mine].astype(np.int64)
-                codes, counts = np.unique((sh[0] + span) * (2 * span + 1) + (sh[1] + span), return_counts=True)
-                shifts = np.stack([codes // (2 * span + 1) - span, codes % (2 * span + 1) - span], axis=1)
-                conts = []
-                for dy, dx in shifts[np.argsort(-counts, kind="stable")[:CONTINUE]]:
-                    ty, tx = y0 + int(dy) - sy0 - ry0, x0 + int(dx) - sx0 - rx0  # that copy's block here
-                    if 0 <= ty < cost.shape[0] and 0 <= tx < cost.shape[1] and np.isfinite(cost[ty, tx]):
-                        conts.append((float(cost[ty, tx]), ty, tx))
-                if conts:
-                    c_cost, ty, tx = min(conts)
-                    bound = best
-                    if (
-                        GAP > 0 and not colour and un.any()
-                    ):  # a continued copy must not draw into a thin gap what its sides lack
-                        gap = _gap_cost(template, un, search, crop, gap_search)
-                        if gap is not None:
-                            with_gap = cost + GAP * gap
-                            bound = float(with_gap.min())
-                            c_cost, ty, tx = min((float(with_gap[ty, tx]), ty, tx) for _, ty, tx in conts)
-                    if c_cost <= bound * (1.0 + COHERE) + 1e-9:
-                        cy, cx = ty, tx
+                offsets = shift[:, y0 : y0 + b, x0 : x0 + b][:, mine].astype(np.int64)
+                # that copy's block here, for each offset (dy, dx)
+                here = [(y0 + dy - s.y0 - ry0, x0 + dx - s.x0 - rx0) for dy, dx in _frequent(offsets, span)]
+                gap_check = GAP > 0 and not colour and un.any()
+                cont = _continued(s, cost, best, here, crop, template, un if gap_check else None)
+                if cont is not None:
+                    cy, cx = cont
         cy, cx = cy + ry0, cx + rx0
-        block = search[cy : cy + b, cx : cx + b]
-        new_region = ~have[win]
-        soft = filled[win]
-        if soft.any():
-            err = ((canvas[win] - block) ** 2).sum(axis=2).astype(np.float64)
-            err[~soft] = _BIG
-            sides = dict(
-                left=soft[:, :ov].any(),
-                top=soft[:ov, :].any(),
-                right=soft[:, b - ov :].any(),
-                bottom=soft[b - ov :, :].any(),
-            )
-            cut = min_cut(err, **{k: (ov if v else 0) for k, v in sides.items()})
-            new_region |= soft & cut
+        block = s.image[cy : cy + b, cx : cx + b]
+        new_region = _block_region(canvas[win], block, have[win], filled[win], ov)
         left -= int(np.count_nonzero(new_region & ~have[win]))
         canvas[win][new_region] = block[new_region]
-        shift[0][win][new_region] = sy0 + cy - y0
-        shift[1][win][new_region] = sx0 + cx - x0
+        shift[0][win][new_region] = s.y0 + cy - y0
+        shift[1][win][new_region] = s.x0 + cx - x0
         filled[win] |= new_region
         cutonly[win] &= ~new_region
         have[win] |= new_region
@@ -364,6 +282,180 @@ def fill_quilt(
     if refining:
         out = _refine(out, hole, changed, src, gen, cancel, lambda p: report(total + int(p.fraction * refine_units)))
     return out.reshape(shape)
+
+
+@dataclass
+class _Search:
+    """The image blocks are copied from: the bounding box of the source (``image``, its corner
+    ``y0``, ``x0`` on the canvas), the corners of its whole source blocks (``valid``), what the costs
+    correlate with (its squares and sums over channels, its channel planes) and, on colour pictures,
+    the coarse colour guide with the blurred chroma it meets (step 4; ``guide`` None otherwise).
+    ``gap``: step 5's blurred source, made when first needed."""
+
+    image: np.ndarray
+    y0: int
+    x0: int
+    valid: np.ndarray
+    sq: np.ndarray
+    sum: np.ndarray
+    planes: list[np.ndarray]
+    guide: np.ndarray | None
+    blur_sq: np.ndarray | None
+    blur_planes: list[np.ndarray]
+    gap: list[np.ndarray]
+
+
+def _search_image(canvas: np.ndarray, hole: np.ndarray, src: np.ndarray, b: int) -> _Search:
+    """The :class:`_Search` of ``src`` on ``canvas`` (its non-source pixels never inside a chosen block)."""
+    ys, xs = np.nonzero(src)
+    sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
+    search = canvas[sy0:sy1, sx0:sx1].copy()  # never a view: the canvas is written
+    guide, blur_sq, blur_planes = None, None, []
+    if GUIDE > 0 and canvas.shape[2] >= 3:  # the colour (not the texture) of a coarse diffusion fill: chroma only
+        guide = _chroma(_coarse_guide(canvas, hole, GUIDE_SCALE))
+        blur = _chroma(cv2.GaussianBlur(search, (0, 0), GUIDE_SCALE / 2.0).reshape(search.shape))
+        blur_sq = np.ascontiguousarray((blur * blur).sum(axis=2))
+        blur_planes = _planes(blur)
+    return _Search(
+        search,
+        sy0,
+        sx0,
+        whole_patches(src[sy0:sy1, sx0:sx1], b),
+        np.ascontiguousarray((search * search).sum(axis=2)),
+        np.ascontiguousarray(search.sum(axis=2)),
+        _planes(search),
+        guide,
+        blur_sq,
+        blur_planes,
+        [],
+    )
+
+
+def _window(have: np.ndarray, py: int, px: int, b: int) -> tuple[int, int]:
+    """The top-left corner of the block window centred on front pixel (``py``, ``px``), moved away from
+    its valued pixels so that they fill about an overlap's width of it (a straight front: B/2 known
+    -> B/3) and the block fills more."""
+    h, w = have.shape
+    y0 = int(min(max(py - b // 2, 0), h - b))
+    x0 = int(min(max(px - b // 2, 0), w - b))
+    sub = have[y0 : y0 + b, x0 : x0 + b]
+    if sub.any() and not sub.all():
+        ky, kx = np.nonzero(sub)
+        y0 = int(min(max(y0 - round(SHIFT * (ky.mean() - (b - 1) / 2)), 0), h - b))
+        x0 = int(min(max(x0 - round(SHIFT * (kx.mean() - (b - 1) / 2)), 0), w - b))
+    return y0, x0
+
+
+def _reach(s: _Search, y0: int, x0: int, b: int) -> tuple[int, int, tuple[slice, slice], np.ndarray]:
+    """Step 3: the block corners searched for the window at (``y0``, ``x0``), the nearest reach that
+    holds any (all of them when none does): ``(first row, first column, the search image's crop, the
+    allowed corners in it)``."""
+    hs, ws = s.valid.shape
+    ry0, rx0, ry1, rx1 = 0, 0, hs, ws
+    reach = REACH
+    while 0 < reach < max(hs, ws):
+        ry0, ry1 = max(0, y0 - s.y0 - reach), min(hs, y0 - s.y0 + reach + 1)
+        rx0, rx1 = max(0, x0 - s.x0 - reach), min(ws, x0 - s.x0 + reach + 1)
+        if ry0 < ry1 and rx0 < rx1 and s.valid[ry0:ry1, rx0:rx1].any():
+            break
+        reach *= 2
+    else:
+        ry0, rx0, ry1, rx1 = 0, 0, hs, ws
+    return ry0, rx0, (slice(ry0, ry1 + b - 1), slice(rx0, rx1 + b - 1)), s.valid[ry0:ry1, rx0:rx1]
+
+
+def _block_cost(
+    s: _Search,
+    win: tuple[slice, slice],
+    crop: tuple[slice, slice],
+    ok: np.ndarray,
+    template: np.ndarray,
+    weight: np.ndarray,
+    un: np.ndarray,
+) -> np.ndarray:
+    """Steps 2 and 4: the cost of every block corner of ``s.image[crop]`` for the window ``win`` whose
+    pixels are ``template``, valued where ``weight`` is 1 and unknown where ``un`` is: the masked SSD
+    with the contrast term, plus the colour guide's on the unknown pixels; inf where not ``ok``."""
+    c = template.shape[2]
+    if weight.any():
+        # masked SSD = sum M I^2 - 2 sum M T I + sum M T^2 (the squares summed over channels first)
+        energy = cv2.matchTemplate(s.sq[crop], weight, cv2.TM_CCORR)  # sum M I^2
+        cost = energy - 2.0 * _ccorr(s.planes, crop, template * weight[..., None])
+        cost += float((weight[..., None] * template * template).sum())
+        if DETAIL > 0:  # the contrast term: the block's and the template's standard deviations
+            n = float(weight.sum()) * c
+            s1 = cv2.matchTemplate(s.sum[crop], weight, cv2.TM_CCORR) / n
+            sq = np.maximum(energy / n - s1 * s1, 0)
+            tm = float((weight[..., None] * template).sum()) / n
+            tv = max(float((weight[..., None] * template * template).sum()) / n - tm * tm, 0.0)
+            cost += DETAIL * n * (np.sqrt(sq) - np.sqrt(tv)) ** 2
+    else:
+        cost = np.zeros(ok.shape, dtype=np.float32)
+    if s.guide is not None and s.blur_sq is not None and un.any():
+        g = np.ascontiguousarray(s.guide[win] * un[..., None])
+        gc = cv2.matchTemplate(s.blur_sq[crop], un, cv2.TM_CCORR) - 2.0 * _ccorr(s.blur_planes, crop, g)
+        gc += float((g * s.guide[win]).sum())
+        cost = cost + GUIDE * np.maximum(gc, 0.0)
+    return np.where(ok & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
+
+
+def _frequent(offsets: np.ndarray, span: int) -> list[tuple[int, int]]:
+    """The :data:`CONTINUE` most frequent of the copies' ``offsets`` ((2, N) int64 rows dy, dx, each
+    below ``span`` in size), the most frequent first."""
+    # each offset as one int64, ordered as (dy, dx) rows are (as np.unique with axis=0 orders them, for less)
+    codes, counts = np.unique((offsets[0] + span) * (2 * span + 1) + (offsets[1] + span), return_counts=True)
+    shifts = np.stack([codes // (2 * span + 1) - span, codes % (2 * span + 1) - span], axis=1)
+    return [(int(dy), int(dx)) for dy, dx in shifts[np.argsort(-counts, kind="stable")[:CONTINUE]]]
+
+
+def _continued(
+    s: _Search,
+    cost: np.ndarray,
+    best: float,
+    here: list[tuple[int, int]],
+    crop: tuple[slice, slice],
+    template: np.ndarray,
+    gap_of: np.ndarray | None,
+) -> tuple[int, int] | None:
+    """Step 5: the corner (in ``cost``) of the cheapest block that continues a copy already in the
+    window (``here``: those copies' corners), when it costs at most ``(1 + COHERE)`` times the
+    ``best``; with ``gap_of`` (the window's unknown pixels, on grey pictures) the thin-gap cost is
+    added to every cost first. None: no continuation."""
+    conts = [
+        (float(cost[ty, tx]), ty, tx)
+        for ty, tx in here
+        if 0 <= ty < cost.shape[0] and 0 <= tx < cost.shape[1] and np.isfinite(cost[ty, tx])
+    ]
+    if not conts:
+        return None
+    c_cost, ty, tx = min(conts)
+    bound = best
+    if gap_of is not None:  # a continued copy must not draw into a thin gap what its sides lack
+        gap = _gap_cost(template, gap_of, s.image, crop, s.gap)
+        if gap is not None:
+            with_gap = cost + GAP * gap
+            bound = float(with_gap.min())
+            c_cost, ty, tx = min((float(with_gap[ty, tx]), ty, tx) for _, ty, tx in conts)
+    return (ty, tx) if c_cost <= bound * (1.0 + COHERE) + 1e-9 else None
+
+
+def _block_region(window: np.ndarray, block: np.ndarray, have: np.ndarray, filled: np.ndarray, ov: int) -> np.ndarray:
+    """Step 6: the window's pixels the new ``block`` writes: its unknown ones, and the ``filled`` ones
+    on the block's side of the minimum-error cut through the overlap strips (``ov`` px) that hold some."""
+    b = window.shape[0]
+    new_region = ~have
+    if filled.any():
+        err = ((window - block) ** 2).sum(axis=2).astype(np.float64)
+        err[~filled] = _BIG
+        sides = dict(
+            left=filled[:, :ov].any(),
+            top=filled[:ov, :].any(),
+            right=filled[:, b - ov :].any(),
+            bottom=filled[b - ov :, :].any(),
+        )
+        cut = min_cut(err, **{k: (ov if v else 0) for k, v in sides.items()})
+        new_region |= filled & cut
+    return new_region
 
 
 def _refine(
