@@ -30,7 +30,7 @@ def _run_patch(
         patch = max(patch, min(BORDER_BLOCK, min(ch, cw) // 3))
     if params.patch is None and patch > min(ch, cw) // 2:  # a default patch fits a small image
         patch = max(3, min(ch, cw) // 2)
-    if params.patch is None and params.engine == "hybrid":  # its 48-px block: at most a third of a small image
+    if params.patch is None and params.engine == "hybrid":  # its large block: at most a third of a small image
         patch = min(patch, max(3, min(ch, cw) // 3))
     return patch
 

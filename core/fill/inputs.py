@@ -14,6 +14,7 @@ from .params import FillParams
 
 
 def _error(cls, message: str, input: str | None = None, **kw):
+    """A ``cls`` error with ``message`` that names the ``input`` it is about."""
     e = cls(message, **kw)
     e.input = input  # the CLI puts that input's file name in front
     return e
