@@ -10,7 +10,7 @@ et al., "PatchMatch" (SIGGRAPH 2009) from :mod:`weft.core.fill.search`:
    channels, the absolute luminance derivatives averaged over 5x5, filled like the colours, so the
    search does not settle on the flattest patches and the fill keeps the texture's energy.
 3. The coarsest level starts from an onion-peel diffusion of the hole's edge. Every level but the
-   finest runs EM iterations (:func:`weft.core.fill.search.em`) with each target pixel's squared
+   finest runs EM iterations (:func:`weft.core.fill.search.em.em`) with each target pixel's squared
    difference weighted by its confidence (1 known, ``GAMMA ** -d`` at depth ``d`` in the hole), so
    the known edge decides the match. A finer level starts from the coarser level's matches, doubled
    and voted (an upsampled image would be blurred, and the flattest patches would match it best).
@@ -170,15 +170,7 @@ def fill_patchmatch(
     """
     arr, hole, source, p = check_inputs(image, hole, source, patch, levels, iterations)
     if guide is not None:
-        given = np.asarray(guide, dtype=np.float32)
-        guide = given[..., None] if given.ndim == 2 else given
-        if guide.ndim != 3 or guide.shape[:2] != hole.shape or not 1 <= guide.shape[2] <= 8:
-            raise ImageError(
-                f"the guide has shape {given.shape}; it must be (H, W) or (H, W, 1..8) with the "
-                f"image's {hole.shape[1]}x{hole.shape[0]}"
-            )
-        if not np.isfinite(guide).all():
-            raise ImageError("the guide holds NaN or infinite values")
+        guide = _checked_guide(guide, hole)
     out = np.array(arr, dtype=np.float32, copy=True)
     if not hole.any():
         return out
@@ -190,25 +182,7 @@ def fill_patchmatch(
     if _FEATURE_WEIGHT > 0:
         img = np.ascontiguousarray(np.concatenate([img, _FEATURE_WEIGHT * _texture_features(img, hole)], axis=2))
 
-    pyramid = [_Level(img.copy(), hole, source, p)]
-    if pyramid[0].n_valid == 0:
-        raise ImageError(
-            f"the source region holds no whole {p}x{p} patch: leave at least a {p}x{p} square "
-            f"of known pixels to copy from (or use a smaller patch)"
-        )
-    max_levels = 64 if levels is None else int(levels)
-    deep = p * (_COARSEST_DEPTH_BORDER if touches_border(hole) else _COARSEST_DEPTH)
-    while len(pyramid) < max_levels:
-        top = pyramid[-1]
-        if levels is None and top.depth <= deep:
-            break
-        if min((top.hole.shape[0] + 1) // 2, (top.hole.shape[1] + 1) // 2) < 2 * p:
-            break
-        nxt = _Level(*_halve(top.img, top.hole, top.source), p)
-        if nxt.n_valid < min(_MIN_SOURCES, top.n_valid) or not nxt.hole.any():
-            break
-        pyramid.append(nxt)
-
+    pyramid = _pyramid(img, hole, source, p, levels)
     n = len(pyramid)
     top = pyramid[-1]
     _onion_fill(top.img, top.hole)  # the coarsest level's start
@@ -220,11 +194,7 @@ def fill_patchmatch(
         # several edges share the weight: each channel is scaled by 1 / their number
         weight = _GUIDE_WEIGHT / guide.shape[2]
         top.img = np.ascontiguousarray(np.concatenate([top.img, weight * guide], axis=2))
-    if iterations is not None:
-        schedule = [int(iterations)] * n
-    else:  # by level, finest first (a single level is the coarsest)
-        middle, coarsest = (_EM_MIDDLE, _EM_COARSEST) if guide is None else (_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED)
-        schedule = ([_EM_FINEST] + [middle] * (n - 2) + [coarsest]) if n > 1 else [coarsest]
+    schedule = _schedule(iterations, n, guide is not None)
     final = _FINAL_REFINE if guide is None else _FINAL_REFINE_GUIDED
     report = ProgressReporter(progress, "fill", sum(schedule) + final)
     done = 0
@@ -293,6 +263,55 @@ def fill_patchmatch(
         worst=_FINAL_WORST,
         last_vote_stride=_LAST_STRIDE,
     )
+
+
+def _checked_guide(guide, hole: np.ndarray) -> np.ndarray:
+    """The ``guide`` as (H, W, K) float32, refused when of another size than the hole, with more than
+    8 channels, or with NaN or infinite values."""
+    given = np.asarray(guide, dtype=np.float32)
+    out = given[..., None] if given.ndim == 2 else given
+    if out.ndim != 3 or out.shape[:2] != hole.shape or not 1 <= out.shape[2] <= 8:
+        raise ImageError(
+            f"the guide has shape {given.shape}; it must be (H, W) or (H, W, 1..8) with the "
+            f"image's {hole.shape[1]}x{hole.shape[0]}"
+        )
+    if not np.isfinite(out).all():
+        raise ImageError("the guide holds NaN or infinite values")
+    return out
+
+
+def _pyramid(img: np.ndarray, hole: np.ndarray, source: np.ndarray, p: int, levels: int | None) -> list[_Level]:
+    """The levels, finest first (step 1): ``levels`` of them, or by default halving until the hole is
+    about :data:`_COARSEST_DEPTH` patches deep (:data:`_COARSEST_DEPTH_BORDER` along the border), as
+    long as a level keeps its whole source patches and both sides at least two patches."""
+    pyramid = [_Level(img.copy(), hole, source, p)]
+    if pyramid[0].n_valid == 0:
+        raise ImageError(
+            f"the source region holds no whole {p}x{p} patch: leave at least a {p}x{p} square "
+            f"of known pixels to copy from (or use a smaller patch)"
+        )
+    max_levels = 64 if levels is None else int(levels)
+    deep = p * (_COARSEST_DEPTH_BORDER if touches_border(hole) else _COARSEST_DEPTH)
+    while len(pyramid) < max_levels:
+        top = pyramid[-1]
+        if levels is None and top.depth <= deep:
+            break
+        if min((top.hole.shape[0] + 1) // 2, (top.hole.shape[1] + 1) // 2) < 2 * p:
+            break
+        nxt = _Level(*_halve(top.img, top.hole, top.source), p)
+        if nxt.n_valid < min(_MIN_SOURCES, top.n_valid) or not nxt.hole.any():
+            break
+        pyramid.append(nxt)
+    return pyramid
+
+
+def _schedule(iterations: int | None, n: int, guided: bool) -> list[int]:
+    """EM iterations on each of the ``n`` levels, finest first: ``iterations`` on every one, or by
+    level (a single level is the coarsest; fewer with a guide, which lays the fill out itself)."""
+    if iterations is not None:
+        return [int(iterations)] * n
+    middle, coarsest = (_EM_MIDDLE_GUIDED, _EM_COARSEST_GUIDED) if guided else (_EM_MIDDLE, _EM_COARSEST)
+    return ([_EM_FINEST] + [middle] * (n - 2) + [coarsest]) if n > 1 else [coarsest]
 
 
 def _halve_plain(a: np.ndarray) -> np.ndarray:

@@ -73,12 +73,18 @@ feed on themselves.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
 
 from ..params import as_rng
 from .common import Progress, check_engine_args, whole_patches
 from .cut import min_cut
+from .quilt_costs import GAP_SIGMA as GAP_SIGMA  # (re-exported: step 5's constants, read here)
+from .quilt_costs import GAP_WIDTH as GAP_WIDTH
+from .quilt_costs import _ccorr, _chroma, _coarse_guide, _gap_cost, _planes
+from .quilt_order import DATA, _edges, _Front, _score
 
 #: E&F's tolerance: a block within (1 + EPSILON) of the best cost may be chosen.
 EPSILON = 0.1
@@ -99,8 +105,6 @@ GUIDE_SCALE = 4
 COHERE = 1.0
 #: How many of the copies already in a window (the most frequent first) are tried for continuing.
 CONTINUE = 4
-#: Weight of the structure term in the fill order (step 1; colour images only); 0 = the count alone.
-DATA = 3.0
 #: EM iterations of the final patch-search refine (step 7; colour images only); 0 = none.
 REFINE = 1
 #: The refine searches, in each iteration, the inexact patches at or above this percentile of their distances.
@@ -109,10 +113,6 @@ REFINE_WORST = 50.0
 REFINE_PATCH = 7
 #: Weight of the thin-gap cost on a continued copy (step 5; grey pictures only); 0 = none.
 GAP = 3.0
-#: A window's unknown pixels form a thin gap when none is farther than this (px) from a valued one.
-GAP_WIDTH = 5.0
-#: The source blocks are blurred by this sigma (px) to meet the gap's diffusion fill.
-GAP_SIGMA = 1.5
 
 
 def is_colour(img: np.ndarray, known: np.ndarray) -> bool:
@@ -160,142 +160,6 @@ def refines(image, hole, refine: bool | None = None) -> bool:
         return bool(refine) and REFINE > 0
     img = np.asarray(image)
     return REFINE > 0 and img.ndim == 3 and is_colour(img, ~np.asarray(hole, dtype=bool))
-
-
-def _chroma(img: np.ndarray) -> np.ndarray:
-    """(H, W, 3) float32: the colour of ``img``'s first three channels less their mean (grey = 0)."""
-    rgb = img[..., :3]
-    return np.ascontiguousarray(rgb - rgb.mean(axis=2, keepdims=True), dtype=np.float32)
-
-
-def _planes(img: np.ndarray) -> list[np.ndarray]:
-    """The channels of (H, W, C) ``img`` as C contiguous (H, W) float32 arrays."""
-    return [np.ascontiguousarray(img[..., k], dtype=np.float32) for k in range(img.shape[2])]
-
-
-def _ccorr(planes: list[np.ndarray], crop: tuple[slice, slice], template: np.ndarray) -> np.ndarray:
-    """``cv2.matchTemplate(image[crop], template, TM_CCORR)`` of the multi-channel image whose channels
-    are ``planes``, as the sum of one single-channel correlation per channel: OpenCV's multi-channel
-    correlation took 1.5-2.5x as long as three single-channel ones on the 216 px crops and 24 px
-    blocks of a fill (equal to float32 rounding)."""
-    out: np.ndarray = cv2.matchTemplate(planes[0][crop], np.ascontiguousarray(template[..., 0]), cv2.TM_CCORR)
-    for k in range(1, len(planes)):
-        out += cv2.matchTemplate(planes[k][crop], np.ascontiguousarray(template[..., k]), cv2.TM_CCORR)
-    return out
-
-
-def _coarse_guide(canvas: np.ndarray, hole: np.ndarray, scale: int) -> np.ndarray:
-    """(H, W, C) float32: the hole filled by diffusion (cv2.inpaint, Telea) at 1/scale, brought back
-    to full size; the known pixels' own values elsewhere (only the hole's are read)."""
-    h, w, c = canvas.shape
-    sh, sw = max(1, h // scale), max(1, w // scale)
-    small = cv2.resize(canvas, (sw, sh), interpolation=cv2.INTER_AREA).reshape(sh, sw, c)
-    cover = cv2.resize(hole.astype(np.float32), (sw, sh), interpolation=cv2.INTER_AREA)
-    known_share = np.maximum(1.0 - cover, 1e-6)[..., None]
-    small = small / known_share  # the mean of the known pixels alone (the hole is 0 in the canvas)
-    up = cv2.resize(_telea(small, cover > 0.5), (w, h), interpolation=cv2.INTER_LINEAR).reshape(h, w, c)
-    return np.ascontiguousarray(up, dtype=np.float32)
-
-
-def _telea(img: np.ndarray, unknown: np.ndarray) -> np.ndarray:
-    """(H, W, C) float32: ``img`` in 8-bit levels, its ``unknown`` pixels (bool (H, W)) filled by
-    diffusion from the others (``cv2.inpaint``, Telea, radius 3, channel by channel)."""
-    mask = unknown.astype(np.uint8)
-    out = np.empty(img.shape, dtype=np.float32)
-    for k in range(img.shape[2]):
-        ch8 = np.clip(np.rint(img[..., k] * 255), 0, 255).astype(np.uint8)
-        out[..., k] = (cv2.inpaint(ch8, mask, 3, cv2.INPAINT_TELEA) if mask.any() else ch8).astype(np.float32) / 255.0
-    return out
-
-
-def _gap_cost(
-    template: np.ndarray, unknown: np.ndarray, search: np.ndarray, crop: tuple[slice, slice], blurred: list[np.ndarray]
-) -> np.ndarray | None:
-    """Step 5's thin-gap cost of every block position of ``search[crop]``, or None when the window's
-    ``unknown`` pixels (float32 0/1) are no thin gap (one lies more than :data:`GAP_WIDTH` px from a
-    valued pixel): the SSD, over those pixels, between the window's diffusion fill (``cv2.inpaint``,
-    Telea, radius 3, from its valued pixels) and the source block blurred by :data:`GAP_SIGMA`.
-    ``blurred`` caches the blurred source (its channel planes, then their summed squares)."""
-    gap = unknown > 0
-    if float(cv2.distanceTransform(gap.astype(np.uint8), cv2.DIST_L2, 3).max()) > GAP_WIDTH:
-        return None
-    if not blurred:
-        soft = cv2.GaussianBlur(search, (0, 0), GAP_SIGMA).reshape(search.shape)
-        blurred.extend(_planes(soft))
-        blurred.append(np.ascontiguousarray((soft * soft).sum(axis=2)))
-    est = _telea(template, gap)
-    g = np.ascontiguousarray(est * unknown[..., None])
-    out = cv2.matchTemplate(blurred[-1][crop], unknown, cv2.TM_CCORR) - 2.0 * _ccorr(blurred[:-1], crop, g)
-    out += float((g * est).sum())
-    return np.maximum(out, 0.0)
-
-
-def _edges(canvas: np.ndarray, known: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The structure term's inputs (step 1): float32 (H, W) gradient magnitude of the known pixels
-    whose 3x3 neighbourhood is known (0 elsewhere, ~normalised by its mean there) and that mask."""
-    grey = canvas.mean(axis=2).astype(np.float32)
-    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
-    inner = (
-        cv2.erode(known.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=1) > 0
-    )
-    mag = np.where(inner, np.sqrt(gx * gx + gy * gy), 0.0).astype(np.float32)
-    mean = float(mag[inner].mean()) if inner.any() else 0.0
-    return (mag / mean if mean > 0 else mag), inner.astype(np.float32)
-
-
-def _score(
-    have: np.ndarray,
-    score: np.ndarray,
-    b: int,
-    y0: int,
-    y1: int,
-    x0: int,
-    x1: int,
-    edges: tuple[np.ndarray, np.ndarray] | None = None,
-) -> None:
-    """Recompute ``score`` (see :func:`fill_quilt`) on rows ``[y0, y1)`` and columns ``[x0, x1)``."""
-    h, w = have.shape
-    m = b // 2 + 2  # context the box filter and the front's dilation read around the region
-    ya, yb, xa, xb = max(0, y0 - m), min(h, y1 + m), max(0, x0 - m), min(w, x1 + m)
-    sub = have[ya:yb, xa:xb]
-    # the window of a centre pixel: rows [y - b//2, y - b//2 + b) (cv2's anchor for even sizes too)
-    count = cv2.boxFilter(sub.astype(np.float32), -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
-    near = (
-        cv2.dilate(sub.astype(np.uint8), np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT, borderValue=0) > 0
-    )
-    front = ~sub & near
-    if edges is not None:  # step 1's structure term: count x (1 + DATA g / G)
-        mag, inner = edges[0][ya:yb, xa:xb], edges[1][ya:yb, xa:xb]
-        g = cv2.boxFilter(mag, -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
-        n = cv2.boxFilter(inner, -1, (b, b), normalize=False, borderType=cv2.BORDER_CONSTANT)
-        count = count * (1.0 + DATA * g / np.maximum(n, 1.0))
-    part = np.where(front, count, -1.0)
-    score[y0:y1, x0:x1] = part[y0 - ya : y1 - ya, x0 - xa : x1 - xa]
-
-
-#: Rows per strip of :class:`_Front`.
-_STRIP = 32
-
-
-class _Front:
-    """The first maximum of ``score`` in scan order (``np.argmax``'s answer), found through the
-    maxima of its strips of :data:`_STRIP` rows: ``update(y0, y1)`` after rows ``[y0, y1)`` of it
-    changed. ``np.argmax`` over a whole 4096² score took 2 ms per block, 13 of a long stroke's 22 s."""
-
-    def __init__(self, score: np.ndarray):
-        self.score = score
-        self.maxima = np.empty(-(-score.shape[0] // _STRIP), dtype=score.dtype)
-        self.update(0, score.shape[0])
-
-    def update(self, y0: int, y1: int) -> None:
-        for k in range(y0 // _STRIP, -(-y1 // _STRIP)):
-            self.maxima[k] = self.score[k * _STRIP : (k + 1) * _STRIP].max()
-
-    def first_max(self) -> tuple[int, int]:
-        k = int(np.argmax(self.maxima))  # the first strip holding the maximum, then its first in scan order
-        y, x = divmod(int(np.argmax(self.score[k * _STRIP : (k + 1) * _STRIP])), self.score.shape[1])
-        return k * _STRIP + y, x
 
 
 def fill_quilt(
@@ -358,21 +222,7 @@ def fill_quilt(
     if cuttable is not None:
         filled |= cuttable
         cutonly |= cuttable
-    # the search image: the bounding box of the source, its non-source pixels never inside a chosen block
-    ys, xs = np.nonzero(src)
-    sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
-    search = canvas[sy0:sy1, sx0:sx1].copy()  # never a view: the canvas is written
-    valid = whole_patches(src[sy0:sy1, sx0:sx1], b)
-    search_sq = np.ascontiguousarray((search * search).sum(axis=2))
-    search_sum = np.ascontiguousarray(search.sum(axis=2))
-    search_planes = _planes(search)
-    guided = GUIDE > 0 and c >= 3
-    if guided:  # the colour (not the texture) of a coarse diffusion fill steers the blocks: chroma only
-        guide = _chroma(_coarse_guide(canvas, hole, GUIDE_SCALE))
-        blur = _chroma(cv2.GaussianBlur(search, (0, 0), GUIDE_SCALE / 2.0).reshape(search.shape))
-        blur_sq = np.ascontiguousarray((blur * blur).sum(axis=2))
-        blur_planes = _planes(blur)
-    gap_search: list[np.ndarray] = []  # step 5's blurred source, made when first needed
+    s = _search_image(canvas, hole, src, b)
     total = int(hole.sum())
     refining = refines(img, hole, refine)
     # the refine's share of the progress: about its share of the time (a fifth)
@@ -392,54 +242,12 @@ def fill_quilt(
         py, px = front.first_max()
         if score[py, px] < 0:  # an unknown region touching nothing valued (cannot happen, kept safe)
             py, px = np.unravel_index(int(np.argmax(~have)), have.shape)  # type: ignore[assignment]  # numpy ints
-        # the window centred there, moved away from its known pixels so that they fill about an
-        # overlap's width of it (a straight front: B/2 known -> B/3) and the block fills more
-        y0 = int(min(max(py - b // 2, 0), h - b))
-        x0 = int(min(max(px - b // 2, 0), w - b))
-        sub = have[y0 : y0 + b, x0 : x0 + b]
-        if sub.any() and not sub.all():
-            ky, kx = np.nonzero(sub)
-            y0 = int(min(max(y0 - round(SHIFT * (ky.mean() - (b - 1) / 2)), 0), h - b))
-            x0 = int(min(max(x0 - round(SHIFT * (kx.mean() - (b - 1) / 2)), 0), w - b))
+        y0, x0 = _window(have, py, px, b)
         win = (slice(y0, y0 + b), slice(x0, x0 + b))
-        weight = have[win].astype(np.float32)
         template = np.ascontiguousarray(canvas[win])
         un = (~have[win]).astype(np.float32)
-        hs, ws = valid.shape
-        ry0, rx0, ry1, rx1 = 0, 0, hs, ws
-        reach = REACH
-        while (
-            0 < reach < max(hs, ws)
-        ):  # the locality prior: blocks from near the window, the nearest reach that has any
-            ry0, ry1 = max(0, y0 - sy0 - reach), min(hs, y0 - sy0 + reach + 1)
-            rx0, rx1 = max(0, x0 - sx0 - reach), min(ws, x0 - sx0 + reach + 1)
-            if ry0 < ry1 and rx0 < rx1 and valid[ry0:ry1, rx0:rx1].any():
-                break
-            reach *= 2
-        else:
-            ry0, rx0, ry1, rx1 = 0, 0, hs, ws
-        crop = (slice(ry0, ry1 + b - 1), slice(rx0, rx1 + b - 1))
-        ok = valid[ry0:ry1, rx0:rx1]
-        if weight.any():
-            # masked SSD = sum M I^2 - 2 sum M T I + sum M T^2 (the squares summed over channels first)
-            energy = cv2.matchTemplate(search_sq[crop], weight, cv2.TM_CCORR)  # sum M I^2
-            cost = energy - 2.0 * _ccorr(search_planes, crop, template * weight[..., None])
-            cost += float((weight[..., None] * template * template).sum())
-            if DETAIL > 0:  # the contrast term: the block's and the template's standard deviations
-                n = float(weight.sum()) * c
-                s1 = cv2.matchTemplate(search_sum[crop], weight, cv2.TM_CCORR) / n
-                sq = np.maximum(energy / n - s1 * s1, 0)
-                tm = float((weight[..., None] * template).sum()) / n
-                tv = max(float((weight[..., None] * template * template).sum()) / n - tm * tm, 0.0)
-                cost += DETAIL * n * (np.sqrt(sq) - np.sqrt(tv)) ** 2
-        else:
-            cost = np.zeros(ok.shape, dtype=np.float32)
-        if guided and un.any():
-            g = np.ascontiguousarray(guide[win] * un[..., None])
-            gc = cv2.matchTemplate(blur_sq[crop], un, cv2.TM_CCORR) - 2.0 * _ccorr(blur_planes, crop, g)
-            gc += float((g * guide[win]).sum())
-            cost = cost + GUIDE * np.maximum(gc, 0.0)
-        cost = np.where(ok & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
+        ry0, rx0, crop, ok = _reach(s, y0, x0, b)
+        cost = _block_cost(s, win, crop, ok, template, have[win].astype(np.float32), un)
         best = float(cost.min())
         cand = np.flatnonzero(cost.ravel() <= best * (1.0 + EPSILON) + 1e-9)
         pick = int(cand[gen.integers(len(cand))])
@@ -447,48 +255,20 @@ def fill_quilt(
         if COHERE > 0:  # continue a neighbouring block's copy when it costs little more: no seam there at all
             mine = filled[win] & ~cutonly[win]  # pixels earlier blocks wrote
             if mine.any():
-                # the copies' offsets as one int64 each, ordered as (dy, dx) rows are (np.unique with
-                # axis=0 sorted them the same way, 5x slower)
-                sh = shift[:, y0 : y0 + b, x0 : x0 + b][:, mine].astype(np.int64)
-                codes, counts = np.unique((sh[0] + span) * (2 * span + 1) + (sh[1] + span), return_counts=True)
-                shifts = np.stack([codes // (2 * span + 1) - span, codes % (2 * span + 1) - span], axis=1)
-                conts = []
-                for dy, dx in shifts[np.argsort(-counts, kind="stable")[:CONTINUE]]:
-                    ty, tx = y0 + int(dy) - sy0 - ry0, x0 + int(dx) - sx0 - rx0  # that copy's block here
-                    if 0 <= ty < cost.shape[0] and 0 <= tx < cost.shape[1] and np.isfinite(cost[ty, tx]):
-                        conts.append((float(cost[ty, tx]), ty, tx))
-                if conts:
-                    c_cost, ty, tx = min(conts)
-                    bound = best
-                    if (
-                        GAP > 0 and not colour and un.any()
-                    ):  # a continued copy must not draw into a thin gap what its sides lack
-                        gap = _gap_cost(template, un, search, crop, gap_search)
-                        if gap is not None:
-                            with_gap = cost + GAP * gap
-                            bound = float(with_gap.min())
-                            c_cost, ty, tx = min((float(with_gap[ty, tx]), ty, tx) for _, ty, tx in conts)
-                    if c_cost <= bound * (1.0 + COHERE) + 1e-9:
-                        cy, cx = ty, tx
+                offsets = shift[:, y0 : y0 + b, x0 : x0 + b][:, mine].astype(np.int64)
+                # that copy's block here, for each offset (dy, dx)
+                here = [(y0 + dy - s.y0 - ry0, x0 + dx - s.x0 - rx0) for dy, dx in _frequent(offsets, span)]
+                gap_check = GAP > 0 and not colour and un.any()
+                cont = _continued(s, cost, best, here, crop, template, un if gap_check else None)
+                if cont is not None:
+                    cy, cx = cont
         cy, cx = cy + ry0, cx + rx0
-        block = search[cy : cy + b, cx : cx + b]
-        new_region = ~have[win]
-        soft = filled[win]
-        if soft.any():
-            err = ((canvas[win] - block) ** 2).sum(axis=2).astype(np.float64)
-            err[~soft] = _BIG
-            sides = dict(
-                left=soft[:, :ov].any(),
-                top=soft[:ov, :].any(),
-                right=soft[:, b - ov :].any(),
-                bottom=soft[b - ov :, :].any(),
-            )
-            cut = min_cut(err, **{k: (ov if v else 0) for k, v in sides.items()})
-            new_region |= soft & cut
+        block = s.image[cy : cy + b, cx : cx + b]
+        new_region = _block_region(canvas[win], block, have[win], filled[win], ov)
         left -= int(np.count_nonzero(new_region & ~have[win]))
         canvas[win][new_region] = block[new_region]
-        shift[0][win][new_region] = sy0 + cy - y0
-        shift[1][win][new_region] = sx0 + cx - x0
+        shift[0][win][new_region] = s.y0 + cy - y0
+        shift[1][win][new_region] = s.x0 + cx - x0
         filled[win] |= new_region
         cutonly[win] &= ~new_region
         have[win] |= new_region
@@ -502,6 +282,180 @@ def fill_quilt(
     if refining:
         out = _refine(out, hole, changed, src, gen, cancel, lambda p: report(total + int(p.fraction * refine_units)))
     return out.reshape(shape)
+
+
+@dataclass
+class _Search:
+    """The image blocks are copied from: the bounding box of the source (``image``, its corner
+    ``y0``, ``x0`` on the canvas), the corners of its whole source blocks (``valid``), what the costs
+    correlate with (its squares and sums over channels, its channel planes) and, on colour pictures,
+    the coarse colour guide with the blurred chroma it meets (step 4; ``guide`` None otherwise).
+    ``gap``: step 5's blurred source, made when first needed."""
+
+    image: np.ndarray
+    y0: int
+    x0: int
+    valid: np.ndarray
+    sq: np.ndarray
+    sum: np.ndarray
+    planes: list[np.ndarray]
+    guide: np.ndarray | None
+    blur_sq: np.ndarray | None
+    blur_planes: list[np.ndarray]
+    gap: list[np.ndarray]
+
+
+def _search_image(canvas: np.ndarray, hole: np.ndarray, src: np.ndarray, b: int) -> _Search:
+    """The :class:`_Search` of ``src`` on ``canvas`` (its non-source pixels never inside a chosen block)."""
+    ys, xs = np.nonzero(src)
+    sy0, sy1, sx0, sx1 = ys.min(), ys.max() + 1, xs.min(), xs.max() + 1
+    search = canvas[sy0:sy1, sx0:sx1].copy()  # never a view: the canvas is written
+    guide, blur_sq, blur_planes = None, None, []
+    if GUIDE > 0 and canvas.shape[2] >= 3:  # the colour (not the texture) of a coarse diffusion fill: chroma only
+        guide = _chroma(_coarse_guide(canvas, hole, GUIDE_SCALE))
+        blur = _chroma(cv2.GaussianBlur(search, (0, 0), GUIDE_SCALE / 2.0).reshape(search.shape))
+        blur_sq = np.ascontiguousarray((blur * blur).sum(axis=2))
+        blur_planes = _planes(blur)
+    return _Search(
+        search,
+        sy0,
+        sx0,
+        whole_patches(src[sy0:sy1, sx0:sx1], b),
+        np.ascontiguousarray((search * search).sum(axis=2)),
+        np.ascontiguousarray(search.sum(axis=2)),
+        _planes(search),
+        guide,
+        blur_sq,
+        blur_planes,
+        [],
+    )
+
+
+def _window(have: np.ndarray, py: int, px: int, b: int) -> tuple[int, int]:
+    """The top-left corner of the block window centred on front pixel (``py``, ``px``), moved away from
+    its valued pixels so that they fill about an overlap's width of it (a straight front: B/2 known
+    -> B/3) and the block fills more."""
+    h, w = have.shape
+    y0 = int(min(max(py - b // 2, 0), h - b))
+    x0 = int(min(max(px - b // 2, 0), w - b))
+    sub = have[y0 : y0 + b, x0 : x0 + b]
+    if sub.any() and not sub.all():
+        ky, kx = np.nonzero(sub)
+        y0 = int(min(max(y0 - round(SHIFT * (ky.mean() - (b - 1) / 2)), 0), h - b))
+        x0 = int(min(max(x0 - round(SHIFT * (kx.mean() - (b - 1) / 2)), 0), w - b))
+    return y0, x0
+
+
+def _reach(s: _Search, y0: int, x0: int, b: int) -> tuple[int, int, tuple[slice, slice], np.ndarray]:
+    """Step 3: the block corners searched for the window at (``y0``, ``x0``), the nearest reach that
+    holds any (all of them when none does): ``(first row, first column, the search image's crop, the
+    allowed corners in it)``."""
+    hs, ws = s.valid.shape
+    ry0, rx0, ry1, rx1 = 0, 0, hs, ws
+    reach = REACH
+    while 0 < reach < max(hs, ws):
+        ry0, ry1 = max(0, y0 - s.y0 - reach), min(hs, y0 - s.y0 + reach + 1)
+        rx0, rx1 = max(0, x0 - s.x0 - reach), min(ws, x0 - s.x0 + reach + 1)
+        if ry0 < ry1 and rx0 < rx1 and s.valid[ry0:ry1, rx0:rx1].any():
+            break
+        reach *= 2
+    else:
+        ry0, rx0, ry1, rx1 = 0, 0, hs, ws
+    return ry0, rx0, (slice(ry0, ry1 + b - 1), slice(rx0, rx1 + b - 1)), s.valid[ry0:ry1, rx0:rx1]
+
+
+def _block_cost(
+    s: _Search,
+    win: tuple[slice, slice],
+    crop: tuple[slice, slice],
+    ok: np.ndarray,
+    template: np.ndarray,
+    weight: np.ndarray,
+    un: np.ndarray,
+) -> np.ndarray:
+    """Steps 2 and 4: the cost of every block corner of ``s.image[crop]`` for the window ``win`` whose
+    pixels are ``template``, valued where ``weight`` is 1 and unknown where ``un`` is: the masked SSD
+    with the contrast term, plus the colour guide's on the unknown pixels; inf where not ``ok``."""
+    c = template.shape[2]
+    if weight.any():
+        # masked SSD = sum M I^2 - 2 sum M T I + sum M T^2 (the squares summed over channels first)
+        energy = cv2.matchTemplate(s.sq[crop], weight, cv2.TM_CCORR)  # sum M I^2
+        cost = energy - 2.0 * _ccorr(s.planes, crop, template * weight[..., None])
+        cost += float((weight[..., None] * template * template).sum())
+        if DETAIL > 0:  # the contrast term: the block's and the template's standard deviations
+            n = float(weight.sum()) * c
+            s1 = cv2.matchTemplate(s.sum[crop], weight, cv2.TM_CCORR) / n
+            sq = np.maximum(energy / n - s1 * s1, 0)
+            tm = float((weight[..., None] * template).sum()) / n
+            tv = max(float((weight[..., None] * template * template).sum()) / n - tm * tm, 0.0)
+            cost += DETAIL * n * (np.sqrt(sq) - np.sqrt(tv)) ** 2
+    else:
+        cost = np.zeros(ok.shape, dtype=np.float32)
+    if s.guide is not None and s.blur_sq is not None and un.any():
+        g = np.ascontiguousarray(s.guide[win] * un[..., None])
+        gc = cv2.matchTemplate(s.blur_sq[crop], un, cv2.TM_CCORR) - 2.0 * _ccorr(s.blur_planes, crop, g)
+        gc += float((g * s.guide[win]).sum())
+        cost = cost + GUIDE * np.maximum(gc, 0.0)
+    return np.where(ok & np.isfinite(cost), np.maximum(cost, 0.0), np.inf)  # float32 rounding: >= 0
+
+
+def _frequent(offsets: np.ndarray, span: int) -> list[tuple[int, int]]:
+    """The :data:`CONTINUE` most frequent of the copies' ``offsets`` ((2, N) int64 rows dy, dx, each
+    below ``span`` in size), the most frequent first."""
+    # each offset as one int64, ordered as (dy, dx) rows are (as np.unique with axis=0 orders them, for less)
+    codes, counts = np.unique((offsets[0] + span) * (2 * span + 1) + (offsets[1] + span), return_counts=True)
+    shifts = np.stack([codes // (2 * span + 1) - span, codes % (2 * span + 1) - span], axis=1)
+    return [(int(dy), int(dx)) for dy, dx in shifts[np.argsort(-counts, kind="stable")[:CONTINUE]]]
+
+
+def _continued(
+    s: _Search,
+    cost: np.ndarray,
+    best: float,
+    here: list[tuple[int, int]],
+    crop: tuple[slice, slice],
+    template: np.ndarray,
+    gap_of: np.ndarray | None,
+) -> tuple[int, int] | None:
+    """Step 5: the corner (in ``cost``) of the cheapest block that continues a copy already in the
+    window (``here``: those copies' corners), when it costs at most ``(1 + COHERE)`` times the
+    ``best``; with ``gap_of`` (the window's unknown pixels, on grey pictures) the thin-gap cost is
+    added to every cost first. None: no continuation."""
+    conts = [
+        (float(cost[ty, tx]), ty, tx)
+        for ty, tx in here
+        if 0 <= ty < cost.shape[0] and 0 <= tx < cost.shape[1] and np.isfinite(cost[ty, tx])
+    ]
+    if not conts:
+        return None
+    c_cost, ty, tx = min(conts)
+    bound = best
+    if gap_of is not None:  # a continued copy must not draw into a thin gap what its sides lack
+        gap = _gap_cost(template, gap_of, s.image, crop, s.gap)
+        if gap is not None:
+            with_gap = cost + GAP * gap
+            bound = float(with_gap.min())
+            c_cost, ty, tx = min((float(with_gap[ty, tx]), ty, tx) for _, ty, tx in conts)
+    return (ty, tx) if c_cost <= bound * (1.0 + COHERE) + 1e-9 else None
+
+
+def _block_region(window: np.ndarray, block: np.ndarray, have: np.ndarray, filled: np.ndarray, ov: int) -> np.ndarray:
+    """Step 6: the window's pixels the new ``block`` writes: its unknown ones, and the ``filled`` ones
+    on the block's side of the minimum-error cut through the overlap strips (``ov`` px) that hold some."""
+    b = window.shape[0]
+    new_region = ~have
+    if filled.any():
+        err = ((window - block) ** 2).sum(axis=2).astype(np.float64)
+        err[~filled] = _BIG
+        sides = dict(
+            left=filled[:, :ov].any(),
+            top=filled[:ov, :].any(),
+            right=filled[:, b - ov :].any(),
+            bottom=filled[b - ov :, :].any(),
+        )
+        cut = min_cut(err, **{k: (ov if v else 0) for k, v in sides.items()})
+        new_region |= filled & cut
+    return new_region
 
 
 def _refine(

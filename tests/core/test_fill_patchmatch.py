@@ -203,7 +203,7 @@ def test_a_source_without_a_whole_patch_is_refused(gravel):
 @pytest.mark.parametrize("bias, takes_neighbours_offset", [(0.0, False), (1.0, True)])
 def test_a_coherence_bias_lets_propagation_take_a_neighbours_offset_within_the_margin(bias, takes_neighbours_offset):
     from weft.core.fill.search import Flat as _Flat
-    from weft.core.fill.search import _try
+    from weft.core.fill.search.em import _try
 
     p = 3
     img = np.random.default_rng(5).random((20, 20, 1)).astype(np.float32)
@@ -248,7 +248,7 @@ def test_a_patchmatch_fill_loads_no_numba():
 def test_stable_argsort_is_numpys_stable_argsort():
     """The refine's principal-axis candidates sort ~80k projections with a key sort that must order
     ties (and -0.0 against 0.0, and infinities) exactly as np.argsort(kind="stable")."""
-    from weft.core.fill.search import _stable_argsort
+    from weft.core.fill.search.refine import _stable_argsort
 
     rng = np.random.default_rng(3)
     for _ in range(50):
