@@ -499,10 +499,9 @@ def main(argv: list[str] | None = None) -> int:
             "cpus": os.cpu_count(),
             "processor": platform.processor() or platform.machine(),
             "opencv": cv2.__version__,
-            "note": "2 cores shared by six engineers' jobs while measured (load average "
-            f"{os.getloadavg()[0]:.1f} at the end; run it with nice); median_cpu_ms is the process's CPU "
-            "time, less affected by the sharing than the wall time; no numba in the detector, so the "
-            "first call's time is the first case's first run",
+            "note": f"load average {os.getloadavg()[0]:.1f} at the end (other jobs on the machine slow the "
+            "wall time); median_cpu_ms is the process's CPU time, over the wall time where OpenCV uses two "
+            "threads; no numba in the detector, so the first call's time is the first case's first run",
         },
         "command": "python -m benchmarks.rectify_suggest" + (f" --repeats {args.repeats}" if args.repeats != 5 else ""),
         "success_rule": "residual right angle within 1 deg and aspect within 2 % at a 3x3 grid over the frame",
