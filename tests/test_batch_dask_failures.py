@@ -27,29 +27,17 @@ from .test_batch import make_frames, scene, slow_scene  # noqa: E402,F401  (fixt
 DASK = Path(sys.executable).with_name("dask")
 
 
-def _run(argv, capfd):
-    code = main([str(a) for a in argv])
-    out, err = capfd.readouterr()
-    return code, out, err
+def _batch(tmp: Path, out_dir: Path, address: str, capfd, *extra: str) -> tuple[int, str]:
+    """``weft batch`` of the scene's recipe over its frames on the scheduler at ``address``: (exit code, stderr)."""
+    argv = ["batch", tmp / "look.json", "--over", "target", tmp / "frames", "-o", out_dir / "{stem}.png"]
+    code = main([str(a) for a in [*argv, "--scheduler", address, *extra]])
+    return code, capfd.readouterr().err
 
 
 @pytest.mark.parametrize("address", ["tls://127.0.0.1:1", "ucx://127.0.0.1:1"])
 def test_an_address_weft_cannot_use_is_one_line(scene, capfd, address):
     tmp, _ = scene
-    code, out, err = _run(
-        [
-            "batch",
-            tmp / "look.json",
-            "--over",
-            "target",
-            tmp / "frames",
-            "-o",
-            tmp / "o" / "{stem}.png",
-            "--scheduler",
-            address,
-        ],
-        capfd,
-    )
+    code, err = _batch(tmp, tmp / "o", address, capfd)
     assert code == 2 and err.count("\n") == 1 and err.startswith(f"weft: cannot reach the Dask scheduler at {address} ")
     assert "internal error" not in err
 
@@ -123,20 +111,7 @@ def test_a_scheduler_without_workers_is_a_time_limit_not_a_silent_wait(scene, ca
     tmp, _ = scene
     with _cluster(tmp_path, workers=0) as (address, _scheduler, _worker):
         monkeypatch.setattr(dask_pool, "WORKER_TIMEOUT", 2.0)
-        code, out, err = _run(
-            [
-                "batch",
-                tmp / "look.json",
-                "--over",
-                "target",
-                tmp / "frames",
-                "-o",
-                tmp / "o" / "{stem}.png",
-                "--scheduler",
-                address,
-            ],
-            capfd,
-        )
+        code, err = _batch(tmp, tmp / "o", address, capfd)
         assert code == 2 and err == (
             f"weft: the Dask scheduler at {address} has no workers (waited 2 s; set "
             "WEFT_DASK_WORKER_TIMEOUT to wait longer)\n"
@@ -150,21 +125,7 @@ def test_a_scheduler_killed_mid_batch_ends_with_the_summary(slow_scene, capfd, t
     with _cluster(tmp_path, workers=1) as (address, scheduler, _worker):
         out_dir = tmp / "killed"
         killer = _kill_when_one_is_written(out_dir, scheduler)
-        code, out, err = _run(
-            [
-                "batch",
-                tmp / "look.json",
-                "--over",
-                "target",
-                tmp / "frames",
-                "-o",
-                out_dir / "{stem}.png",
-                "--scheduler",
-                address,
-                "-q",
-            ],
-            capfd,
-        )
+        code, err = _batch(tmp, out_dir, address, capfd, "-q")
         killer.join()
         lines = err.strip().splitlines()
         assert code == 1 and "Traceback" not in err and "internal error" not in err, err
@@ -179,21 +140,7 @@ def test_a_cluster_left_without_workers_mid_batch_ends_with_the_summary(slow_sce
         monkeypatch.setattr(dask_pool, "WORKER_TIMEOUT", 3.0)
         out_dir = tmp / "orphaned"
         killer = _kill_when_one_is_written(out_dir, worker)
-        code, out, err = _run(
-            [
-                "batch",
-                tmp / "look.json",
-                "--over",
-                "target",
-                tmp / "frames",
-                "-o",
-                out_dir / "{stem}.png",
-                "--scheduler",
-                address,
-                "-q",
-            ],
-            capfd,
-        )
+        code, err = _batch(tmp, out_dir, address, capfd, "-q")
         killer.join()
         lines = err.strip().splitlines()
         assert code == 1 and "Traceback" not in err, err

@@ -149,7 +149,7 @@ def test_edits_that_go_on_are_autosaved_while_they_go_on(window, qtbot, monkeypa
         if len(edits) >= 300:
             ticker.stop()
 
-    ticker = QTimer(interval=30)  # an edit every 30 ms, for 9 s or more
+    ticker = QTimer(interval=30)  # edits keep coming well past the autosave interval
     ticker.timeout.connect(edit)
     ticker.start()
     try:
