@@ -564,21 +564,8 @@ def test_a_fill_batch_keeps_each_items_bit_depth_as_weft_fill_does(tmp_path, cap
         "seed": 3,
     }
     (tmp_path / "fill.json").write_text(json.dumps(recipe))
-    code, _, err = run(
-        [
-            "batch",
-            tmp_path / "fill.json",
-            "--over",
-            "image",
-            frames,
-            "-o",
-            tmp_path / "out" / "{stem}.png",
-            "--workers",
-            "1",
-            "-q",
-        ],
-        capsys,
-    )
+    batch = ["batch", tmp_path / "fill.json", "--over", "image", frames, "--workers", "1", "-q"]
+    code, _, err = run([*batch, "-o", tmp_path / "out" / "{stem}.png"], capsys)
     assert code == 0, err
     assert load_image(tmp_path / "out" / "a16.png").info.bit_depth == 16
     assert load_image(tmp_path / "out" / "b8.png").info.bit_depth == 8
@@ -590,39 +577,9 @@ def test_a_fill_batch_keeps_each_items_bit_depth_as_weft_fill_does(tmp_path, cap
         assert run(["run", tmp_path / f"{stem}.json", "-o", ref, "-q"], capsys)[0] == 0
         assert ref.read_bytes() == (tmp_path / "out" / f"{stem}.png").read_bytes()
     # a re-run finds them done (the resume check expects each item's own depth)
-    code, _, err = run(
-        [
-            "batch",
-            tmp_path / "fill.json",
-            "--over",
-            "image",
-            frames,
-            "-o",
-            tmp_path / "out" / "{stem}.png",
-            "--workers",
-            "1",
-            "-q",
-        ],
-        capsys,
-    )
+    code, _, err = run([*batch, "-o", tmp_path / "out" / "{stem}.png"], capsys)
     assert code == 0 and err.strip() == "0 written, 2 already done", err
     # --bit-depth decides for every item
-    code, _, err = run(
-        [
-            "batch",
-            tmp_path / "fill.json",
-            "--over",
-            "image",
-            frames,
-            "--bit-depth",
-            "8",
-            "-o",
-            tmp_path / "out8" / "{stem}.png",
-            "--workers",
-            "1",
-            "-q",
-        ],
-        capsys,
-    )
+    code, _, err = run([*batch, "--bit-depth", "8", "-o", tmp_path / "out8" / "{stem}.png"], capsys)
     assert code == 0, err
     assert {load_image(tmp_path / "out8" / f"{s}.png").info.bit_depth for s in ("a16", "b8")} == {8}
