@@ -29,8 +29,8 @@ from .stroke import MaskStroke
 #: and margins (the canvas's edges dragged outward: an uncrop).
 SQUARE, LINES, MASK, MARGINS = _interface.SQUARE, _interface.LINES, _interface.MASK, _interface.MARGINS
 
-# The value types are documented, pickled and imported under the package's name, as they were
-# before the package was split into modules.
+# The value types are documented, pickled and imported under the package's name (saved pickles and
+# the API pages name weft.core.geometry.Square, not the module that defines it).
 for _cls in (GeometryValue, Square, FeatureLines, LineDraft, Mask, MaskStroke, Margins):
     _cls.__module__ = __name__
 del _cls
